@@ -1,0 +1,488 @@
+//! Reference finite elements and quadrature.
+//!
+//! Isoparametric Lagrange elements on the reference square `[-1,1]^2` (Q4, Q9) and the reference
+//! triangle `{xi, eta >= 0, xi + eta <= 1}` (T3, T6): the geometry and the displacement share the
+//! shape functions `N_a`, so `x(xi) = sum_a N_a(xi) x_a` and `u(xi) = sum_a N_a(xi) u_a`.
+//! Isoparametric elements reproduce every linear field exactly on any non-inverted mesh, which is
+//! what makes the (single-body) patch test pass on distorted meshes.
+//!
+//! Node ordering (the same as VTK's `QUAD`, `BIQUADRATIC_QUAD`, `TRIANGLE`, `QUADRATIC_TRIANGLE`):
+//! corners counter-clockwise, then mid-side nodes (side `i` joins corner `i` and corner `i+1`),
+//! then the Q9 centre node.
+//!
+//! Quadrature for the stiffness: Gauss 2x2 (Q4), 3x3 (Q9), 1 point (T3), 3 points of degree 2 (T6).
+//! These integrate `B^T D B det J` exactly on straight-sided (affine) triangles and integrate the
+//! divergence identity behind the patch test exactly on distorted quadrilaterals (`dN/dx det J` is a
+//! polynomial of degree (1,1) for Q4 and (3,3) for Q9). Error norms use richer rules.
+//!
+//! Edges (facets) are `Line2` (nodes at s = -1, +1) or `Line3` (nodes at s = -1, +1, 0), ordered
+//! counter-clockwise around their element, so the outward normal is the tangent turned clockwise.
+
+use serde::{Deserialize, Serialize};
+
+/// A reference element type.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ElementKind {
+    Q4,
+    Q9,
+    T3,
+    T6,
+}
+
+/// A reference edge type.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum EdgeKind {
+    Line2,
+    Line3,
+}
+
+/// A quadrature point on a reference cell: natural coordinates and weight.
+#[derive(Copy, Clone, Debug)]
+pub struct QuadPoint {
+    pub xi: [f64; 2],
+    pub weight: f64,
+}
+
+const Q4_EDGES: [&[usize]; 4] = [&[0, 1], &[1, 2], &[2, 3], &[3, 0]];
+const Q9_EDGES: [&[usize]; 4] = [&[0, 1, 4], &[1, 2, 5], &[2, 3, 6], &[3, 0, 7]];
+const T3_EDGES: [&[usize]; 3] = [&[0, 1], &[1, 2], &[2, 0]];
+const T6_EDGES: [&[usize]; 3] = [&[0, 1, 3], &[1, 2, 4], &[2, 0, 5]];
+
+/// Natural coordinates of the nodes of each element (same order as the shape functions).
+const Q4_NODES: [[f64; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+const Q9_NODES: [[f64; 2]; 9] = [
+    [-1.0, -1.0],
+    [1.0, -1.0],
+    [1.0, 1.0],
+    [-1.0, 1.0],
+    [0.0, -1.0],
+    [1.0, 0.0],
+    [0.0, 1.0],
+    [-1.0, 0.0],
+    [0.0, 0.0],
+];
+const T3_NODES: [[f64; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+const T6_NODES: [[f64; 2]; 6] = [
+    [0.0, 0.0],
+    [1.0, 0.0],
+    [0.0, 1.0],
+    [0.5, 0.0],
+    [0.5, 0.5],
+    [0.0, 0.5],
+];
+
+/// Largest number of nodes of any element; sizes stack buffers.
+pub const MAX_NODES: usize = 9;
+
+impl ElementKind {
+    pub fn node_count(self) -> usize {
+        match self {
+            ElementKind::Q4 => 4,
+            ElementKind::Q9 => 9,
+            ElementKind::T3 => 3,
+            ElementKind::T6 => 6,
+        }
+    }
+
+    /// Number of corner (vertex) nodes; they come first in the node list.
+    pub fn corner_count(self) -> usize {
+        match self {
+            ElementKind::Q4 | ElementKind::Q9 => 4,
+            ElementKind::T3 | ElementKind::T6 => 3,
+        }
+    }
+
+    pub fn is_quadratic(self) -> bool {
+        matches!(self, ElementKind::Q9 | ElementKind::T6)
+    }
+
+    pub fn edge_kind(self) -> EdgeKind {
+        if self.is_quadratic() {
+            EdgeKind::Line3
+        } else {
+            EdgeKind::Line2
+        }
+    }
+
+    /// Local node indices of each edge, counter-clockwise: `[start, end]` or `[start, end, mid]`.
+    pub fn edges(self) -> &'static [&'static [usize]] {
+        match self {
+            ElementKind::Q4 => &Q4_EDGES,
+            ElementKind::Q9 => &Q9_EDGES,
+            ElementKind::T3 => &T3_EDGES,
+            ElementKind::T6 => &T6_EDGES,
+        }
+    }
+
+    /// Natural coordinates of the element's nodes.
+    pub fn node_coordinates(self) -> &'static [[f64; 2]] {
+        match self {
+            ElementKind::Q4 => &Q4_NODES,
+            ElementKind::Q9 => &Q9_NODES,
+            ElementKind::T3 => &T3_NODES,
+            ElementKind::T6 => &T6_NODES,
+        }
+    }
+
+    /// Natural coordinates of the element centre.
+    pub fn centre(self) -> [f64; 2] {
+        match self {
+            ElementKind::Q4 | ElementKind::Q9 => [0.0, 0.0],
+            ElementKind::T3 | ElementKind::T6 => [1.0 / 3.0, 1.0 / 3.0],
+        }
+    }
+
+    /// VTK cell type id.
+    pub fn vtk_cell_type(self) -> u8 {
+        match self {
+            ElementKind::Q4 => 9,
+            ElementKind::Q9 => 28,
+            ElementKind::T3 => 5,
+            ElementKind::T6 => 22,
+        }
+    }
+
+    /// Shape functions `n[a]` and their natural derivatives `dn[a] = [dN_a/dxi, dN_a/deta]`.
+    pub fn shape(self, xi: [f64; 2], n: &mut [f64], dn: &mut [[f64; 2]]) {
+        let [s, t] = xi;
+        match self {
+            ElementKind::Q4 => {
+                for (a, c) in Q4_NODES.iter().enumerate() {
+                    n[a] = 0.25 * (1.0 + c[0] * s) * (1.0 + c[1] * t);
+                    dn[a] = [
+                        0.25 * c[0] * (1.0 + c[1] * t),
+                        0.25 * c[1] * (1.0 + c[0] * s),
+                    ];
+                }
+            }
+            ElementKind::Q9 => {
+                for (a, c) in Q9_NODES.iter().enumerate() {
+                    let (ls, dls) = lagrange_1d_quadratic(c[0], s);
+                    let (lt, dlt) = lagrange_1d_quadratic(c[1], t);
+                    n[a] = ls * lt;
+                    dn[a] = [dls * lt, ls * dlt];
+                }
+            }
+            ElementKind::T3 => {
+                n[0] = 1.0 - s - t;
+                n[1] = s;
+                n[2] = t;
+                dn[0] = [-1.0, -1.0];
+                dn[1] = [1.0, 0.0];
+                dn[2] = [0.0, 1.0];
+            }
+            ElementKind::T6 => {
+                let l1 = 1.0 - s - t;
+                let (l2, l3) = (s, t);
+                // d(l1, l2, l3)/d(s, t)
+                let d1 = [-1.0, -1.0];
+                let d2 = [1.0, 0.0];
+                let d3 = [0.0, 1.0];
+                let corner = |l: f64, d: [f64; 2]| (l * (2.0 * l - 1.0), [(4.0 * l - 1.0) * d[0], (4.0 * l - 1.0) * d[1]]);
+                let mid = |la: f64, da: [f64; 2], lb: f64, db: [f64; 2]| {
+                    (4.0 * la * lb, [4.0 * (da[0] * lb + la * db[0]), 4.0 * (da[1] * lb + la * db[1])])
+                };
+                let vals = [
+                    corner(l1, d1),
+                    corner(l2, d2),
+                    corner(l3, d3),
+                    mid(l1, d1, l2, d2),
+                    mid(l2, d2, l3, d3),
+                    mid(l3, d3, l1, d1),
+                ];
+                for (a, (v, d)) in vals.into_iter().enumerate() {
+                    n[a] = v;
+                    dn[a] = d;
+                }
+            }
+        }
+    }
+
+    /// Quadrature rule that integrates the stiffness of this element (see module docs).
+    pub fn stiffness_rule(self) -> Vec<QuadPoint> {
+        match self {
+            ElementKind::Q4 => gauss_square(2),
+            ElementKind::Q9 => gauss_square(3),
+            ElementKind::T3 => triangle_rule(1),
+            ElementKind::T6 => triangle_rule(2),
+        }
+    }
+
+    /// A richer rule for error norms of smooth reference fields.
+    pub fn error_rule(self) -> Vec<QuadPoint> {
+        match self {
+            ElementKind::Q4 | ElementKind::Q9 => gauss_square(5),
+            ElementKind::T3 | ElementKind::T6 => triangle_rule(5),
+        }
+    }
+}
+
+impl EdgeKind {
+    pub fn node_count(self) -> usize {
+        match self {
+            EdgeKind::Line2 => 2,
+            EdgeKind::Line3 => 3,
+        }
+    }
+
+    /// Shape functions on `s in [-1, 1]` and their derivatives; node order `[start, end(, mid)]`.
+    pub fn shape(self, s: f64, n: &mut [f64], dn: &mut [f64]) {
+        match self {
+            EdgeKind::Line2 => {
+                n[0] = 0.5 * (1.0 - s);
+                n[1] = 0.5 * (1.0 + s);
+                dn[0] = -0.5;
+                dn[1] = 0.5;
+            }
+            EdgeKind::Line3 => {
+                n[0] = 0.5 * s * (s - 1.0);
+                n[1] = 0.5 * s * (s + 1.0);
+                n[2] = 1.0 - s * s;
+                dn[0] = s - 0.5;
+                dn[1] = s + 0.5;
+                dn[2] = -2.0 * s;
+            }
+        }
+    }
+
+    /// Gauss points that integrate the consistent load of a polynomial traction of degree `p`
+    /// times the edge shape functions exactly on a straight edge.
+    pub fn load_rule(self) -> Vec<(f64, f64)> {
+        match self {
+            EdgeKind::Line2 => gauss_legendre(3),
+            EdgeKind::Line3 => gauss_legendre(4),
+        }
+    }
+}
+
+/// Value and derivative of the 1D quadratic Lagrange polynomial that is 1 at `node` (-1, 0 or 1).
+fn lagrange_1d_quadratic(node: f64, s: f64) -> (f64, f64) {
+    if node < -0.5 {
+        (0.5 * s * (s - 1.0), s - 0.5)
+    } else if node > 0.5 {
+        (0.5 * s * (s + 1.0), s + 0.5)
+    } else {
+        (1.0 - s * s, -2.0 * s)
+    }
+}
+
+/// Gauss-Legendre points and weights on `[-1, 1]`, by Newton iteration on `P_n`.
+pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    assert!(n >= 1, "a Gauss rule needs at least one point");
+    let mut rule = Vec::with_capacity(n);
+    for i in 0..n {
+        // Chebyshev-like initial guess, then Newton on the Legendre polynomial.
+        let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 1.0;
+        for _ in 0..100 {
+            let (p, d) = legendre_with_derivative(n, x);
+            dp = d;
+            let dx = p / d;
+            x -= dx;
+            if dx.abs() < 1e-16 {
+                break;
+            }
+        }
+        let (_, d) = legendre_with_derivative(n, x);
+        dp = if d != 0.0 { d } else { dp };
+        let w = 2.0 / ((1.0 - x * x) * dp * dp);
+        rule.push((x, w));
+    }
+    rule.sort_by(|a, b| a.0.total_cmp(&b.0));
+    rule
+}
+
+fn legendre_with_derivative(n: usize, x: f64) -> (f64, f64) {
+    let (mut p0, mut p1) = (1.0, x);
+    for k in 2..=n {
+        let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+        p0 = p1;
+        p1 = p2;
+    }
+    let p = if n == 0 { 1.0 } else { p1 };
+    let d = n as f64 * (x * p - p0) / (x * x - 1.0);
+    (p, d)
+}
+
+/// Tensor-product Gauss rule with `n x n` points on `[-1, 1]^2`.
+pub fn gauss_square(n: usize) -> Vec<QuadPoint> {
+    let g = gauss_legendre(n);
+    let mut out = Vec::with_capacity(n * n);
+    for &(y, wy) in &g {
+        for &(x, wx) in &g {
+            out.push(QuadPoint { xi: [x, y], weight: wx * wy });
+        }
+    }
+    out
+}
+
+/// Symmetric rules on the reference triangle (area 1/2) exact for polynomials of `degree`:
+/// 1 (centroid), 2 (three interior points), 5 (Radon's seven points).
+pub fn triangle_rule(degree: usize) -> Vec<QuadPoint> {
+    let p = |a: f64, b: f64, w: f64| QuadPoint { xi: [a, b], weight: w };
+    match degree {
+        0 | 1 => vec![p(1.0 / 3.0, 1.0 / 3.0, 0.5)],
+        2 => {
+            let w = 1.0 / 6.0;
+            vec![
+                p(1.0 / 6.0, 1.0 / 6.0, w),
+                p(2.0 / 3.0, 1.0 / 6.0, w),
+                p(1.0 / 6.0, 2.0 / 3.0, w),
+            ]
+        }
+        _ => {
+            let r15 = 15f64.sqrt();
+            let (a1, b1) = ((6.0 - r15) / 21.0, (9.0 + 2.0 * r15) / 21.0);
+            let (a2, b2) = ((6.0 + r15) / 21.0, (9.0 - 2.0 * r15) / 21.0);
+            let (w1, w2) = ((155.0 - r15) / 2400.0, (155.0 + r15) / 2400.0);
+            vec![
+                p(1.0 / 3.0, 1.0 / 3.0, 9.0 / 80.0),
+                p(a1, a1, w1),
+                p(b1, a1, w1),
+                p(a1, b1, w1),
+                p(a2, a2, w2),
+                p(b2, a2, w2),
+                p(a2, b2, w2),
+            ]
+        }
+    }
+}
+
+/// Geometry of an element at one natural point: shape values, Cartesian derivatives and `det J`.
+#[derive(Clone, Debug)]
+pub struct PointValues {
+    pub n: [f64; MAX_NODES],
+    pub dndx: [[f64; 2]; MAX_NODES],
+    pub det_j: f64,
+    pub x: [f64; 2],
+}
+
+/// Evaluate shape values, Cartesian gradients and the Jacobian determinant at `xi` for an
+/// element with nodal coordinates `coords` (in element node order).
+pub fn point_values(kind: ElementKind, coords: &[[f64; 2]], xi: [f64; 2]) -> PointValues {
+    let nn = kind.node_count();
+    let mut n = [0.0; MAX_NODES];
+    let mut dn = [[0.0; 2]; MAX_NODES];
+    kind.shape(xi, &mut n[..nn], &mut dn[..nn]);
+    // J = dx/dxi: J[i][j] = d x_i / d xi_j
+    let mut j = [[0.0; 2]; 2];
+    let mut x = [0.0; 2];
+    for a in 0..nn {
+        for i in 0..2 {
+            x[i] += n[a] * coords[a][i];
+            for k in 0..2 {
+                j[i][k] += coords[a][i] * dn[a][k];
+            }
+        }
+    }
+    let det_j = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+    let mut dndx = [[0.0; 2]; MAX_NODES];
+    if det_j != 0.0 {
+        let inv = [
+            [j[1][1] / det_j, -j[0][1] / det_j],
+            [-j[1][0] / det_j, j[0][0] / det_j],
+        ];
+        for a in 0..nn {
+            // dN/dx_i = dN/dxi_k * dxi_k/dx_i
+            dndx[a] = [
+                dn[a][0] * inv[0][0] + dn[a][1] * inv[1][0],
+                dn[a][0] * inv[0][1] + dn[a][1] * inv[1][1],
+            ];
+        }
+    }
+    PointValues { n, dndx, det_j, x }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gauss_rules_integrate_their_degree() {
+        for n in 1..=6 {
+            let g = gauss_legendre(n);
+            for deg in 0..(2 * n) {
+                let num: f64 = g.iter().map(|(x, w)| w * x.powi(deg as i32)).sum();
+                let exact = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
+                assert!((num - exact).abs() < 1e-14, "n={n} deg={deg}: {num} vs {exact}");
+            }
+        }
+    }
+
+    #[test]
+    fn triangle_rules_integrate_their_degree() {
+        // int over the reference triangle of xi^a eta^b = a! b! / (a+b+2)!
+        let fact = |k: u32| (1..=k).map(f64::from).product::<f64>();
+        for (degree, rule) in [(1, triangle_rule(1)), (2, triangle_rule(2)), (5, triangle_rule(5))] {
+            for a in 0..=degree {
+                for b in 0..=(degree - a) {
+                    let num: f64 = rule.iter().map(|q| q.weight * q.xi[0].powi(a as i32) * q.xi[1].powi(b as i32)).sum();
+                    let exact = fact(a) * fact(b) / fact(a + b + 2);
+                    assert!((num - exact).abs() < 1e-15, "degree {degree}: x^{a} y^{b}: {num} vs {exact}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn shape_functions_are_kronecker_and_partition_of_unity() {
+        for kind in [ElementKind::Q4, ElementKind::Q9, ElementKind::T3, ElementKind::T6] {
+            let nn = kind.node_count();
+            let mut n = [0.0; MAX_NODES];
+            let mut dn = [[0.0; 2]; MAX_NODES];
+            for (b, xb) in kind.node_coordinates().iter().enumerate() {
+                kind.shape(*xb, &mut n[..nn], &mut dn[..nn]);
+                for a in 0..nn {
+                    let expect = if a == b { 1.0 } else { 0.0 };
+                    assert!((n[a] - expect).abs() < 1e-15, "{kind:?}: N_{a}(node {b}) = {}", n[a]);
+                }
+            }
+            // derivatives sum to zero and match finite differences at an arbitrary point
+            let xi = [0.21, 0.17];
+            kind.shape(xi, &mut n[..nn], &mut dn[..nn]);
+            let h = 1e-6;
+            for k in 0..2 {
+                let mut sum = 0.0;
+                let mut xp = xi;
+                xp[k] += h;
+                let mut xm = xi;
+                xm[k] -= h;
+                let (mut np, mut nm) = ([0.0; MAX_NODES], [0.0; MAX_NODES]);
+                let mut scratch = [[0.0; 2]; MAX_NODES];
+                kind.shape(xp, &mut np[..nn], &mut scratch[..nn]);
+                kind.shape(xm, &mut nm[..nn], &mut scratch[..nn]);
+                for a in 0..nn {
+                    sum += dn[a][k];
+                    let fd = (np[a] - nm[a]) / (2.0 * h);
+                    assert!((fd - dn[a][k]).abs() < 1e-8, "{kind:?} dN_{a}/dxi_{k}");
+                }
+                assert!(sum.abs() < 1e-14);
+            }
+        }
+    }
+
+    #[test]
+    fn edge_shapes_match_element_shapes_on_the_boundary() {
+        // Along edge 0 of each element (from corner 0 to corner 1), the element shape functions of
+        // the edge nodes equal the edge shape functions.
+        for kind in [ElementKind::Q4, ElementKind::Q9, ElementKind::T3, ElementKind::T6] {
+            let nn = kind.node_count();
+            let edge = kind.edges()[0];
+            let x0 = kind.node_coordinates()[edge[0]];
+            let x1 = kind.node_coordinates()[edge[1]];
+            for s in [-0.8, -0.1, 0.4, 1.0] {
+                let t = 0.5 * (1.0 + s);
+                let xi = [x0[0] + t * (x1[0] - x0[0]), x0[1] + t * (x1[1] - x0[1])];
+                let mut n = [0.0; MAX_NODES];
+                let mut dn = [[0.0; 2]; MAX_NODES];
+                kind.shape(xi, &mut n[..nn], &mut dn[..nn]);
+                let mut ne = [0.0; 3];
+                let mut dne = [0.0; 3];
+                kind.edge_kind().shape(s, &mut ne, &mut dne);
+                for (k, &a) in edge.iter().enumerate() {
+                    assert!((n[a] - ne[k]).abs() < 1e-14, "{kind:?} edge node {k}");
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,191 @@
+//! The `contact-patch` command-line tool.
+
+use clap::{Parser, Subcommand};
+use contact_patch::output::write_run;
+use contact_patch::run::{run_case, Outcome};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Duration;
+
+#[derive(Parser)]
+#[command(
+    name = "contact-patch",
+    version,
+    about = "Finite-element contact solver with a verification harness",
+    after_help = "Examples:\n  contact-patch run cases/patch-single/q4-distorted.json --out out/q4\n  contact-patch check cases/patch-single cases/convergence\n\nExit codes: 0 success, 1 a check failed, 2 bad input or a failed solve."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve one case and write summary.json and one .vtu file per body.
+    #[command(after_help = "Example:\n  contact-patch run cases/patch-single/q9-distorted.json --out out/q9\n\nThe output folder is replaced only when the run succeeds (default: out/<case name>).")]
+    Run {
+        /// The case file (JSON).
+        case: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Run the checks declared in cases; exit 0 only when every check of every case passes.
+    #[command(after_help = "Example:\n  contact-patch check cases/patch-single cases/convergence/cantilever-q4.json\n\nFolders are searched recursively for *.json case files.")]
+    Check {
+        /// Case files or folders of case files.
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Run { case, out } => run(&case, out),
+        Command::Check { paths } => check(&paths),
+    }
+}
+
+fn spinner() -> Option<ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(ProgressStyle::with_template("{spinner} {elapsed} {msg}").expect("valid template"));
+    bar.enable_steady_tick(Duration::from_millis(120));
+    Some(bar)
+}
+
+fn run(case: &Path, out: Option<PathBuf>) -> ExitCode {
+    let bar = spinner();
+    let mut progress = |stage: &str| {
+        if let Some(b) = &bar {
+            b.set_message(format!("{}: {stage}", case.display()));
+        }
+    };
+    let result = run_case(case, &mut progress).and_then(|outcome| {
+        let dir = out.unwrap_or_else(|| Path::new("out").join(&outcome.model.name));
+        progress("writing output");
+        write_run(&dir, &outcome)?;
+        Ok((outcome, dir))
+    });
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    match result {
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+        Ok((outcome, dir)) => {
+            print_outcome(&outcome);
+            println!("output: {}", dir.display());
+            if outcome.passed() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }
+    }
+}
+
+fn print_outcome(o: &Outcome) {
+    let t = &o.solution.timings;
+    println!(
+        "{}: {} dofs, {} equations; mesh {:.3}s, assembly {:.3}s, factorization {:.3}s, solve {:.3}s, total {:.3}s",
+        o.model.name, o.model.dof_count, o.solution.equations, t.mesh, t.assembly, t.factorization, t.solve, t.total
+    );
+    for c in &o.checks {
+        println!("  {} {} (error {:.3e}, tol {:.1e})", if c.passed { "pass" } else { "FAIL" }, c.check, c.error, c.tol);
+    }
+}
+
+/// Case files named by `paths` (folders searched recursively), sorted.
+fn collect_cases(paths: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), String> {
+        let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: cannot read the folder: {e}", dir.display()))?;
+        let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+        paths.sort();
+        for p in paths {
+            if p.is_dir() {
+                walk(&p, out)?;
+            } else if p.extension().is_some_and(|x| x == "json") {
+                out.push(p);
+            }
+        }
+        Ok(())
+    }
+    let mut out = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            walk(p, &mut out)?;
+        } else if p.exists() {
+            out.push(p.clone());
+        } else {
+            return Err(format!("{}: no such file or folder\n  hint: give case files (*.json) or folders that contain them", p.display()));
+        }
+    }
+    if out.is_empty() {
+        return Err("no case files (*.json) found in the given folders".into());
+    }
+    Ok(out)
+}
+
+fn check(paths: &[PathBuf]) -> ExitCode {
+    let cases = match collect_cases(paths) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = ProgressBar::new(cases.len() as u64);
+        b.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed} {msg}").expect("valid template"));
+        b
+    });
+    let mut failures: Vec<(String, String)> = Vec::new();
+    let mut errors = 0;
+    for case in &cases {
+        if let Some(b) = &bar {
+            b.set_message(case.display().to_string());
+        }
+        match run_case(case, &mut |_| {}) {
+            Ok(outcome) => {
+                let (pass, fail): (Vec<_>, Vec<_>) = outcome.checks.iter().partition(|c| c.passed);
+                let line = format!("{} ({} checks, {:.3}s)", case.display(), outcome.checks.len(), outcome.solution.timings.total);
+                match &bar {
+                    Some(b) => b.println(format!("{} {line}", if fail.is_empty() { "pass" } else { "FAIL" })),
+                    None => println!("{} {line}", if fail.is_empty() { "pass" } else { "FAIL" }),
+                }
+                let _ = pass;
+                for c in fail {
+                    failures.push((case.display().to_string(), format!("{} (error {:.3e} > tol {:.1e})", c.check, c.error, c.tol)));
+                }
+            }
+            Err(e) => {
+                errors += 1;
+                failures.push((case.display().to_string(), format!("error: {e}")));
+            }
+        }
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    if failures.is_empty() {
+        println!("all {} cases pass", cases.len());
+        return ExitCode::SUCCESS;
+    }
+    println!("\n| case | failure |\n|---|---|");
+    for (case, what) in &failures {
+        println!("| {case} | {} |", what.replace('\n', " "));
+    }
+    println!("\n{} of {} cases failed", failures.iter().map(|f| &f.0).collect::<std::collections::BTreeSet<_>>().len(), cases.len());
+    ExitCode::from(if errors > 0 { 2 } else { 1 })
+}

@@ -1,0 +1,362 @@
+//! Meshes: nodes, cells of one element kind, boundary facets, and named node and facet sets.
+//!
+//! The structured block generator takes the vertex coordinates along x and y as arbitrary lists
+//! of breaks (the contact patch meshes need uneven, non-nested breaks), optionally moves some
+//! vertices to distort the grid, and derives the higher-order nodes from the (moved) vertices:
+//! mid-side nodes at edge midpoints, the Q9 centre at the mean of its corners, so every element
+//! keeps straight sides. Triangles split each quadrilateral cell along the diagonal from its
+//! lower-left to its upper-right vertex.
+//!
+//! A facet is `(cell, local edge)`; only boundary facets (edges owned by one cell) enter facet
+//! sets. Every body gets the sets `left`, `right`, `bottom`, `top` (nodes and boundary facets on
+//! the sides of its bounding box), the corner node sets `bottom_left`, `bottom_right`,
+//! `top_left`, `top_right`, and `all` (nodes).
+
+use crate::fe::ElementKind;
+use std::collections::{BTreeMap, HashMap};
+
+/// A facet: a cell and one of its local edges.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Facet {
+    pub cell: usize,
+    pub edge: usize,
+}
+
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    pub kind: ElementKind,
+    pub nodes: Vec<[f64; 2]>,
+    /// Flat connectivity, `kind.node_count()` entries per cell.
+    pub connectivity: Vec<usize>,
+    pub node_sets: BTreeMap<String, Vec<usize>>,
+    pub facet_sets: BTreeMap<String, Vec<Facet>>,
+}
+
+impl Mesh {
+    /// Build a mesh from explicit data and add the automatic sets.
+    pub fn new(kind: ElementKind, nodes: Vec<[f64; 2]>, connectivity: Vec<usize>) -> Self {
+        let mut mesh = Mesh {
+            kind,
+            nodes,
+            connectivity,
+            node_sets: BTreeMap::new(),
+            facet_sets: BTreeMap::new(),
+        };
+        mesh.add_automatic_sets();
+        mesh
+    }
+
+    pub fn cell_count(&self) -> usize {
+        self.connectivity.len() / self.kind.node_count()
+    }
+
+    pub fn cell(&self, c: usize) -> &[usize] {
+        let nn = self.kind.node_count();
+        &self.connectivity[c * nn..(c + 1) * nn]
+    }
+
+    /// Coordinates of the nodes of cell `c`, in element order.
+    pub fn cell_coords(&self, c: usize) -> Vec<[f64; 2]> {
+        self.cell(c).iter().map(|&n| self.nodes[n]).collect()
+    }
+
+    /// Global node ids of a facet, in edge order `[start, end(, mid)]`.
+    pub fn facet_nodes(&self, f: Facet) -> Vec<usize> {
+        let cell = self.cell(f.cell);
+        self.kind.edges()[f.edge].iter().map(|&l| cell[l]).collect()
+    }
+
+    /// Axis-aligned bounding box `[min, max]`.
+    pub fn bounding_box(&self) -> [[f64; 2]; 2] {
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for p in &self.nodes {
+            for i in 0..2 {
+                lo[i] = lo[i].min(p[i]);
+                hi[i] = hi[i].max(p[i]);
+            }
+        }
+        [lo, hi]
+    }
+
+    /// A length scale for geometric tolerances.
+    pub fn size(&self) -> f64 {
+        let [lo, hi] = self.bounding_box();
+        (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE)
+    }
+
+    /// Facets that belong to exactly one cell, in cell order.
+    pub fn boundary_facets(&self) -> Vec<Facet> {
+        let mut count: HashMap<(usize, usize), usize> = HashMap::new();
+        let edges = self.kind.edges();
+        for c in 0..self.cell_count() {
+            let cell = self.cell(c);
+            for e in edges {
+                let (a, b) = (cell[e[0]], cell[e[1]]);
+                *count.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        let mut out = Vec::new();
+        for c in 0..self.cell_count() {
+            let cell = self.cell(c);
+            for (k, e) in edges.iter().enumerate() {
+                let (a, b) = (cell[e[0]], cell[e[1]]);
+                if count[&(a.min(b), a.max(b))] == 1 {
+                    out.push(Facet { cell: c, edge: k });
+                }
+            }
+        }
+        out
+    }
+
+    /// Nodes inside the closed box `[lo, hi]` (with tolerance `tol`).
+    pub fn nodes_in_box(&self, lo: [f64; 2], hi: [f64; 2], tol: f64) -> Vec<usize> {
+        (0..self.nodes.len())
+            .filter(|&n| inside(self.nodes[n], lo, hi, tol))
+            .collect()
+    }
+
+    /// Boundary facets whose nodes all lie in the closed box `[lo, hi]`.
+    pub fn facets_in_box(&self, lo: [f64; 2], hi: [f64; 2], tol: f64) -> Vec<Facet> {
+        self.boundary_facets()
+            .into_iter()
+            .filter(|&f| self.facet_nodes(f).iter().all(|&n| inside(self.nodes[n], lo, hi, tol)))
+            .collect()
+    }
+
+    /// The node closest to `p`, with its distance.
+    pub fn nearest_node(&self, p: [f64; 2]) -> Option<(usize, f64)> {
+        self.nodes
+            .iter()
+            .enumerate()
+            .map(|(i, q)| (i, ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2)).sqrt()))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// A geometric tolerance relative to the mesh size.
+    pub fn tolerance(&self) -> f64 {
+        1e-9 * self.size()
+    }
+
+    fn add_automatic_sets(&mut self) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let [lo, hi] = self.bounding_box();
+        let tol = self.tolerance();
+        let inf = f64::INFINITY;
+        let sides = [
+            ("left", [lo[0], -inf], [lo[0], inf]),
+            ("right", [hi[0], -inf], [hi[0], inf]),
+            ("bottom", [-inf, lo[1]], [inf, lo[1]]),
+            ("top", [-inf, hi[1]], [inf, hi[1]]),
+        ];
+        for (name, a, b) in sides {
+            let nodes = self.nodes_in_box(a, b, tol);
+            let facets = self.facets_in_box(a, b, tol);
+            self.node_sets.insert(name.to_string(), nodes);
+            self.facet_sets.insert(name.to_string(), facets);
+        }
+        let corners = [
+            ("bottom_left", [lo[0], lo[1]]),
+            ("bottom_right", [hi[0], lo[1]]),
+            ("top_left", [lo[0], hi[1]]),
+            ("top_right", [hi[0], hi[1]]),
+        ];
+        for (name, p) in corners {
+            let nodes = self.nodes_in_box(p, p, tol);
+            self.node_sets.insert(name.to_string(), nodes);
+        }
+        self.node_sets.insert("all".to_string(), (0..self.nodes.len()).collect());
+    }
+}
+
+fn inside(p: [f64; 2], lo: [f64; 2], hi: [f64; 2], tol: f64) -> bool {
+    (0..2).all(|i| p[i] >= lo[i] - tol && p[i] <= hi[i] + tol)
+}
+
+/// Problems found while generating a block mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BlockError {
+    TooFewBreaks { axis: char, count: usize },
+    NotIncreasing { axis: char, index: usize, value: f64, previous: f64 },
+    NoVertexAt { from: [f64; 2] },
+}
+
+impl std::fmt::Display for BlockError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BlockError::TooFewBreaks { axis, count } => write!(
+                f,
+                "the {axis} breaks need at least two values (got {count}); list the element boundaries, e.g. [0, 1, 2]"
+            ),
+            BlockError::NotIncreasing { axis, index, value, previous } => write!(
+                f,
+                "the {axis} breaks must increase strictly, but entry {index} ({value}) is not greater than the one before ({previous})"
+            ),
+            BlockError::NoVertexAt { from } => write!(
+                f,
+                "a move starts at ({}, {}), where the block has no vertex; use the coordinates of a grid vertex",
+                from[0], from[1]
+            ),
+        }
+    }
+}
+
+/// Generate a structured block mesh (see the module docs).
+pub fn block(
+    kind: ElementKind,
+    xs: &[f64],
+    ys: &[f64],
+    moves: &[([f64; 2], [f64; 2])],
+) -> Result<Mesh, BlockError> {
+    for (axis, b) in [('x', xs), ('y', ys)] {
+        if b.len() < 2 {
+            return Err(BlockError::TooFewBreaks { axis, count: b.len() });
+        }
+        for i in 1..b.len() {
+            if b[i].partial_cmp(&b[i - 1]) != Some(std::cmp::Ordering::Greater) {
+                return Err(BlockError::NotIncreasing { axis, index: i, value: b[i], previous: b[i - 1] });
+            }
+        }
+    }
+    let (nx, ny) = (xs.len() - 1, ys.len() - 1);
+    // vertex grid, then moves
+    let mut vertex = vec![[0.0; 2]; (nx + 1) * (ny + 1)];
+    for j in 0..=ny {
+        for i in 0..=nx {
+            vertex[j * (nx + 1) + i] = [xs[i], ys[j]];
+        }
+    }
+    let size = (xs[nx] - xs[0]).max(ys[ny] - ys[0]);
+    for &(from, to) in moves {
+        let k = vertex
+            .iter()
+            .position(|v| (v[0] - from[0]).abs() <= 1e-9 * size && (v[1] - from[1]).abs() <= 1e-9 * size)
+            .ok_or(BlockError::NoVertexAt { from })?;
+        vertex[k] = to;
+    }
+    let v = |i: usize, j: usize| vertex[j * (nx + 1) + i];
+    let mid = |a: [f64; 2], b: [f64; 2]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+
+    // Node lattice: step 1 (linear) or 2 (quadratic) per cell; only lattice points in use get ids.
+    let q = if kind.is_quadratic() { 2 } else { 1 };
+    let (lx, ly) = (q * nx + 1, q * ny + 1);
+    let mut id = vec![usize::MAX; lx * ly];
+    let mut nodes = Vec::new();
+    let mut node_at = |li: usize, lj: usize, nodes: &mut Vec<[f64; 2]>| -> usize {
+        let k = lj * lx + li;
+        if id[k] == usize::MAX {
+            let p = if q == 1 {
+                v(li, lj)
+            } else {
+                let (i, j) = (li / 2, lj / 2);
+                match (li % 2, lj % 2) {
+                    (0, 0) => v(i, j),
+                    (1, 0) => mid(v(i, j), v(i + 1, j)),
+                    (0, 1) => mid(v(i, j), v(i, j + 1)),
+                    _ => {
+                        if kind == ElementKind::Q9 {
+                            let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
+                            [0.25 * (a[0] + b[0] + c[0] + d[0]), 0.25 * (a[1] + b[1] + c[1] + d[1])]
+                        } else {
+                            mid(v(i, j), v(i + 1, j + 1))
+                        }
+                    }
+                }
+            };
+            id[k] = nodes.len();
+            nodes.push(p);
+        }
+        id[k]
+    };
+    let mut conn = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let (a, b) = (q * i, q * j);
+            match kind {
+                ElementKind::Q4 => {
+                    for (di, dj) in [(0, 0), (1, 0), (1, 1), (0, 1)] {
+                        conn.push(node_at(a + di, b + dj, &mut nodes));
+                    }
+                }
+                ElementKind::Q9 => {
+                    for (di, dj) in [(0, 0), (2, 0), (2, 2), (0, 2), (1, 0), (2, 1), (1, 2), (0, 1), (1, 1)] {
+                        conn.push(node_at(a + di, b + dj, &mut nodes));
+                    }
+                }
+                ElementKind::T3 => {
+                    for tri in [[(0, 0), (1, 0), (1, 1)], [(0, 0), (1, 1), (0, 1)]] {
+                        for (di, dj) in tri {
+                            conn.push(node_at(a + di, b + dj, &mut nodes));
+                        }
+                    }
+                }
+                ElementKind::T6 => {
+                    let tris = [
+                        [(0, 0), (2, 0), (2, 2), (1, 0), (2, 1), (1, 1)],
+                        [(0, 0), (2, 2), (0, 2), (1, 1), (1, 2), (0, 1)],
+                    ];
+                    for tri in tris {
+                        for (di, dj) in tri {
+                            conn.push(node_at(a + di, b + dj, &mut nodes));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(Mesh::new(kind, nodes, conn))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn block_counts_and_automatic_sets() {
+        let m = block(ElementKind::Q4, &[0.0, 1.0, 3.0], &[0.0, 2.0], &[]).unwrap();
+        assert_eq!(m.nodes.len(), 6);
+        assert_eq!(m.cell_count(), 2);
+        assert_eq!(m.node_sets["left"].len(), 2);
+        assert_eq!(m.facet_sets["top"].len(), 2);
+        assert_eq!(m.node_sets["top_right"], vec![m.nearest_node([3.0, 2.0]).unwrap().0]);
+        assert_eq!(m.boundary_facets().len(), 6);
+
+        let q9 = block(ElementKind::Q9, &[0.0, 1.0, 3.0], &[0.0, 2.0], &[]).unwrap();
+        assert_eq!(q9.nodes.len(), 15);
+        assert_eq!(q9.cell_count(), 2);
+        let t6 = block(ElementKind::T6, &[0.0, 1.0, 3.0], &[0.0, 2.0], &[]).unwrap();
+        assert_eq!(t6.nodes.len(), 15);
+        assert_eq!(t6.cell_count(), 4);
+        let t3 = block(ElementKind::T3, &[0.0, 1.0, 3.0], &[0.0, 2.0], &[]).unwrap();
+        assert_eq!((t3.nodes.len(), t3.cell_count()), (6, 4));
+    }
+
+    #[test]
+    fn moved_vertex_keeps_quadratic_nodes_on_straight_sides() {
+        let m = block(ElementKind::Q9, &[0.0, 1.0, 2.0], &[0.0, 1.0, 2.0], &[([1.0, 1.0], [1.2, 0.7])]).unwrap();
+        let (moved, d) = m.nearest_node([1.2, 0.7]).unwrap();
+        assert!(d < 1e-14);
+        // the mid-side node between (1,0) and the moved vertex sits at their midpoint
+        let (_, d) = m.nearest_node([1.1, 0.35]).unwrap();
+        assert!(d < 1e-14, "mid-side node not at the midpoint");
+        assert!(m.node_sets["all"].contains(&moved));
+    }
+
+    #[test]
+    fn bad_breaks_and_moves_are_reported() {
+        assert_eq!(
+            block(ElementKind::Q4, &[0.0], &[0.0, 1.0], &[]).unwrap_err(),
+            BlockError::TooFewBreaks { axis: 'x', count: 1 }
+        );
+        assert!(matches!(
+            block(ElementKind::Q4, &[0.0, 1.0], &[0.0, 1.0, 1.0], &[]),
+            Err(BlockError::NotIncreasing { axis: 'y', index: 2, .. })
+        ));
+        assert!(matches!(
+            block(ElementKind::Q4, &[0.0, 1.0], &[0.0, 1.0], &[([0.5, 0.5], [0.4, 0.4])]),
+            Err(BlockError::NoVertexAt { .. })
+        ));
+    }
+}

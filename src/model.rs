@@ -1,0 +1,650 @@
+//! The model: a case file validated once into typed objects.
+//!
+//! `Model::build` resolves every name in the case (materials, bodies, node and facet sets),
+//! generates the meshes, checks each element's Jacobian, numbers the dofs
+//! (`offset_b + 2 node + component`), collects prescribed values and assembles the consistent
+//! external force vector:
+//!
+//! * traction `t` on a facet: `f_a = int_facet N_a t t_h ds` (`t_h` the thickness),
+//! * pressure `p`: `t = -p n` with `n` the outward unit normal (`n ds = [dy, -dx]` for an edge
+//!   ordered counter-clockwise around its element),
+//! * body force `b`: `f_a = int_cell N_a b t_h dA`,
+//!
+//! each with a Gauss rule exact for polynomial data on straight edges and affine cells
+//! (Line2: 3 points, Line3: 4 points). Finally it verifies that every body is held against
+//! its three rigid-body modes, so that an unconstrained body is reported by name instead of
+//! surfacing as a singular matrix.
+//!
+//! Everything that can be wrong in a case is found here and reported as `Error::Invalid` (what,
+//! where, how to fix it); nothing later needs to re-validate.
+
+use crate::error::{Error, Result};
+use crate::exact::ExactField;
+use crate::fe::{point_values, ElementKind};
+use crate::mesh::{block, Facet, Mesh};
+use crate::scene::{
+    Case, Check, FacetSetSpec, MeshSpec, NodeSetSpec, Physics, Plane, Prescribed, TractionSpec,
+};
+use crate::solid::{check_geometry, Elasticity};
+use std::path::Path;
+
+/// One elastic body: its mesh (with named sets), material and first global dof.
+#[derive(Clone, Debug)]
+pub struct Body {
+    pub name: String,
+    pub material_name: String,
+    pub material: Elasticity,
+    pub mesh: Mesh,
+    pub dof_offset: usize,
+}
+
+impl Body {
+    /// Global dof of `component` (0 = x, 1 = y) of local node `node`.
+    pub fn dof(&self, node: usize, component: usize) -> usize {
+        self.dof_offset + 2 * node + component
+    }
+
+    pub fn dof_count(&self) -> usize {
+        2 * self.mesh.nodes.len()
+    }
+
+    /// Global dofs of cell `c`, in element dof order `[x0, y0, x1, y1, ...]`.
+    pub fn cell_dofs(&self, c: usize, out: &mut Vec<usize>) {
+        out.clear();
+        for &n in self.mesh.cell(c) {
+            out.push(self.dof(n, 0));
+            out.push(self.dof(n, 1));
+        }
+    }
+}
+
+/// A validated scene, ready to solve.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub name: String,
+    pub description: String,
+    /// Where the case came from (used in every message).
+    pub source: String,
+    pub plane: Plane,
+    pub thickness: f64,
+    pub bodies: Vec<Body>,
+    pub dof_count: usize,
+    /// Prescribed value of each global dof, if any.
+    pub prescribed: Vec<Option<f64>>,
+    /// Consistent external nodal forces.
+    pub external_force: Vec<f64>,
+    pub exact: Option<ExactField>,
+    pub physics: Physics,
+    /// Checks with every name already resolved.
+    pub checks: Vec<Check>,
+    /// `(body index, node set)` of every support, for reaction summaries.
+    pub support_sets: Vec<(usize, String)>,
+}
+
+/// Read, parse and validate a case file.
+pub fn load(path: &Path) -> Result<Model> {
+    let source = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(&source, "reading the case", e))?;
+    let case = parse(&text, &source)?;
+    Model::build(&case, &source)
+}
+
+/// Parse case JSON; errors carry line, column and a hint.
+pub fn parse(text: &str, source: &str) -> Result<Case> {
+    serde_json::from_str::<Case>(text).map_err(|e| {
+        let message = e.to_string();
+        // serde_json appends " at line L column C"; the location is reported separately.
+        let message = match message.rfind(" at line ") {
+            Some(k) => message[..k].to_string(),
+            None => message,
+        };
+        let hint = if message.starts_with("unknown field") {
+            "remove or rename the field; the accepted names are listed above".to_string()
+        } else if message.starts_with("missing field") {
+            "add the field; see the cases under cases/ for complete examples".to_string()
+        } else if message.starts_with("unknown variant") {
+            "use one of the accepted values listed above".to_string()
+        } else if e.is_syntax() || e.is_eof() {
+            "the file is not valid JSON near this position (a missing comma, bracket or quote?)"
+                .to_string()
+        } else {
+            "the value does not have the expected type or shape; see the cases under cases/"
+                .to_string()
+        };
+        Error::Parse {
+            path: source.to_string(),
+            line: e.line(),
+            column: e.column(),
+            message,
+            hint,
+        }
+    })
+}
+
+impl Model {
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    pub fn body(&self, name: &str) -> Option<&Body> {
+        self.bodies.iter().find(|b| b.name == name)
+    }
+
+    /// Validate `case` and build the model. `source` names the case in messages.
+    pub fn build(case: &Case, source: &str) -> Result<Model> {
+        let invalid = |location: String, problem: String, hint: &str| {
+            Error::invalid(source, location, problem, hint)
+        };
+        let plane = case.analysis.plane;
+        let thickness = case.analysis.thickness;
+        if !(thickness.is_finite() && thickness > 0.0) {
+            return Err(invalid(
+                "analysis.thickness".into(),
+                format!("thickness must be a positive number, got {thickness}"),
+                "use the out-of-plane thickness (1 for plane strain per unit length)",
+            ));
+        }
+        for (name, m) in &case.materials {
+            if !(m.youngs_modulus.is_finite() && m.youngs_modulus > 0.0) {
+                return Err(invalid(
+                    format!("materials.{name}.E"),
+                    format!("Young's modulus must be positive and finite, got {}", m.youngs_modulus),
+                    "give E > 0",
+                ));
+            }
+            if !(m.nu.is_finite() && m.nu > -1.0 && m.nu < 0.5) {
+                return Err(invalid(
+                    format!("materials.{name}.nu"),
+                    format!("Poisson's ratio must lie in (-1, 0.5), got {}", m.nu),
+                    "nu = 0.5 (incompressible) is not supported by displacement elements; use e.g. 0.499",
+                ));
+            }
+        }
+        if case.bodies.is_empty() {
+            return Err(invalid("bodies".into(), "the case has no bodies".into(), "add at least one body"));
+        }
+
+        let mut bodies: Vec<Body> = Vec::new();
+        let mut offset = 0;
+        for (bi, spec) in case.bodies.iter().enumerate() {
+            let at = format!("bodies[{bi}] '{}'", spec.name);
+            if bodies.iter().any(|b| b.name == spec.name) {
+                return Err(invalid(at, format!("a second body is named '{}'", spec.name), "give every body a unique name"));
+            }
+            let Some(mat) = case.materials.get(&spec.material) else {
+                let known: Vec<&String> = case.materials.keys().collect();
+                return Err(invalid(
+                    format!("{at}.material"),
+                    format!("material '{}' is not defined", spec.material),
+                    &format!("define it under \"materials\" or use one of {known:?}"),
+                ));
+            };
+            let mut mesh = build_mesh(&spec.mesh, source, &at)?;
+            check_cells(&mesh, source, &at)?;
+            add_user_sets(&mut mesh, spec, source, &at)?;
+            let body = Body {
+                name: spec.name.clone(),
+                material_name: spec.material.clone(),
+                material: Elasticity::new(mat.youngs_modulus, mat.nu, plane),
+                mesh,
+                dof_offset: offset,
+            };
+            offset += body.dof_count();
+            bodies.push(body);
+        }
+
+        let exact = case.exact.as_ref().map(ExactField::from);
+        let mut model = Model {
+            name: case.name.clone(),
+            description: case.description.clone(),
+            source: source.to_string(),
+            plane,
+            thickness,
+            dof_count: offset,
+            prescribed: vec![None; offset],
+            external_force: vec![0.0; offset],
+            bodies,
+            exact,
+            physics: case.physics.clone(),
+            checks: Vec::new(),
+            support_sets: Vec::new(),
+        };
+        model.apply_supports(case)?;
+        model.apply_loads(case)?;
+        model.resolve_checks(case)?;
+        model.check_rigid_modes()?;
+        Ok(model)
+    }
+
+    fn find_body(&self, name: &str, location: &str) -> Result<&Body> {
+        self.body(name).ok_or_else(|| {
+            let known: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
+            Error::invalid(
+                &self.source,
+                location,
+                format!("body '{name}' does not exist"),
+                format!("use one of the bodies {known:?}"),
+            )
+        })
+    }
+
+    fn find_node_set<'a>(&self, body: &'a Body, set: &str, location: &str) -> Result<&'a [usize]> {
+        body.mesh.node_sets.get(set).map(|v| v.as_slice()).ok_or_else(|| {
+            let known: Vec<&String> = body.mesh.node_sets.keys().collect();
+            Error::invalid(
+                &self.source,
+                location,
+                format!("body '{}' has no node set '{set}'", body.name),
+                format!("define it under the body's \"node_sets\" or use one of {known:?}"),
+            )
+        })
+    }
+
+    fn find_facet_set<'a>(&self, body: &'a Body, set: &str, location: &str) -> Result<&'a [Facet]> {
+        body.mesh.facet_sets.get(set).map(|v| v.as_slice()).ok_or_else(|| {
+            let known: Vec<&String> = body.mesh.facet_sets.keys().collect();
+            Error::invalid(
+                &self.source,
+                location,
+                format!("body '{}' has no facet set '{set}'", body.name),
+                format!("define it under the body's \"facet_sets\" or use one of {known:?}"),
+            )
+        })
+    }
+
+    fn require_exact(&self, location: &str) -> Result<ExactField> {
+        self.exact.clone().ok_or_else(|| {
+            Error::invalid(
+                &self.source,
+                location,
+                "\"exact\" is used but the case defines no exact solution",
+                "add an \"exact\" section (e.g. {\"kind\": \"uniform_stress\", \"stress\": [0, -10, 0]}) or give a number",
+            )
+        })
+    }
+
+    fn apply_supports(&mut self, case: &Case) -> Result<()> {
+        for (k, s) in case.supports.iter().enumerate() {
+            let at = format!("supports[{k}]");
+            let body = self.find_body(&s.body, &at)?.clone();
+            let nodes = self.find_node_set(&body, &s.set, &at)?.to_vec();
+            let entry = (self.body_index(&s.body).expect("found above"), s.set.clone());
+            if !self.support_sets.contains(&entry) {
+                self.support_sets.push(entry);
+            }
+            if s.x.is_none() && s.y.is_none() {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    "the support fixes no component",
+                    "add \"x\" and/or \"y\" (a number, or \"exact\")",
+                ));
+            }
+            for (comp, value) in [(0, s.x), (1, s.y)] {
+                let Some(value) = value else { continue };
+                if let Prescribed::Value(v) = value {
+                    if !v.is_finite() {
+                        return Err(Error::invalid(&self.source, &at, "the prescribed value is not finite", "give a finite number"));
+                    }
+                }
+                let exact = match value {
+                    Prescribed::Exact(_) => Some(self.require_exact(&at)?),
+                    Prescribed::Value(_) => None,
+                };
+                for &n in &nodes {
+                    let v = match (value, &exact) {
+                        (Prescribed::Value(v), _) => v,
+                        (_, Some(f)) => f.displacement(body.mesh.nodes[n], &body.material)[comp],
+                        _ => unreachable!("exact checked above"),
+                    };
+                    let dof = body.dof(n, comp);
+                    match self.prescribed[dof] {
+                        Some(old) if (old - v).abs() > 1e-12 * (old.abs() + v.abs()).max(1e-300) => {
+                            let p = body.mesh.nodes[n];
+                            return Err(Error::invalid(
+                                &self.source,
+                                &at,
+                                format!(
+                                    "node {n} of body '{}' at ({}, {}) gets u_{} = {v} here but {old} from an earlier support",
+                                    body.name, p[0], p[1], ["x", "y"][comp]
+                                ),
+                                "remove one of the conflicting supports or make their values agree",
+                            ));
+                        }
+                        _ => self.prescribed[dof] = Some(v),
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn apply_loads(&mut self, case: &Case) -> Result<()> {
+        for (k, load) in case.loads.iter().enumerate() {
+            let at = format!("loads[{k}]");
+            let body = self.find_body(&load.body, &at)?.clone();
+            let given = [load.pressure.is_some(), load.traction.is_some(), load.body_force.is_some()];
+            if given.iter().filter(|&&g| g).count() != 1 {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    "a load needs exactly one of \"pressure\", \"traction\" or \"body_force\"",
+                    "split it into one load per kind",
+                ));
+            }
+            let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+            if let Some(b) = load.body_force {
+                if load.set.is_some() {
+                    return Err(Error::invalid(&self.source, &at, "a body force acts on the whole body and takes no \"set\"", "remove \"set\""));
+                }
+                if !finite(&b) {
+                    return Err(Error::invalid(&self.source, &at, "the body force is not finite", "give finite numbers"));
+                }
+                add_body_force(&body, b, self.thickness, &mut self.external_force);
+                continue;
+            }
+            let Some(set) = &load.set else {
+                return Err(Error::invalid(&self.source, &at, "a pressure or traction needs a facet \"set\"", "add \"set\": the name of a facet set of the body"));
+            };
+            let facets = self.find_facet_set(&body, set, &at)?.to_vec();
+            let traction = match (load.pressure, load.traction) {
+                (Some(p), _) => {
+                    if !p.is_finite() {
+                        return Err(Error::invalid(&self.source, &at, "the pressure is not finite", "give a finite number"));
+                    }
+                    EdgeTraction::Pressure(p)
+                }
+                (_, Some(TractionSpec::Vector(t))) => {
+                    if !finite(&t) {
+                        return Err(Error::invalid(&self.source, &at, "the traction is not finite", "give finite numbers"));
+                    }
+                    EdgeTraction::Vector(t)
+                }
+                (_, Some(TractionSpec::Exact(_))) => EdgeTraction::Exact(self.require_exact(&at)?),
+                _ => unreachable!("exactly one load kind checked above"),
+            };
+            for f in facets {
+                add_facet_load(&body, f, &traction, self.thickness, &mut self.external_force);
+            }
+        }
+        Ok(())
+    }
+
+    fn resolve_checks(&mut self, case: &Case) -> Result<()> {
+        for (k, check) in case.checks.iter().enumerate() {
+            let at = format!("checks[{k}]");
+            let tol = match check {
+                Check::UniformStress { body, tol, .. } => {
+                    if let Some(b) = body {
+                        self.find_body(b, &at)?;
+                    }
+                    *tol
+                }
+                Check::ExactDisplacement { tol } => {
+                    self.require_exact(&at)?;
+                    *tol
+                }
+                Check::Reaction { body, set, tol, .. } => {
+                    let b = self.find_body(body, &at)?;
+                    let nodes = self.find_node_set(b, set, &at)?;
+                    let _ = nodes;
+                    *tol
+                }
+                Check::Displacement { body, tol, .. } => {
+                    self.find_body(body, &at)?;
+                    *tol
+                }
+            };
+            if !(tol.is_finite() && tol >= 0.0) {
+                return Err(Error::invalid(&self.source, &at, format!("tolerance must be a non-negative number, got {tol}"), "give e.g. 1e-10"));
+            }
+            self.checks.push(check.clone());
+        }
+        Ok(())
+    }
+
+    /// Every body must be held against translation in x and y and rotation.
+    fn check_rigid_modes(&self) -> Result<()> {
+        for body in &self.bodies {
+            if let Some(mode) = free_rigid_mode(body, &self.prescribed) {
+                return Err(Error::invalid(
+                    &self.source,
+                    format!("body '{}'", body.name),
+                    format!("the body is not held against rigid motion: it can {mode}"),
+                    "add supports (e.g. \"y\": 0 on a side and \"x\": 0 at one corner) so that it can neither translate nor rotate",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The first rigid-body mode (translation x, translation y, rotation) that the prescribed dofs
+/// of `body` do not restrain, described in words.
+///
+/// Restraint is measured by the Gram matrix `G_kl = sum_{d prescribed} m_k(d) m_l(d)` of the
+/// three modes `m` restricted to prescribed dofs (rotation about the body's centre, scaled by its
+/// size): the body is held iff `G` is non-singular.
+pub fn free_rigid_mode(body: &Body, prescribed: &[Option<f64>]) -> Option<&'static str> {
+    let mesh = &body.mesh;
+    let [lo, hi] = mesh.bounding_box();
+    let c = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+    let scale = mesh.size();
+    let mut g = [[0.0f64; 3]; 3];
+    for (n, p) in mesh.nodes.iter().enumerate() {
+        for comp in 0..2 {
+            if prescribed[body.dof(n, comp)].is_none() {
+                continue;
+            }
+            let rot = [-(p[1] - c[1]) / scale, (p[0] - c[0]) / scale];
+            let m = [if comp == 0 { 1.0 } else { 0.0 }, if comp == 1 { 1.0 } else { 0.0 }, rot[comp]];
+            for k in 0..3 {
+                for l in 0..3 {
+                    g[k][l] += m[k] * m[l];
+                }
+            }
+        }
+    }
+    if g[0][0] == 0.0 {
+        return Some("translate in x (no node has u_x prescribed)");
+    }
+    if g[1][1] == 0.0 {
+        return Some("translate in y (no node has u_y prescribed)");
+    }
+    let det = g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1]) - g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0])
+        + g[0][2] * (g[1][0] * g[2][1] - g[1][1] * g[2][0]);
+    let trace = g[0][0] + g[1][1] + g[2][2];
+    if det <= 1e-12 * trace.powi(3) {
+        return Some("rotate (the prescribed components all lie along one line of action)");
+    }
+    None
+}
+
+fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {
+    match spec {
+        MeshSpec::Block(b) => {
+            let xs = b.x.values();
+            let ys = b.y.values();
+            if xs.iter().chain(&ys).any(|v| !v.is_finite()) {
+                return Err(Error::invalid(source, format!("{at}.mesh.block"), "a break is not finite", "give finite coordinates"));
+            }
+            let moves: Vec<_> = b.moves.iter().map(|m| (m.from, m.to)).collect();
+            block(b.element, &xs, &ys, &moves)
+                .map_err(|e| Error::invalid(source, format!("{at}.mesh.block"), e, "fix the breaks or moves"))
+        }
+        MeshSpec::Explicit(e) => {
+            let nn = e.element.node_count();
+            for (i, p) in e.nodes.iter().enumerate() {
+                if !(p[0].is_finite() && p[1].is_finite()) {
+                    return Err(Error::invalid(source, format!("{at}.mesh.explicit.nodes[{i}]"), "the coordinates are not finite", "give finite coordinates"));
+                }
+            }
+            let mut conn = Vec::with_capacity(nn * e.cells.len());
+            for (c, cell) in e.cells.iter().enumerate() {
+                if cell.len() != nn {
+                    return Err(Error::invalid(
+                        source,
+                        format!("{at}.mesh.explicit.cells[{c}]"),
+                        format!("a {:?} cell needs {nn} nodes, got {}", e.element, cell.len()),
+                        "list corners counter-clockwise, then mid-side nodes (then the Q9 centre)",
+                    ));
+                }
+                for &n in cell {
+                    if n >= e.nodes.len() {
+                        return Err(Error::invalid(
+                            source,
+                            format!("{at}.mesh.explicit.cells[{c}]"),
+                            format!("node {n} does not exist (the mesh has {} nodes, numbered from 0)", e.nodes.len()),
+                            "use node indices below the number of nodes",
+                        ));
+                    }
+                }
+                conn.extend_from_slice(cell);
+            }
+            if e.cells.is_empty() {
+                return Err(Error::invalid(source, format!("{at}.mesh.explicit.cells"), "the mesh has no cells", "add cells"));
+            }
+            Ok(Mesh::new(e.element, e.nodes.clone(), conn))
+        }
+    }
+}
+
+/// Every cell must have a positive Jacobian at its nodes and quadrature points.
+fn check_cells(mesh: &Mesh, source: &str, at: &str) -> Result<()> {
+    for c in 0..mesh.cell_count() {
+        let coords = mesh.cell_coords(c);
+        if let Err(bad) = check_geometry(mesh.kind, &coords) {
+            let what = if bad.inverted { "inverted (negative Jacobian)" } else { "degenerate (zero-area)" };
+            return Err(Error::invalid(
+                source,
+                format!("{at}: element {c} (nodes {:?})", mesh.cell(c)),
+                format!("the element is {what}: det J = {:.3e} at ({:.6}, {:.6})", bad.det_j, bad.at[0], bad.at[1]),
+                "list the corners counter-clockwise, keep every interior angle below 180 degrees and mid-side nodes near the middle of their sides",
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn add_user_sets(mesh: &mut Mesh, spec: &crate::scene::BodySpec, source: &str, at: &str) -> Result<()> {
+    let tol = mesh.tolerance();
+    for (name, set) in &spec.node_sets {
+        let loc = format!("{at}.node_sets.{name}");
+        if mesh.node_sets.contains_key(name) {
+            return Err(Error::invalid(source, loc, format!("'{name}' is a built-in set name"), "choose another name; the built-in sets are left, right, bottom, top, the corners and all"));
+        }
+        let nodes = match set {
+            NodeSetSpec::Box(b) => mesh.nodes_in_box(b.min, b.max, tol),
+            NodeSetSpec::Point(p) => match mesh.nearest_node(*p) {
+                Some((n, d)) if d <= tol => vec![n],
+                Some((n, d)) => {
+                    let q = mesh.nodes[n];
+                    return Err(Error::invalid(
+                        source,
+                        loc,
+                        format!("no node at ({}, {}); the nearest is node {n} at ({}, {}), {d:.3e} away", p[0], p[1], q[0], q[1]),
+                        "give the exact coordinates of a node",
+                    ));
+                }
+                None => Vec::new(),
+            },
+            NodeSetSpec::Nodes(ids) => {
+                if let Some(&bad) = ids.iter().find(|&&n| n >= mesh.nodes.len()) {
+                    return Err(Error::invalid(source, loc, format!("node {bad} does not exist (the body has {} nodes)", mesh.nodes.len()), "use node indices below the number of nodes"));
+                }
+                ids.clone()
+            }
+        };
+        if nodes.is_empty() {
+            return Err(Error::invalid(source, loc, "the set selects no node", "check the box limits against the body's coordinates"));
+        }
+        mesh.node_sets.insert(name.clone(), nodes);
+    }
+    for (name, set) in &spec.facet_sets {
+        let loc = format!("{at}.facet_sets.{name}");
+        if mesh.facet_sets.contains_key(name) {
+            return Err(Error::invalid(source, loc, format!("'{name}' is a built-in set name"), "choose another name; the built-in facet sets are left, right, bottom and top"));
+        }
+        let facets = match set {
+            FacetSetSpec::Box(b) => mesh.facets_in_box(b.min, b.max, tol),
+            FacetSetSpec::Facets(list) => {
+                let mut out = Vec::new();
+                for &[cell, edge] in list {
+                    if cell >= mesh.cell_count() || edge >= mesh.kind.edges().len() {
+                        return Err(Error::invalid(source, loc, format!("facet [{cell}, {edge}] does not exist"), "use [cell, local edge] with valid indices"));
+                    }
+                    out.push(Facet { cell, edge });
+                }
+                out
+            }
+        };
+        if facets.is_empty() {
+            return Err(Error::invalid(source, loc, "the set selects no boundary facet", "a facet enters a box set only when all its nodes lie in the box"));
+        }
+        mesh.facet_sets.insert(name.clone(), facets);
+    }
+    Ok(())
+}
+
+/// What acts on a facet.
+enum EdgeTraction {
+    Pressure(f64),
+    Vector([f64; 2]),
+    Exact(ExactField),
+}
+
+/// Consistent nodal forces of a distributed load on one facet, added into `force`.
+fn add_facet_load(body: &Body, facet: Facet, traction: &EdgeTraction, thickness: f64, force: &mut [f64]) {
+    let nodes = body.mesh.facet_nodes(facet);
+    let kind = body.mesh.kind.edge_kind();
+    let nn = kind.node_count();
+    let mut n = [0.0; 3];
+    let mut dn = [0.0; 3];
+    for (s, w) in kind.load_rule() {
+        kind.shape(s, &mut n[..nn], &mut dn[..nn]);
+        let mut x = [0.0; 2];
+        let mut dx = [0.0; 2];
+        for a in 0..nn {
+            let p = body.mesh.nodes[nodes[a]];
+            for i in 0..2 {
+                x[i] += n[a] * p[i];
+                dx[i] += dn[a] * p[i];
+            }
+        }
+        // n ds = [dy, -dx] ds for a counter-clockwise edge.
+        let n_ds = [dx[1], -dx[0]];
+        let length = (n_ds[0] * n_ds[0] + n_ds[1] * n_ds[1]).sqrt();
+        let t_ds = match traction {
+            EdgeTraction::Pressure(p) => [-p * n_ds[0], -p * n_ds[1]],
+            EdgeTraction::Vector(t) => [t[0] * length, t[1] * length],
+            EdgeTraction::Exact(f) => {
+                let s = f.stress(x);
+                [s[0] * n_ds[0] + s[2] * n_ds[1], s[2] * n_ds[0] + s[1] * n_ds[1]]
+            }
+        };
+        for a in 0..nn {
+            for i in 0..2 {
+                force[body.dof(nodes[a], i)] += w * thickness * n[a] * t_ds[i];
+            }
+        }
+    }
+}
+
+/// Consistent nodal forces of a constant body force over the whole body.
+fn add_body_force(body: &Body, b: [f64; 2], thickness: f64, force: &mut [f64]) {
+    let kind: ElementKind = body.mesh.kind;
+    let rule = kind.error_rule();
+    for c in 0..body.mesh.cell_count() {
+        let coords = body.mesh.cell_coords(c);
+        let cell = body.mesh.cell(c);
+        for q in &rule {
+            let pv = point_values(kind, &coords, q.xi);
+            let w = q.weight * pv.det_j * thickness;
+            for (a, &node) in cell.iter().enumerate() {
+                for i in 0..2 {
+                    force[body.dof(node, i)] += w * pv.n[a] * b[i];
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,208 @@
+//! Run output: `summary.json` and one VTK XML unstructured grid (`<body>.vtu`) per body.
+//!
+//! The folder is written under a temporary name next to the target and renamed into place only
+//! when every file is complete, so a folder named like the target is always a whole run.
+//! The `.vtu` files are ASCII VTK XML (version 0.1) with point data `displacement` (3
+//! components, z = 0) and `stress` (`xx, yy, xy`, averaged at nodes), `stress_zz`, and cell
+//! data `stress` at cell centres; VTK cell types 9 (Q4), 28 (Q9), 5 (T3), 22 (T6), whose node
+//! orders match ours.
+
+use crate::checks::CheckResult;
+use crate::error::{Error, Result};
+use crate::model::Body;
+use crate::post::{cell_stresses, nodal_stresses};
+use crate::run::Outcome;
+use crate::solve::Timings;
+use serde::Serialize;
+use std::fs;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+#[derive(Serialize)]
+pub struct Summary {
+    pub case: String,
+    pub source: String,
+    pub description: String,
+    pub passed: bool,
+    pub dofs: usize,
+    pub equations: usize,
+    pub matrix_nonzeros: usize,
+    pub relative_residual: f64,
+    pub bodies: Vec<BodySummary>,
+    pub reactions: Vec<ReactionSummary>,
+    pub checks: Vec<CheckResult>,
+    pub timings: Timings,
+}
+
+#[derive(Serialize)]
+pub struct BodySummary {
+    pub name: String,
+    pub element: String,
+    pub material: String,
+    pub nodes: usize,
+    pub cells: usize,
+    /// `[min, max]` of u_x, u_y and of the nodal stresses xx, yy, xy.
+    pub u_x: [f64; 2],
+    pub u_y: [f64; 2],
+    pub stress_xx: [f64; 2],
+    pub stress_yy: [f64; 2],
+    pub stress_xy: [f64; 2],
+}
+
+/// Sum of the reactions over a supported node set.
+#[derive(Serialize)]
+pub struct ReactionSummary {
+    pub body: String,
+    pub set: String,
+    pub x: f64,
+    pub y: f64,
+}
+
+fn range(values: impl Iterator<Item = f64>) -> [f64; 2] {
+    values.fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], v| [lo.min(v), hi.max(v)])
+}
+
+pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
+    let Outcome { model, solution, checks } = outcome;
+    let u = &solution.u;
+    let bodies = model
+        .bodies
+        .iter()
+        .zip(nodal)
+        .map(|(b, s)| {
+            let n = b.mesh.nodes.len();
+            BodySummary {
+                name: b.name.clone(),
+                element: format!("{:?}", b.mesh.kind),
+                material: b.material_name.clone(),
+                nodes: n,
+                cells: b.mesh.cell_count(),
+                u_x: range((0..n).map(|k| u[b.dof(k, 0)])),
+                u_y: range((0..n).map(|k| u[b.dof(k, 1)])),
+                stress_xx: range(s.iter().map(|v| v[0])),
+                stress_yy: range(s.iter().map(|v| v[1])),
+                stress_xy: range(s.iter().map(|v| v[2])),
+            }
+        })
+        .collect();
+    let reactions = model
+        .support_sets
+        .iter()
+        .map(|(bi, set)| {
+            let b = &model.bodies[*bi];
+            let nodes = &b.mesh.node_sets[set];
+            let sum = |c: usize| nodes.iter().map(|&n| solution.reactions[b.dof(n, c)]).sum();
+            ReactionSummary { body: b.name.clone(), set: set.clone(), x: sum(0), y: sum(1) }
+        })
+        .collect();
+    Summary {
+        case: model.name.clone(),
+        source: model.source.clone(),
+        description: model.description.clone(),
+        passed: outcome.passed(),
+        dofs: model.dof_count,
+        equations: solution.equations,
+        matrix_nonzeros: solution.matrix_nonzeros,
+        relative_residual: solution.relative_residual,
+        bodies,
+        reactions,
+        checks: checks.clone(),
+        timings: solution.timings.clone(),
+    }
+}
+
+/// Write `summary.json` and the `.vtu` files into `dir` (replaced as a whole).
+pub fn write_run(dir: &Path, outcome: &Outcome) -> Result<()> {
+    let nodal: Vec<Vec<[f64; 3]>> = outcome.model.bodies.iter().map(|b| nodal_stresses(b, &outcome.solution.u)).collect();
+    let summary = summary(outcome, &nodal);
+    write_folder_atomically(dir, |tmp| {
+        let path = tmp.join("summary.json");
+        let text = serde_json::to_string_pretty(&summary).expect("the summary serializes");
+        fs::write(&path, text + "\n").map_err(|e| Error::io(path.display(), "writing", e))?;
+        for (b, s) in outcome.model.bodies.iter().zip(&nodal) {
+            let path = tmp.join(format!("{}.vtu", b.name));
+            write_vtu(&path, b, &outcome.solution.u, s)?;
+        }
+        Ok(())
+    })
+}
+
+/// Build a folder under a temporary name with `fill`, then move it to `dir`.
+pub fn write_folder_atomically(dir: &Path, fill: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
+    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    fs::create_dir_all(parent).map_err(|e| Error::io(parent.display(), "creating the output folder", e))?;
+    let tmp: PathBuf = parent.join(format!(".{name}.partial-{}", std::process::id()));
+    if tmp.exists() {
+        let _ = fs::remove_dir_all(&tmp);
+    }
+    fs::create_dir(&tmp).map_err(|e| Error::io(tmp.display(), "creating the output folder", e))?;
+    if let Err(e) = fill(&tmp) {
+        let _ = fs::remove_dir_all(&tmp);
+        return Err(e);
+    }
+    if dir.exists() {
+        fs::remove_dir_all(dir).map_err(|e| Error::io(dir.display(), "replacing the previous output", e))?;
+    }
+    fs::rename(&tmp, dir).map_err(|e| Error::io(dir.display(), "moving the output into place", e))
+}
+
+/// One VTK XML unstructured grid for one body.
+pub fn write_vtu(path: &Path, body: &Body, u: &[f64], nodal_stress: &[[f64; 3]]) -> Result<()> {
+    let io = |e| Error::io(path.display(), "writing", e);
+    let file = fs::File::create(path).map_err(io)?;
+    let mut w = BufWriter::new(file);
+    let mesh = &body.mesh;
+    let cells = cell_stresses(body, u);
+    let nn = mesh.kind.node_count();
+    let mut text = String::new();
+    use std::fmt::Write as _;
+    let _ = writeln!(text, "<?xml version=\"1.0\"?>");
+    let _ = writeln!(text, "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">");
+    let _ = writeln!(text, "<UnstructuredGrid>");
+    let _ = writeln!(text, "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">", mesh.nodes.len(), mesh.cell_count());
+    let _ = writeln!(text, "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">");
+    for p in &mesh.nodes {
+        let _ = writeln!(text, "{} {} 0", p[0], p[1]);
+    }
+    let _ = writeln!(text, "</DataArray></Points>");
+    let _ = writeln!(text, "<Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">");
+    for c in 0..mesh.cell_count() {
+        let ids: Vec<String> = mesh.cell(c).iter().map(|n| n.to_string()).collect();
+        let _ = writeln!(text, "{}", ids.join(" "));
+    }
+    let _ = writeln!(text, "</DataArray><DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">");
+    for c in 0..mesh.cell_count() {
+        let _ = writeln!(text, "{}", (c + 1) * nn);
+    }
+    let _ = writeln!(text, "</DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">");
+    for _ in 0..mesh.cell_count() {
+        let _ = writeln!(text, "{}", mesh.kind.vtk_cell_type());
+    }
+    let _ = writeln!(text, "</DataArray></Cells>");
+    let _ = writeln!(text, "<PointData Vectors=\"displacement\">");
+    let _ = writeln!(text, "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">");
+    for n in 0..mesh.nodes.len() {
+        let _ = writeln!(text, "{} {} 0", u[body.dof(n, 0)], u[body.dof(n, 1)]);
+    }
+    let _ = writeln!(text, "</DataArray>");
+    let _ = writeln!(text, "<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"3\" ComponentName0=\"xx\" ComponentName1=\"yy\" ComponentName2=\"xy\" format=\"ascii\">");
+    for s in nodal_stress {
+        let _ = writeln!(text, "{} {} {}", s[0], s[1], s[2]);
+    }
+    let _ = writeln!(text, "</DataArray>");
+    let _ = writeln!(text, "<DataArray type=\"Float64\" Name=\"stress_zz\" format=\"ascii\">");
+    for s in nodal_stress {
+        let _ = writeln!(text, "{}", body.material.sigma_zz(*s));
+    }
+    let _ = writeln!(text, "</DataArray></PointData>");
+    let _ = writeln!(text, "<CellData Tensors=\"\">");
+    let _ = writeln!(text, "<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"3\" ComponentName0=\"xx\" ComponentName1=\"yy\" ComponentName2=\"xy\" format=\"ascii\">");
+    for s in &cells {
+        let _ = writeln!(text, "{} {} {}", s[0], s[1], s[2]);
+    }
+    let _ = writeln!(text, "</DataArray></CellData>");
+    let _ = writeln!(text, "</Piece></UnstructuredGrid></VTKFile>");
+    w.write_all(text.as_bytes()).map_err(io)?;
+    w.flush().map_err(io)
+}

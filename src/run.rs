@@ -1,0 +1,41 @@
+//! One run of one case: load and validate, solve, judge the checks, time every stage.
+
+use crate::checks::{evaluate, CheckResult};
+use crate::error::Result;
+use crate::model::{load, Model};
+use crate::solve::{solve_static, Solution};
+use std::path::Path;
+use std::time::Instant;
+
+/// Everything a run produced.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    pub model: Model,
+    pub solution: Solution,
+    pub checks: Vec<CheckResult>,
+}
+
+impl Outcome {
+    pub fn passed(&self) -> bool {
+        self.checks.iter().all(|c| c.passed)
+    }
+}
+
+/// Run the case file at `path`; `progress` hears the name of each stage.
+pub fn run_case(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Outcome> {
+    let start = Instant::now();
+    progress("meshing");
+    let model = load(path)?;
+    let mesh_time = start.elapsed().as_secs_f64();
+    run_model(model, mesh_time, start, progress)
+}
+
+/// Solve an already built model (`mesh_time` and `start` feed the timing breakdown).
+pub fn run_model(model: Model, mesh_time: f64, start: Instant, progress: &mut dyn FnMut(&str)) -> Result<Outcome> {
+    let mut solution = solve_static(&model, progress)?;
+    progress("checking");
+    let checks = evaluate(&model, &solution);
+    solution.timings.mesh = mesh_time;
+    solution.timings.total = start.elapsed().as_secs_f64();
+    Ok(Outcome { model, solution, checks })
+}

@@ -1,0 +1,306 @@
+//! The case file: a JSON description of one scene, read with serde into typed objects.
+//!
+//! A case names its materials, bodies (each with a mesh and named sets), supports, loads, an
+//! optional exact solution, the physics it asks for, and the checks that judge the result.
+//! Unknown fields are rejected everywhere. Physics is opt-in: a scene that does not ask for a
+//! feature never pays for it. Everything here is plain data; `model::Model::build` validates it
+//! once and resolves names into indices.
+//!
+//! Units are the user's; the only convention is compression-positive contact pressure and
+//! pressure loads that push against the outward normal.
+
+use crate::fe::ElementKind;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// Short identifier; the default output folder is `out/<name>`.
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    #[serde(default)]
+    pub analysis: Analysis,
+    pub materials: BTreeMap<String, MaterialSpec>,
+    pub bodies: Vec<BodySpec>,
+    #[serde(default)]
+    pub supports: Vec<Support>,
+    #[serde(default)]
+    pub loads: Vec<Load>,
+    /// An analytic reference solution, used by `exact` supports/tractions and by checks.
+    #[serde(default)]
+    pub exact: Option<ExactSpec>,
+    #[serde(default)]
+    pub physics: Physics,
+    #[serde(default)]
+    pub checks: Vec<Check>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Analysis {
+    #[serde(default)]
+    pub plane: Plane,
+    #[serde(default = "one")]
+    pub thickness: f64,
+}
+
+impl Default for Analysis {
+    fn default() -> Self {
+        Analysis {
+            plane: Plane::Strain,
+            thickness: 1.0,
+        }
+    }
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Plane {
+    #[default]
+    Strain,
+    Stress,
+}
+
+/// Isotropic linear elasticity.
+#[derive(Copy, Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    #[serde(rename = "E")]
+    pub youngs_modulus: f64,
+    pub nu: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    pub name: String,
+    pub material: String,
+    pub mesh: MeshSpec,
+    #[serde(default)]
+    pub node_sets: BTreeMap<String, NodeSetSpec>,
+    #[serde(default)]
+    pub facet_sets: BTreeMap<String, FacetSetSpec>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MeshSpec {
+    /// Structured block from element breaks along x and y.
+    Block(BlockSpec),
+    /// Nodes and cells given one by one (element node order as in `fe`).
+    Explicit(ExplicitMeshSpec),
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlockSpec {
+    pub element: ElementKind,
+    pub x: Breaks,
+    pub y: Breaks,
+    /// Vertices moved after generation, to distort the grid.
+    #[serde(default)]
+    pub moves: Vec<Move>,
+}
+
+/// Element boundaries along one axis: an explicit list, or uniform divisions.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Breaks {
+    List(Vec<f64>),
+    Uniform(UniformBreaks),
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UniformBreaks {
+    pub from: f64,
+    pub to: f64,
+    pub divisions: usize,
+}
+
+impl Breaks {
+    pub fn values(&self) -> Vec<f64> {
+        match self {
+            Breaks::List(v) => v.clone(),
+            Breaks::Uniform(u) => (0..=u.divisions)
+                .map(|i| u.from + (u.to - u.from) * i as f64 / u.divisions.max(1) as f64)
+                .collect(),
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Move {
+    pub from: [f64; 2],
+    pub to: [f64; 2],
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExplicitMeshSpec {
+    pub element: ElementKind,
+    pub nodes: Vec<[f64; 2]>,
+    pub cells: Vec<Vec<usize>>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NodeSetSpec {
+    /// Nodes in a closed axis-aligned box.
+    Box(BoxSpec),
+    /// The node at a point (within a small tolerance).
+    Point([f64; 2]),
+    /// Node ids.
+    Nodes(Vec<usize>),
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FacetSetSpec {
+    /// Boundary facets whose nodes all lie in a closed axis-aligned box.
+    Box(BoxSpec),
+    /// `[cell, local edge]` pairs.
+    Facets(Vec<[usize; 2]>),
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    pub min: [f64; 2],
+    pub max: [f64; 2],
+}
+
+/// The keyword `"exact"`: take the value from the case's exact solution.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FromExact {
+    Exact,
+}
+
+/// A prescribed displacement component: a number, or `"exact"`.
+#[derive(Copy, Clone, Debug, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Prescribed {
+    Value(f64),
+    Exact(FromExact),
+}
+
+/// Prescribed displacement components on a node set (`x`, `y` or both).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Support {
+    pub body: String,
+    pub set: String,
+    #[serde(default)]
+    pub x: Option<Prescribed>,
+    #[serde(default)]
+    pub y: Option<Prescribed>,
+}
+
+/// A traction vector, or `"exact"` (sigma_exact . n).
+#[derive(Copy, Clone, Debug, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum TractionSpec {
+    Vector([f64; 2]),
+    Exact(FromExact),
+}
+
+/// One load: `pressure` or `traction` on a facet set, or a `body_force` on a whole body.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Load {
+    pub body: String,
+    #[serde(default)]
+    pub set: Option<String>,
+    /// Pressure (force per area) pushing against the outward normal.
+    #[serde(default)]
+    pub pressure: Option<f64>,
+    /// Traction (force per area) in global components.
+    #[serde(default)]
+    pub traction: Option<TractionSpec>,
+    /// Force per volume.
+    #[serde(default)]
+    pub body_force: Option<[f64; 2]>,
+}
+
+/// Analytic reference solutions.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ExactSpec {
+    /// Constant stress `[xx, yy, xy]`, displacement `u = eps x` (no rigid motion).
+    UniformStress { stress: [f64; 3] },
+    /// Timoshenko & Goodier's cantilever: x in [0, length], y in [-depth/2, depth/2], clamped
+    /// at x = 0 in the exact sense, parabolic shear `load` (total, per thickness) at x = length.
+    TimoshenkoCantilever { load: f64, length: f64, depth: f64 },
+}
+
+/// What the scene simulates beyond static, small-strain, frictionless elasticity. Every
+/// extra effect is opt-in.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Physics {
+    #[serde(default)]
+    pub kinematics: Kinematics,
+}
+
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Kinematics {
+    #[default]
+    SmallStrain,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Component {
+    X,
+    Y,
+}
+
+impl Component {
+    pub fn index(self) -> usize {
+        match self {
+            Component::X => 0,
+            Component::Y => 1,
+        }
+    }
+}
+
+/// A check judged after the solve; tolerances belong to the case.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(tag = "check", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Check {
+    /// Max over quadrature points (all bodies, or `body`) of |sigma - stress| / max|stress|
+    /// over the components xx, yy, xy.
+    UniformStress {
+        #[serde(default)]
+        body: Option<String>,
+        stress: [f64; 3],
+        tol: f64,
+    },
+    /// Relative L2 error of the displacement against the case's exact solution.
+    ExactDisplacement { tol: f64 },
+    /// Sum of the reactions on a supported node set, one component.
+    Reaction {
+        body: String,
+        set: String,
+        component: Component,
+        value: f64,
+        tol: f64,
+    },
+    /// Displacement component at the node nearest to `point`.
+    Displacement {
+        body: String,
+        point: [f64; 2],
+        component: Component,
+        value: f64,
+        tol: f64,
+    },
+}

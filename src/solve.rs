@@ -1,0 +1,227 @@
+//! The static solve of small-strain elasticity: `K u = f` with prescribed dofs eliminated.
+//!
+//! Equations are numbered over the free dofs only. With `u = [u_f; u_p]` and `u_p` prescribed,
+//! `K_ff u_f = f_f - K_fp u_p` is assembled element by element (the `K_fp u_p` term from each
+//! element's own block), factored by sparse Cholesky and solved. Reactions are the residual of
+//! the full system, `r = K u - f`, evaluated element by element; at free dofs it is the
+//! equilibrium error (reported as `residual`), at prescribed dofs it is the support reaction.
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::solid::{element_stiffness, MAX_DOFS};
+use crate::sparse::{Cholesky, FactorError, PatternBuilder, SymmetricPattern};
+use std::time::Instant;
+
+/// Marks a dof that has no equation (it is prescribed).
+pub const NO_EQUATION: usize = usize::MAX;
+
+/// Wall-clock seconds of each stage of a run.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Timings {
+    /// Reading, validating and meshing the case.
+    pub mesh: f64,
+    /// Sparsity pattern, element kernels and scatter.
+    pub assembly: f64,
+    /// Symbolic analysis and numeric Cholesky factorization.
+    pub factorization: f64,
+    /// Triangular solves and reactions.
+    pub solve: f64,
+    pub total: f64,
+}
+
+/// The displacement solution and what the solve measured.
+#[derive(Clone, Debug)]
+pub struct Solution {
+    /// Global displacement vector (prescribed values included).
+    pub u: Vec<f64>,
+    /// `K u - f` at every dof: reactions at prescribed dofs, equilibrium error elsewhere.
+    pub reactions: Vec<f64>,
+    pub equations: usize,
+    pub matrix_nonzeros: usize,
+    /// Largest |K u - f| at a free dof relative to the largest external or reaction force.
+    pub relative_residual: f64,
+    pub timings: Timings,
+}
+
+/// Equation number of each global dof (`NO_EQUATION` for prescribed dofs).
+pub fn number_equations(model: &Model) -> (Vec<usize>, usize) {
+    let mut count = 0;
+    let eq = model
+        .prescribed
+        .iter()
+        .map(|p| {
+            if p.is_some() {
+                NO_EQUATION
+            } else {
+                count += 1;
+                count - 1
+            }
+        })
+        .collect();
+    (eq, count)
+}
+
+/// Sparsity pattern of `K_ff` from the cells of every body.
+pub fn stiffness_pattern(model: &Model, eq: &[usize], n: usize) -> SymmetricPattern {
+    let mut builder = PatternBuilder::new(n);
+    let mut dofs = Vec::with_capacity(MAX_DOFS);
+    let mut eqs = Vec::with_capacity(MAX_DOFS);
+    for body in &model.bodies {
+        for c in 0..body.mesh.cell_count() {
+            body.cell_dofs(c, &mut dofs);
+            eqs.clear();
+            eqs.extend(dofs.iter().map(|&d| eq[d]));
+            builder.add_block(&eqs);
+        }
+    }
+    builder.build()
+}
+
+/// Calls `visit(dofs, ke)` for every cell of every body.
+pub fn for_each_element_stiffness(model: &Model, mut visit: impl FnMut(&[usize], &[f64])) {
+    let mut dofs = Vec::with_capacity(MAX_DOFS);
+    let mut ke = [0.0; MAX_DOFS * MAX_DOFS];
+    for body in &model.bodies {
+        let kind = body.mesh.kind;
+        let rule = kind.stiffness_rule();
+        let nd = 2 * kind.node_count();
+        for c in 0..body.mesh.cell_count() {
+            let coords = body.mesh.cell_coords(c);
+            element_stiffness(kind, &coords, &body.material, model.thickness, &rule, &mut ke);
+            body.cell_dofs(c, &mut dofs);
+            visit(&dofs, &ke[..nd * nd]);
+        }
+    }
+}
+
+/// Solve the linear static problem. `progress` is told the name of each stage as it starts.
+pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+    let mut timings = Timings::default();
+    let t = Instant::now();
+    progress("assembling");
+    let (eq, n) = number_equations(model);
+    let mut u: Vec<f64> = model.prescribed.iter().map(|p| p.unwrap_or(0.0)).collect();
+    let pattern = stiffness_pattern(model, &eq, n);
+    let mut values = vec![0.0; pattern.nnz()];
+    let mut rhs = vec![0.0; n];
+    for (d, &e) in eq.iter().enumerate() {
+        if e != NO_EQUATION {
+            rhs[e] = model.external_force[d];
+        }
+    }
+    let mut eqs = Vec::with_capacity(MAX_DOFS);
+    for_each_element_stiffness(model, |dofs, ke| {
+        eqs.clear();
+        eqs.extend(dofs.iter().map(|&d| eq[d]));
+        pattern.scatter(&eqs, ke, &mut values);
+        // move K_fp u_p to the right-hand side
+        let m = dofs.len();
+        for (b, &db) in dofs.iter().enumerate() {
+            if eqs[b] != NO_EQUATION || u[db] == 0.0 {
+                continue;
+            }
+            for a in 0..m {
+                if eqs[a] != NO_EQUATION {
+                    rhs[eqs[a]] -= ke[a * m + b] * u[db];
+                }
+            }
+        }
+    });
+    timings.assembly = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    progress("factorizing");
+    let singular = |equation: Option<usize>| {
+        let where_ = equation
+            .and_then(|e| eq.iter().position(|&x| x == e))
+            .map(|d| describe_dof(model, d))
+            .unwrap_or_else(|| "an unknown equation".into());
+        Error::Solver {
+            path: model.source.clone(),
+            problem: format!("the stiffness matrix is singular or not positive definite (first bad pivot at {where_})"),
+            hint: "a part of a body may be disconnected from the supports (a mechanism); add supports or connect it".into(),
+        }
+    };
+    let solution = if n > 0 {
+        let chol = Cholesky::analyse(&pattern).map_err(|e| Error::Solver {
+            path: model.source.clone(),
+            problem: format!("the symbolic factorization failed: {e:?}"),
+            hint: "the problem may be too large for the memory of this machine".into(),
+        })?;
+        let factor = chol.factor(&pattern, &values).map_err(|e| match e {
+            FactorError::NotPositiveDefinite { equation } => singular(Some(equation)),
+            FactorError::Other(msg) => Error::Solver {
+                path: model.source.clone(),
+                problem: format!("the factorization failed: {msg}"),
+                hint: "the problem may be too large for the memory of this machine".into(),
+            },
+        })?;
+        timings.factorization = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        progress("solving");
+        factor.solve_in_place(&mut rhs);
+        timings.solve = t.elapsed().as_secs_f64();
+        rhs
+    } else {
+        Vec::new()
+    };
+    if solution.iter().any(|v| !v.is_finite()) {
+        return Err(singular(None));
+    }
+    for (d, &e) in eq.iter().enumerate() {
+        if e != NO_EQUATION {
+            u[d] = solution[e];
+        }
+    }
+
+    let t = Instant::now();
+    let reactions = residual(model, &u);
+    let scale = model
+        .external_force
+        .iter()
+        .chain(reactions.iter().enumerate().filter(|(d, _)| eq[*d] == NO_EQUATION).map(|(_, r)| r))
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let worst = reactions
+        .iter()
+        .enumerate()
+        .filter(|(d, _)| eq[*d] != NO_EQUATION)
+        .fold(0.0f64, |m, (_, r)| m.max(r.abs()));
+    timings.solve += t.elapsed().as_secs_f64();
+    Ok(Solution {
+        u,
+        reactions,
+        equations: n,
+        matrix_nonzeros: pattern.nnz(),
+        relative_residual: if scale > 0.0 { worst / scale } else { worst },
+        timings,
+    })
+}
+
+/// `K u - f`, element by element.
+pub fn residual(model: &Model, u: &[f64]) -> Vec<f64> {
+    let mut r: Vec<f64> = model.external_force.iter().map(|f| -f).collect();
+    for_each_element_stiffness(model, |dofs, ke| {
+        let m = dofs.len();
+        for a in 0..m {
+            let mut s = 0.0;
+            for b in 0..m {
+                s += ke[a * m + b] * u[dofs[b]];
+            }
+            r[dofs[a]] += s;
+        }
+    });
+    r
+}
+
+/// "body 'x', node n at (x, y), u_x" for a global dof.
+pub fn describe_dof(model: &Model, dof: usize) -> String {
+    for body in &model.bodies {
+        if dof >= body.dof_offset && dof < body.dof_offset + body.dof_count() {
+            let local = dof - body.dof_offset;
+            let node = local / 2;
+            let p = body.mesh.nodes[node];
+            return format!("body '{}', node {node} at ({}, {}), u_{}", body.name, p[0], p[1], ["x", "y"][local % 2]);
+        }
+    }
+    format!("dof {dof}")
+}

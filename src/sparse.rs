@@ -1,0 +1,229 @@
+//! Sparse symmetric matrices: a pattern computed once, scatter-assembly, sparse Cholesky.
+//!
+//! The global matrix is stored as its upper triangle (row <= column) in compressed sparse
+//! columns, the layout faer's sparse Cholesky reads with `Side::Upper`. The pattern is the union
+//! of the dense blocks that every element (and, later, every contact pair or mortar segment)
+//! couples; it is fixed before any value is assembled, so the symbolic factorization (fill-
+//! reducing ordering and elimination tree) is computed once and reused for every numeric
+//! factorization with the same pattern (Newton iterations, penalty sweeps).
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Mat, Side};
+
+/// Upper-triangular CSC pattern of a symmetric `n x n` matrix.
+#[derive(Clone, Debug)]
+pub struct SymmetricPattern {
+    pub n: usize,
+    pub col_ptr: Vec<usize>,
+    pub row_idx: Vec<usize>,
+}
+
+/// Collects the dense blocks that couple equations, then freezes them into a pattern.
+#[derive(Debug)]
+pub struct PatternBuilder {
+    n: usize,
+    columns: Vec<Vec<usize>>,
+}
+
+impl PatternBuilder {
+    pub fn new(n: usize) -> Self {
+        PatternBuilder { n, columns: vec![Vec::new(); n] }
+    }
+
+    /// Couple every pair of the equations in `eqs` (entries `>= n` are ignored, so callers can
+    /// pass a sentinel for eliminated dofs).
+    pub fn add_block(&mut self, eqs: &[usize]) {
+        for &j in eqs {
+            if j >= self.n {
+                continue;
+            }
+            for &i in eqs {
+                if i <= j {
+                    self.columns[j].push(i);
+                }
+            }
+        }
+    }
+
+    pub fn build(self) -> SymmetricPattern {
+        let mut col_ptr = Vec::with_capacity(self.n + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0);
+        for (j, mut col) in self.columns.into_iter().enumerate() {
+            col.push(j); // the diagonal is always stored
+            col.sort_unstable();
+            col.dedup();
+            row_idx.extend_from_slice(&col);
+            col_ptr.push(row_idx.len());
+        }
+        SymmetricPattern { n: self.n, col_ptr, row_idx }
+    }
+}
+
+impl SymmetricPattern {
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// Position of entry `(i, j)` (either order) in the value array.
+    pub fn position(&self, i: usize, j: usize) -> Option<usize> {
+        let (r, c) = if i <= j { (i, j) } else { (j, i) };
+        let range = self.col_ptr[c]..self.col_ptr[c + 1];
+        self.row_idx[range.clone()].binary_search(&r).ok().map(|k| range.start + k)
+    }
+
+    /// Add the dense symmetric block `ke` (row-major, `eqs.len()` square) into `values`;
+    /// entries whose equation is `>= n` (eliminated) are skipped. Panics if the block was not
+    /// part of the pattern, which is a programming error.
+    pub fn scatter(&self, eqs: &[usize], ke: &[f64], values: &mut [f64]) {
+        let m = eqs.len();
+        for (b, &j) in eqs.iter().enumerate() {
+            if j >= self.n {
+                continue;
+            }
+            let range = self.col_ptr[j]..self.col_ptr[j + 1];
+            let rows = &self.row_idx[range.clone()];
+            for (a, &i) in eqs.iter().enumerate() {
+                if i > j {
+                    continue;
+                }
+                let k = rows.binary_search(&i).expect("entry outside the assembled pattern");
+                values[range.start + k] += ke[a * m + b];
+            }
+        }
+    }
+
+    pub fn symbolic(&self) -> SymbolicSparseColMatRef<'_, usize> {
+        SymbolicSparseColMatRef::new_checked(self.n, self.n, &self.col_ptr, None, &self.row_idx)
+    }
+
+    /// `y = A x` for the symmetric matrix whose upper triangle is `values`.
+    pub fn mul(&self, values: &[f64], x: &[f64], y: &mut [f64]) {
+        y.iter_mut().for_each(|v| *v = 0.0);
+        for j in 0..self.n {
+            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
+                let i = self.row_idx[k];
+                y[i] += values[k] * x[j];
+                if i != j {
+                    y[j] += values[k] * x[i];
+                }
+            }
+        }
+    }
+}
+
+/// Why a factorization failed.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FactorError {
+    /// The matrix is not positive definite: pivot `equation` was not positive.
+    NotPositiveDefinite { equation: usize },
+    /// Out of memory or another non-numerical failure.
+    Other(String),
+}
+
+/// Sparse Cholesky `A = L L^T` with the symbolic analysis done once per pattern.
+pub struct Cholesky {
+    symbolic: SymbolicLlt<usize>,
+}
+
+impl Cholesky {
+    /// Analyse the pattern (ordering, elimination tree, supernodes).
+    pub fn analyse(pattern: &SymmetricPattern) -> Result<Self, FactorError> {
+        let symbolic = SymbolicLlt::try_new(pattern.symbolic(), Side::Upper)
+            .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+        Ok(Cholesky { symbolic })
+    }
+
+    /// Numeric factorization of the matrix with this pattern and `values`.
+    pub fn factor(&self, pattern: &SymmetricPattern, values: &[f64]) -> Result<Factor, FactorError> {
+        let mat = SparseColMatRef::new(pattern.symbolic(), values);
+        Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Upper)
+            .map(|llt| Factor { llt })
+            .map_err(|e| match e {
+                faer::sparse::linalg::LltError::Numeric(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot {
+                    index,
+                }) => FactorError::NotPositiveDefinite { equation: index },
+                other => FactorError::Other(format!("{other:?}")),
+            })
+    }
+}
+
+/// A numeric factorization, ready to solve.
+pub struct Factor {
+    llt: Llt<usize, f64>,
+}
+
+impl Factor {
+    /// Solve `A x = b` in place.
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        let mut rhs = Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
+        self.llt.solve_in_place(rhs.as_mut());
+        for (i, v) in b.iter_mut().enumerate() {
+            *v = rhs[(i, 0)];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn assembled_laplacian_solves() {
+        // 1D chain of springs: blocks [i, i+1] with [[1, -1], [-1, 1]], plus 1 on the diagonal.
+        let n = 50;
+        let mut pb = PatternBuilder::new(n);
+        for i in 0..n - 1 {
+            pb.add_block(&[i, i + 1]);
+        }
+        let pattern = pb.build();
+        assert_eq!(pattern.nnz(), 2 * n - 1);
+        let mut values = vec![0.0; pattern.nnz()];
+        for i in 0..n - 1 {
+            pattern.scatter(&[i, i + 1], &[1.0, -1.0, -1.0, 1.0], &mut values);
+        }
+        for i in 0..n {
+            values[pattern.position(i, i).unwrap()] += 1.0;
+        }
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let mut b = vec![0.0; n];
+        pattern.mul(&values, &x, &mut b);
+        let chol = Cholesky::analyse(&pattern).unwrap();
+        let f = chol.factor(&pattern, &values).unwrap();
+        f.solve_in_place(&mut b);
+        for i in 0..n {
+            assert!((b[i] - x[i]).abs() < 1e-12, "{i}: {} vs {}", b[i], x[i]);
+        }
+        // the same symbolic analysis serves a second matrix with the same pattern
+        let doubled: Vec<f64> = values.iter().map(|v| 2.0 * v).collect();
+        let mut b2 = vec![0.0; n];
+        pattern.mul(&doubled, &x, &mut b2);
+        chol.factor(&pattern, &doubled).unwrap().solve_in_place(&mut b2);
+        assert!(b2.iter().zip(&x).all(|(a, b)| (a - b).abs() < 1e-12));
+    }
+
+    #[test]
+    fn singular_matrix_is_reported() {
+        let mut pb = PatternBuilder::new(2);
+        pb.add_block(&[0, 1]);
+        let pattern = pb.build();
+        let mut values = vec![0.0; pattern.nnz()];
+        pattern.scatter(&[0, 1], &[1.0, -1.0, -1.0, 1.0], &mut values);
+        let chol = Cholesky::analyse(&pattern).unwrap();
+        assert!(matches!(chol.factor(&pattern, &values), Err(FactorError::NotPositiveDefinite { .. })));
+    }
+
+    #[test]
+    fn eliminated_equations_are_skipped() {
+        let mut pb = PatternBuilder::new(2);
+        pb.add_block(&[0, usize::MAX, 1]);
+        let pattern = pb.build();
+        let mut values = vec![0.0; pattern.nnz()];
+        let ke = [2.0, 9.0, -1.0, 9.0, 9.0, 9.0, -1.0, 9.0, 2.0];
+        pattern.scatter(&[0, usize::MAX, 1], &ke, &mut values);
+        assert_eq!(values[pattern.position(0, 1).unwrap()], -1.0);
+        assert_eq!(values[pattern.position(1, 1).unwrap()], 2.0);
+    }
+}
