@@ -24,9 +24,15 @@ impl From<&ExactSpec> for ExactField {
     fn from(spec: &ExactSpec) -> Self {
         match *spec {
             ExactSpec::UniformStress { stress } => ExactField::UniformStress { stress },
-            ExactSpec::TimoshenkoCantilever { load, length, depth } => {
-                ExactField::TimoshenkoCantilever { load, length, depth }
-            }
+            ExactSpec::TimoshenkoCantilever {
+                load,
+                length,
+                depth,
+            } => ExactField::TimoshenkoCantilever {
+                load,
+                length,
+                depth,
+            },
         }
     }
 }
@@ -39,14 +45,20 @@ impl ExactField {
                 let e = mat.strain_of_stress(stress);
                 [e[0] * x + 0.5 * e[2] * y, 0.5 * e[2] * x + e[1] * y]
             }
-            ExactField::TimoshenkoCantilever { load, length, depth } => {
+            ExactField::TimoshenkoCantilever {
+                load,
+                length,
+                depth,
+            } => {
                 let (e, nu) = mat.plane_stress_equivalent();
                 let i = depth.powi(3) / 12.0;
                 let c = load / (6.0 * e * i);
                 let d2 = depth * depth / 4.0;
                 [
                     -c * y * ((6.0 * length - 3.0 * x) * x + (2.0 + nu) * (y * y - d2)),
-                    c * (3.0 * nu * y * y * (length - x) + (4.0 + 5.0 * nu) * d2 * x + (3.0 * length - x) * x * x),
+                    c * (3.0 * nu * y * y * (length - x)
+                        + (4.0 + 5.0 * nu) * d2 * x
+                        + (3.0 * length - x) * x * x),
                 ]
             }
         }
@@ -56,7 +68,11 @@ impl ExactField {
         let [x, y] = p;
         match *self {
             ExactField::UniformStress { stress } => stress,
-            ExactField::TimoshenkoCantilever { load, length, depth } => {
+            ExactField::TimoshenkoCantilever {
+                load,
+                length,
+                depth,
+            } => {
                 let i = depth.powi(3) / 12.0;
                 [
                     -load * (length - x) * y / i,
@@ -77,8 +93,14 @@ mod tests {
     #[test]
     fn displacement_and_stress_agree() {
         let fields = [
-            ExactField::UniformStress { stress: [1.0, -2.0, 0.5] },
-            ExactField::TimoshenkoCantilever { load: 3.0, length: 8.0, depth: 2.0 },
+            ExactField::UniformStress {
+                stress: [1.0, -2.0, 0.5],
+            },
+            ExactField::TimoshenkoCantilever {
+                load: 3.0,
+                length: 8.0,
+                depth: 2.0,
+            },
         ];
         for plane in [Plane::Strain, Plane::Stress] {
             let mat = Elasticity::new(1000.0, 0.3, plane);
@@ -96,7 +118,12 @@ mod tests {
                     let s = mat.stress(strain);
                     let se = f.stress(p);
                     for i in 0..3 {
-                        assert!((s[i] - se[i]).abs() < 1e-6 * (1.0 + se[i].abs()), "{f:?} {plane:?} {i}: {} vs {}", s[i], se[i]);
+                        assert!(
+                            (s[i] - se[i]).abs() < 1e-6 * (1.0 + se[i].abs()),
+                            "{f:?} {plane:?} {i}: {} vs {}",
+                            s[i],
+                            se[i]
+                        );
                     }
                 }
             }

@@ -178,9 +178,20 @@ impl ElementKind {
                 let d1 = [-1.0, -1.0];
                 let d2 = [1.0, 0.0];
                 let d3 = [0.0, 1.0];
-                let corner = |l: f64, d: [f64; 2]| (l * (2.0 * l - 1.0), [(4.0 * l - 1.0) * d[0], (4.0 * l - 1.0) * d[1]]);
+                let corner = |l: f64, d: [f64; 2]| {
+                    (
+                        l * (2.0 * l - 1.0),
+                        [(4.0 * l - 1.0) * d[0], (4.0 * l - 1.0) * d[1]],
+                    )
+                };
                 let mid = |la: f64, da: [f64; 2], lb: f64, db: [f64; 2]| {
-                    (4.0 * la * lb, [4.0 * (da[0] * lb + la * db[0]), 4.0 * (da[1] * lb + la * db[1])])
+                    (
+                        4.0 * la * lb,
+                        [
+                            4.0 * (da[0] * lb + la * db[0]),
+                            4.0 * (da[1] * lb + la * db[1]),
+                        ],
+                    )
                 };
                 let vals = [
                     corner(l1, d1),
@@ -310,7 +321,10 @@ pub fn gauss_square(n: usize) -> Vec<QuadPoint> {
     let mut out = Vec::with_capacity(n * n);
     for &(y, wy) in &g {
         for &(x, wx) in &g {
-            out.push(QuadPoint { xi: [x, y], weight: wx * wy });
+            out.push(QuadPoint {
+                xi: [x, y],
+                weight: wx * wy,
+            });
         }
     }
     out
@@ -319,7 +333,10 @@ pub fn gauss_square(n: usize) -> Vec<QuadPoint> {
 /// Symmetric rules on the reference triangle (area 1/2) exact for polynomials of `degree`:
 /// 1 (centroid), 2 (three interior points), 5 (Radon's seven points).
 pub fn triangle_rule(degree: usize) -> Vec<QuadPoint> {
-    let p = |a: f64, b: f64, w: f64| QuadPoint { xi: [a, b], weight: w };
+    let p = |a: f64, b: f64, w: f64| QuadPoint {
+        xi: [a, b],
+        weight: w,
+    };
     match degree {
         0 | 1 => vec![p(1.0 / 3.0, 1.0 / 3.0, 0.5)],
         2 => {
@@ -403,8 +420,15 @@ mod tests {
             let g = gauss_legendre(n);
             for deg in 0..(2 * n) {
                 let num: f64 = g.iter().map(|(x, w)| w * x.powi(deg as i32)).sum();
-                let exact = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
-                assert!((num - exact).abs() < 1e-14, "n={n} deg={deg}: {num} vs {exact}");
+                let exact = if deg % 2 == 1 {
+                    0.0
+                } else {
+                    2.0 / (deg as f64 + 1.0)
+                };
+                assert!(
+                    (num - exact).abs() < 1e-14,
+                    "n={n} deg={deg}: {num} vs {exact}"
+                );
             }
         }
     }
@@ -413,12 +437,22 @@ mod tests {
     fn triangle_rules_integrate_their_degree() {
         // int over the reference triangle of xi^a eta^b = a! b! / (a+b+2)!
         let fact = |k: u32| (1..=k).map(f64::from).product::<f64>();
-        for (degree, rule) in [(1, triangle_rule(1)), (2, triangle_rule(2)), (5, triangle_rule(5))] {
+        for (degree, rule) in [
+            (1, triangle_rule(1)),
+            (2, triangle_rule(2)),
+            (5, triangle_rule(5)),
+        ] {
             for a in 0..=degree {
                 for b in 0..=(degree - a) {
-                    let num: f64 = rule.iter().map(|q| q.weight * q.xi[0].powi(a as i32) * q.xi[1].powi(b as i32)).sum();
+                    let num: f64 = rule
+                        .iter()
+                        .map(|q| q.weight * q.xi[0].powi(a as i32) * q.xi[1].powi(b as i32))
+                        .sum();
                     let exact = fact(a) * fact(b) / fact(a + b + 2);
-                    assert!((num - exact).abs() < 1e-15, "degree {degree}: x^{a} y^{b}: {num} vs {exact}");
+                    assert!(
+                        (num - exact).abs() < 1e-15,
+                        "degree {degree}: x^{a} y^{b}: {num} vs {exact}"
+                    );
                 }
             }
         }
@@ -426,7 +460,12 @@ mod tests {
 
     #[test]
     fn shape_functions_are_kronecker_and_partition_of_unity() {
-        for kind in [ElementKind::Q4, ElementKind::Q9, ElementKind::T3, ElementKind::T6] {
+        for kind in [
+            ElementKind::Q4,
+            ElementKind::Q9,
+            ElementKind::T3,
+            ElementKind::T6,
+        ] {
             let nn = kind.node_count();
             let mut n = [0.0; MAX_NODES];
             let mut dn = [[0.0; 2]; MAX_NODES];
@@ -434,7 +473,11 @@ mod tests {
                 kind.shape(*xb, &mut n[..nn], &mut dn[..nn]);
                 for a in 0..nn {
                     let expect = if a == b { 1.0 } else { 0.0 };
-                    assert!((n[a] - expect).abs() < 1e-15, "{kind:?}: N_{a}(node {b}) = {}", n[a]);
+                    assert!(
+                        (n[a] - expect).abs() < 1e-15,
+                        "{kind:?}: N_{a}(node {b}) = {}",
+                        n[a]
+                    );
                 }
             }
             // derivatives sum to zero and match finite differences at an arbitrary point
@@ -465,7 +508,12 @@ mod tests {
     fn edge_shapes_match_element_shapes_on_the_boundary() {
         // Along edge 0 of each element (from corner 0 to corner 1), the element shape functions of
         // the edge nodes equal the edge shape functions.
-        for kind in [ElementKind::Q4, ElementKind::Q9, ElementKind::T3, ElementKind::T6] {
+        for kind in [
+            ElementKind::Q4,
+            ElementKind::Q9,
+            ElementKind::T3,
+            ElementKind::T6,
+        ] {
             let nn = kind.node_count();
             let edge = kind.edges()[0];
             let x0 = kind.node_coordinates()[edge[0]];

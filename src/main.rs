@@ -24,7 +24,9 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Solve one case and write summary.json and one .vtu file per body.
-    #[command(after_help = "Example:\n  contact-patch run cases/patch-single/q9-distorted.json --out out/q9\n\nThe output folder is replaced only when the run succeeds (default: out/<case name>).")]
+    #[command(
+        after_help = "Example:\n  contact-patch run cases/patch-single/q9-distorted.json --out out/q9\n\nThe output folder is replaced only when the run succeeds (default: out/<case name>)."
+    )]
     Run {
         /// The case file (JSON).
         case: PathBuf,
@@ -33,7 +35,9 @@ enum Command {
         out: Option<PathBuf>,
     },
     /// Run the checks declared in cases; exit 0 only when every check of every case passes.
-    #[command(after_help = "Example:\n  contact-patch check cases/patch-single cases/convergence/cantilever-q4.json\n\nFolders are searched recursively for *.json case files.")]
+    #[command(
+        after_help = "Example:\n  contact-patch check cases/patch-single cases/convergence/cantilever-q4.json\n\nFolders are searched recursively for *.json case files."
+    )]
     Check {
         /// Case files or folders of case files.
         #[arg(required = true)]
@@ -54,7 +58,9 @@ fn spinner() -> Option<ProgressBar> {
         return None;
     }
     let bar = ProgressBar::new_spinner();
-    bar.set_style(ProgressStyle::with_template("{spinner} {elapsed} {msg}").expect("valid template"));
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {elapsed} {msg}").expect("valid template"),
+    );
     bar.enable_steady_tick(Duration::from_millis(120));
     Some(bar)
 }
@@ -99,14 +105,21 @@ fn print_outcome(o: &Outcome) {
         o.model.name, o.model.dof_count, o.solution.equations, t.mesh, t.assembly, t.factorization, t.solve, t.total
     );
     for c in &o.checks {
-        println!("  {} {} (error {:.3e}, tol {:.1e})", if c.passed { "pass" } else { "FAIL" }, c.check, c.error, c.tol);
+        println!(
+            "  {} {} (error {:.3e}, tol {:.1e})",
+            if c.passed { "pass" } else { "FAIL" },
+            c.check,
+            c.error,
+            c.tol
+        );
     }
 }
 
 /// Case files named by `paths` (folders searched recursively), sorted.
 fn collect_cases(paths: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
     fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), String> {
-        let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: cannot read the folder: {e}", dir.display()))?;
+        let entries = std::fs::read_dir(dir)
+            .map_err(|e| format!("{}: cannot read the folder: {e}", dir.display()))?;
         let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
         paths.sort();
         for p in paths {
@@ -144,7 +157,10 @@ fn check(paths: &[PathBuf]) -> ExitCode {
     };
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = ProgressBar::new(cases.len() as u64);
-        b.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed} {msg}").expect("valid template"));
+        b.set_style(
+            ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed} {msg}")
+                .expect("valid template"),
+        );
         b
     });
     let mut failures: Vec<(String, String)> = Vec::new();
@@ -156,14 +172,25 @@ fn check(paths: &[PathBuf]) -> ExitCode {
         match run_case(case, &mut |_| {}) {
             Ok(outcome) => {
                 let (pass, fail): (Vec<_>, Vec<_>) = outcome.checks.iter().partition(|c| c.passed);
-                let line = format!("{} ({} checks, {:.3}s)", case.display(), outcome.checks.len(), outcome.solution.timings.total);
+                let line = format!(
+                    "{} ({} checks, {:.3}s)",
+                    case.display(),
+                    outcome.checks.len(),
+                    outcome.solution.timings.total
+                );
                 match &bar {
-                    Some(b) => b.println(format!("{} {line}", if fail.is_empty() { "pass" } else { "FAIL" })),
+                    Some(b) => b.println(format!(
+                        "{} {line}",
+                        if fail.is_empty() { "pass" } else { "FAIL" }
+                    )),
                     None => println!("{} {line}", if fail.is_empty() { "pass" } else { "FAIL" }),
                 }
                 let _ = pass;
                 for c in fail {
-                    failures.push((case.display().to_string(), format!("{} (error {:.3e} > tol {:.1e})", c.check, c.error, c.tol)));
+                    failures.push((
+                        case.display().to_string(),
+                        format!("{} (error {:.3e} > tol {:.1e})", c.check, c.error, c.tol),
+                    ));
                 }
             }
             Err(e) => {
@@ -186,6 +213,14 @@ fn check(paths: &[PathBuf]) -> ExitCode {
     for (case, what) in &failures {
         println!("| {case} | {} |", what.replace('\n', " "));
     }
-    println!("\n{} of {} cases failed", failures.iter().map(|f| &f.0).collect::<std::collections::BTreeSet<_>>().len(), cases.len());
+    println!(
+        "\n{} of {} cases failed",
+        failures
+            .iter()
+            .map(|f| &f.0)
+            .collect::<std::collections::BTreeSet<_>>()
+            .len(),
+        cases.len()
+    );
     ExitCode::from(if errors > 0 { 2 } else { 1 })
 }

@@ -118,9 +118,27 @@ impl Mesh {
 
     /// Boundary facets whose nodes all lie in the closed box `[lo, hi]`.
     pub fn facets_in_box(&self, lo: [f64; 2], hi: [f64; 2], tol: f64) -> Vec<Facet> {
-        self.boundary_facets()
-            .into_iter()
-            .filter(|&f| self.facet_nodes(f).iter().all(|&n| inside(self.nodes[n], lo, hi, tol)))
+        self.select_facets(&self.boundary_facets(), lo, hi, tol)
+    }
+
+    /// The facets of `candidates` whose nodes all lie in the closed box `[lo, hi]`.
+    fn select_facets(
+        &self,
+        candidates: &[Facet],
+        lo: [f64; 2],
+        hi: [f64; 2],
+        tol: f64,
+    ) -> Vec<Facet> {
+        let edges = self.kind.edges();
+        candidates
+            .iter()
+            .copied()
+            .filter(|f| {
+                let cell = self.cell(f.cell);
+                edges[f.edge]
+                    .iter()
+                    .all(|&l| inside(self.nodes[cell[l]], lo, hi, tol))
+            })
             .collect()
     }
 
@@ -145,6 +163,7 @@ impl Mesh {
         let [lo, hi] = self.bounding_box();
         let tol = self.tolerance();
         let inf = f64::INFINITY;
+        let boundary = self.boundary_facets();
         let sides = [
             ("left", [lo[0], -inf], [lo[0], inf]),
             ("right", [hi[0], -inf], [hi[0], inf]),
@@ -153,7 +172,7 @@ impl Mesh {
         ];
         for (name, a, b) in sides {
             let nodes = self.nodes_in_box(a, b, tol);
-            let facets = self.facets_in_box(a, b, tol);
+            let facets = self.select_facets(&boundary, a, b, tol);
             self.node_sets.insert(name.to_string(), nodes);
             self.facet_sets.insert(name.to_string(), facets);
         }
@@ -167,7 +186,8 @@ impl Mesh {
             let nodes = self.nodes_in_box(p, p, tol);
             self.node_sets.insert(name.to_string(), nodes);
         }
-        self.node_sets.insert("all".to_string(), (0..self.nodes.len()).collect());
+        self.node_sets
+            .insert("all".to_string(), (0..self.nodes.len()).collect());
     }
 }
 
@@ -178,9 +198,19 @@ fn inside(p: [f64; 2], lo: [f64; 2], hi: [f64; 2], tol: f64) -> bool {
 /// Problems found while generating a block mesh.
 #[derive(Debug, Clone, PartialEq)]
 pub enum BlockError {
-    TooFewBreaks { axis: char, count: usize },
-    NotIncreasing { axis: char, index: usize, value: f64, previous: f64 },
-    NoVertexAt { from: [f64; 2] },
+    TooFewBreaks {
+        axis: char,
+        count: usize,
+    },
+    NotIncreasing {
+        axis: char,
+        index: usize,
+        value: f64,
+        previous: f64,
+    },
+    NoVertexAt {
+        from: [f64; 2],
+    },
 }
 
 impl std::fmt::Display for BlockError {
@@ -212,11 +242,19 @@ pub fn block(
 ) -> Result<Mesh, BlockError> {
     for (axis, b) in [('x', xs), ('y', ys)] {
         if b.len() < 2 {
-            return Err(BlockError::TooFewBreaks { axis, count: b.len() });
+            return Err(BlockError::TooFewBreaks {
+                axis,
+                count: b.len(),
+            });
         }
         for i in 1..b.len() {
             if b[i].partial_cmp(&b[i - 1]) != Some(std::cmp::Ordering::Greater) {
-                return Err(BlockError::NotIncreasing { axis, index: i, value: b[i], previous: b[i - 1] });
+                return Err(BlockError::NotIncreasing {
+                    axis,
+                    index: i,
+                    value: b[i],
+                    previous: b[i - 1],
+                });
             }
         }
     }
@@ -232,7 +270,9 @@ pub fn block(
     for &(from, to) in moves {
         let k = vertex
             .iter()
-            .position(|v| (v[0] - from[0]).abs() <= 1e-9 * size && (v[1] - from[1]).abs() <= 1e-9 * size)
+            .position(|v| {
+                (v[0] - from[0]).abs() <= 1e-9 * size && (v[1] - from[1]).abs() <= 1e-9 * size
+            })
             .ok_or(BlockError::NoVertexAt { from })?;
         vertex[k] = to;
     }
@@ -258,7 +298,10 @@ pub fn block(
                     _ => {
                         if kind == ElementKind::Q9 {
                             let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
-                            [0.25 * (a[0] + b[0] + c[0] + d[0]), 0.25 * (a[1] + b[1] + c[1] + d[1])]
+                            [
+                                0.25 * (a[0] + b[0] + c[0] + d[0]),
+                                0.25 * (a[1] + b[1] + c[1] + d[1]),
+                            ]
                         } else {
                             mid(v(i, j), v(i + 1, j + 1))
                         }
@@ -281,7 +324,17 @@ pub fn block(
                     }
                 }
                 ElementKind::Q9 => {
-                    for (di, dj) in [(0, 0), (2, 0), (2, 2), (0, 2), (1, 0), (2, 1), (1, 2), (0, 1), (1, 1)] {
+                    for (di, dj) in [
+                        (0, 0),
+                        (2, 0),
+                        (2, 2),
+                        (0, 2),
+                        (1, 0),
+                        (2, 1),
+                        (1, 2),
+                        (0, 1),
+                        (1, 1),
+                    ] {
                         conn.push(node_at(a + di, b + dj, &mut nodes));
                     }
                 }
@@ -320,7 +373,10 @@ mod tests {
         assert_eq!(m.cell_count(), 2);
         assert_eq!(m.node_sets["left"].len(), 2);
         assert_eq!(m.facet_sets["top"].len(), 2);
-        assert_eq!(m.node_sets["top_right"], vec![m.nearest_node([3.0, 2.0]).unwrap().0]);
+        assert_eq!(
+            m.node_sets["top_right"],
+            vec![m.nearest_node([3.0, 2.0]).unwrap().0]
+        );
         assert_eq!(m.boundary_facets().len(), 6);
 
         let q9 = block(ElementKind::Q9, &[0.0, 1.0, 3.0], &[0.0, 2.0], &[]).unwrap();
@@ -335,7 +391,13 @@ mod tests {
 
     #[test]
     fn moved_vertex_keeps_quadratic_nodes_on_straight_sides() {
-        let m = block(ElementKind::Q9, &[0.0, 1.0, 2.0], &[0.0, 1.0, 2.0], &[([1.0, 1.0], [1.2, 0.7])]).unwrap();
+        let m = block(
+            ElementKind::Q9,
+            &[0.0, 1.0, 2.0],
+            &[0.0, 1.0, 2.0],
+            &[([1.0, 1.0], [1.2, 0.7])],
+        )
+        .unwrap();
         let (moved, d) = m.nearest_node([1.2, 0.7]).unwrap();
         assert!(d < 1e-14);
         // the mid-side node between (1,0) and the moved vertex sits at their midpoint
@@ -348,14 +410,26 @@ mod tests {
     fn bad_breaks_and_moves_are_reported() {
         assert_eq!(
             block(ElementKind::Q4, &[0.0], &[0.0, 1.0], &[]).unwrap_err(),
-            BlockError::TooFewBreaks { axis: 'x', count: 1 }
+            BlockError::TooFewBreaks {
+                axis: 'x',
+                count: 1
+            }
         );
         assert!(matches!(
             block(ElementKind::Q4, &[0.0, 1.0], &[0.0, 1.0, 1.0], &[]),
-            Err(BlockError::NotIncreasing { axis: 'y', index: 2, .. })
+            Err(BlockError::NotIncreasing {
+                axis: 'y',
+                index: 2,
+                ..
+            })
         ));
         assert!(matches!(
-            block(ElementKind::Q4, &[0.0, 1.0], &[0.0, 1.0], &[([0.5, 0.5], [0.4, 0.4])]),
+            block(
+                ElementKind::Q4,
+                &[0.0, 1.0],
+                &[0.0, 1.0],
+                &[([0.5, 0.5], [0.4, 0.4])]
+            ),
             Err(BlockError::NoVertexAt { .. })
         ));
     }

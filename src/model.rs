@@ -84,7 +84,8 @@ pub struct Model {
 /// Read, parse and validate a case file.
 pub fn load(path: &Path) -> Result<Model> {
     let source = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(&source, "reading the case", e))?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| Error::io(&source, "reading the case", e))?;
     let case = parse(&text, &source)?;
     Model::build(&case, &source)
 }
@@ -148,7 +149,10 @@ impl Model {
             if !(m.youngs_modulus.is_finite() && m.youngs_modulus > 0.0) {
                 return Err(invalid(
                     format!("materials.{name}.E"),
-                    format!("Young's modulus must be positive and finite, got {}", m.youngs_modulus),
+                    format!(
+                        "Young's modulus must be positive and finite, got {}",
+                        m.youngs_modulus
+                    ),
                     "give E > 0",
                 ));
             }
@@ -161,7 +165,11 @@ impl Model {
             }
         }
         if case.bodies.is_empty() {
-            return Err(invalid("bodies".into(), "the case has no bodies".into(), "add at least one body"));
+            return Err(invalid(
+                "bodies".into(),
+                "the case has no bodies".into(),
+                "add at least one body",
+            ));
         }
 
         let mut bodies: Vec<Body> = Vec::new();
@@ -169,7 +177,11 @@ impl Model {
         for (bi, spec) in case.bodies.iter().enumerate() {
             let at = format!("bodies[{bi}] '{}'", spec.name);
             if bodies.iter().any(|b| b.name == spec.name) {
-                return Err(invalid(at, format!("a second body is named '{}'", spec.name), "give every body a unique name"));
+                return Err(invalid(
+                    at,
+                    format!("a second body is named '{}'", spec.name),
+                    "give every body a unique name",
+                ));
             }
             let Some(mat) = case.materials.get(&spec.material) else {
                 let known: Vec<&String> = case.materials.keys().collect();
@@ -229,27 +241,35 @@ impl Model {
     }
 
     fn find_node_set<'a>(&self, body: &'a Body, set: &str, location: &str) -> Result<&'a [usize]> {
-        body.mesh.node_sets.get(set).map(|v| v.as_slice()).ok_or_else(|| {
-            let known: Vec<&String> = body.mesh.node_sets.keys().collect();
-            Error::invalid(
-                &self.source,
-                location,
-                format!("body '{}' has no node set '{set}'", body.name),
-                format!("define it under the body's \"node_sets\" or use one of {known:?}"),
-            )
-        })
+        body.mesh
+            .node_sets
+            .get(set)
+            .map(|v| v.as_slice())
+            .ok_or_else(|| {
+                let known: Vec<&String> = body.mesh.node_sets.keys().collect();
+                Error::invalid(
+                    &self.source,
+                    location,
+                    format!("body '{}' has no node set '{set}'", body.name),
+                    format!("define it under the body's \"node_sets\" or use one of {known:?}"),
+                )
+            })
     }
 
     fn find_facet_set<'a>(&self, body: &'a Body, set: &str, location: &str) -> Result<&'a [Facet]> {
-        body.mesh.facet_sets.get(set).map(|v| v.as_slice()).ok_or_else(|| {
-            let known: Vec<&String> = body.mesh.facet_sets.keys().collect();
-            Error::invalid(
-                &self.source,
-                location,
-                format!("body '{}' has no facet set '{set}'", body.name),
-                format!("define it under the body's \"facet_sets\" or use one of {known:?}"),
-            )
-        })
+        body.mesh
+            .facet_sets
+            .get(set)
+            .map(|v| v.as_slice())
+            .ok_or_else(|| {
+                let known: Vec<&String> = body.mesh.facet_sets.keys().collect();
+                Error::invalid(
+                    &self.source,
+                    location,
+                    format!("body '{}' has no facet set '{set}'", body.name),
+                    format!("define it under the body's \"facet_sets\" or use one of {known:?}"),
+                )
+            })
     }
 
     fn require_exact(&self, location: &str) -> Result<ExactField> {
@@ -268,7 +288,10 @@ impl Model {
             let at = format!("supports[{k}]");
             let body = self.find_body(&s.body, &at)?.clone();
             let nodes = self.find_node_set(&body, &s.set, &at)?.to_vec();
-            let entry = (self.body_index(&s.body).expect("found above"), s.set.clone());
+            let entry = (
+                self.body_index(&s.body).expect("found above"),
+                s.set.clone(),
+            );
             if !self.support_sets.contains(&entry) {
                 self.support_sets.push(entry);
             }
@@ -284,7 +307,12 @@ impl Model {
                 let Some(value) = value else { continue };
                 if let Prescribed::Value(v) = value {
                     if !v.is_finite() {
-                        return Err(Error::invalid(&self.source, &at, "the prescribed value is not finite", "give a finite number"));
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "the prescribed value is not finite",
+                            "give a finite number",
+                        ));
                     }
                 }
                 let exact = match value {
@@ -299,7 +327,9 @@ impl Model {
                     };
                     let dof = body.dof(n, comp);
                     match self.prescribed[dof] {
-                        Some(old) if (old - v).abs() > 1e-12 * (old.abs() + v.abs()).max(1e-300) => {
+                        Some(old)
+                            if (old - v).abs() > 1e-12 * (old.abs() + v.abs()).max(1e-300) =>
+                        {
                             let p = body.mesh.nodes[n];
                             return Err(Error::invalid(
                                 &self.source,
@@ -323,7 +353,11 @@ impl Model {
         for (k, load) in case.loads.iter().enumerate() {
             let at = format!("loads[{k}]");
             let body = self.find_body(&load.body, &at)?.clone();
-            let given = [load.pressure.is_some(), load.traction.is_some(), load.body_force.is_some()];
+            let given = [
+                load.pressure.is_some(),
+                load.traction.is_some(),
+                load.body_force.is_some(),
+            ];
             if given.iter().filter(|&&g| g).count() != 1 {
                 return Err(Error::invalid(
                     &self.source,
@@ -335,28 +369,53 @@ impl Model {
             let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
             if let Some(b) = load.body_force {
                 if load.set.is_some() {
-                    return Err(Error::invalid(&self.source, &at, "a body force acts on the whole body and takes no \"set\"", "remove \"set\""));
+                    return Err(Error::invalid(
+                        &self.source,
+                        &at,
+                        "a body force acts on the whole body and takes no \"set\"",
+                        "remove \"set\"",
+                    ));
                 }
                 if !finite(&b) {
-                    return Err(Error::invalid(&self.source, &at, "the body force is not finite", "give finite numbers"));
+                    return Err(Error::invalid(
+                        &self.source,
+                        &at,
+                        "the body force is not finite",
+                        "give finite numbers",
+                    ));
                 }
                 add_body_force(&body, b, self.thickness, &mut self.external_force);
                 continue;
             }
             let Some(set) = &load.set else {
-                return Err(Error::invalid(&self.source, &at, "a pressure or traction needs a facet \"set\"", "add \"set\": the name of a facet set of the body"));
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    "a pressure or traction needs a facet \"set\"",
+                    "add \"set\": the name of a facet set of the body",
+                ));
             };
             let facets = self.find_facet_set(&body, set, &at)?.to_vec();
             let traction = match (load.pressure, load.traction) {
                 (Some(p), _) => {
                     if !p.is_finite() {
-                        return Err(Error::invalid(&self.source, &at, "the pressure is not finite", "give a finite number"));
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "the pressure is not finite",
+                            "give a finite number",
+                        ));
                     }
                     EdgeTraction::Pressure(p)
                 }
                 (_, Some(TractionSpec::Vector(t))) => {
                     if !finite(&t) {
-                        return Err(Error::invalid(&self.source, &at, "the traction is not finite", "give finite numbers"));
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "the traction is not finite",
+                            "give finite numbers",
+                        ));
                     }
                     EdgeTraction::Vector(t)
                 }
@@ -364,7 +423,13 @@ impl Model {
                 _ => unreachable!("exactly one load kind checked above"),
             };
             for f in facets {
-                add_facet_load(&body, f, &traction, self.thickness, &mut self.external_force);
+                add_facet_load(
+                    &body,
+                    f,
+                    &traction,
+                    self.thickness,
+                    &mut self.external_force,
+                );
             }
         }
         Ok(())
@@ -396,7 +461,12 @@ impl Model {
                 }
             };
             if !(tol.is_finite() && tol >= 0.0) {
-                return Err(Error::invalid(&self.source, &at, format!("tolerance must be a non-negative number, got {tol}"), "give e.g. 1e-10"));
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    format!("tolerance must be a non-negative number, got {tol}"),
+                    "give e.g. 1e-10",
+                ));
             }
             self.checks.push(check.clone());
         }
@@ -437,7 +507,11 @@ pub fn free_rigid_mode(body: &Body, prescribed: &[Option<f64>]) -> Option<&'stat
                 continue;
             }
             let rot = [-(p[1] - c[1]) / scale, (p[0] - c[0]) / scale];
-            let m = [if comp == 0 { 1.0 } else { 0.0 }, if comp == 1 { 1.0 } else { 0.0 }, rot[comp]];
+            let m = [
+                if comp == 0 { 1.0 } else { 0.0 },
+                if comp == 1 { 1.0 } else { 0.0 },
+                rot[comp],
+            ];
             for k in 0..3 {
                 for l in 0..3 {
                     g[k][l] += m[k] * m[l];
@@ -451,7 +525,8 @@ pub fn free_rigid_mode(body: &Body, prescribed: &[Option<f64>]) -> Option<&'stat
     if g[1][1] == 0.0 {
         return Some("translate in y (no node has u_y prescribed)");
     }
-    let det = g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1]) - g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0])
+    let det = g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1])
+        - g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0])
         + g[0][2] * (g[1][0] * g[2][1] - g[1][1] * g[2][0]);
     let trace = g[0][0] + g[1][1] + g[2][2];
     if det <= 1e-12 * trace.powi(3) {
@@ -466,17 +541,33 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {
             let xs = b.x.values();
             let ys = b.y.values();
             if xs.iter().chain(&ys).any(|v| !v.is_finite()) {
-                return Err(Error::invalid(source, format!("{at}.mesh.block"), "a break is not finite", "give finite coordinates"));
+                return Err(Error::invalid(
+                    source,
+                    format!("{at}.mesh.block"),
+                    "a break is not finite",
+                    "give finite coordinates",
+                ));
             }
             let moves: Vec<_> = b.moves.iter().map(|m| (m.from, m.to)).collect();
-            block(b.element, &xs, &ys, &moves)
-                .map_err(|e| Error::invalid(source, format!("{at}.mesh.block"), e, "fix the breaks or moves"))
+            block(b.element, &xs, &ys, &moves).map_err(|e| {
+                Error::invalid(
+                    source,
+                    format!("{at}.mesh.block"),
+                    e,
+                    "fix the breaks or moves",
+                )
+            })
         }
         MeshSpec::Explicit(e) => {
             let nn = e.element.node_count();
             for (i, p) in e.nodes.iter().enumerate() {
                 if !(p[0].is_finite() && p[1].is_finite()) {
-                    return Err(Error::invalid(source, format!("{at}.mesh.explicit.nodes[{i}]"), "the coordinates are not finite", "give finite coordinates"));
+                    return Err(Error::invalid(
+                        source,
+                        format!("{at}.mesh.explicit.nodes[{i}]"),
+                        "the coordinates are not finite",
+                        "give finite coordinates",
+                    ));
                 }
             }
             let mut conn = Vec::with_capacity(nn * e.cells.len());
@@ -485,7 +576,11 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {
                     return Err(Error::invalid(
                         source,
                         format!("{at}.mesh.explicit.cells[{c}]"),
-                        format!("a {:?} cell needs {nn} nodes, got {}", e.element, cell.len()),
+                        format!(
+                            "a {:?} cell needs {nn} nodes, got {}",
+                            e.element,
+                            cell.len()
+                        ),
                         "list corners counter-clockwise, then mid-side nodes (then the Q9 centre)",
                     ));
                 }
@@ -494,7 +589,10 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {
                         return Err(Error::invalid(
                             source,
                             format!("{at}.mesh.explicit.cells[{c}]"),
-                            format!("node {n} does not exist (the mesh has {} nodes, numbered from 0)", e.nodes.len()),
+                            format!(
+                                "node {n} does not exist (the mesh has {} nodes, numbered from 0)",
+                                e.nodes.len()
+                            ),
                             "use node indices below the number of nodes",
                         ));
                     }
@@ -502,7 +600,12 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {
                 conn.extend_from_slice(cell);
             }
             if e.cells.is_empty() {
-                return Err(Error::invalid(source, format!("{at}.mesh.explicit.cells"), "the mesh has no cells", "add cells"));
+                return Err(Error::invalid(
+                    source,
+                    format!("{at}.mesh.explicit.cells"),
+                    "the mesh has no cells",
+                    "add cells",
+                ));
             }
             Ok(Mesh::new(e.element, e.nodes.clone(), conn))
         }
@@ -514,7 +617,11 @@ fn check_cells(mesh: &Mesh, source: &str, at: &str) -> Result<()> {
     for c in 0..mesh.cell_count() {
         let coords = mesh.cell_coords(c);
         if let Err(bad) = check_geometry(mesh.kind, &coords) {
-            let what = if bad.inverted { "inverted (negative Jacobian)" } else { "degenerate (zero-area)" };
+            let what = if bad.inverted {
+                "inverted (negative Jacobian)"
+            } else {
+                "degenerate (zero-area)"
+            };
             return Err(Error::invalid(
                 source,
                 format!("{at}: element {c} (nodes {:?})", mesh.cell(c)),
@@ -526,7 +633,12 @@ fn check_cells(mesh: &Mesh, source: &str, at: &str) -> Result<()> {
     Ok(())
 }
 
-fn add_user_sets(mesh: &mut Mesh, spec: &crate::scene::BodySpec, source: &str, at: &str) -> Result<()> {
+fn add_user_sets(
+    mesh: &mut Mesh,
+    spec: &crate::scene::BodySpec,
+    source: &str,
+    at: &str,
+) -> Result<()> {
     let tol = mesh.tolerance();
     for (name, set) in &spec.node_sets {
         let loc = format!("{at}.node_sets.{name}");
@@ -550,20 +662,38 @@ fn add_user_sets(mesh: &mut Mesh, spec: &crate::scene::BodySpec, source: &str, a
             },
             NodeSetSpec::Nodes(ids) => {
                 if let Some(&bad) = ids.iter().find(|&&n| n >= mesh.nodes.len()) {
-                    return Err(Error::invalid(source, loc, format!("node {bad} does not exist (the body has {} nodes)", mesh.nodes.len()), "use node indices below the number of nodes"));
+                    return Err(Error::invalid(
+                        source,
+                        loc,
+                        format!(
+                            "node {bad} does not exist (the body has {} nodes)",
+                            mesh.nodes.len()
+                        ),
+                        "use node indices below the number of nodes",
+                    ));
                 }
                 ids.clone()
             }
         };
         if nodes.is_empty() {
-            return Err(Error::invalid(source, loc, "the set selects no node", "check the box limits against the body's coordinates"));
+            return Err(Error::invalid(
+                source,
+                loc,
+                "the set selects no node",
+                "check the box limits against the body's coordinates",
+            ));
         }
         mesh.node_sets.insert(name.clone(), nodes);
     }
     for (name, set) in &spec.facet_sets {
         let loc = format!("{at}.facet_sets.{name}");
         if mesh.facet_sets.contains_key(name) {
-            return Err(Error::invalid(source, loc, format!("'{name}' is a built-in set name"), "choose another name; the built-in facet sets are left, right, bottom and top"));
+            return Err(Error::invalid(
+                source,
+                loc,
+                format!("'{name}' is a built-in set name"),
+                "choose another name; the built-in facet sets are left, right, bottom and top",
+            ));
         }
         let facets = match set {
             FacetSetSpec::Box(b) => mesh.facets_in_box(b.min, b.max, tol),
@@ -571,7 +701,12 @@ fn add_user_sets(mesh: &mut Mesh, spec: &crate::scene::BodySpec, source: &str, a
                 let mut out = Vec::new();
                 for &[cell, edge] in list {
                     if cell >= mesh.cell_count() || edge >= mesh.kind.edges().len() {
-                        return Err(Error::invalid(source, loc, format!("facet [{cell}, {edge}] does not exist"), "use [cell, local edge] with valid indices"));
+                        return Err(Error::invalid(
+                            source,
+                            loc,
+                            format!("facet [{cell}, {edge}] does not exist"),
+                            "use [cell, local edge] with valid indices",
+                        ));
                     }
                     out.push(Facet { cell, edge });
                 }
@@ -579,7 +714,12 @@ fn add_user_sets(mesh: &mut Mesh, spec: &crate::scene::BodySpec, source: &str, a
             }
         };
         if facets.is_empty() {
-            return Err(Error::invalid(source, loc, "the set selects no boundary facet", "a facet enters a box set only when all its nodes lie in the box"));
+            return Err(Error::invalid(
+                source,
+                loc,
+                "the set selects no boundary facet",
+                "a facet enters a box set only when all its nodes lie in the box",
+            ));
         }
         mesh.facet_sets.insert(name.clone(), facets);
     }
@@ -594,7 +734,13 @@ enum EdgeTraction {
 }
 
 /// Consistent nodal forces of a distributed load on one facet, added into `force`.
-fn add_facet_load(body: &Body, facet: Facet, traction: &EdgeTraction, thickness: f64, force: &mut [f64]) {
+fn add_facet_load(
+    body: &Body,
+    facet: Facet,
+    traction: &EdgeTraction,
+    thickness: f64,
+    force: &mut [f64],
+) {
     let nodes = body.mesh.facet_nodes(facet);
     let kind = body.mesh.kind.edge_kind();
     let nn = kind.node_count();
@@ -619,7 +765,10 @@ fn add_facet_load(body: &Body, facet: Facet, traction: &EdgeTraction, thickness:
             EdgeTraction::Vector(t) => [t[0] * length, t[1] * length],
             EdgeTraction::Exact(f) => {
                 let s = f.stress(x);
-                [s[0] * n_ds[0] + s[2] * n_ds[1], s[2] * n_ds[0] + s[1] * n_ds[1]]
+                [
+                    s[0] * n_ds[0] + s[2] * n_ds[1],
+                    s[2] * n_ds[0] + s[1] * n_ds[1],
+                ]
             }
         };
         for a in 0..nn {

@@ -59,11 +59,17 @@ pub struct ReactionSummary {
 }
 
 fn range(values: impl Iterator<Item = f64>) -> [f64; 2] {
-    values.fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], v| [lo.min(v), hi.max(v)])
+    values.fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], v| {
+        [lo.min(v), hi.max(v)]
+    })
 }
 
 pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
-    let Outcome { model, solution, checks } = outcome;
+    let Outcome {
+        model,
+        solution,
+        checks,
+    } = outcome;
     let u = &solution.u;
     let bodies = model
         .bodies
@@ -92,7 +98,12 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
             let b = &model.bodies[*bi];
             let nodes = &b.mesh.node_sets[set];
             let sum = |c: usize| nodes.iter().map(|&n| solution.reactions[b.dof(n, c)]).sum();
-            ReactionSummary { body: b.name.clone(), set: set.clone(), x: sum(0), y: sum(1) }
+            ReactionSummary {
+                body: b.name.clone(),
+                set: set.clone(),
+                x: sum(0),
+                y: sum(1),
+            }
         })
         .collect();
     Summary {
@@ -113,7 +124,12 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
 
 /// Write `summary.json` and the `.vtu` files into `dir` (replaced as a whole).
 pub fn write_run(dir: &Path, outcome: &Outcome) -> Result<()> {
-    let nodal: Vec<Vec<[f64; 3]>> = outcome.model.bodies.iter().map(|b| nodal_stresses(b, &outcome.solution.u)).collect();
+    let nodal: Vec<Vec<[f64; 3]>> = outcome
+        .model
+        .bodies
+        .iter()
+        .map(|b| nodal_stresses(b, &outcome.solution.u))
+        .collect();
     let summary = summary(outcome, &nodal);
     write_folder_atomically(dir, |tmp| {
         let path = tmp.join("summary.json");
@@ -129,9 +145,16 @@ pub fn write_run(dir: &Path, outcome: &Outcome) -> Result<()> {
 
 /// Build a folder under a temporary name with `fill`, then move it to `dir`.
 pub fn write_folder_atomically(dir: &Path, fill: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
-    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    fs::create_dir_all(parent).map_err(|e| Error::io(parent.display(), "creating the output folder", e))?;
+    let name = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let parent = dir
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    fs::create_dir_all(parent)
+        .map_err(|e| Error::io(parent.display(), "creating the output folder", e))?;
     let tmp: PathBuf = parent.join(format!(".{name}.partial-{}", std::process::id()));
     if tmp.exists() {
         let _ = fs::remove_dir_all(&tmp);
@@ -142,7 +165,8 @@ pub fn write_folder_atomically(dir: &Path, fill: impl FnOnce(&Path) -> Result<()
         return Err(e);
     }
     if dir.exists() {
-        fs::remove_dir_all(dir).map_err(|e| Error::io(dir.display(), "replacing the previous output", e))?;
+        fs::remove_dir_all(dir)
+            .map_err(|e| Error::io(dir.display(), "replacing the previous output", e))?;
     }
     fs::rename(&tmp, dir).map_err(|e| Error::io(dir.display(), "moving the output into place", e))
 }
@@ -158,24 +182,44 @@ pub fn write_vtu(path: &Path, body: &Body, u: &[f64], nodal_stress: &[[f64; 3]])
     let mut text = String::new();
     use std::fmt::Write as _;
     let _ = writeln!(text, "<?xml version=\"1.0\"?>");
-    let _ = writeln!(text, "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">");
+    let _ = writeln!(
+        text,
+        "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">"
+    );
     let _ = writeln!(text, "<UnstructuredGrid>");
-    let _ = writeln!(text, "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">", mesh.nodes.len(), mesh.cell_count());
-    let _ = writeln!(text, "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">");
+    let _ = writeln!(
+        text,
+        "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
+        mesh.nodes.len(),
+        mesh.cell_count()
+    );
+    let _ = writeln!(
+        text,
+        "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
+    );
     for p in &mesh.nodes {
         let _ = writeln!(text, "{} {} 0", p[0], p[1]);
     }
     let _ = writeln!(text, "</DataArray></Points>");
-    let _ = writeln!(text, "<Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">");
+    let _ = writeln!(
+        text,
+        "<Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
+    );
     for c in 0..mesh.cell_count() {
         let ids: Vec<String> = mesh.cell(c).iter().map(|n| n.to_string()).collect();
         let _ = writeln!(text, "{}", ids.join(" "));
     }
-    let _ = writeln!(text, "</DataArray><DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">");
+    let _ = writeln!(
+        text,
+        "</DataArray><DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
+    );
     for c in 0..mesh.cell_count() {
         let _ = writeln!(text, "{}", (c + 1) * nn);
     }
-    let _ = writeln!(text, "</DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">");
+    let _ = writeln!(
+        text,
+        "</DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
+    );
     for _ in 0..mesh.cell_count() {
         let _ = writeln!(text, "{}", mesh.kind.vtk_cell_type());
     }
@@ -191,7 +235,10 @@ pub fn write_vtu(path: &Path, body: &Body, u: &[f64], nodal_stress: &[[f64; 3]])
         let _ = writeln!(text, "{} {} {}", s[0], s[1], s[2]);
     }
     let _ = writeln!(text, "</DataArray>");
-    let _ = writeln!(text, "<DataArray type=\"Float64\" Name=\"stress_zz\" format=\"ascii\">");
+    let _ = writeln!(
+        text,
+        "<DataArray type=\"Float64\" Name=\"stress_zz\" format=\"ascii\">"
+    );
     for s in nodal_stress {
         let _ = writeln!(text, "{}", body.material.sigma_zz(*s));
     }

@@ -30,7 +30,11 @@ pub fn stress_at(body: &Body, u: &[f64], c: usize, xi: [f64; 2]) -> ([f64; 3], [
 }
 
 /// Calls `visit(cell, x, sigma)` at every stiffness quadrature point of `body`.
-pub fn for_each_quadrature_stress(body: &Body, u: &[f64], mut visit: impl FnMut(usize, [f64; 2], [f64; 3])) {
+pub fn for_each_quadrature_stress(
+    body: &Body,
+    u: &[f64],
+    mut visit: impl FnMut(usize, [f64; 2], [f64; 3]),
+) {
     let rule = body.mesh.kind.stiffness_rule();
     for c in 0..body.mesh.cell_count() {
         for q in &rule {
@@ -43,7 +47,9 @@ pub fn for_each_quadrature_stress(body: &Body, u: &[f64], mut visit: impl FnMut(
 /// Stress at the centre of every cell.
 pub fn cell_stresses(body: &Body, u: &[f64]) -> Vec<[f64; 3]> {
     let centre = body.mesh.kind.centre();
-    (0..body.mesh.cell_count()).map(|c| stress_at(body, u, c, centre).0).collect()
+    (0..body.mesh.cell_count())
+        .map(|c| stress_at(body, u, c, centre).0)
+        .collect()
 }
 
 /// Nodal stresses averaged over the cells that share each node.
@@ -63,7 +69,13 @@ pub fn nodal_stresses(body: &Body, u: &[f64]) -> Vec<[f64; 3]> {
     }
     sum.iter()
         .zip(&count)
-        .map(|(s, &k)| if k == 0 { [0.0; 3] } else { s.map(|v| v / k as f64) })
+        .map(|(s, &k)| {
+            if k == 0 {
+                [0.0; 3]
+            } else {
+                s.map(|v| v / k as f64)
+            }
+        })
         .collect()
 }
 

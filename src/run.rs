@@ -31,11 +31,20 @@ pub fn run_case(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Outcome> 
 }
 
 /// Solve an already built model (`mesh_time` and `start` feed the timing breakdown).
-pub fn run_model(model: Model, mesh_time: f64, start: Instant, progress: &mut dyn FnMut(&str)) -> Result<Outcome> {
+pub fn run_model(
+    model: Model,
+    mesh_time: f64,
+    start: Instant,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Outcome> {
     let mut solution = solve_static(&model, progress)?;
     progress("checking");
     let checks = evaluate(&model, &solution);
     solution.timings.mesh = mesh_time;
     solution.timings.total = start.elapsed().as_secs_f64();
-    Ok(Outcome { model, solution, checks })
+    Ok(Outcome {
+        model,
+        solution,
+        checks,
+    })
 }

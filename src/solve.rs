@@ -87,7 +87,14 @@ pub fn for_each_element_stiffness(model: &Model, mut visit: impl FnMut(&[usize],
         let nd = 2 * kind.node_count();
         for c in 0..body.mesh.cell_count() {
             let coords = body.mesh.cell_coords(c);
-            element_stiffness(kind, &coords, &body.material, model.thickness, &rule, &mut ke);
+            element_stiffness(
+                kind,
+                &coords,
+                &body.material,
+                model.thickness,
+                &rule,
+                &mut ke,
+            );
             body.cell_dofs(c, &mut dofs);
             visit(&dofs, &ke[..nd * nd]);
         }
@@ -179,7 +186,13 @@ pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Sol
     let scale = model
         .external_force
         .iter()
-        .chain(reactions.iter().enumerate().filter(|(d, _)| eq[*d] == NO_EQUATION).map(|(_, r)| r))
+        .chain(
+            reactions
+                .iter()
+                .enumerate()
+                .filter(|(d, _)| eq[*d] == NO_EQUATION)
+                .map(|(_, r)| r),
+        )
         .fold(0.0f64, |m, v| m.max(v.abs()));
     let worst = reactions
         .iter()
@@ -220,7 +233,13 @@ pub fn describe_dof(model: &Model, dof: usize) -> String {
             let local = dof - body.dof_offset;
             let node = local / 2;
             let p = body.mesh.nodes[node];
-            return format!("body '{}', node {node} at ({}, {}), u_{}", body.name, p[0], p[1], ["x", "y"][local % 2]);
+            return format!(
+                "body '{}', node {node} at ({}, {}), u_{}",
+                body.name,
+                p[0],
+                p[1],
+                ["x", "y"][local % 2]
+            );
         }
     }
     format!("dof {dof}")

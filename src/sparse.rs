@@ -29,7 +29,10 @@ pub struct PatternBuilder {
 
 impl PatternBuilder {
     pub fn new(n: usize) -> Self {
-        PatternBuilder { n, columns: vec![Vec::new(); n] }
+        PatternBuilder {
+            n,
+            columns: vec![Vec::new(); n],
+        }
     }
 
     /// Couple every pair of the equations in `eqs` (entries `>= n` are ignored, so callers can
@@ -58,7 +61,11 @@ impl PatternBuilder {
             row_idx.extend_from_slice(&col);
             col_ptr.push(row_idx.len());
         }
-        SymmetricPattern { n: self.n, col_ptr, row_idx }
+        SymmetricPattern {
+            n: self.n,
+            col_ptr,
+            row_idx,
+        }
     }
 }
 
@@ -71,7 +78,10 @@ impl SymmetricPattern {
     pub fn position(&self, i: usize, j: usize) -> Option<usize> {
         let (r, c) = if i <= j { (i, j) } else { (j, i) };
         let range = self.col_ptr[c]..self.col_ptr[c + 1];
-        self.row_idx[range.clone()].binary_search(&r).ok().map(|k| range.start + k)
+        self.row_idx[range.clone()]
+            .binary_search(&r)
+            .ok()
+            .map(|k| range.start + k)
     }
 
     /// Add the dense symmetric block `ke` (row-major, `eqs.len()` square) into `values`;
@@ -89,7 +99,9 @@ impl SymmetricPattern {
                 if i > j {
                     continue;
                 }
-                let k = rows.binary_search(&i).expect("entry outside the assembled pattern");
+                let k = rows
+                    .binary_search(&i)
+                    .expect("entry outside the assembled pattern");
                 values[range.start + k] += ke[a * m + b];
             }
         }
@@ -137,14 +149,18 @@ impl Cholesky {
     }
 
     /// Numeric factorization of the matrix with this pattern and `values`.
-    pub fn factor(&self, pattern: &SymmetricPattern, values: &[f64]) -> Result<Factor, FactorError> {
+    pub fn factor(
+        &self,
+        pattern: &SymmetricPattern,
+        values: &[f64],
+    ) -> Result<Factor, FactorError> {
         let mat = SparseColMatRef::new(pattern.symbolic(), values);
         Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Upper)
             .map(|llt| Factor { llt })
             .map_err(|e| match e {
-                faer::sparse::linalg::LltError::Numeric(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot {
-                    index,
-                }) => FactorError::NotPositiveDefinite { equation: index },
+                faer::sparse::linalg::LltError::Numeric(
+                    faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index },
+                ) => FactorError::NotPositiveDefinite { equation: index },
                 other => FactorError::Other(format!("{other:?}")),
             })
     }
@@ -200,7 +216,9 @@ mod tests {
         let doubled: Vec<f64> = values.iter().map(|v| 2.0 * v).collect();
         let mut b2 = vec![0.0; n];
         pattern.mul(&doubled, &x, &mut b2);
-        chol.factor(&pattern, &doubled).unwrap().solve_in_place(&mut b2);
+        chol.factor(&pattern, &doubled)
+            .unwrap()
+            .solve_in_place(&mut b2);
         assert!(b2.iter().zip(&x).all(|(a, b)| (a - b).abs() < 1e-12));
     }
 
@@ -212,7 +230,10 @@ mod tests {
         let mut values = vec![0.0; pattern.nnz()];
         pattern.scatter(&[0, 1], &[1.0, -1.0, -1.0, 1.0], &mut values);
         let chol = Cholesky::analyse(&pattern).unwrap();
-        assert!(matches!(chol.factor(&pattern, &values), Err(FactorError::NotPositiveDefinite { .. })));
+        assert!(matches!(
+            chol.factor(&pattern, &values),
+            Err(FactorError::NotPositiveDefinite { .. })
+        ));
     }
 
     #[test]

@@ -1,0 +1,144 @@
+//! `contact-patch run` writes `summary.json` and one `.vtu` per body; both are read back here.
+
+use std::process::Command;
+
+/// The numbers inside the `<DataArray ... Name="name" ...>` element of a VTU file's `section`
+/// (`Points`, `PointData`, `CellData`, `Cells`).
+fn data_array(xml: &str, section: &str, name: Option<&str>) -> Vec<f64> {
+    let start = xml
+        .find(&format!("<{section}"))
+        .unwrap_or_else(|| panic!("no <{section}>"));
+    let end = start + xml[start..].find(&format!("</{section}>")).unwrap();
+    let body = &xml[start..end];
+    let open = match name {
+        Some(n) => body
+            .find(&format!("Name=\"{n}\""))
+            .unwrap_or_else(|| panic!("no array {n} in {section}")),
+        None => body.find("<DataArray").unwrap(),
+    };
+    let from = open + body[open..].find('>').unwrap() + 1;
+    let to = from + body[from..].find("</DataArray>").unwrap();
+    body[from..to]
+        .split_whitespace()
+        .map(|t| t.parse().unwrap())
+        .collect()
+}
+
+fn attribute(xml: &str, name: &str) -> usize {
+    let k = xml.find(&format!("{name}=\"")).unwrap() + name.len() + 2;
+    xml[k..k + xml[k..].find('"').unwrap()].parse().unwrap()
+}
+
+#[test]
+fn vtu_and_summary_read_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("q9");
+    let case = format!(
+        "{}/cases/patch-single/q9-distorted.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .args(["run", &case, "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["dofs"], 98);
+    assert_eq!(summary["passed"], true);
+    for stage in ["mesh", "assembly", "factorization", "solve", "total"] {
+        assert!(
+            summary["timings"][stage].as_f64().unwrap() >= 0.0,
+            "timing {stage}"
+        );
+    }
+    let body = &summary["bodies"][0];
+    assert_eq!(body["element"], "Q9");
+    // the exact stress is uniform, so every extreme equals it
+    for (field, value) in [("stress_xx", 3.0), ("stress_yy", -10.0), ("stress_xy", 2.0)] {
+        for v in body[field].as_array().unwrap() {
+            assert!((v.as_f64().unwrap() - value).abs() < 1e-10, "{field}: {v}");
+        }
+    }
+
+    let xml = std::fs::read_to_string(out.join("patch.vtu")).unwrap();
+    assert!(xml.starts_with("<?xml") && xml.trim_end().ends_with("</VTKFile>"));
+    let (points, cells) = (
+        attribute(&xml, "NumberOfPoints"),
+        attribute(&xml, "NumberOfCells"),
+    );
+    assert_eq!((points, cells), (49, 9));
+    let coords = data_array(&xml, "Points", None);
+    let u = data_array(&xml, "PointData", Some("displacement"));
+    let nodal = data_array(&xml, "PointData", Some("stress"));
+    let cell = data_array(&xml, "CellData", Some("stress"));
+    let types = data_array(&xml, "Cells", Some("types"));
+    let offsets = data_array(&xml, "Cells", Some("offsets"));
+    assert_eq!(
+        (coords.len(), u.len(), nodal.len(), cell.len()),
+        (3 * points, 3 * points, 3 * points, 3 * cells)
+    );
+    assert!(
+        types.iter().all(|&t| t == 28.0),
+        "Q9 is VTK_BIQUADRATIC_QUAD"
+    );
+    assert_eq!(offsets.last(), Some(&(9.0 * cells as f64)));
+    // the displacement read back is the exact field u = eps x (plane strain, E = 1000, nu = 0.3)
+    let (e, nu) = (1000.0, 0.3);
+    let (sxx, syy, sxy) = (3.0, -10.0, 2.0);
+    let exx = (1.0 + nu) / e * ((1.0 - nu) * sxx - nu * syy);
+    let eyy = (1.0 + nu) / e * ((1.0 - nu) * syy - nu * sxx);
+    let gxy = 2.0 * (1.0 + nu) / e * sxy;
+    for k in 0..points {
+        let (x, y) = (coords[3 * k], coords[3 * k + 1]);
+        let exact = [exx * x + 0.5 * gxy * y, 0.5 * gxy * x + eyy * y];
+        for i in 0..2 {
+            assert!(
+                (u[3 * k + i] - exact[i]).abs() < 1e-14,
+                "node {k}: {} vs {}",
+                u[3 * k + i],
+                exact[i]
+            );
+        }
+    }
+    for s in cell.chunks(3).chain(nodal.chunks(3)) {
+        assert!(
+            (s[0] - sxx).abs() < 1e-10 && (s[1] - syy).abs() < 1e-10 && (s[2] - sxy).abs() < 1e-10,
+            "{s:?}"
+        );
+    }
+}
+
+#[test]
+fn a_failed_run_keeps_the_previous_output_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let case = format!(
+        "{}/cases/patch-single/t3-distorted.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let bin = env!("CARGO_BIN_EXE_contact-patch");
+    assert!(Command::new(bin)
+        .args(["run", &case, "--out", out.to_str().unwrap()])
+        .status()
+        .unwrap()
+        .success());
+    let before = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let bad = dir.path().join("bad.json");
+    std::fs::write(&bad, "{\"name\": \"x\", ").unwrap();
+    let status = Command::new(bin)
+        .args(["run", bad.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .status()
+        .unwrap();
+    assert_eq!(status.code(), Some(2));
+    assert_eq!(
+        std::fs::read_to_string(out.join("summary.json")).unwrap(),
+        before
+    );
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 2, "no partial folder may remain: {names:?}");
+}
