@@ -16,14 +16,24 @@ use std::hint::black_box;
 fn distorted(kind: ElementKind) -> Vec<[f64; 2]> {
     kind.node_coordinates()
         .iter()
-        .map(|&[s, t]| [2.0 + 1.3 * s + 0.2 * t + 0.05 * s * t, 1.0 + 0.1 * s + 0.9 * t])
+        .map(|&[s, t]| {
+            [
+                2.0 + 1.3 * s + 0.2 * t + 0.05 * s * t,
+                1.0 + 0.1 * s + 0.9 * t,
+            ]
+        })
         .collect()
 }
 
 fn kernels(c: &mut Criterion) {
     let mat = Elasticity::new(1000.0, 0.3, contact_patch::scene::Plane::Strain);
     let mut group = c.benchmark_group("element_stiffness");
-    for kind in [ElementKind::Q4, ElementKind::Q9, ElementKind::T3, ElementKind::T6] {
+    for kind in [
+        ElementKind::Q4,
+        ElementKind::Q9,
+        ElementKind::T3,
+        ElementKind::T6,
+    ] {
         let coords = distorted(kind);
         let rule = kind.stiffness_rule();
         let mut ke = [0.0; MAX_DOFS * MAX_DOFS];
@@ -52,7 +62,9 @@ fn assembly(c: &mut Criterion) {
     let mut values = vec![0.0; pattern.nnz()];
     let mut group = c.benchmark_group("q4_block_50x50");
     group.sample_size(20);
-    group.bench_function("pattern", |b| b.iter(|| stiffness_pattern(black_box(&model), &eq, n)));
+    group.bench_function("pattern", |b| {
+        b.iter(|| stiffness_pattern(black_box(&model), &eq, n))
+    });
     group.bench_function("kernels_and_scatter", |b| {
         b.iter(|| {
             values.iter_mut().for_each(|v| *v = 0.0);
@@ -65,8 +77,12 @@ fn assembly(c: &mut Criterion) {
         })
     });
     let chol = Cholesky::analyse(&pattern).unwrap();
-    group.bench_function("symbolic_cholesky", |b| b.iter(|| Cholesky::analyse(black_box(&pattern)).unwrap()));
-    group.bench_function("numeric_cholesky", |b| b.iter(|| chol.factor(&pattern, black_box(&values)).unwrap()));
+    group.bench_function("symbolic_cholesky", |b| {
+        b.iter(|| Cholesky::analyse(black_box(&pattern)).unwrap())
+    });
+    group.bench_function("numeric_cholesky", |b| {
+        b.iter(|| chol.factor(&pattern, black_box(&values)).unwrap())
+    });
     group.finish();
 }
 

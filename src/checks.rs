@@ -34,6 +34,77 @@ fn relative(got: f64, value: f64) -> f64 {
     }
 }
 
+/// Max over the rows of `pair` (all pairs if `None`) of `|lambda_i / A_i - p_i| / max|sigma|`,
+/// with `p_i = -n . sigma_exact . n` the exact contact pressure at the slave node. Infinite
+/// when the solve produced no contact state.
+pub fn pressure_error(
+    model: &Model,
+    solution: &Solution,
+    exact: &crate::exact::ExactField,
+    pair: Option<usize>,
+) -> f64 {
+    let Some(state) = &solution.contact else {
+        return f64::INFINITY;
+    };
+    let mut worst = 0.0f64;
+    for (i, r) in state.rows.iter().enumerate() {
+        if pair.is_some_and(|k| k != r.pair) {
+            continue;
+        }
+        let s = exact.stress(r.point);
+        let scale = s
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(f64::MIN_POSITIVE);
+        let n = r.normal;
+        let p = -(n[0] * (s[0] * n[0] + s[2] * n[1]) + n[1] * (s[2] * n[0] + s[1] * n[1]));
+        let e = (state.forces[i] / r.area - p).abs() / scale;
+        worst = if e.is_nan() || e > worst { e } else { worst };
+    }
+    let _ = model;
+    worst
+}
+
+/// Largest of: the net contact force and moment (relative to the sum of |contact forces|,
+/// moments divided by the model size) and the relative equilibrium residual of the solve.
+pub fn force_balance(model: &Model, solution: &Solution) -> f64 {
+    let Some(state) = &solution.contact else {
+        return f64::INFINITY;
+    };
+    let (mut fx, mut fy, mut moment, mut total) = (0.0, 0.0, 0.0, 0.0f64);
+    for (r, &lambda) in state.rows.iter().zip(&state.forces) {
+        total += lambda.abs();
+        for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
+            let body = model
+                .bodies
+                .iter()
+                .find(|b| d >= b.dof_offset && d < b.dof_offset + b.dof_count())
+                .expect("a body owns every dof");
+            let local = d - body.dof_offset;
+            let p = body.mesh.nodes[local / 2];
+            let f = c * lambda;
+            if local % 2 == 0 {
+                fx += f;
+                moment -= p[1] * f;
+            } else {
+                fy += f;
+                moment += p[0] * f;
+            }
+        }
+    }
+    let size = model
+        .bodies
+        .iter()
+        .map(|b| b.mesh.size())
+        .fold(0.0, f64::max);
+    let net = if total > 0.0 {
+        fx.abs().max(fy.abs()).max(moment.abs() / size) / total
+    } else {
+        0.0
+    };
+    net.max(solution.relative_residual)
+}
+
 /// Judge every check of the model (names were resolved when the model was built).
 pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
     let u = &solution.u;
@@ -72,6 +143,12 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
                     let got: f64 = b.mesh.node_sets[set].iter().map(|&n| solution.reactions[b.dof(n, comp)]).sum();
                     (format!("reaction {component:?} on {body}.{set} = {got:.6e} (expected {value})"), relative(got, *value), *tol)
                 }
+                Check::ContactPressure { pair, tol } => {
+                    let exact = model.exact.as_ref().expect("resolved when the model was built");
+                    let k = model.contact.iter().position(|p| p.name == *pair).expect("resolved when the model was built");
+                    (format!("contact pressure of '{pair}' against the exact stress"), pressure_error(model, solution, exact, Some(k)), *tol)
+                }
+                Check::ForceBalance { tol } => ("force balance of the contact forces and equilibrium".to_string(), force_balance(model, solution), *tol),
                 Check::Displacement { body, point, component, value, tol } => {
                     let b = model.body(body).expect("resolved when the model was built");
                     let (n, _) = b.mesh.nearest_node(*point).expect("a body has nodes");

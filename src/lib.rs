@@ -25,6 +25,7 @@
 //! [`solve`]; a scene that does not ask for them never builds them.
 
 pub mod checks;
+pub mod contact;
 pub mod error;
 pub mod exact;
 pub mod fe;

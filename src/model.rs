@@ -23,7 +23,8 @@ use crate::exact::ExactField;
 use crate::fe::{point_values, ElementKind};
 use crate::mesh::{block, Facet, Mesh};
 use crate::scene::{
-    Case, Check, FacetSetSpec, MeshSpec, NodeSetSpec, Physics, Plane, Prescribed, TractionSpec,
+    Case, Check, DiscretizationSpec, EnforcementSpec, FacetSetSpec, MeshSpec, NodeSetSpec, Physics,
+    Plane, Prescribed, RigidSurface, SweepSpec, TractionSpec,
 };
 use crate::solid::{check_geometry, Elasticity};
 use std::path::Path;
@@ -58,6 +59,41 @@ impl Body {
     }
 }
 
+/// The master side of a resolved contact pair.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MasterSide {
+    Body { body: usize, facets: Vec<Facet> },
+    Rigid(RigidSurface),
+}
+
+/// A contact pair with its names resolved.
+#[derive(Clone, Debug)]
+pub struct ContactPair {
+    pub name: String,
+    /// Slave body index and facets.
+    pub slave: (usize, Vec<Facet>),
+    pub master: MasterSide,
+    pub discretization: DiscretizationSpec,
+    pub enforcement: EnforcementSpec,
+}
+
+impl ContactPair {
+    /// The same pair with slave and master exchanged (a body master is required).
+    pub fn swapped(&self) -> Option<ContactPair> {
+        match &self.master {
+            MasterSide::Body { body, facets } => Some(ContactPair {
+                slave: (*body, facets.clone()),
+                master: MasterSide::Body {
+                    body: self.slave.0,
+                    facets: self.slave.1.clone(),
+                },
+                ..self.clone()
+            }),
+            MasterSide::Rigid(_) => None,
+        }
+    }
+}
+
 /// A validated scene, ready to solve.
 #[derive(Clone, Debug)]
 pub struct Model {
@@ -79,6 +115,10 @@ pub struct Model {
     pub checks: Vec<Check>,
     /// `(body index, node set)` of every support, for reaction summaries.
     pub support_sets: Vec<(usize, String)>,
+    /// Contact pairs (empty: no contact is simulated).
+    pub contact: Vec<ContactPair>,
+    /// The case's sweep (used by `contact-patch table`).
+    pub sweep: Option<SweepSpec>,
 }
 
 /// Read, parse and validate a case file.
@@ -220,9 +260,12 @@ impl Model {
             physics: case.physics.clone(),
             checks: Vec::new(),
             support_sets: Vec::new(),
+            contact: Vec::new(),
+            sweep: case.sweep.clone(),
         };
         model.apply_supports(case)?;
         model.apply_loads(case)?;
+        model.resolve_contact(case)?;
         model.resolve_checks(case)?;
         model.check_rigid_modes()?;
         Ok(model)
@@ -435,6 +478,140 @@ impl Model {
         Ok(())
     }
 
+    fn resolve_contact(&mut self, case: &Case) -> Result<()> {
+        for (k, spec) in case.contact.iter().enumerate() {
+            let at = format!("contact[{k}] '{}'", spec.name);
+            if self.contact.iter().any(|p| p.name == spec.name) {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    "a second contact pair has this name",
+                    "give every pair a unique name",
+                ));
+            }
+            let slave_body = self.find_body(&spec.slave.body, &format!("{at}.slave"))?;
+            let slave_facets = self
+                .find_facet_set(slave_body, &spec.slave.set, &format!("{at}.slave"))?
+                .to_vec();
+            let slave = (
+                self.body_index(&spec.slave.body).expect("found"),
+                slave_facets,
+            );
+            let m = &spec.master;
+            let master = match (&m.body, &m.set, &m.rigid) {
+                (Some(b), Some(set), None) => {
+                    let body = self.find_body(b, &format!("{at}.master"))?;
+                    let facets = self.find_facet_set(body, set, &format!("{at}.master"))?.to_vec();
+                    let body = self.body_index(b).expect("found");
+                    if body == slave.0 {
+                        return Err(Error::invalid(&self.source, format!("{at}.master"), "self-contact (slave and master on one body) is not supported", "use two bodies"));
+                    }
+                    MasterSide::Body { body, facets }
+                }
+                (None, None, Some(rigid)) => {
+                    let ok = match *rigid {
+                        RigidSurface::Line { point, normal } => {
+                            point.iter().chain(&normal).all(|v| v.is_finite()) && normal.iter().any(|&v| v != 0.0)
+                        }
+                        RigidSurface::Circle { centre, radius } => centre.iter().all(|v| v.is_finite()) && radius.is_finite() && radius > 0.0,
+                    };
+                    if !ok {
+                        return Err(Error::invalid(&self.source, format!("{at}.master.rigid"), "the rigid surface is degenerate (zero normal, non-positive radius or non-finite values)", "give a non-zero normal or a positive radius"));
+                    }
+                    MasterSide::Rigid(rigid.clone())
+                }
+                _ => {
+                    return Err(Error::invalid(
+                        &self.source,
+                        format!("{at}.master"),
+                        "the master needs either \"body\" and \"set\", or \"rigid\"",
+                        "e.g. {\"body\": \"foundation\", \"set\": \"top\"} or {\"rigid\": {\"kind\": \"line\", \"point\": [0, 0], \"normal\": [0, 1]}}",
+                    ))
+                }
+            };
+            if let DiscretizationSpec::NodeToSurface { passes, .. } = spec.discretization {
+                if passes != 1 && passes != 2 {
+                    return Err(Error::invalid(
+                        &self.source,
+                        format!("{at}.discretization.passes"),
+                        format!("passes must be 1 or 2, got {passes}"),
+                        "use 1 (one-pass) or 2 (two-pass)",
+                    ));
+                }
+            }
+            validate_enforcement(
+                &spec.enforcement,
+                &self.source,
+                &format!("{at}.enforcement"),
+            )?;
+            if let Some(first) = self.contact.first() {
+                if first.enforcement != spec.enforcement {
+                    return Err(Error::invalid(
+                        &self.source,
+                        &at,
+                        "all contact pairs of a case must use one enforcement method",
+                        "give every pair the same \"enforcement\"",
+                    ));
+                }
+            }
+            self.contact.push(ContactPair {
+                name: spec.name.clone(),
+                slave,
+                master,
+                discretization: spec.discretization.clone(),
+                enforcement: spec.enforcement.clone(),
+            });
+        }
+        if let Some(sweep) = &case.sweep {
+            if self.contact.is_empty() {
+                return Err(Error::invalid(
+                    &self.source,
+                    "sweep",
+                    "a sweep varies the first contact pair, but the case has none",
+                    "add a \"contact\" pair",
+                ));
+            }
+            for (k, e) in sweep.enforcements.iter().enumerate() {
+                validate_enforcement(e, &self.source, &format!("sweep.enforcements[{k}]"))?;
+            }
+            for (k, d) in sweep.discretizations.iter().enumerate() {
+                if let Some(slave) = &d.slave {
+                    let pair = &self.contact[0];
+                    let names: Vec<&str> = std::iter::once(pair.slave.0)
+                        .chain(match &pair.master {
+                            MasterSide::Body { body, .. } => Some(*body),
+                            MasterSide::Rigid(_) => None,
+                        })
+                        .map(|b| self.bodies[b].name.as_str())
+                        .collect();
+                    if !names.contains(&slave.as_str()) {
+                        return Err(Error::invalid(
+                            &self.source,
+                            format!("sweep.discretizations[{k}].slave"),
+                            format!("'{slave}' is not a body of the first contact pair"),
+                            format!("use one of {names:?}"),
+                        ));
+                    }
+                }
+            }
+            if !(sweep.penalty_factor.is_finite()
+                && sweep.penalty_factor > 0.0
+                && sweep.tol.is_finite()
+                && sweep.tol > 0.0
+                && sweep.pressure.is_finite()
+                && sweep.pressure != 0.0)
+            {
+                return Err(Error::invalid(
+                    &self.source,
+                    "sweep",
+                    "penalty_factor and tol must be positive and pressure non-zero",
+                    "e.g. \"penalty_factor\": 1000, \"tol\": 1e-10, \"pressure\": 10",
+                ));
+            }
+        }
+        Ok(())
+    }
+
     fn resolve_checks(&mut self, case: &Case) -> Result<()> {
         for (k, check) in case.checks.iter().enumerate() {
             let at = format!("checks[{k}]");
@@ -459,6 +636,31 @@ impl Model {
                     self.find_body(body, &at)?;
                     *tol
                 }
+                Check::ContactPressure { pair, tol } => {
+                    if !self.contact.iter().any(|p| p.name == *pair) {
+                        let known: Vec<&str> =
+                            self.contact.iter().map(|p| p.name.as_str()).collect();
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            format!("contact pair '{pair}' does not exist"),
+                            format!("use one of {known:?}"),
+                        ));
+                    }
+                    self.require_exact(&at)?;
+                    *tol
+                }
+                Check::ForceBalance { tol } => {
+                    if self.contact.is_empty() {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "force_balance checks contact forces, but the case has no contact",
+                            "remove the check or add a contact pair",
+                        ));
+                    }
+                    *tol
+                }
             };
             if !(tol.is_finite() && tol >= 0.0) {
                 return Err(Error::invalid(
@@ -473,9 +675,25 @@ impl Model {
         Ok(())
     }
 
-    /// Every body must be held against translation in x and y and rotation.
+    /// Every body must be held against translation in x and y and rotation: by its supports,
+    /// or, for a body in contact, by its supports together with the contact constraints (all
+    /// assumed closed) and the supports of the bodies it touches.
     fn check_rigid_modes(&self) -> Result<()> {
-        for body in &self.bodies {
+        let in_contact: Vec<bool> = (0..self.bodies.len())
+            .map(|b| {
+                self.contact.iter().any(|p| {
+                    p.slave.0 == b
+                        || matches!(&p.master, MasterSide::Body { body, .. } if *body == b)
+                })
+            })
+            .collect();
+        if in_contact.iter().any(|&c| c) {
+            self.check_rigid_modes_with_contact(&in_contact)?;
+        }
+        for (bi, body) in self.bodies.iter().enumerate() {
+            if in_contact[bi] {
+                continue;
+            }
             if let Some(mode) = free_rigid_mode(body, &self.prescribed) {
                 return Err(Error::invalid(
                     &self.source,
@@ -487,6 +705,118 @@ impl Model {
         }
         Ok(())
     }
+}
+
+impl Model {
+    /// The rigid modes of all bodies in contact (3 per body) must be restrained by the prescribed
+    /// dofs and the contact rows together: the Gram matrix of the restraints, expressed in the
+    /// modal coordinates, must be non-singular.
+    fn check_rigid_modes_with_contact(&self, in_contact: &[bool]) -> Result<()> {
+        let bodies: Vec<usize> = (0..self.bodies.len()).filter(|&b| in_contact[b]).collect();
+        let nm = 3 * bodies.len();
+        // modal value of dof d: (mode index, value) for the body owning it
+        let mode_of = |d: usize| -> Option<(usize, [f64; 3])> {
+            let (k, &b) = bodies.iter().enumerate().find(|(_, &b)| {
+                let body = &self.bodies[b];
+                d >= body.dof_offset && d < body.dof_offset + body.dof_count()
+            })?;
+            let body = &self.bodies[b];
+            let local = d - body.dof_offset;
+            let p = body.mesh.nodes[local / 2];
+            let [lo, hi] = body.mesh.bounding_box();
+            let c = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+            let s = body.mesh.size();
+            let comp = local % 2;
+            let rot = [-(p[1] - c[1]) / s, (p[0] - c[0]) / s][comp];
+            Some((
+                3 * k,
+                [
+                    if comp == 0 { 1.0 } else { 0.0 },
+                    if comp == 1 { 1.0 } else { 0.0 },
+                    rot,
+                ],
+            ))
+        };
+        let mut g = vec![0.0; nm * nm];
+        let mut add = |v: &[f64]| {
+            for a in 0..nm {
+                for b in 0..nm {
+                    g[a * nm + b] += v[a] * v[b];
+                }
+            }
+        };
+        for d in 0..self.dof_count {
+            if self.prescribed[d].is_some() {
+                if let Some((base, m)) = mode_of(d) {
+                    let mut v = vec![0.0; nm];
+                    v[base..base + 3].copy_from_slice(&m);
+                    add(&v);
+                }
+            }
+        }
+        for pair in &self.contact {
+            let rows = match crate::contact::discretization::constraints(self, pair) {
+                Ok(r) => r,
+                Err(_) => continue, // reported when the pair is solved
+            };
+            for r in rows {
+                let mut v = vec![0.0; nm];
+                for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
+                    if let Some((base, m)) = mode_of(d) {
+                        for i in 0..3 {
+                            v[base + i] += c * m[i];
+                        }
+                    }
+                }
+                add(&v);
+            }
+        }
+        let (eig, vecs) = crate::contact::solver::jacobi_eigen(&g, nm);
+        let max = eig.iter().fold(0.0f64, |a, &e| a.max(e.abs()));
+        if let Some(k) = (0..nm).find(|&k| eig[k].abs() <= 1e-10 * max.max(f64::MIN_POSITIVE)) {
+            // the body that moves most in the free mode
+            let (kb, _) = (0..bodies.len())
+                .map(|j| {
+                    (
+                        j,
+                        (0..3)
+                            .map(|i| vecs[(3 * j + i) * nm + k].powi(2))
+                            .sum::<f64>(),
+                    )
+                })
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .expect("a body");
+            let comps: Vec<f64> = (0..3).map(|i| vecs[(3 * kb + i) * nm + k]).collect();
+            let what = if comps[2].abs() > comps[0].abs().max(comps[1].abs()) {
+                "rotate"
+            } else if comps[0].abs() > comps[1].abs() {
+                "translate in x"
+            } else {
+                "translate in y"
+            };
+            return Err(Error::invalid(
+                &self.source,
+                format!("body '{}'", self.bodies[bodies[kb]].name),
+                format!("the body is not held against rigid motion even with every contact closed: it can {what}"),
+                "add supports; frictionless contact holds a body only along the contact normals (e.g. fix u_x at one node of a punch)",
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn validate_enforcement(e: &EnforcementSpec, source: &str, at: &str) -> Result<()> {
+    if let Some(kappa) = crate::contact::enforcement::kappa(e) {
+        if !(kappa.is_finite() && kappa > 0.0) {
+            return Err(Error::invalid(
+                source,
+                at,
+                format!("kappa must be positive and finite, got {kappa}"),
+                "a penalty of 10 to 1000 times E / h is a common start",
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The first rigid-body mode (translation x, translation y, rotation) that the prescribed dofs

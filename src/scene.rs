@@ -33,8 +33,153 @@ pub struct Case {
     pub exact: Option<ExactSpec>,
     #[serde(default)]
     pub physics: Physics,
+    /// Contact pairs (frictionless, small strain).
+    #[serde(default)]
+    pub contact: Vec<ContactSpec>,
+    /// Variants of the contact pairs that `contact-patch table` runs (the case itself runs
+    /// the pairs as written).
+    #[serde(default)]
+    pub sweep: Option<SweepSpec>,
     #[serde(default)]
     pub checks: Vec<Check>,
+}
+
+/// A facet set of a body.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceSpec {
+    pub body: String,
+    pub set: String,
+}
+
+/// A rigid, fixed analytic master surface.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum RigidSurface {
+    /// The line through `point`; `normal` points to the side where the slave body lives.
+    Line { point: [f64; 2], normal: [f64; 2] },
+    /// A circle; the slave body lives outside it.
+    Circle { centre: [f64; 2], radius: f64 },
+}
+
+/// The master side of a pair: a facet set of a body, or a rigid surface.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MasterSpec {
+    #[serde(default)]
+    pub body: Option<String>,
+    #[serde(default)]
+    pub set: Option<String>,
+    #[serde(default)]
+    pub rigid: Option<RigidSurface>,
+}
+
+/// One contact pair: slave facets against master facets (or a rigid surface), with a
+/// discretization and an enforcement method.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    pub name: String,
+    pub slave: SurfaceSpec,
+    pub master: MasterSpec,
+    pub discretization: DiscretizationSpec,
+    pub enforcement: EnforcementSpec,
+}
+
+/// Which normal defines the gap of a node-to-surface constraint.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NormalChoice {
+    /// The outward normal of the master facet at the closest point.
+    #[default]
+    Master,
+    /// The averaged normal of the slave surface at the slave node (smoother sliding).
+    Slave,
+}
+
+fn one_pass() -> u8 {
+    1
+}
+
+/// The discretization axis.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum DiscretizationSpec {
+    /// Each slave node against the master node at the same place.
+    NodeToNode,
+    /// Each slave node against the master surface; two passes add the master nodes
+    /// against the slave surface.
+    NodeToSurface {
+        #[serde(default = "one_pass")]
+        passes: u8,
+        #[serde(default)]
+        normal: NormalChoice,
+    },
+}
+
+/// When the augmented Lagrangian updates its multipliers.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MultiplierUpdate {
+    /// After every Newton (active-set) iteration.
+    #[default]
+    PerIteration,
+    /// In an outer loop, after the inner Newton loop has converged.
+    OuterLoop,
+}
+
+/// The enforcement axis. `kappa` is a penalty per unit contact area (pressure per gap).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum EnforcementSpec {
+    Lagrange,
+    PerturbedLagrange {
+        kappa: f64,
+    },
+    Penalty {
+        kappa: f64,
+    },
+    PerturbedTangent {
+        kappa: f64,
+    },
+    AugmentedLagrange {
+        kappa: f64,
+        #[serde(default)]
+        update: MultiplierUpdate,
+    },
+    Elimination,
+}
+
+/// One discretization variant of a sweep: a discretization, and which body is the slave of
+/// a one-pass run (default: the pair's own slave).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepDiscretization {
+    pub discretization: DiscretizationSpec,
+    #[serde(default)]
+    pub slave: Option<String>,
+}
+
+/// The product of discretizations and enforcements that `contact-patch table` runs on the
+/// case's first contact pair.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepSpec {
+    /// Label of the mesh in tables (e.g. "A").
+    pub mesh: String,
+    pub discretizations: Vec<SweepDiscretization>,
+    pub enforcements: Vec<EnforcementSpec>,
+    /// Penalty-type methods run again with kappa times this factor.
+    #[serde(default = "thousand")]
+    pub penalty_factor: f64,
+    /// Uniform pressure of the patch test, for the pressure error.
+    pub pressure: f64,
+    /// Tolerance of the patch-test verdict (relative to the pressure).
+    pub tol: f64,
+}
+
+fn thousand() -> f64 {
+    1000.0
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -295,6 +440,11 @@ pub enum Check {
         value: f64,
         tol: f64,
     },
+    /// Every active contact force of a pair equals `-n . sigma_exact . n` times its
+    /// tributary area (relative to `max |sigma_exact|`); needs the case's exact solution.
+    ContactPressure { pair: String, tol: f64 },
+    /// Sum of the contact forces and the equilibrium residual, relative to the largest force.
+    ForceBalance { tol: f64 },
     /// Displacement component at the node nearest to `point`.
     Displacement {
         body: String,

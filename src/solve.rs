@@ -41,6 +41,8 @@ pub struct Solution {
     /// Largest |K u - f| at a free dof relative to the largest external or reaction force.
     pub relative_residual: f64,
     pub timings: Timings,
+    /// What the contact solve found, when the model has contact pairs.
+    pub contact: Option<crate::contact::solver::ContactState>,
 }
 
 /// Equation number of each global dof (`NO_EQUATION` for prescribed dofs).
@@ -59,22 +61,6 @@ pub fn number_equations(model: &Model) -> (Vec<usize>, usize) {
         })
         .collect();
     (eq, count)
-}
-
-/// Sparsity pattern of `K_ff` from the cells of every body.
-pub fn stiffness_pattern(model: &Model, eq: &[usize], n: usize) -> SymmetricPattern {
-    let mut builder = PatternBuilder::new(n);
-    let mut dofs = Vec::with_capacity(MAX_DOFS);
-    let mut eqs = Vec::with_capacity(MAX_DOFS);
-    for body in &model.bodies {
-        for c in 0..body.mesh.cell_count() {
-            body.cell_dofs(c, &mut dofs);
-            eqs.clear();
-            eqs.extend(dofs.iter().map(|&d| eq[d]));
-            builder.add_block(&eqs);
-        }
-    }
-    builder.build()
 }
 
 /// Calls `visit(dofs, ke)` for every cell of every body.
@@ -101,91 +87,166 @@ pub fn for_each_element_stiffness(model: &Model, mut visit: impl FnMut(&[usize],
     }
 }
 
-/// Solve the linear static problem. `progress` is told the name of each stage as it starts.
-pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
-    let mut timings = Timings::default();
-    let t = Instant::now();
-    progress("assembling");
+/// The assembled stiffness over the free equations: `K_ff` and `f_f - K_fp u_p`.
+pub struct LinearSystem {
+    /// Equation of each global dof (`NO_EQUATION` when prescribed).
+    pub eq: Vec<usize>,
+    pub n: usize,
+    pub pattern: SymmetricPattern,
+    /// Values of `K_ff` on `pattern`.
+    pub k: Vec<f64>,
+    /// `f_f - K_fp u_p`.
+    pub rhs: Vec<f64>,
+    /// Global vector holding the prescribed values (zero at free dofs).
+    pub u_prescribed: Vec<f64>,
+}
+
+impl LinearSystem {
+    /// Global displacement from the free-equation solution `x`.
+    pub fn expand(&self, x: &[f64]) -> Vec<f64> {
+        let mut u = self.u_prescribed.clone();
+        for (d, &e) in self.eq.iter().enumerate() {
+            if e != NO_EQUATION {
+                u[d] = x[e];
+            }
+        }
+        u
+    }
+
+    /// The error for a stiffness that cannot be factored.
+    pub fn singular(&self, model: &Model, equation: Option<usize>) -> Error {
+        let where_ = equation
+            .and_then(|e| self.eq.iter().position(|&x| x == e))
+            .map(|d| describe_dof(model, d))
+            .unwrap_or_else(|| "an unknown equation".into());
+        Error::Solver {
+            path: model.source.clone(),
+            problem: format!("the stiffness matrix is singular or not positive definite (first bad pivot at {where_})"),
+            hint: "a part of a body may be disconnected from the supports (a mechanism), or a body held only by contact lost it; add supports or connect it".into(),
+        }
+    }
+
+    pub fn factor_error(&self, model: &Model, e: FactorError) -> Error {
+        match e {
+            FactorError::NotPositiveDefinite { equation } => self.singular(model, Some(equation)),
+            FactorError::Other(msg) => Error::Solver {
+                path: model.source.clone(),
+                problem: format!("the factorization failed: {msg}"),
+                hint: "the problem may be too large for the memory of this machine".into(),
+            },
+        }
+    }
+}
+
+/// Assemble `K_ff` and the right-hand side. `extra_blocks` (global dofs) are added to the
+/// sparsity pattern, e.g. the dofs coupled by contact constraints.
+pub fn assemble(model: &Model, extra_blocks: &[Vec<usize>]) -> LinearSystem {
     let (eq, n) = number_equations(model);
-    let mut u: Vec<f64> = model.prescribed.iter().map(|p| p.unwrap_or(0.0)).collect();
-    let pattern = stiffness_pattern(model, &eq, n);
-    let mut values = vec![0.0; pattern.nnz()];
+    let u_prescribed: Vec<f64> = model.prescribed.iter().map(|p| p.unwrap_or(0.0)).collect();
+    let mut builder = PatternBuilder::new(n);
+    let mut dofs = Vec::with_capacity(MAX_DOFS);
+    let mut eqs = Vec::with_capacity(MAX_DOFS);
+    for body in &model.bodies {
+        for c in 0..body.mesh.cell_count() {
+            body.cell_dofs(c, &mut dofs);
+            eqs.clear();
+            eqs.extend(dofs.iter().map(|&d| eq[d]));
+            builder.add_block(&eqs);
+        }
+    }
+    for block in extra_blocks {
+        let eqs: Vec<usize> = block.iter().map(|&d| eq[d]).collect();
+        builder.add_block(&eqs);
+    }
+    let pattern = builder.build();
+    let mut k = vec![0.0; pattern.nnz()];
     let mut rhs = vec![0.0; n];
     for (d, &e) in eq.iter().enumerate() {
         if e != NO_EQUATION {
             rhs[e] = model.external_force[d];
         }
     }
-    let mut eqs = Vec::with_capacity(MAX_DOFS);
     for_each_element_stiffness(model, |dofs, ke| {
         eqs.clear();
         eqs.extend(dofs.iter().map(|&d| eq[d]));
-        pattern.scatter(&eqs, ke, &mut values);
+        pattern.scatter(&eqs, ke, &mut k);
         // move K_fp u_p to the right-hand side
         let m = dofs.len();
         for (b, &db) in dofs.iter().enumerate() {
-            if eqs[b] != NO_EQUATION || u[db] == 0.0 {
+            if eqs[b] != NO_EQUATION || u_prescribed[db] == 0.0 {
                 continue;
             }
             for a in 0..m {
                 if eqs[a] != NO_EQUATION {
-                    rhs[eqs[a]] -= ke[a * m + b] * u[db];
+                    rhs[eqs[a]] -= ke[a * m + b] * u_prescribed[db];
                 }
             }
         }
     });
+    LinearSystem {
+        eq,
+        n,
+        pattern,
+        k,
+        rhs,
+        u_prescribed,
+    }
+}
+
+/// Solve the static problem (with contact when the model has contact pairs). `progress` is
+/// told the name of each stage as it starts.
+pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+    if !model.contact.is_empty() {
+        return crate::contact::solver::solve(model, progress);
+    }
+    let mut timings = Timings::default();
+    let t = Instant::now();
+    progress("assembling");
+    let sys = assemble(model, &[]);
     timings.assembly = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
     progress("factorizing");
-    let singular = |equation: Option<usize>| {
-        let where_ = equation
-            .and_then(|e| eq.iter().position(|&x| x == e))
-            .map(|d| describe_dof(model, d))
-            .unwrap_or_else(|| "an unknown equation".into());
-        Error::Solver {
-            path: model.source.clone(),
-            problem: format!("the stiffness matrix is singular or not positive definite (first bad pivot at {where_})"),
-            hint: "a part of a body may be disconnected from the supports (a mechanism); add supports or connect it".into(),
-        }
-    };
-    let solution = if n > 0 {
-        let chol = Cholesky::analyse(&pattern).map_err(|e| Error::Solver {
-            path: model.source.clone(),
-            problem: format!("the symbolic factorization failed: {e:?}"),
-            hint: "the problem may be too large for the memory of this machine".into(),
-        })?;
-        let factor = chol.factor(&pattern, &values).map_err(|e| match e {
-            FactorError::NotPositiveDefinite { equation } => singular(Some(equation)),
-            FactorError::Other(msg) => Error::Solver {
-                path: model.source.clone(),
-                problem: format!("the factorization failed: {msg}"),
-                hint: "the problem may be too large for the memory of this machine".into(),
-            },
-        })?;
+    let mut x = sys.rhs.clone();
+    if sys.n > 0 {
+        let chol = Cholesky::analyse(&sys.pattern).map_err(|e| sys.factor_error(model, e))?;
+        let factor = chol
+            .factor(&sys.pattern, &sys.k)
+            .map_err(|e| sys.factor_error(model, e))?;
         timings.factorization = t.elapsed().as_secs_f64();
         let t = Instant::now();
         progress("solving");
-        factor.solve_in_place(&mut rhs);
+        factor.solve_in_place(&mut x);
         timings.solve = t.elapsed().as_secs_f64();
-        rhs
-    } else {
-        Vec::new()
-    };
-    if solution.iter().any(|v| !v.is_finite()) {
-        return Err(singular(None));
     }
-    for (d, &e) in eq.iter().enumerate() {
-        if e != NO_EQUATION {
-            u[d] = solution[e];
-        }
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err(sys.singular(model, None));
     }
-
+    let u = sys.expand(&x);
     let t = Instant::now();
-    let reactions = residual(model, &u);
+    let mut solution = finish(model, &sys, u, &[], timings);
+    solution.timings.solve += t.elapsed().as_secs_f64();
+    Ok(solution)
+}
+
+/// Reactions and the equilibrium residual of `u`, given contact nodal forces `contact_force`
+/// (global, possibly empty).
+pub fn finish(
+    model: &Model,
+    sys: &LinearSystem,
+    u: Vec<f64>,
+    contact_force: &[f64],
+    timings: Timings,
+) -> Solution {
+    let mut reactions = residual(model, &u);
+    for (r, c) in reactions.iter_mut().zip(contact_force) {
+        *r -= c;
+    }
+    let eq = &sys.eq;
     let scale = model
         .external_force
         .iter()
+        .chain(contact_force)
         .chain(
             reactions
                 .iter()
@@ -199,15 +260,15 @@ pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Sol
         .enumerate()
         .filter(|(d, _)| eq[*d] != NO_EQUATION)
         .fold(0.0f64, |m, (_, r)| m.max(r.abs()));
-    timings.solve += t.elapsed().as_secs_f64();
-    Ok(Solution {
+    Solution {
         u,
         reactions,
-        equations: n,
-        matrix_nonzeros: pattern.nnz(),
+        equations: sys.n,
+        matrix_nonzeros: sys.pattern.nnz(),
         relative_residual: if scale > 0.0 { worst / scale } else { worst },
         timings,
-    })
+        contact: None,
+    }
 }
 
 /// `K u - f`, element by element.

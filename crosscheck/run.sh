@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# The cross-check in one command (from anywhere in the repository):
+#
+#     bash crosscheck/run.sh [CASE.json ...]
+#
+# 1. finds Python 3.12 (pyenv's newest 3.12.x, else python3.12 on PATH); without it prints one
+#    line starting with "SKIPPED:" and exits 0;
+# 2. creates .venv-xcheck (repository root, git-ignored) if missing or not 3.12, and installs
+#    crosscheck/requirements.txt into it unless that exact file is already installed;
+# 3. builds our tool (cargo build --release) and runs every case into a temporary folder
+#    (kept when XCHECK_OUT=DIR is given);
+# 4. solves the same cases on the meshes our tool wrote with DOLFINx and scikit-fem;
+# 5. writes reports/crosscheck.md and reports/crosscheck.json; exits 1 when any verdict fails.
+#
+# Default cases: cases/patch-single, cases/convergence (single-body elasticity) and
+# crosscheck/cases (cross-check-only cases).
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$ROOT"
+SECONDS=0
+VENV="$ROOT/.venv-xcheck"
+REQ="$ROOT/crosscheck/requirements.txt"
+
+# --- 1. Python 3.12 ---------------------------------------------------------------------------
+PY312=""
+PYENV_ROOT_DIR="${PYENV_ROOT:-$HOME/.pyenv}"
+if command -v pyenv >/dev/null 2>&1; then
+    PYENV_ROOT_DIR="$(pyenv root)"
+fi
+if [ -d "$PYENV_ROOT_DIR/versions" ]; then
+    v="$(ls "$PYENV_ROOT_DIR/versions" | grep -E '^3\.12\.[0-9]+$' | sort -V | tail -n 1 || true)"
+    if [ -n "$v" ] && [ -x "$PYENV_ROOT_DIR/versions/$v/bin/python3" ]; then
+        PY312="$PYENV_ROOT_DIR/versions/$v/bin/python3"   # = PYENV_VERSION=$v python3
+    fi
+fi
+if [ -z "$PY312" ] && command -v python3.12 >/dev/null 2>&1; then
+    PY312="$(command -v python3.12)"
+fi
+if [ -z "$PY312" ]; then
+    echo "SKIPPED: crosscheck: no Python 3.12 interpreter (none in pyenv's versions under $PYENV_ROOT_DIR, no python3.12 on PATH); DOLFINx 0.11 wheels need Python 3.12"
+    exit 0
+fi
+
+# --- 2. the environment -----------------------------------------------------------------------
+is312() { "$1" -c 'import sys; sys.exit(0 if sys.version_info[:2] == (3, 12) else 1)' 2>/dev/null; }
+if [ ! -x "$VENV/bin/python" ] || ! is312 "$VENV/bin/python"; then
+    echo "crosscheck: creating $VENV with $PY312"
+    rm -rf "$VENV"
+    "$PY312" -m venv "$VENV"
+fi
+STAMP="$VENV/.xcheck-requirements.sha256"
+WANT="$(sha256sum "$REQ" | cut -d' ' -f1)"
+if [ "$(cat "$STAMP" 2>/dev/null || true)" != "$WANT" ]; then
+    echo "crosscheck: installing crosscheck/requirements.txt"
+    "$VENV/bin/python" -m pip install --disable-pip-version-check -q -r "$REQ"
+    echo "$WANT" > "$STAMP"
+fi
+PY="$VENV/bin/python"
+
+# --- 3. our tool -------------------------------------------------------------------------------
+cargo build --release -q
+TOOL="$ROOT/target/release/contact-patch"
+if [ -n "${XCHECK_OUT:-}" ]; then
+    OUT="$XCHECK_OUT"
+    mkdir -p "$OUT"
+else
+    OUT="$(mktemp -d "${TMPDIR:-/tmp}/xcheck.XXXXXX")"
+    trap 'rm -rf "$OUT"' EXIT
+fi
+if [ "$#" -gt 0 ]; then
+    CASES=("$@")
+else
+    CASES=(cases/patch-single/*.json cases/convergence/*.json crosscheck/cases/*.json)
+fi
+dups="$(for c in "${CASES[@]}"; do basename "$c" .json; done | sort | uniq -d)"
+if [ -n "$dups" ]; then
+    echo "crosscheck: two cases share a file name: $dups" >&2
+    exit 1
+fi
+for c in "${CASES[@]}"; do
+    name="$(basename "$c" .json)"
+    rc=0
+    "$TOOL" run "$c" --out "$OUT/$name" > "$OUT/$name.log" 2>&1 || rc=$?
+    # 1 = one of the case's own checks failed (output still written); 2 = no solution.
+    if [ "$rc" -ge 2 ]; then
+        echo "crosscheck: our tool failed on $c (exit $rc):" >&2
+        cat "$OUT/$name.log" >&2
+    fi
+done
+echo "crosscheck: our tool ran ${#CASES[@]} cases ($SECONDS s so far)"
+
+# --- 4. the references --------------------------------------------------------------------------
+# Their own failures are recorded in the reference files and fail the verdicts in step 5.
+"$PY" crosscheck/ref_dolfinx.py "$OUT" "${CASES[@]}" > "$OUT/dolfinx.log" 2>&1 \
+    || { echo "crosscheck: DOLFINx reported errors:" >&2; cat "$OUT/dolfinx.log" >&2; }
+"$PY" crosscheck/ref_skfem.py "$OUT" "${CASES[@]}" > "$OUT/skfem.log" 2>&1 \
+    || { echo "crosscheck: scikit-fem reported errors:" >&2; cat "$OUT/skfem.log" >&2; }
+
+# --- 5. the verdicts ------------------------------------------------------------------------------
+echo "$SECONDS" > "$OUT/elapsed"
+"$PY" crosscheck/report.py "$OUT" reports/crosscheck.md reports/crosscheck.json "${CASES[@]}"

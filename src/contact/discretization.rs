@@ -1,0 +1,280 @@
+//! The discretization axis: contact pairs turned into [`Constraint`] rows.
+//!
+//! * **Node-to-node**: slave node `s` against the master node `m` at the same place,
+//!   `g = n_m . (x_s - x_m)` with the master's nodal normal. Needs the two surfaces' nodes to
+//!   match one to one.
+//! * **Node-to-surface** (Hallquist's slave-node/master-segment pair): slave node `s` against
+//!   the point `xi` of a master facet, `g = nu . (x_s - sum_b N_b(xi) x_b)`, so the row is
+//!   `nu` on the slave dofs and `-N_b(xi) nu` on the facet's dofs. With **master normals**
+//!   `xi` is the closest point and `nu` the facet's outward normal there; with **slave
+//!   normals** `nu = -n_s` (the slave surface's nodal normal, reversed) and `xi` is where the
+//!   ray from the slave node along `nu` meets the facet (Taylor 2004: smoother sliding).
+//!   **Corner condition**: a slave node that projects inside no facet but lies in the wedge
+//!   outside a convex master corner is held against the corner vertex, along the direction
+//!   from the vertex to the node (or the vertex's averaged normal when it sits on it).
+//! * **Two-pass**: the rows of the pass with the roles swapped are appended (pass 2).
+//! * **Rigid masters**: a line `g = n . (x_s - p)` or a circle `g = |x_s - c| - R` with
+//!   `n = (x_s - c)/|x_s - c|`; only slave dofs appear.
+//!
+//! Every row carries the slave node's tributary area, so penalty forces (`kappa A g`) do not
+//! depend on the mesh. Geometry is evaluated in the reference configuration (small strain).
+
+use super::geometry::{closest_point, edge_shape, facet_point, ray_point, unit_normal, Surface};
+use super::search::BucketGrid;
+use super::Constraint;
+use crate::model::{ContactPair, MasterSide, Model};
+use crate::scene::{DiscretizationSpec, NormalChoice, RigidSurface};
+
+/// Tolerance on the facet parameter for "inside the facet".
+const INSIDE: f64 = 1e-9;
+
+/// The constraint rows of `pair`, or the reason the discretization does not apply.
+pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>, String> {
+    let slave_body = &model.bodies[pair.slave.0];
+    let slave = Surface::new(pair.slave.0, slave_body, &pair.slave.1, model.thickness);
+    match (&pair.discretization, &pair.master) {
+        (_, MasterSide::Rigid(rigid)) => match pair.discretization {
+            DiscretizationSpec::NodeToSurface { passes: 1, .. } => {
+                Ok(rigid_rows(model, &slave, rigid))
+            }
+            DiscretizationSpec::NodeToNode => {
+                Err("node-to-node needs a master body with nodes, not a rigid surface".into())
+            }
+            _ => Err(
+                "two passes need a master body; a rigid surface has no nodes to act as slaves"
+                    .into(),
+            ),
+        },
+        (DiscretizationSpec::NodeToNode, MasterSide::Body { body, facets }) => {
+            let master = Surface::new(*body, &model.bodies[*body], facets, model.thickness);
+            node_to_node(model, &slave, &master)
+        }
+        (
+            DiscretizationSpec::NodeToSurface { passes, normal },
+            MasterSide::Body { body, facets },
+        ) => {
+            let master = Surface::new(*body, &model.bodies[*body], facets, model.thickness);
+            let mut rows = node_to_surface(model, &slave, &master, *normal, 1);
+            if *passes == 2 {
+                rows.extend(node_to_surface(model, &master, &slave, *normal, 2));
+            }
+            Ok(rows)
+        }
+    }
+}
+
+fn owner(dofs: &[usize], coeffs: &[f64], slave_dofs: usize) -> usize {
+    let k = (0..slave_dofs)
+        .max_by(|&a, &b| coeffs[a].abs().total_cmp(&coeffs[b].abs()))
+        .expect("a slave dof");
+    dofs[k]
+}
+
+/// A row `nu . (u_s - sum_b w_b u_b)` with zero coefficients dropped.
+#[allow(clippy::too_many_arguments)]
+fn row(
+    model: &Model,
+    slave: &Surface,
+    node: usize,
+    nu: [f64; 2],
+    g0: f64,
+    master: Option<(&Surface, &[usize], &[f64])>,
+    pass: u8,
+) -> Constraint {
+    let sb = &model.bodies[slave.body];
+    let mut dofs = Vec::new();
+    let mut coeffs = Vec::new();
+    for i in 0..2 {
+        if nu[i].abs() > 1e-14 {
+            dofs.push(sb.dof(node, i));
+            coeffs.push(nu[i]);
+        }
+    }
+    let slave_dofs = dofs.len();
+    if let Some((m, nodes, weights)) = master {
+        let mb = &model.bodies[m.body];
+        for (&n, &w) in nodes.iter().zip(weights) {
+            for i in 0..2 {
+                let c = -w * nu[i];
+                if c.abs() > 1e-14 {
+                    dofs.push(mb.dof(n, i));
+                    coeffs.push(c);
+                }
+            }
+        }
+    }
+    let owner = owner(&dofs, &coeffs, slave_dofs);
+    Constraint {
+        dofs,
+        coeffs,
+        g0,
+        area: slave.nodes[&node].area,
+        normal: nu,
+        slave_body: slave.body,
+        slave_node: node,
+        point: sb.mesh.nodes[node],
+        pass,
+        owner,
+        pair: 0,
+    }
+}
+
+fn node_to_node(
+    model: &Model,
+    slave: &Surface,
+    master: &Surface,
+) -> Result<Vec<Constraint>, String> {
+    let mb = &model.bodies[master.body];
+    let sb = &model.bodies[slave.body];
+    let tol = 1e-9 * mb.mesh.size();
+    let master_nodes: Vec<usize> = master.nodes.keys().copied().collect();
+    let grid = BucketGrid::new(
+        master_nodes
+            .iter()
+            .map(|&n| [mb.mesh.nodes[n], mb.mesh.nodes[n]])
+            .collect(),
+    );
+    let mut rows = Vec::new();
+    let mut used = vec![false; master_nodes.len()];
+    for (&s, _) in &slave.nodes {
+        let p = sb.mesh.nodes[s];
+        let hit = grid.query(p, tol).into_iter().next();
+        let Some(k) = hit else {
+            return Err(format!(
+                "the interface nodes do not match: slave node at ({}, {}) has no master node there",
+                p[0], p[1]
+            ));
+        };
+        used[k] = true;
+        let m = master_nodes[k];
+        let n = master.nodes[&m].normal;
+        let x = mb.mesh.nodes[m];
+        let g0 = n[0] * (p[0] - x[0]) + n[1] * (p[1] - x[1]);
+        rows.push(row(model, slave, s, n, g0, Some((master, &[m], &[1.0])), 1));
+    }
+    if let Some(k) = used.iter().position(|u| !u) {
+        let x = mb.mesh.nodes[master_nodes[k]];
+        return Err(format!(
+            "the interface nodes do not match: master node at ({}, {}) has no slave node there",
+            x[0], x[1]
+        ));
+    }
+    Ok(rows)
+}
+
+fn node_to_surface(
+    model: &Model,
+    slave: &Surface,
+    master: &Surface,
+    normal: NormalChoice,
+    pass: u8,
+) -> Vec<Constraint> {
+    let sb = &model.bodies[slave.body];
+    let mb = &model.bodies[master.body];
+    let grid = BucketGrid::new(master.boxes());
+    let radius = master.facet_size();
+    let tol = 1e-12 * mb.mesh.size();
+    let kind = master.kind;
+    let mut rows = Vec::new();
+    for (&s, data) in &slave.nodes {
+        let p = sb.mesh.nodes[s];
+        let candidates = grid.query(p, radius);
+        // (|distance|, facet, parameter, normal)
+        let mut best: Option<(f64, usize, f64, [f64; 2])> = None;
+        for &f in &candidates {
+            let coords = &master.coords[f];
+            let (xi, nu) = match normal {
+                NormalChoice::Master => {
+                    let xi = closest_point(kind, coords, p);
+                    let (_, t) = facet_point(kind, coords, xi.clamp(-1.0, 1.0));
+                    (xi, unit_normal(t))
+                }
+                NormalChoice::Slave => {
+                    let nu = [-data.normal[0], -data.normal[1]];
+                    (ray_point(kind, coords, p, nu), nu)
+                }
+            };
+            if !(xi.abs() <= 1.0 + INSIDE) {
+                continue;
+            }
+            let xi = xi.clamp(-1.0, 1.0);
+            let (x, _) = facet_point(kind, coords, xi);
+            let d = ((p[0] - x[0]).powi(2) + (p[1] - x[1]).powi(2)).sqrt();
+            if best.is_none_or(|b| d < b.0 - tol) {
+                best = Some((d, f, xi, nu));
+            }
+        }
+        if let Some((_, f, xi, nu)) = best {
+            let coords = &master.coords[f];
+            let (x, _) = facet_point(kind, coords, xi);
+            let (n, _) = edge_shape(kind, xi);
+            let g0 = nu[0] * (p[0] - x[0]) + nu[1] * (p[1] - x[1]);
+            let k = kind.node_count();
+            rows.push(row(
+                model,
+                slave,
+                s,
+                nu,
+                g0,
+                Some((master, &master.facets[f], &n[..k])),
+                pass,
+            ));
+            continue;
+        }
+        // corner condition: the nearest vertex of the candidate facets
+        let vertex = candidates
+            .iter()
+            .flat_map(|&f| [master.facets[f][0], master.facets[f][1]])
+            .min_by(|&a, &b| {
+                let d = |n: usize| {
+                    (mb.mesh.nodes[n][0] - p[0]).powi(2) + (mb.mesh.nodes[n][1] - p[1]).powi(2)
+                };
+                d(a).total_cmp(&d(b))
+            });
+        if let Some(v) = vertex {
+            let x = mb.mesh.nodes[v];
+            let d = [p[0] - x[0], p[1] - x[1]];
+            let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+            let nu = if l > tol {
+                [d[0] / l, d[1] / l]
+            } else {
+                master.nodes[&v].normal
+            };
+            let g0 = nu[0] * d[0] + nu[1] * d[1];
+            rows.push(row(
+                model,
+                slave,
+                s,
+                nu,
+                g0,
+                Some((master, &[v], &[1.0])),
+                pass,
+            ));
+        }
+    }
+    rows
+}
+
+fn rigid_rows(model: &Model, slave: &Surface, rigid: &RigidSurface) -> Vec<Constraint> {
+    let sb = &model.bodies[slave.body];
+    slave
+        .nodes
+        .keys()
+        .map(|&s| {
+            let p = sb.mesh.nodes[s];
+            let (nu, g0) = match *rigid {
+                RigidSurface::Line { point, normal } => {
+                    let l = (normal[0] * normal[0] + normal[1] * normal[1]).sqrt();
+                    let n = [normal[0] / l, normal[1] / l];
+                    (n, n[0] * (p[0] - point[0]) + n[1] * (p[1] - point[1]))
+                }
+                RigidSurface::Circle { centre, radius } => {
+                    let d = [p[0] - centre[0], p[1] - centre[1]];
+                    let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                    ([d[0] / l, d[1] / l], l - radius)
+                }
+            };
+            row(model, slave, s, nu, g0, None, 1)
+        })
+        .collect()
+}

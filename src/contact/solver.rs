@@ -1,0 +1,699 @@
+//! The active-set Newton loop for frictionless small-strain contact, written once against
+//! [`Constraint`] rows for every enforcement method (see [`super::enforcement`]).
+//!
+//! Unknowns: free displacements `u` and one contact force `lambda_i >= 0` per row (compression
+//! positive). Equilibrium `K u = f + B^T lambda`; complementarity `g >= 0`, `lambda >= 0`,
+//! `g lambda = 0`. Each iteration solves the linear problem of the current active set, then
+//! updates the set: an active row whose force turns tensile is released, an inactive row that
+//! penetrates is activated (for penalty-type methods: a row is active when its trial force
+//! `lambda_k - kappa A g` is compressive). The loop ends with a [`Termination`] reason.
+//!
+//! Linear algebra: `M = K + sum_i w_i b_i b_i^T` over the active rows, factored by sparse
+//! Cholesky; the pattern includes every candidate row, so its symbolic analysis is done once.
+//! Lagrange multipliers come from the Schur complement `S = B M^-1 B^T` (dense, one column per
+//! active row) with `w = rho` (an augmentation that leaves the solution unchanged and makes `M`
+//! definite even for bodies held only by contact). `S` is decomposed by Jacobi rotations; its
+//! null eigenvalues are the rank deficiency of the multiplier system (duplicated constraints
+//! of a two-pass discretization), and the pseudo-inverse picks the minimum-norm multipliers,
+//! so the displacement is still returned when it exists.
+
+use super::discretization::constraints;
+use super::enforcement::{elimination_obstacle, Method};
+use super::Constraint;
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::scene::MultiplierUpdate;
+use crate::solve::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
+use crate::sparse::{Cholesky, PatternBuilder};
+use std::collections::HashSet;
+use std::time::Instant;
+
+/// Why the active-set loop stopped.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Termination {
+    Converged,
+    IterationLimit,
+    ActiveSetCycling,
+    /// The linear system could not be solved (the message says why).
+    Singular(String),
+}
+
+/// What the contact solve found.
+#[derive(Clone, Debug)]
+pub struct ContactState {
+    pub rows: Vec<Constraint>,
+    pub active: Vec<bool>,
+    /// Contact force of each row (zero when inactive).
+    pub forces: Vec<f64>,
+    pub gaps: Vec<f64>,
+    pub termination: Termination,
+    /// Linear solves performed (Newton iterations, inner and outer).
+    pub iterations: usize,
+    /// Number of dependent rows among the active constraints (rank deficiency of `B B^T`).
+    pub rank_deficiency: usize,
+}
+
+/// Most linear solves of one contact solve.
+pub const MAX_ITERATIONS: usize = 200;
+
+/// A row in equation space: free equations, coefficients, gap with prescribed values folded in.
+struct EqRow {
+    eqs: Vec<usize>,
+    coeffs: Vec<f64>,
+    g0: f64,
+}
+
+impl EqRow {
+    fn dot(&self, x: &[f64]) -> f64 {
+        self.eqs
+            .iter()
+            .zip(&self.coeffs)
+            .map(|(&e, c)| c * x[e])
+            .sum()
+    }
+    fn add_to(&self, scale: f64, y: &mut [f64]) {
+        for (&e, c) in self.eqs.iter().zip(&self.coeffs) {
+            y[e] += scale * c;
+        }
+    }
+}
+
+/// Solve the contact problem of `model` (all pairs share one enforcement method).
+pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+    let mut timings = Timings::default();
+    let t = Instant::now();
+    progress("contact search");
+    let mut rows = Vec::new();
+    for (k, pair) in model.contact.iter().enumerate() {
+        let r = constraints(model, pair).map_err(|reason| {
+            Error::invalid(
+                &model.source,
+                format!("contact '{}'", pair.name),
+                format!("the discretization does not apply: {reason}"),
+                "choose another discretization for this pair",
+            )
+        })?;
+        rows.extend(r.into_iter().map(|mut c| {
+            c.pair = k;
+            c
+        }));
+    }
+    let method = Method::from_spec(&model.contact[0].enforcement);
+    if method == Method::Elimination {
+        if let Some(why) = elimination_obstacle(&rows, &model.prescribed) {
+            return Err(Error::invalid(
+                &model.source,
+                format!("contact '{}'", model.contact[0].name),
+                format!("constraint elimination does not apply: {why}"),
+                "use another enforcement method for this pair",
+            ));
+        }
+    }
+    progress("assembling");
+    let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.dofs.clone()).collect();
+    let sys = assemble(model, &blocks);
+    let eq_rows: Vec<EqRow> = rows
+        .iter()
+        .map(|r| {
+            let mut out = EqRow {
+                eqs: Vec::new(),
+                coeffs: Vec::new(),
+                g0: r.g0,
+            };
+            for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
+                match sys.eq[d] {
+                    NO_EQUATION => out.g0 += c * sys.u_prescribed[d],
+                    e => {
+                        out.eqs.push(e);
+                        out.coeffs.push(c);
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    timings.assembly = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    progress("contact iterations");
+    let chol = Cholesky::analyse(&sys.pattern).map_err(|e| sys.factor_error(model, e))?;
+    let mut kernel = Kernel {
+        model,
+        sys: &sys,
+        rows: &eq_rows,
+        chol,
+        factorizations: 0.0,
+        solves: 0.0,
+    };
+    let state = kernel.active_set_loop(method, &rows);
+    let (x, forces, active, termination, iterations) = state;
+    let factor_time = kernel.factorizations;
+    let solve_time = kernel.solves;
+    timings.factorization = factor_time;
+    timings.solve = (t.elapsed().as_secs_f64() - factor_time).max(0.0);
+    let _ = solve_time;
+
+    let u = sys.expand(&x);
+    let mut contact_force = vec![0.0; model.dof_count];
+    for (r, &f) in rows.iter().zip(&forces) {
+        for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
+            contact_force[d] += c * f;
+        }
+    }
+    let gaps: Vec<f64> = rows.iter().map(|r| r.gap(&u)).collect();
+    let active_rows: Vec<&EqRow> = eq_rows
+        .iter()
+        .zip(&active)
+        .filter(|(_, &a)| a)
+        .map(|(r, _)| r)
+        .collect();
+    let rank_deficiency = rank_deficiency(&active_rows, sys.n);
+    let mut solution = finish(model, &sys, u, &contact_force, timings);
+    solution.contact = Some(ContactState {
+        rows,
+        active,
+        forces,
+        gaps,
+        termination,
+        iterations,
+        rank_deficiency,
+    });
+    Ok(solution)
+}
+
+struct Kernel<'a> {
+    model: &'a Model,
+    sys: &'a LinearSystem,
+    rows: &'a [EqRow],
+    chol: Cholesky,
+    factorizations: f64,
+    solves: f64,
+}
+
+type LoopResult = (Vec<f64>, Vec<f64>, Vec<bool>, Termination, usize);
+
+impl Kernel<'_> {
+    /// Size of the model, for gap tolerances.
+    fn gap_tol(&self) -> f64 {
+        let size = self
+            .model
+            .bodies
+            .iter()
+            .map(|b| b.mesh.size())
+            .fold(0.0, f64::max);
+        1e-13 * size
+    }
+
+    /// Factor `K + sum_active w_i b_i b_i^T`.
+    fn factor(
+        &mut self,
+        active: &[bool],
+        w: &[f64],
+    ) -> std::result::Result<crate::sparse::Factor, String> {
+        let t = Instant::now();
+        let mut values = self.sys.k.clone();
+        for (i, row) in self.rows.iter().enumerate() {
+            if !active[i] || w[i] == 0.0 {
+                continue;
+            }
+            let m = row.eqs.len();
+            let mut block = vec![0.0; m * m];
+            for a in 0..m {
+                for b in 0..m {
+                    block[a * m + b] = w[i] * row.coeffs[a] * row.coeffs[b];
+                }
+            }
+            self.sys.pattern.scatter(&row.eqs, &block, &mut values);
+        }
+        let f = self
+            .chol
+            .factor(&self.sys.pattern, &values)
+            .map_err(|e| self.sys.factor_error(self.model, e).to_string());
+        self.factorizations += t.elapsed().as_secs_f64();
+        f
+    }
+
+    /// Penalty-type solve: `M u = rhs + sum_active b_i (lambda_k,i - w_i g0_i)`.
+    fn regularized(
+        &mut self,
+        active: &[bool],
+        w: &[f64],
+        lambda_k: &[f64],
+    ) -> std::result::Result<Vec<f64>, String> {
+        let f = self.factor(active, w)?;
+        let mut x = self.sys.rhs.clone();
+        for (i, row) in self.rows.iter().enumerate() {
+            if active[i] {
+                row.add_to(lambda_k[i] - w[i] * row.g0, &mut x);
+            }
+        }
+        f.solve_in_place(&mut x);
+        Ok(x)
+    }
+
+    /// Lagrange multipliers by the Schur complement of the augmented system.
+    fn lagrange(&mut self, active: &[bool]) -> std::result::Result<(Vec<f64>, Vec<f64>), String> {
+        let n = self.sys.n;
+        // rho: the stiffness scale, so that M stays well conditioned
+        let mut rho = 0.0f64;
+        for j in 0..n {
+            if let Some(p) = self.sys.pattern.position(j, j) {
+                rho = rho.max(self.sys.k[p]);
+            }
+        }
+        let rho = if rho > 0.0 { rho } else { 1.0 };
+        let w = vec![rho; self.rows.len()];
+        let f = self.factor(active, &w)?;
+        let idx: Vec<usize> = (0..self.rows.len()).filter(|&i| active[i]).collect();
+        let mut z0 = self.sys.rhs.clone();
+        for &i in &idx {
+            self.rows[i].add_to(-rho * self.rows[i].g0, &mut z0);
+        }
+        f.solve_in_place(&mut z0);
+        let mut zs: Vec<Vec<f64>> = Vec::with_capacity(idx.len());
+        for &i in &idx {
+            let mut z = vec![0.0; n];
+            self.rows[i].add_to(1.0, &mut z);
+            f.solve_in_place(&mut z);
+            zs.push(z);
+        }
+        let m = idx.len();
+        let mut s = vec![0.0; m * m];
+        let mut r = vec![0.0; m];
+        for a in 0..m {
+            r[a] = -self.rows[idx[a]].g0 - self.rows[idx[a]].dot(&z0);
+            for b in 0..m {
+                s[a * m + b] = self.rows[idx[a]].dot(&zs[b]);
+            }
+        }
+        // symmetrize round-off
+        for a in 0..m {
+            for b in 0..a {
+                let v = 0.5 * (s[a * m + b] + s[b * m + a]);
+                s[a * m + b] = v;
+                s[b * m + a] = v;
+            }
+        }
+        let lam = pseudo_solve(&s, &r, m)?;
+        let mut x = z0;
+        for (k, z) in zs.iter().enumerate() {
+            for j in 0..n {
+                x[j] += lam[k] * z[j];
+            }
+        }
+        let mut forces = vec![0.0; self.rows.len()];
+        for (k, &i) in idx.iter().enumerate() {
+            forces[i] = lam[k];
+        }
+        Ok((x, forces))
+    }
+
+    /// Constraint elimination: each active row solved for its owned equation.
+    fn eliminate(
+        &mut self,
+        active: &[bool],
+        owners: &[usize],
+    ) -> std::result::Result<(Vec<f64>, Vec<f64>), String> {
+        let n = self.sys.n;
+        // map: equation -> (reduced terms, constant)
+        let mut is_owner = vec![usize::MAX; n];
+        for i in 0..self.rows.len() {
+            if active[i] {
+                is_owner[owners[i]] = i;
+            }
+        }
+        let mut reduced = vec![usize::MAX; n];
+        let mut nr = 0;
+        for e in 0..n {
+            if is_owner[e] == usize::MAX {
+                reduced[e] = nr;
+                nr += 1;
+            }
+        }
+        let mut terms: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+        let mut constant = vec![0.0; n];
+        for e in 0..n {
+            match is_owner[e] {
+                usize::MAX => terms[e].push((reduced[e], 1.0)),
+                i => {
+                    let row = &self.rows[i];
+                    let k = row
+                        .eqs
+                        .iter()
+                        .position(|&q| q == e)
+                        .expect("the owner is in its row");
+                    let co = row.coeffs[k];
+                    constant[e] = -row.g0 / co;
+                    for (&q, &c) in row.eqs.iter().zip(&row.coeffs) {
+                        if q != e {
+                            terms[e].push((reduced[q], -c / co));
+                        }
+                    }
+                }
+            }
+        }
+        let t = Instant::now();
+        let p = &self.sys.pattern;
+        let mut builder = PatternBuilder::new(nr);
+        for j in 0..n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let i = p.row_idx[k];
+                let mut block: Vec<usize> = terms[i].iter().chain(&terms[j]).map(|t| t.0).collect();
+                block.sort_unstable();
+                block.dedup();
+                builder.add_block(&block);
+            }
+        }
+        let rp = builder.build();
+        let mut values = vec![0.0; rp.nnz()];
+        for j in 0..n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let i = p.row_idx[k];
+                let kij = self.sys.k[k];
+                let pairs: &[(usize, usize)] = if i == j { &[(i, j)] } else { &[(i, j), (j, i)] };
+                for &(r, c) in pairs {
+                    for &(pr, a) in &terms[r] {
+                        for &(pc, b) in &terms[c] {
+                            if pr <= pc {
+                                values[rp.position(pr, pc).expect("in the reduced pattern")] +=
+                                    a * b * kij;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // rhs: T^T (rhs - K t)
+        let mut kt = vec![0.0; n];
+        p.mul(&self.sys.k, &constant, &mut kt);
+        let mut rb = vec![0.0; nr];
+        for e in 0..n {
+            let v = self.sys.rhs[e] - kt[e];
+            for &(q, a) in &terms[e] {
+                rb[q] += a * v;
+            }
+        }
+        let chol = Cholesky::analyse(&rp).map_err(|e| format!("{e:?}"))?;
+        let f = chol
+            .factor(&rp, &values)
+            .map_err(|e| self.sys.factor_error(self.model, e).to_string())?;
+        self.factorizations += t.elapsed().as_secs_f64();
+        f.solve_in_place(&mut rb);
+        let mut x = constant.clone();
+        for e in 0..n {
+            for &(q, a) in &terms[e] {
+                x[e] += a * rb[q];
+            }
+        }
+        // forces from the residual at the owned equations: (K x - rhs)_o = c_o lambda
+        let mut kx = vec![0.0; n];
+        p.mul(&self.sys.k, &x, &mut kx);
+        let mut forces = vec![0.0; self.rows.len()];
+        for (i, row) in self.rows.iter().enumerate() {
+            if active[i] {
+                let o = owners[i];
+                let k = row
+                    .eqs
+                    .iter()
+                    .position(|&q| q == o)
+                    .expect("the owner is in its row");
+                forces[i] = (kx[o] - self.sys.rhs[o]) / row.coeffs[k];
+            }
+        }
+        Ok((x, forces))
+    }
+
+    fn active_set_loop(&mut self, method: Method, rows: &[Constraint]) -> LoopResult {
+        let nrows = self.rows.len();
+        let gap_tol = self.gap_tol();
+        let mut active: Vec<bool> = self.rows.iter().map(|r| r.g0 <= gap_tol).collect();
+        let kappa_w = |kappa: f64| -> Vec<f64> { rows.iter().map(|r| kappa * r.area).collect() };
+        let owners: Vec<usize> = rows.iter().map(|r| self.sys.eq[r.owner]).collect();
+        let mut lambda_k = vec![0.0; nrows];
+        let mut x = vec![0.0; self.sys.n];
+        let mut forces = vec![0.0; nrows];
+        let mut seen: HashSet<Vec<bool>> = HashSet::new();
+        seen.insert(active.clone());
+        for it in 1..=MAX_ITERATIONS {
+            let step = match method {
+                Method::Lagrange => self.lagrange(&active),
+                Method::Elimination => self.eliminate(&active, &owners),
+                Method::Regularized { kappa } | Method::AugmentedLagrange { kappa, .. } => {
+                    let w = kappa_w(kappa);
+                    self.regularized(&active, &w, &lambda_k).map(|x| {
+                        let f = (0..nrows)
+                            .map(|i| {
+                                if active[i] {
+                                    lambda_k[i] - w[i] * (self.rows[i].g0 + self.rows[i].dot(&x))
+                                } else {
+                                    0.0
+                                }
+                            })
+                            .collect();
+                        (x, f)
+                    })
+                }
+                Method::PerturbedTangent { kappa } => {
+                    // Newton on the Lagrange residual with the perturbed tangent
+                    let w = kappa_w(kappa);
+                    let mut ku = vec![0.0; self.sys.n];
+                    self.sys.pattern.mul(&self.sys.k, &x, &mut ku);
+                    let mut b = vec![0.0; self.sys.n];
+                    for j in 0..self.sys.n {
+                        b[j] = self.sys.rhs[j] - ku[j];
+                    }
+                    for (i, row) in self.rows.iter().enumerate() {
+                        if active[i] {
+                            row.add_to(forces[i], &mut b);
+                            let r_g = -(row.g0 + row.dot(&x));
+                            row.add_to(w[i] * r_g, &mut b);
+                        }
+                    }
+                    match self.factor(&active, &w) {
+                        Ok(f) => {
+                            f.solve_in_place(&mut b);
+                            let xn: Vec<f64> = x.iter().zip(&b).map(|(a, d)| a + d).collect();
+                            let f = (0..nrows)
+                                .map(|i| {
+                                    if active[i] {
+                                        let r_g = -(self.rows[i].g0 + self.rows[i].dot(&x));
+                                        forces[i] + w[i] * (r_g - self.rows[i].dot(&b))
+                                    } else {
+                                        0.0
+                                    }
+                                })
+                                .collect();
+                            Ok((xn, f))
+                        }
+                        Err(e) => Err(e),
+                    }
+                }
+            };
+            let (xn, fnew) = match step {
+                Ok(v) => v,
+                Err(msg) => return (x, forces, active, Termination::Singular(msg), it),
+            };
+            x = xn;
+            forces = fnew;
+            let gaps: Vec<f64> = self.rows.iter().map(|r| r.g0 + r.dot(&x)).collect();
+            let fmax = forces.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let force_tol = 1e-10 * fmax;
+            let max_active_gap = (0..nrows)
+                .filter(|&i| active[i])
+                .fold(0.0f64, |m, i| m.max(gaps[i].abs()));
+            let new_active: Vec<bool> = match method {
+                Method::Lagrange | Method::Elimination | Method::PerturbedTangent { .. } => (0
+                    ..nrows)
+                    .map(|i| {
+                        if active[i] {
+                            forces[i] >= -force_tol
+                        } else {
+                            gaps[i] < -gap_tol
+                        }
+                    })
+                    .collect(),
+                Method::Regularized { kappa } | Method::AugmentedLagrange { kappa, .. } => (0
+                    ..nrows)
+                    .map(|i| lambda_k[i] - kappa * rows[i].area * gaps[i] > force_tol)
+                    .collect(),
+            };
+            let stable = new_active == active;
+            let converged = match method {
+                Method::Lagrange | Method::Elimination | Method::Regularized { .. } => stable,
+                Method::PerturbedTangent { .. } => stable && max_active_gap <= gap_tol,
+                Method::AugmentedLagrange { kappa, update } => {
+                    let done = stable && max_active_gap <= gap_tol;
+                    // Uzawa: lambda_k <- max(0, lambda_k - kappa A g)
+                    let uzawa = |lk: &mut Vec<f64>| {
+                        for i in 0..nrows {
+                            lk[i] = (lk[i] - kappa * rows[i].area * gaps[i]).max(0.0);
+                        }
+                    };
+                    if !done && (update == MultiplierUpdate::PerIteration || stable) {
+                        uzawa(&mut lambda_k);
+                    }
+                    done
+                }
+            };
+            if converged {
+                return (x, forces, active, Termination::Converged, it);
+            }
+            let cycles = matches!(
+                method,
+                Method::Lagrange | Method::Elimination | Method::Regularized { .. }
+            );
+            if cycles && !stable && !seen.insert(new_active.clone()) {
+                return (x, forces, new_active, Termination::ActiveSetCycling, it);
+            }
+            active = new_active;
+        }
+        (
+            x,
+            forces,
+            active,
+            Termination::IterationLimit,
+            MAX_ITERATIONS,
+        )
+    }
+}
+
+/// Minimum-norm solution of the symmetric positive semi-definite system `S x = r` (`m x m`,
+/// row-major) by Jacobi eigen-decomposition; fails when `r` is not in the range of `S`.
+fn pseudo_solve(s: &[f64], r: &[f64], m: usize) -> std::result::Result<Vec<f64>, String> {
+    if m == 0 {
+        return Ok(Vec::new());
+    }
+    let (eig, v) = jacobi_eigen(s, m);
+    let max = eig.iter().fold(0.0f64, |a, &e| a.max(e.abs()));
+    let mut x = vec![0.0; m];
+    let mut residual_in_null = 0.0f64;
+    let rnorm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+    for k in 0..m {
+        let proj: f64 = (0..m).map(|i| v[i * m + k] * r[i]).sum();
+        if eig[k].abs() > 1e-10 * max {
+            for i in 0..m {
+                x[i] += v[i * m + k] * proj / eig[k];
+            }
+        } else {
+            residual_in_null = residual_in_null.max(proj.abs());
+        }
+    }
+    if residual_in_null > 1e-8 * rnorm.max(f64::MIN_POSITIVE) && residual_in_null > 1e-14 {
+        return Err(format!(
+            "the active constraints contradict each other (the multiplier system is singular and inconsistent, residual {residual_in_null:.2e})"
+        ));
+    }
+    Ok(x)
+}
+
+/// Eigenvalues and eigenvectors (columns of `v`, row-major) of a symmetric matrix.
+pub fn jacobi_eigen(s: &[f64], m: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut a = s.to_vec();
+    let mut v = vec![0.0; m * m];
+    for i in 0..m {
+        v[i * m + i] = 1.0;
+    }
+    for _sweep in 0..100 {
+        let off: f64 = (0..m)
+            .flat_map(|i| (0..m).filter(move |&j| j != i).map(move |j| (i, j)))
+            .map(|(i, j)| a[i * m + j].powi(2))
+            .sum();
+        let diag: f64 = (0..m).map(|i| a[i * m + i].powi(2)).sum();
+        if off <= 1e-30 * diag || off == 0.0 {
+            break;
+        }
+        for p in 0..m {
+            for q in (p + 1)..m {
+                let apq = a[p * m + q];
+                if apq.abs() < 1e-300 {
+                    continue;
+                }
+                let theta = (a[q * m + q] - a[p * m + p]) / (2.0 * apq);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let sn = t * c;
+                for k in 0..m {
+                    let akp = a[k * m + p];
+                    let akq = a[k * m + q];
+                    a[k * m + p] = c * akp - sn * akq;
+                    a[k * m + q] = sn * akp + c * akq;
+                }
+                for k in 0..m {
+                    let apk = a[p * m + k];
+                    let aqk = a[q * m + k];
+                    a[p * m + k] = c * apk - sn * aqk;
+                    a[q * m + k] = sn * apk + c * aqk;
+                }
+                for k in 0..m {
+                    let vkp = v[k * m + p];
+                    let vkq = v[k * m + q];
+                    v[k * m + p] = c * vkp - sn * vkq;
+                    v[k * m + q] = sn * vkp + c * vkq;
+                }
+            }
+        }
+    }
+    ((0..m).map(|i| a[i * m + i]).collect(), v)
+}
+
+/// Number of dependent rows among `rows`: null eigenvalues of the Gram matrix `B B^T`.
+fn rank_deficiency(rows: &[&EqRow], n: usize) -> usize {
+    let m = rows.len();
+    if m == 0 {
+        return 0;
+    }
+    let mut dense = vec![0.0; n];
+    let mut g = vec![0.0; m * m];
+    for a in 0..m {
+        rows[a].add_to(1.0, &mut dense);
+        for b in 0..m {
+            g[a * m + b] = rows[b].dot(&dense);
+        }
+        for &e in &rows[a].eqs {
+            dense[e] = 0.0;
+        }
+    }
+    let (eig, _) = jacobi_eigen(&g, m);
+    let max = eig.iter().fold(0.0f64, |a, &e| a.max(e.abs()));
+    eig.iter().filter(|e| e.abs() <= 1e-10 * max).count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jacobi_recovers_a_rank_deficient_spectrum() {
+        // S = v v^T + w w^T in 3D: eigenvalues {0, |v|^2-ish, ...}, one null direction
+        let v = [1.0, 2.0, 0.5];
+        let w = [0.0, 1.0, -1.0];
+        let mut s = vec![0.0; 9];
+        for i in 0..3 {
+            for j in 0..3 {
+                s[i * 3 + j] = v[i] * v[j] + w[i] * w[j];
+            }
+        }
+        let (eig, vecs) = jacobi_eigen(&s, 3);
+        assert_eq!(eig.iter().filter(|e| e.abs() < 1e-12).count(), 1);
+        for k in 0..3 {
+            for i in 0..3 {
+                let sv: f64 = (0..3).map(|j| s[i * 3 + j] * vecs[j * 3 + k]).sum();
+                assert!((sv - eig[k] * vecs[i * 3 + k]).abs() < 1e-12);
+            }
+        }
+        // a consistent right-hand side is solved with the minimum-norm solution
+        let r: Vec<f64> = (0..3).map(|i| 2.0 * s[i * 3] + s[i * 3 + 1]).collect();
+        let x = pseudo_solve(&s, &r, 3).unwrap();
+        let back: Vec<f64> = (0..3)
+            .map(|i| (0..3).map(|j| s[i * 3 + j] * x[j]).sum())
+            .collect();
+        assert!(back.iter().zip(&r).all(|(a, b)| (a - b).abs() < 1e-12));
+        // an inconsistent one is refused
+        let null: Vec<f64> = (0..3)
+            .map(|i| vecs[i * 3 + eig.iter().position(|e| e.abs() < 1e-12).unwrap()])
+            .collect();
+        assert!(pseudo_solve(&s, &null, 3).is_err());
+    }
+}
