@@ -1,14 +1,14 @@
 //! Criterion benchmarks of the element kernels and of the global assembly.
 //!
 //! Representative configurations, not sweeps: one stiffness per element kind on a distorted
-//! cell, and pattern + scatter + factorization of a 50 x 50 Q4 plane-strain block (5,202
+//! cell, and full assembly (pattern + values), kernels + scatter, and factorization of a 50 x 50 Q4 plane-strain block (5,202
 //! dofs). Compare the figures as ratios within one run (e.g. Q9 vs Q4 kernel, factorization vs
 //! assembly), never as absolute times across machines.
 
 use contact_patch::fe::ElementKind;
 use contact_patch::model::{parse, Model};
 use contact_patch::solid::{element_stiffness, Elasticity, MAX_DOFS};
-use contact_patch::solve::{for_each_element_stiffness, number_equations, stiffness_pattern};
+use contact_patch::solve::{assemble, for_each_element_stiffness};
 use contact_patch::sparse::Cholesky;
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
@@ -57,13 +57,13 @@ fn block_model(n: usize) -> Model {
 
 fn assembly(c: &mut Criterion) {
     let model = block_model(50);
-    let (eq, n) = number_equations(&model);
-    let pattern = stiffness_pattern(&model, &eq, n);
+    let sys = assemble(&model, &[]);
+    let (eq, pattern) = (&sys.eq, &sys.pattern);
     let mut values = vec![0.0; pattern.nnz()];
     let mut group = c.benchmark_group("q4_block_50x50");
     group.sample_size(20);
-    group.bench_function("pattern", |b| {
-        b.iter(|| stiffness_pattern(black_box(&model), &eq, n))
+    group.bench_function("assemble_pattern_and_values", |b| {
+        b.iter(|| assemble(black_box(&model), &[]))
     });
     group.bench_function("kernels_and_scatter", |b| {
         b.iter(|| {
@@ -76,12 +76,12 @@ fn assembly(c: &mut Criterion) {
             });
         })
     });
-    let chol = Cholesky::analyse(&pattern).unwrap();
+    let chol = Cholesky::analyse(pattern).unwrap();
     group.bench_function("symbolic_cholesky", |b| {
-        b.iter(|| Cholesky::analyse(black_box(&pattern)).unwrap())
+        b.iter(|| Cholesky::analyse(black_box(pattern)).unwrap())
     });
     group.bench_function("numeric_cholesky", |b| {
-        b.iter(|| chol.factor(&pattern, black_box(&values)).unwrap())
+        b.iter(|| chol.factor(pattern, black_box(&values)).unwrap())
     });
     group.finish();
 }

@@ -14,6 +14,7 @@ quadrature of our tool (see common.STIFFNESS_DEGREE). Solve: PETSc LU (MUMPS).
 
 import dolfinx_solver  # noqa: F401  (must come before dolfinx and petsc4py)
 
+import json
 import sys
 import time
 from pathlib import Path
@@ -160,9 +161,11 @@ def main(argv):
                                        "basix": basix.__version__}})
             write_reference(target, pb, "dolfinx", u, extra)
             print(f"dolfinx {name}: {time.perf_counter() - t0:.1f} s", flush=True)
-        except (Unsupported, RuntimeError) as e:
+        except Exception as e:  # noqa: BLE001  (recorded; the report fails this case)
             failed += 1
-            target.write_text('{"error": %s}' % __import__("json").dumps(str(e)))
+            target.parent.mkdir(parents=True, exist_ok=True)
+            msg = str(e) if isinstance(e, (Unsupported, RuntimeError)) else f"{type(e).__name__}: {e}"
+            target.write_text(json.dumps({"error": msg}))
             print(f"dolfinx {name}: ERROR {e}", flush=True)
     return 1 if failed else 0
 

@@ -15,6 +15,7 @@ Exit status 1 when any verdict fails (including a missing or failed reference so
 """
 
 import json
+import os
 import subprocess
 import sys
 from datetime import datetime, timezone
@@ -196,7 +197,7 @@ def main(argv):
     seconds = float((root / "elapsed").read_text()) if (root / "elapsed").exists() else float("nan")
     report = {
         "generated": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
-        "ours_version": git_describe(repo),
+        "ours_version": os.environ.get("XCHECK_OURS_VERSION") or git_describe(repo),
         "python": sys.version.split()[0],
         "versions": versions,
         "tolerance": TOL,

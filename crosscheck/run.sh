@@ -7,8 +7,8 @@
 #    line starting with "SKIPPED:" and exits 0;
 # 2. creates .venv-xcheck (repository root, git-ignored) if missing or not 3.12, and installs
 #    crosscheck/requirements.txt into it unless that exact file is already installed;
-# 3. builds our tool (cargo build --release) and runs every case into a temporary folder
-#    (kept when XCHECK_OUT=DIR is given);
+# 3. builds our tool (cargo build --release; XCHECK_SKIP_BUILD=1 uses the binary already in
+#    target/release) and runs every case into a temporary folder (kept when XCHECK_OUT=DIR);
 # 4. solves the same cases on the meshes our tool wrote with DOLFINx and scikit-fem;
 # 5. writes reports/crosscheck.md and reports/crosscheck.json; exits 1 when any verdict fails.
 #
@@ -58,8 +58,14 @@ fi
 PY="$VENV/bin/python"
 
 # --- 3. our tool -------------------------------------------------------------------------------
-cargo build --release -q
 TOOL="$ROOT/target/release/contact-patch"
+XCHECK_OURS_VERSION="$(git describe --always --dirty 2>/dev/null || echo unknown)"
+if [ -z "${XCHECK_SKIP_BUILD:-}" ]; then
+    cargo build --release -q
+else
+    XCHECK_OURS_VERSION="prebuilt target/release binary of $(date -u -r "$TOOL" '+%Y-%m-%d %H:%M UTC'); tree now $XCHECK_OURS_VERSION"
+fi
+export XCHECK_OURS_VERSION
 if [ -n "${XCHECK_OUT:-}" ]; then
     OUT="$XCHECK_OUT"
     mkdir -p "$OUT"

@@ -34,6 +34,17 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Run the contact patch-test catalogue and write reports/patch-table.md and .json.
+    #[command(
+        after_help = "Example:\n  contact-patch table\n  contact-patch table cases/patch/patch-C-nu0.3.json --out /tmp/reports"
+    )]
+    Table {
+        /// Case files or folders with a sweep (default: cases/patch).
+        paths: Vec<PathBuf>,
+        /// Folder for patch-table.md and patch-table.json.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
     /// Run the checks declared in cases; exit 0 only when every check of every case passes.
     #[command(
         after_help = "Example:\n  contact-patch check cases/patch-single cases/convergence/cantilever-q4.json\n\nFolders are searched recursively for *.json case files."
@@ -50,6 +61,7 @@ fn main() -> ExitCode {
     match cli.command {
         Command::Run { case, out } => run(&case, out),
         Command::Check { paths } => check(&paths),
+        Command::Table { paths, out } => table(&paths, &out),
     }
 }
 
@@ -223,4 +235,77 @@ fn check(paths: &[PathBuf]) -> ExitCode {
         cases.len()
     );
     ExitCode::from(if errors > 0 { 2 } else { 1 })
+}
+
+fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
+    let paths = if paths.is_empty() {
+        vec![PathBuf::from("cases/patch")]
+    } else {
+        paths.to_vec()
+    };
+    let cases = match collect_cases(&paths) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = ProgressBar::new(cases.len() as u64);
+        b.set_style(
+            ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed} {msg}")
+                .expect("valid template"),
+        );
+        b
+    });
+    let start = std::time::Instant::now();
+    let mut cells = Vec::new();
+    for case in &cases {
+        let mut progress = |m: &str| {
+            if let Some(b) = &bar {
+                b.set_message(m.to_string());
+            }
+        };
+        match contact_patch::harness::run_sweep(case, &mut progress) {
+            Ok(c) => cells.extend(c),
+            Err(e) => {
+                if let Some(b) = &bar {
+                    b.finish_and_clear();
+                }
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        }
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let report = contact_patch::report::patch_report(&cells, start.elapsed().as_secs_f64());
+    let json = serde_json::to_string_pretty(&cells).expect("cells serialize") + "\n";
+    let written = std::fs::create_dir_all(out)
+        .and_then(|_| write_replacing(&out.join("patch-table.json"), &json))
+        .and_then(|_| write_replacing(&out.join("patch-table.md"), &report));
+    if let Err(e) = written {
+        eprintln!("error: {}: writing the tables failed: {e}", out.display());
+        return ExitCode::from(2);
+    }
+    println!("{}", contact_patch::report::seed_summary(&cells));
+    println!(
+        "{} cells in {:.2}s; wrote {} and {}",
+        cells.len(),
+        start.elapsed().as_secs_f64(),
+        out.join("patch-table.md").display(),
+        out.join("patch-table.json").display()
+    );
+    ExitCode::SUCCESS
+}
+
+/// Write a file under a temporary name and rename it into place.
+fn write_replacing(path: &Path, text: &str) -> std::io::Result<()> {
+    let tmp = path.with_extension("partial");
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, path)
 }

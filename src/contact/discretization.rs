@@ -136,7 +136,7 @@ fn node_to_node(
     );
     let mut rows = Vec::new();
     let mut used = vec![false; master_nodes.len()];
-    for (&s, _) in &slave.nodes {
+    for &s in slave.nodes.keys() {
         let p = sb.mesh.nodes[s];
         let hit = grid.query(p, tol).into_iter().next();
         let Some(k) = hit else {
@@ -194,7 +194,7 @@ fn node_to_surface(
                     (ray_point(kind, coords, p, nu), nu)
                 }
             };
-            if !(xi.abs() <= 1.0 + INSIDE) {
+            if xi.is_nan() || xi.abs() > 1.0 + INSIDE {
                 continue;
             }
             let xi = xi.clamp(-1.0, 1.0);

@@ -1,0 +1,377 @@
+//! The patch-test harness: expand each case's sweep (discretizations x enforcements), run every
+//! cell, judge it, and render the tables.
+//!
+//! **Verdicts** (Taylor & Papadopoulos 1991; data in `shared/design/benchmarks.md` s. 1):
+//! * `stress_error`: max over the quadrature points of both bodies and over `xx, yy, xy` of
+//!   `|sigma - sigma_exact| / p`.
+//! * `pressure_error`: max over the rows of `|lambda_i / A_i - p_i| / p`.
+//! * `force_balance`: net contact force and moment, and the equilibrium residual.
+//! * Exact methods (Lagrange, elimination, perturbed tangent, augmented Lagrangian) pass when
+//!   the stress error and, if the multipliers are unique (no rank deficiency), the pressure
+//!   error are within the sweep's tolerance, the force balance within 1e-12, and the active-set
+//!   loop converged.
+//! * Penalty-type methods (penalty, perturbed Lagrangian) satisfy the gap only approximately;
+//!   they run at `kappa` and at `penalty_factor * kappa` and are judged on the stress error: a
+//!   pass when it is round-off at both (`round-off`) or falls at least `penalty_factor / 10`
+//!   times (`1/kappa`, a consistent method converging as the penalty grows); a fail when it
+//!   does not fall (`no fall`: a consistency failure).
+//! * **Stability**: `rank_deficiency` counts dependent active constraints; a singular
+//!   multiplier system fails the stability half of the test even when the displacements pass.
+//! * `n/a` cells say why the combination does not apply.
+
+use crate::contact::discretization::constraints;
+use crate::contact::enforcement::{elimination_obstacle, kappa, name, scaled};
+use crate::contact::solver::Termination;
+use crate::error::Result;
+use crate::model::{load, Model};
+use crate::post::for_each_quadrature_stress;
+use crate::scene::{DiscretizationSpec, EnforcementSpec};
+use crate::solve::{solve_static, Solution};
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+
+/// One cell of the patch table.
+#[derive(Clone, Debug, Serialize)]
+pub struct Cell {
+    pub case: String,
+    pub mesh: String,
+    pub nu: f64,
+    pub discretization: String,
+    pub passes: Option<u8>,
+    pub slave: Option<String>,
+    pub enforcement: String,
+    pub kappa: Option<f64>,
+    pub verdict: String,
+    pub stress_error: Option<f64>,
+    /// Penalty-type methods: the stress error at `penalty_factor * kappa`.
+    pub stress_error_stiff: Option<f64>,
+    /// Penalty-type methods: `round-off`, `1/kappa` or `no fall`.
+    pub penalty_trend: Option<String>,
+    pub pressure_error: Option<f64>,
+    pub force_balance: Option<f64>,
+    pub max_penetration: Option<f64>,
+    pub rank_deficiency: Option<usize>,
+    pub newton_iterations: Option<usize>,
+    pub termination: Option<String>,
+    pub time_ms: f64,
+    pub note: String,
+}
+
+/// What one solve measured.
+struct Measured {
+    stress_error: f64,
+    pressure_error: f64,
+    force_balance: f64,
+    max_penetration: f64,
+    rank_deficiency: usize,
+    iterations: usize,
+    termination: Termination,
+}
+
+fn measure(model: &Model, solution: &Solution, pressure: f64) -> Measured {
+    let exact = model.exact.as_ref();
+    let mut stress_error = 0.0f64;
+    if let Some(exact) = exact {
+        for body in &model.bodies {
+            for_each_quadrature_stress(body, &solution.u, |_, x, s| {
+                let se = exact.stress(x);
+                for i in 0..3 {
+                    let e = (s[i] - se[i]).abs() / pressure.abs();
+                    stress_error = if e.is_nan() || e > stress_error {
+                        e
+                    } else {
+                        stress_error
+                    };
+                }
+            });
+        }
+    }
+    let state = solution.contact.as_ref().expect("a contact solve");
+    let pressure_error = exact
+        .map(|e| crate::checks::pressure_error(solution, e, None, Some(pressure.abs())))
+        .unwrap_or(f64::NAN);
+    Measured {
+        stress_error,
+        pressure_error,
+        force_balance: crate::checks::force_balance(model, solution),
+        max_penetration: state.gaps.iter().fold(0.0f64, |m, &g| m.max(-g)),
+        rank_deficiency: state.rank_deficiency,
+        iterations: state.iterations,
+        termination: state.termination.clone(),
+    }
+}
+
+/// Run the sweep of one case file.
+pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell>> {
+    let base = load(path)?;
+    let Some(sweep) = base.sweep.clone() else {
+        return Ok(Vec::new());
+    };
+    let nu = base.bodies[0].material.nu;
+    let pair0 = base.contact[0].clone();
+    let mut cells = Vec::new();
+    for d in &sweep.discretizations {
+        let slave_name = d.slave.clone();
+        let mut pair = pair0.clone();
+        if let Some(s) = &slave_name {
+            if base.bodies[pair.slave.0].name != *s {
+                pair = pair
+                    .swapped()
+                    .expect("validated: the slave is a body of the pair");
+            }
+        }
+        pair.discretization = d.discretization.clone();
+        let (disc_name, passes, slave) = match &d.discretization {
+            DiscretizationSpec::NodeToNode => (
+                "node_to_node",
+                None,
+                Some(base.bodies[pair.slave.0].name.clone()),
+            ),
+            DiscretizationSpec::NodeToSurface { passes: 2, .. } => {
+                ("node_to_surface", Some(2), None)
+            }
+            DiscretizationSpec::NodeToSurface { passes, .. } => (
+                "node_to_surface",
+                Some(*passes),
+                Some(base.bodies[pair.slave.0].name.clone()),
+            ),
+        };
+        for e in &sweep.enforcements {
+            progress(&format!(
+                "{} {disc_name} {} {}",
+                sweep.mesh,
+                passes.map(|p| format!("{p}p")).unwrap_or_default(),
+                name(e)
+            ));
+            let mut cell = Cell {
+                case: base.name.clone(),
+                mesh: sweep.mesh.clone(),
+                nu,
+                discretization: disc_name.into(),
+                passes,
+                slave: slave.clone(),
+                enforcement: name(e).into(),
+                kappa: kappa(e),
+                verdict: "n/a".into(),
+                stress_error: None,
+                stress_error_stiff: None,
+                penalty_trend: None,
+                pressure_error: None,
+                force_balance: None,
+                max_penetration: None,
+                rank_deficiency: None,
+                newton_iterations: None,
+                termination: None,
+                time_ms: 0.0,
+                note: String::new(),
+            };
+            let mut model = base.clone();
+            pair.enforcement = e.clone();
+            model.contact = vec![pair.clone()];
+            let rows = match constraints(&model, &pair) {
+                Ok(r) => r,
+                Err(why) => {
+                    cell.note = why;
+                    cells.push(cell);
+                    continue;
+                }
+            };
+            if *e == EnforcementSpec::Elimination {
+                if let Some(why) = elimination_obstacle(&rows, &model.prescribed) {
+                    cell.note = why;
+                    cells.push(cell);
+                    continue;
+                }
+            }
+            let start = Instant::now();
+            let solved = solve_static(&model, &mut |_| {});
+            cell.time_ms = start.elapsed().as_secs_f64() * 1e3;
+            let m = match solved {
+                Ok(s) => measure(&model, &s, sweep.pressure),
+                Err(err) => {
+                    cell.verdict = "fail".into();
+                    cell.note = format!(
+                        "no solution: {}",
+                        err.to_string().lines().next().unwrap_or_default()
+                    );
+                    cells.push(cell);
+                    continue;
+                }
+            };
+            cell.stress_error = Some(m.stress_error);
+            cell.pressure_error = Some(m.pressure_error);
+            cell.force_balance = Some(m.force_balance);
+            cell.max_penetration = Some(m.max_penetration);
+            cell.rank_deficiency = Some(m.rank_deficiency);
+            cell.newton_iterations = Some(m.iterations);
+            cell.termination = Some(match &m.termination {
+                Termination::Singular(_) => "singular".into(),
+                t => serde_json::to_value(t)
+                    .ok()
+                    .and_then(|v| v.as_str().map(String::from))
+                    .unwrap_or_default(),
+            });
+            let converged = m.termination == Termination::Converged;
+            let mut notes = Vec::new();
+            if let Termination::Singular(msg) = &m.termination {
+                notes.push(msg.clone());
+            } else if !converged {
+                notes.push(format!("the active-set loop ended by {:?}", m.termination));
+            }
+            let balanced = m.force_balance <= 1e-12;
+            if !balanced {
+                notes.push(format!("force balance {:.1e}", m.force_balance));
+            }
+            let unique = m.rank_deficiency == 0;
+            if !unique {
+                notes.push(format!(
+                    "multipliers not unique: {} dependent constraints (fails stability)",
+                    m.rank_deficiency
+                ));
+            }
+            let pass = if let (Some(k), true) = (
+                kappa(e),
+                matches!(
+                    e,
+                    EnforcementSpec::Penalty { .. } | EnforcementSpec::PerturbedLagrange { .. }
+                ),
+            ) {
+                let mut stiff = model.clone();
+                stiff.contact[0].enforcement = scaled(e, sweep.penalty_factor);
+                let start = Instant::now();
+                let s2 = solve_static(&stiff, &mut |_| {});
+                cell.time_ms += start.elapsed().as_secs_f64() * 1e3;
+                let e2 = match s2 {
+                    Ok(s) => measure(&stiff, &s, sweep.pressure).stress_error,
+                    Err(_) => f64::INFINITY,
+                };
+                cell.stress_error_stiff = Some(e2);
+                let trend = if m.stress_error <= sweep.tol && e2 <= sweep.tol {
+                    "round-off"
+                } else if e2 * sweep.penalty_factor / 10.0 <= m.stress_error {
+                    "1/kappa"
+                } else {
+                    "no fall"
+                };
+                cell.penalty_trend = Some(trend.into());
+                notes.push(format!(
+                    "kappa = {k:e}: stress error {trend} as kappa grows {}x",
+                    sweep.penalty_factor
+                ));
+                converged && balanced && trend != "no fall"
+            } else {
+                let pressure_ok = !unique || m.pressure_error <= sweep.tol;
+                converged && balanced && m.stress_error <= sweep.tol && pressure_ok
+            };
+            cell.verdict = if pass { "pass" } else { "fail" }.into();
+            cell.note = notes.join("; ");
+            cells.push(cell);
+        }
+    }
+    Ok(cells)
+}
+
+/// Round an error for the snapshot: `0` below `1e-10` (round-off), else one significant digit.
+pub fn rounded(e: Option<f64>) -> String {
+    match e {
+        None => "-".into(),
+        Some(v) if v.is_nan() => "NaN".into(),
+        Some(v) if v.is_infinite() => "inf".into(),
+        Some(v) if v < 1e-10 => "0".into(),
+        Some(v) => format!("{v:.0e}"),
+    }
+}
+
+fn short(v: &str) -> &str {
+    match v {
+        "pass" => "p",
+        "fail" => "f",
+        _ => "n/a",
+    }
+}
+
+/// The seed's verdict row at one `nu`, from the Lagrange-multiplier cells.
+pub fn seed_row(cells: &[Cell], nu: f64) -> Vec<(String, String)> {
+    let find = |mesh: &str, passes: u8, slave: Option<&str>| {
+        cells
+            .iter()
+            .find(|c| {
+                c.mesh == mesh
+                    && c.nu == nu
+                    && c.enforcement == "lagrange"
+                    && c.passes == Some(passes)
+                    && c.slave.as_deref() == slave
+            })
+            .map(|c| short(&c.verdict).to_string())
+    };
+    let one_pass = |mesh: &str| {
+        let a = find(mesh, 1, Some("punch"));
+        let b = find(mesh, 1, Some("foundation"));
+        match (a, b) {
+            (Some(a), Some(b)) if a == b => a,
+            (Some(a), Some(b)) => format!("{a}/{b}"),
+            _ => "?".into(),
+        }
+    };
+    let two_pass = |mesh: &str| find(mesh, 2, None).unwrap_or_else(|| "?".into());
+    vec![
+        ("A".into(), one_pass("A")),
+        ("B-1p".into(), one_pass("B")),
+        ("B-2p".into(), two_pass("B")),
+        ("C-1p".into(), one_pass("C")),
+        ("C-2p".into(), two_pass("C")),
+        ("D".into(), one_pass("D")),
+        ("E".into(), one_pass("E")),
+    ]
+}
+
+/// The seed's published row (Taylor 2004, "1991: The Contact Patch Test").
+pub const SEED_ROW: [(&str, &str); 7] = [
+    ("A", "p"),
+    ("B-1p", "p/f"),
+    ("B-2p", "p"),
+    ("C-1p", "f"),
+    ("C-2p", "p"),
+    ("D", "p"),
+    ("E", "f"),
+];
+
+/// The full grid as a Markdown table; `with_time` adds the time column (not in snapshots).
+pub fn grid_markdown(cells: &[Cell], with_time: bool) -> String {
+    let mut s = String::from("| mesh | nu | discretization | passes | slave | enforcement | verdict | stress error | at 1000 kappa | trend | pressure error | rank def. | iterations |");
+    s += if with_time {
+        " time ms | note |\n"
+    } else {
+        " note |\n"
+    };
+    s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+    s += if with_time { "---|---|\n" } else { "---|\n" };
+    for c in cells {
+        s += &format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            c.mesh,
+            c.nu,
+            c.discretization,
+            c.passes.map(|p| p.to_string()).unwrap_or("-".into()),
+            c.slave.as_deref().unwrap_or("-"),
+            c.enforcement,
+            c.verdict,
+            rounded(c.stress_error),
+            rounded(c.stress_error_stiff),
+            c.penalty_trend.as_deref().unwrap_or("-"),
+            rounded(c.pressure_error),
+            c.rank_deficiency
+                .map(|r| r.to_string())
+                .unwrap_or("-".into()),
+            c.newton_iterations
+                .map(|r| r.to_string())
+                .unwrap_or("-".into()),
+        );
+        if with_time {
+            s += &format!(" {:.2} |", c.time_ms);
+        }
+        s += &format!(" {} |\n", c.note.replace('|', "/"));
+    }
+    s
+}

@@ -1,0 +1,60 @@
+//! The patch-test table: the seed's row is reproduced with Lagrange multipliers at every nu,
+//! every passing cell balances its forces, and the whole grid (errors rounded so that round-off
+//! does not churn it, times left out) is a reviewed insta snapshot in `snapshots/`.
+
+use contact_patch::harness::{grid_markdown, run_sweep, Cell};
+use contact_patch::report::seed_summary;
+use std::path::Path;
+
+fn catalogue() -> Vec<Cell> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/patch");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "json"))
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 15, "meshes A-E at three values of nu");
+    files
+        .iter()
+        .flat_map(|f| run_sweep(f, &mut |_| {}).unwrap())
+        .collect()
+}
+
+#[test]
+fn patch_table() {
+    let cells = catalogue();
+    let summary = seed_summary(&cells);
+    for line in summary.lines().filter(|l| l.starts_with("| Lagrange")) {
+        assert!(
+            line.ends_with("| yes |"),
+            "the seed's row is not reproduced:\n{summary}"
+        );
+    }
+    for c in cells.iter().filter(|c| c.verdict == "pass") {
+        assert!(c.force_balance.unwrap() <= 1e-12, "{c:?}");
+    }
+    // every enforcement method passes somewhere and is n/a only with a reason
+    for c in cells.iter().filter(|c| c.verdict == "n/a") {
+        assert!(!c.note.is_empty(), "n/a without a reason: {c:?}");
+    }
+    // the penalty-type methods were also run at 1000 kappa
+    for c in cells
+        .iter()
+        .filter(|c| c.enforcement == "penalty" && c.verdict != "n/a")
+    {
+        assert!(
+            c.stress_error_stiff.is_some() && c.penalty_trend.is_some(),
+            "{c:?}"
+        );
+    }
+    let mut settings = insta::Settings::clone_current();
+    settings.set_snapshot_path("../snapshots");
+    settings.set_prepend_module_to_snapshot(false);
+    settings.bind(|| {
+        insta::assert_snapshot!(
+            "patch_table",
+            format!("{summary}\n{}", grid_markdown(&cells, false))
+        );
+    });
+}
