@@ -5,7 +5,9 @@
 //!   quadrature points of the chosen bodies (absolute when `s = 0`);
 //! * `exact_displacement`: relative L2 displacement error against the case's exact solution;
 //! * `reaction`: sum of `K u - f` over a node set, one component;
-//! * `displacement`: one component at the node nearest to a point.
+//! * `displacement`: one component at the node nearest to a point;
+//! * `contact_pressure`, `force_balance`, `contact_force`, `max_contact_pressure`: contact
+//!   forces (see the functions below).
 //!
 //! For the last two the error is `|got - value| / |value|`, or `|got|` when `value = 0`.
 
@@ -64,14 +66,26 @@ pub fn pressure_error(
     worst
 }
 
-/// Largest of: the net contact force and moment (relative to the sum of |contact forces|,
-/// moments divided by the model size) and the relative equilibrium residual of the solve.
+/// Largest of: the net contact force and moment between deformable bodies (relative to the sum
+/// of |contact forces|, moments divided by the model size; rows against rigid surfaces are left
+/// out, the rigid surface takes their force) and the relative equilibrium residual of the solve.
 pub fn force_balance(model: &Model, solution: &Solution) -> f64 {
     let Some(state) = &solution.contact else {
         return f64::INFINITY;
     };
     let (mut fx, mut fy, mut moment, mut total) = (0.0, 0.0, 0.0, 0.0f64);
-    for (r, &lambda) in state.rows.iter().zip(&state.forces) {
+    let between_bodies = |r: &&crate::contact::Constraint| {
+        matches!(
+            model.contact[r.pair].master,
+            crate::model::MasterSide::Body { .. }
+        )
+    };
+    for (r, &lambda) in state
+        .rows
+        .iter()
+        .zip(&state.forces)
+        .filter(|(r, _)| between_bodies(r))
+    {
         total += lambda.abs();
         for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
             let body = model
@@ -146,6 +160,24 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
                     let exact = model.exact.as_ref().expect("resolved when the model was built");
                     let k = model.contact.iter().position(|p| p.name == *pair).expect("resolved when the model was built");
                     (format!("contact pressure of '{pair}' against the exact stress"), pressure_error(solution, exact, Some(k), None), *tol)
+                }
+                Check::ContactForce { pair, component, value, tol } => {
+                    let k = model.contact.iter().position(|p| p.name == *pair).expect("resolved when the model was built");
+                    let got: f64 = solution
+                        .contact
+                        .as_ref()
+                        .map(|c| c.rows.iter().zip(&c.forces).filter(|(r, _)| r.pair == k).map(|(r, f)| f * r.normal[component.index()]).sum())
+                        .unwrap_or(f64::NAN);
+                    (format!("total contact force {component:?} of '{pair}' = {got:.6e} (expected {value})"), relative(got, *value), *tol)
+                }
+                Check::MaxContactPressure { pair, value, tol } => {
+                    let k = model.contact.iter().position(|p| p.name == *pair).expect("resolved when the model was built");
+                    let got = solution
+                        .contact
+                        .as_ref()
+                        .map(|c| c.rows.iter().zip(&c.forces).filter(|(r, _)| r.pair == k).fold(0.0f64, |m, (r, f)| m.max(f / r.area)))
+                        .unwrap_or(f64::NAN);
+                    (format!("max contact pressure of '{pair}' = {got:.6e} (expected {value})"), relative(got, *value), *tol)
                 }
                 Check::ForceBalance { tol } => ("force balance of the contact forces and equilibrium".to_string(), force_balance(model, solution), *tol),
                 Check::Displacement { body, point, component, value, tol } => {

@@ -54,6 +54,8 @@ pub struct Cell {
     pub rank_deficiency: Option<usize>,
     pub newton_iterations: Option<usize>,
     pub termination: Option<String>,
+    /// `cholesky`, `ldlt` or `schur-pseudo-inverse` (see `contact::solver::ContactState`).
+    pub linear_solver: Option<String>,
     pub time_ms: f64,
     pub note: String,
 }
@@ -67,6 +69,7 @@ struct Measured {
     rank_deficiency: usize,
     iterations: usize,
     termination: Termination,
+    linear_solver: &'static str,
 }
 
 fn measure(model: &Model, solution: &Solution, pressure: f64) -> Measured {
@@ -99,6 +102,7 @@ fn measure(model: &Model, solution: &Solution, pressure: f64) -> Measured {
         rank_deficiency: state.rank_deficiency,
         iterations: state.iterations,
         termination: state.termination.clone(),
+        linear_solver: state.linear_solver,
     }
 }
 
@@ -163,6 +167,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 rank_deficiency: None,
                 newton_iterations: None,
                 termination: None,
+                linear_solver: None,
                 time_ms: 0.0,
                 note: String::new(),
             };
@@ -205,6 +210,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             cell.max_penetration = Some(m.max_penetration);
             cell.rank_deficiency = Some(m.rank_deficiency);
             cell.newton_iterations = Some(m.iterations);
+            cell.linear_solver = Some(m.linear_solver.to_string());
             cell.termination = Some(match &m.termination {
                 Termination::Singular(_) => "singular".into(),
                 t => serde_json::to_value(t)

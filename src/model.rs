@@ -636,6 +636,20 @@ impl Model {
                     self.find_body(body, &at)?;
                     *tol
                 }
+                Check::ContactForce { pair, tol, .. }
+                | Check::MaxContactPressure { pair, tol, .. } => {
+                    if !self.contact.iter().any(|p| p.name == *pair) {
+                        let known: Vec<&str> =
+                            self.contact.iter().map(|p| p.name.as_str()).collect();
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            format!("contact pair '{pair}' does not exist"),
+                            format!("use one of {known:?}"),
+                        ));
+                    }
+                    *tol
+                }
                 Check::ContactPressure { pair, tol } => {
                     if !self.contact.iter().any(|p| p.name == *pair) {
                         let known: Vec<&str> =
@@ -755,10 +769,15 @@ impl Model {
             }
         }
         for pair in &self.contact {
-            let rows = match crate::contact::discretization::constraints(self, pair) {
-                Ok(r) => r,
-                Err(_) => continue, // reported when the pair is solved
-            };
+            let rows =
+                crate::contact::discretization::constraints(self, pair).map_err(|reason| {
+                    Error::invalid(
+                        &self.source,
+                        format!("contact '{}'", pair.name),
+                        format!("the discretization does not apply: {reason}"),
+                        "choose another discretization for this pair",
+                    )
+                })?;
             for r in rows {
                 let mut v = vec![0.0; nm];
                 for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {

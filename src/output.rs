@@ -31,7 +31,29 @@ pub struct Summary {
     pub bodies: Vec<BodySummary>,
     pub reactions: Vec<ReactionSummary>,
     pub checks: Vec<CheckResult>,
+    /// What the contact solve found (absent without contact).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactSummary>,
     pub timings: Timings,
+}
+
+/// The contact solve in numbers.
+#[derive(Serialize)]
+pub struct ContactSummary {
+    pub termination: String,
+    pub iterations: usize,
+    pub linear_solver: String,
+    pub constraints: usize,
+    pub active: usize,
+    pub rank_deficiency: usize,
+    /// Sum of the contact forces acting on the slave bodies, `[x, y]`.
+    pub total_force: [f64; 2],
+    /// Largest `lambda_i / A_i` (nodal contact pressure).
+    pub max_pressure: f64,
+    /// Extent `[min, max]` of the active slave nodes along x and y.
+    pub active_extent: [[f64; 2]; 2],
+    /// Largest penetration (`-min g`, zero when no row penetrates).
+    pub max_penetration: f64,
 }
 
 #[derive(Serialize)]
@@ -106,7 +128,40 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
             }
         })
         .collect();
+    let contact = solution.contact.as_ref().map(|c| {
+        let mut total = [0.0; 2];
+        let mut extent = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
+        let mut max_pressure = 0.0f64;
+        for (i, r) in c.rows.iter().enumerate() {
+            for k in 0..2 {
+                total[k] += c.forces[i] * r.normal[k];
+            }
+            if c.active[i] {
+                max_pressure = max_pressure.max(c.forces[i] / r.area);
+                for k in 0..2 {
+                    extent[k][0] = extent[k][0].min(r.point[k]);
+                    extent[k][1] = extent[k][1].max(r.point[k]);
+                }
+            }
+        }
+        ContactSummary {
+            termination: match &c.termination {
+                crate::contact::solver::Termination::Singular(m) => format!("singular: {m}"),
+                t => format!("{t:?}"),
+            },
+            iterations: c.iterations,
+            linear_solver: c.linear_solver.to_string(),
+            constraints: c.rows.len(),
+            active: c.active.iter().filter(|&&a| a).count(),
+            rank_deficiency: c.rank_deficiency,
+            total_force: total,
+            max_pressure,
+            active_extent: extent,
+            max_penetration: c.gaps.iter().fold(0.0f64, |m, &g| m.max(-g)),
+        }
+    });
     Summary {
+        contact,
         case: model.name.clone(),
         source: model.source.clone(),
         description: model.description.clone(),

@@ -445,6 +445,15 @@ pub enum Check {
     ContactPressure { pair: String, tol: f64 },
     /// Sum of the contact forces and the equilibrium residual, relative to the largest force.
     ForceBalance { tol: f64 },
+    /// One component of the total contact force of a pair on its slave body.
+    ContactForce {
+        pair: String,
+        component: Component,
+        value: f64,
+        tol: f64,
+    },
+    /// The largest nodal contact pressure `lambda_i / A_i` of a pair (relative error).
+    MaxContactPressure { pair: String, value: f64, tol: f64 },
     /// Displacement component at the node nearest to `point`.
     Displacement {
         body: String,

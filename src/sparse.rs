@@ -6,11 +6,21 @@
 //! couples; it is fixed before any value is assembled, so the symbolic factorization (fill-
 //! reducing ordering and elimination tree) is computed once and reused for every numeric
 //! factorization with the same pattern (Newton iterations, penalty sweeps).
+//!
+//! Saddle-point systems `[[K, -B^T], [-B, 0]]` (Lagrange multipliers) are factored as
+//! `P A P^T = L D L^T` with faer's supernodal/simplicial LDL^T and the expected pivot signs
+//! (+ for displacements, - for multipliers) given to its dynamic regularization; the ordering is
+//! plain AMD, so the solve is followed by a few steps of iterative refinement.
 
+use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, LdltRef, SymbolicCholesky, SymmetricOrdering,
+};
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Mat, Side};
+use faer::{Conj, Mat, Par, Side};
+use std::sync::Arc;
 
 /// Upper-triangular CSC pattern of a symmetric `n x n` matrix.
 #[derive(Clone, Debug)]
@@ -182,6 +192,121 @@ impl Factor {
     }
 }
 
+/// Sparse `L D L^T` of a symmetric indefinite matrix with known pivot signs.
+pub struct Ldlt {
+    symbolic: Arc<SymbolicCholesky<usize>>,
+}
+
+/// A numeric `L D L^T` factorization.
+pub struct LdltFactor {
+    symbolic: Arc<SymbolicCholesky<usize>>,
+    values: Vec<f64>,
+}
+
+impl Ldlt {
+    /// Symbolic analysis with the ordering "AMD of the leading `leading x leading` block, then
+    /// the remaining equations in order", so that multipliers (numbered last) are eliminated
+    /// after their displacements and every pivot has its expected sign exactly.
+    pub fn analyse(pattern: &SymmetricPattern, leading: usize) -> Result<Self, FactorError> {
+        let n = pattern.n;
+        fn other(e: impl std::fmt::Debug) -> FactorError {
+            FactorError::Other(format!("{e:?}"))
+        }
+        let nnz = pattern.col_ptr[leading];
+        let block = SymbolicSparseColMatRef::new_checked(
+            leading,
+            leading,
+            &pattern.col_ptr[..=leading],
+            None,
+            &pattern.row_idx[..nnz],
+        );
+        let mut fwd = vec![0usize; n];
+        let mut inv = vec![0usize; n];
+        let mut mem = MemBuffer::new(faer::sparse::linalg::amd::order_scratch::<usize>(
+            leading, nnz,
+        ));
+        faer::sparse::linalg::amd::order(
+            &mut fwd[..leading],
+            &mut inv[..leading],
+            block,
+            Default::default(),
+            MemStack::new(&mut mem),
+        )
+        .map_err(other)?;
+        for k in leading..n {
+            fwd[k] = k;
+            inv[k] = k;
+        }
+        let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.symbolic(),
+            Side::Upper,
+            SymmetricOrdering::Custom(perm),
+            Default::default(),
+        )
+        .map_err(other)?;
+        Ok(Ldlt {
+            symbolic: Arc::new(symbolic),
+        })
+    }
+
+    /// Factor with expected pivot `signs` (+1 / -1 per equation); a pivot of the wrong sign or
+    /// smaller than `epsilon` is replaced by `epsilon` with the expected sign.
+    pub fn factor(
+        &self,
+        pattern: &SymmetricPattern,
+        values: &[f64],
+        signs: &[i8],
+        epsilon: f64,
+    ) -> Result<LdltFactor, FactorError> {
+        let mut l = vec![0.0; self.symbolic.len_val()];
+        let par = Par::Seq;
+        let mut mem = MemBuffer::new(
+            self.symbolic
+                .factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
+        );
+        let mat = SparseColMatRef::new(pattern.symbolic(), values);
+        let regularization = faer::linalg::cholesky::ldlt::factor::LdltRegularization {
+            dynamic_regularization_signs: Some(signs),
+            dynamic_regularization_delta: epsilon,
+            dynamic_regularization_epsilon: epsilon,
+        };
+        self.symbolic
+            .factorize_numeric_ldlt(
+                &mut l,
+                mat,
+                Side::Upper,
+                regularization,
+                par,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+        Ok(LdltFactor {
+            symbolic: self.symbolic.clone(),
+            values: l,
+        })
+    }
+}
+
+impl LdltFactor {
+    /// Solve `A x = b` in place.
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        let par = Par::Seq;
+        let mut rhs = Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
+        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, par));
+        LdltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            rhs.as_mut(),
+            par,
+            MemStack::new(&mut mem),
+        );
+        for (i, v) in b.iter_mut().enumerate() {
+            *v = rhs[(i, 0)];
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -234,6 +359,36 @@ mod tests {
             chol.factor(&pattern, &values),
             Err(FactorError::NotPositiveDefinite { .. })
         ));
+    }
+
+    #[test]
+    fn ldlt_solves_a_saddle_point_system() {
+        // K = tridiagonal SPD (3 x 3), one constraint u0 - u2 = 0.5: [[K, -b], [-b^T, 0]]
+        let mut pb = PatternBuilder::new(4);
+        pb.add_block(&[0, 1]);
+        pb.add_block(&[1, 2]);
+        pb.add_block(&[0, 2, 3]);
+        let p = pb.build();
+        let mut v = vec![0.0; p.nnz()];
+        let mut set = |i: usize, j: usize, x: f64| v[p.position(i, j).unwrap()] = x;
+        set(0, 0, 2.0);
+        set(1, 1, 2.0);
+        set(2, 2, 2.0);
+        set(0, 1, -1.0);
+        set(1, 2, -1.0);
+        set(0, 3, -1.0);
+        set(2, 3, 1.0);
+        let x = [0.3, -0.2, -0.2, 1.7];
+        let mut b = vec![0.0; 4];
+        p.mul(&v, &x, &mut b);
+        let f = Ldlt::analyse(&p, 3)
+            .unwrap()
+            .factor(&p, &v, &[1, 1, 1, -1], 1e-14)
+            .unwrap();
+        f.solve_in_place(&mut b);
+        for i in 0..4 {
+            assert!((b[i] - x[i]).abs() < 1e-12, "{i}: {} vs {}", b[i], x[i]);
+        }
     }
 
     #[test]

@@ -228,3 +228,112 @@ fn check_command_reports_failures_in_a_table() {
         .unwrap();
     assert_eq!(o.status.code(), Some(0));
 }
+
+/// A punch on a block: contact holds the punch vertically, a support at its top-left corner
+/// horizontally.
+const CONTACT: &str = r#"{
+  "name": "contact-base",
+  "materials": {"m": {"E": 1000.0, "nu": 0.3}},
+  "bodies": [{"name": "base", "material": "m", "mesh": {"block": {"element": "Q4", "x": [0, 1, 2], "y": [0, 1]}}},
+             {"name": "punch", "material": "m", "mesh": {"block": {"element": "Q4", "x": [0, 1, 2], "y": [1, 2]}}}],
+  "supports": [{"body": "base", "set": "bottom", "y": 0.0}, {"body": "base", "set": "bottom_left", "x": 0.0},
+               {"body": "punch", "set": "top_left", "x": 0.0}],
+  "loads": [{"body": "punch", "set": "top", "pressure": 1.0}],
+  "contact": [{"name": "c", "slave": {"body": "punch", "set": "bottom"}, "master": {"body": "base", "set": "top"},
+               "discretization": {"kind": "node_to_surface", "passes": 1}, "enforcement": {"kind": "lagrange"}}],
+  "checks": [{"check": "uniform_stress", "stress": [0.0, -1.0, 0.0], "tol": 1e-10}]
+}"#;
+
+#[test]
+fn the_good_contact_case_runs() {
+    let (code, stderr, output) = run(CONTACT);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(output);
+}
+
+#[test]
+fn contact_with_a_missing_set_is_named() {
+    let text = CONTACT.replace(
+        "\"master\": {\"body\": \"base\", \"set\": \"top\"}",
+        "\"master\": {\"body\": \"base\", \"set\": \"rim\"}",
+    );
+    assert_rejected(&text, &["contact[0] 'c'.master", "no facet set 'rim'"]);
+}
+
+#[test]
+fn contact_with_an_unknown_enforcement_is_named() {
+    let text = CONTACT.replace("{\"kind\": \"lagrange\"}", "{\"kind\": \"nitsche\"}");
+    assert_rejected(&text, &["unknown variant `nitsche`", "case.json:"]);
+}
+
+#[test]
+fn contact_with_a_bad_penalty_is_rejected() {
+    let text = CONTACT.replace(
+        "{\"kind\": \"lagrange\"}",
+        "{\"kind\": \"penalty\", \"kappa\": -5}",
+    );
+    assert_rejected(
+        &text,
+        &["contact[0] 'c'.enforcement", "kappa must be positive"],
+    );
+}
+
+#[test]
+fn contact_with_a_master_that_is_neither_body_nor_rigid() {
+    let text = CONTACT.replace(
+        "\"master\": {\"body\": \"base\", \"set\": \"top\"}",
+        "\"master\": {\"body\": \"base\"}",
+    );
+    assert_rejected(
+        &text,
+        &[
+            "contact[0] 'c'.master",
+            "either \"body\" and \"set\", or \"rigid\"",
+        ],
+    );
+}
+
+#[test]
+fn a_discretization_that_does_not_apply_says_why() {
+    // node-to-node on meshes whose interface nodes do not match
+    let text = CONTACT
+        .replace(
+            "\"x\": [0, 1, 2], \"y\": [1, 2]",
+            "\"x\": [0, 0.7, 2], \"y\": [1, 2]",
+        )
+        .replace(
+            "{\"kind\": \"node_to_surface\", \"passes\": 1}",
+            "{\"kind\": \"node_to_node\"}",
+        );
+    assert_rejected(&text, &["contact 'c'", "does not apply", "do not match"]);
+}
+
+#[test]
+fn a_punch_held_only_by_frictionless_contact_is_explained() {
+    let text = CONTACT.replace(
+        ",\n               {\"body\": \"punch\", \"set\": \"top_left\", \"x\": 0.0}",
+        "",
+    );
+    assert_rejected(
+        &text,
+        &[
+            "body 'punch'",
+            "even with every contact closed",
+            "translate in x",
+        ],
+    );
+}
+
+#[test]
+fn elimination_that_does_not_apply_says_why() {
+    let text = CONTACT
+        .replace("{\"kind\": \"lagrange\"}", "{\"kind\": \"elimination\"}")
+        .replace("\"passes\": 1", "\"passes\": 2");
+    assert_rejected(
+        &text,
+        &[
+            "constraint elimination does not apply",
+            "no constraint owns it",
+        ],
+    );
+}

@@ -38,6 +38,18 @@ fn patch_table() {
     for c in cells.iter().filter(|c| c.verdict == "n/a") {
         assert!(!c.note.is_empty(), "n/a without a reason: {c:?}");
     }
+    // Lagrange multipliers: LDL^T when the rows are independent, the Schur pseudo-inverse when not
+    for c in cells
+        .iter()
+        .filter(|c| c.enforcement == "lagrange" && c.verdict != "n/a")
+    {
+        let expected = if c.rank_deficiency == Some(0) {
+            "ldlt"
+        } else {
+            "schur-pseudo-inverse"
+        };
+        assert_eq!(c.linear_solver.as_deref(), Some(expected), "{c:?}");
+    }
     // the penalty-type methods were also run at 1000 kappa
     for c in cells
         .iter()

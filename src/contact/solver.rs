@@ -52,6 +52,10 @@ pub struct ContactState {
     pub iterations: usize,
     /// Number of dependent rows among the active constraints (rank deficiency of `B B^T`).
     pub rank_deficiency: usize,
+    /// The linear solver of the last iteration: `cholesky` (penalty-type, perturbed tangent,
+    /// augmented Lagrangian, elimination), `ldlt` (Lagrange, independent rows) or
+    /// `schur-pseudo-inverse` (Lagrange, dependent rows).
+    pub linear_solver: &'static str,
 }
 
 /// Most linear solves of one contact solve.
@@ -143,11 +147,18 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
         sys: &sys,
         rows: &eq_rows,
         chol,
+        saddle: if method == Method::Lagrange {
+            Saddle::new(&sys, &eq_rows)
+        } else {
+            None
+        },
+        linear_solver: "cholesky",
         factorizations: 0.0,
         solves: 0.0,
     };
     let state = kernel.active_set_loop(method, &rows);
     let (x, forces, active, termination, iterations) = state;
+    let linear_solver = kernel.linear_solver;
     let factor_time = kernel.factorizations;
     let solve_time = kernel.solves;
     timings.factorization = factor_time;
@@ -178,8 +189,48 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
         termination,
         iterations,
         rank_deficiency,
+        linear_solver,
     });
     Ok(solution)
+}
+
+/// The saddle-point pattern `[[K, B^T], [B, D]]` over all candidate rows, analysed once.
+struct Saddle {
+    pattern: crate::sparse::SymmetricPattern,
+    /// Position in `pattern` of each stored entry of the stiffness pattern.
+    k_positions: Vec<usize>,
+    ldlt: crate::sparse::Ldlt,
+}
+
+impl Saddle {
+    fn new(sys: &LinearSystem, rows: &[EqRow]) -> Option<Saddle> {
+        let (n, m) = (sys.n, rows.len());
+        let mut b = PatternBuilder::new(n + m);
+        let p = &sys.pattern;
+        for j in 0..n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                b.add_block(&[p.row_idx[k], j]);
+            }
+        }
+        for (i, row) in rows.iter().enumerate() {
+            for &e in &row.eqs {
+                b.add_block(&[e, n + i]);
+            }
+        }
+        let pattern = b.build();
+        let mut k_positions = Vec::with_capacity(p.nnz());
+        for j in 0..n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                k_positions.push(pattern.position(p.row_idx[k], j)?);
+            }
+        }
+        let ldlt = crate::sparse::Ldlt::analyse(&pattern, n).ok()?;
+        Some(Saddle {
+            pattern,
+            k_positions,
+            ldlt,
+        })
+    }
 }
 
 struct Kernel<'a> {
@@ -187,6 +238,9 @@ struct Kernel<'a> {
     sys: &'a LinearSystem,
     rows: &'a [EqRow],
     chol: Cholesky,
+    /// Built only for Lagrange multipliers.
+    saddle: Option<Saddle>,
+    linear_solver: &'static str,
     factorizations: f64,
     solves: f64,
 }
@@ -215,6 +269,17 @@ impl Kernel<'_> {
         w: &[f64],
     ) -> std::result::Result<crate::sparse::Factor, String> {
         let t = Instant::now();
+        let values = self.augmented(active, w);
+        let f = self
+            .chol
+            .factor(&self.sys.pattern, &values)
+            .map_err(|e| self.sys.factor_error(self.model, e).to_string());
+        self.factorizations += t.elapsed().as_secs_f64();
+        f
+    }
+
+    /// Values of `K + sum_active w_i b_i b_i^T` on the stiffness pattern.
+    fn augmented(&self, active: &[bool], w: &[f64]) -> Vec<f64> {
         let mut values = self.sys.k.clone();
         for (i, row) in self.rows.iter().enumerate() {
             if !active[i] || w[i] == 0.0 {
@@ -229,12 +294,76 @@ impl Kernel<'_> {
             }
             self.sys.pattern.scatter(&row.eqs, &block, &mut values);
         }
-        let f = self
-            .chol
-            .factor(&self.sys.pattern, &values)
-            .map_err(|e| self.sys.factor_error(self.model, e).to_string());
+        values
+    }
+
+    /// Lagrange multipliers from the saddle-point system
+    /// `[[K + rho B^T B, -B^T], [-B, 0]] [u; lambda] = [f - rho B^T g0; g0]` (inactive rows:
+    /// `-lambda_i = 0`), factored by LDL^T with multipliers ordered last, plus two steps of
+    /// iterative refinement. `None` when the refined residual is not small (the caller falls
+    /// back to the Schur complement).
+    fn lagrange_ldlt(&mut self, active: &[bool], rho: f64) -> Option<(Vec<f64>, Vec<f64>)> {
+        let t = Instant::now();
+        let n = self.sys.n;
+        let m = self.rows.len();
+        let saddle = self.saddle.as_ref()?;
+        let w = vec![rho; m];
+        let k = self.augmented(active, &w);
+        let mut values = vec![0.0; saddle.pattern.nnz()];
+        for (p, &v) in saddle.k_positions.iter().zip(&k) {
+            values[*p] += v;
+        }
+        let mut rhs = self.sys.rhs.clone();
+        rhs.resize(n + m, 0.0);
+        for (i, row) in self.rows.iter().enumerate() {
+            let diag = saddle
+                .pattern
+                .position(n + i, n + i)
+                .expect("diagonal stored");
+            if active[i] {
+                for (&e, &c) in row.eqs.iter().zip(&row.coeffs) {
+                    values[saddle.pattern.position(e, n + i).expect("coupling stored")] = -c;
+                }
+                row.add_to(-rho * row.g0, &mut rhs);
+                rhs[n + i] = row.g0;
+            } else {
+                values[diag] = -1.0;
+            }
+        }
+        let mut signs = vec![1i8; n + m];
+        signs[n..].iter_mut().for_each(|s| *s = -1);
+        let scale = k.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let factor = saddle
+            .ldlt
+            .factor(&saddle.pattern, &values, &signs, 1e-13 * scale)
+            .ok()?;
         self.factorizations += t.elapsed().as_secs_f64();
-        f
+        let mut x = rhs.clone();
+        factor.solve_in_place(&mut x);
+        let norm = rhs
+            .iter()
+            .fold(0.0f64, |a, v| a.max(v.abs()))
+            .max(f64::MIN_POSITIVE);
+        let mut r = vec![0.0; n + m];
+        let mut residual = f64::INFINITY;
+        for _ in 0..3 {
+            saddle.pattern.mul(&values, &x, &mut r);
+            r.iter_mut().zip(&rhs).for_each(|(a, b)| *a = b - *a);
+            residual = r.iter().fold(0.0f64, |a, v| a.max(v.abs())) / norm;
+            if residual < 1e-15 {
+                break;
+            }
+            factor.solve_in_place(&mut r);
+            x.iter_mut().zip(&r).for_each(|(a, d)| *a += d);
+        }
+        if !(residual < 1e-10) {
+            return None;
+        }
+        let forces = (0..m)
+            .map(|i| if active[i] { x[n + i] } else { 0.0 })
+            .collect();
+        x.truncate(n);
+        Some((x, forces))
     }
 
     /// Penalty-type solve: `M u = rhs + sum_active b_i (lambda_k,i - w_i g0_i)`.
@@ -255,7 +384,8 @@ impl Kernel<'_> {
         Ok(x)
     }
 
-    /// Lagrange multipliers by the Schur complement of the augmented system.
+    /// Lagrange multipliers: LDL^T of the saddle-point system when the active rows are
+    /// independent, else the Schur complement of the augmented system with a pseudo-inverse.
     fn lagrange(&mut self, active: &[bool]) -> std::result::Result<(Vec<f64>, Vec<f64>), String> {
         let n = self.sys.n;
         // rho: the stiffness scale, so that M stays well conditioned
@@ -266,6 +396,21 @@ impl Kernel<'_> {
             }
         }
         let rho = if rho > 0.0 { rho } else { 1.0 };
+        let active_rows: Vec<&EqRow> = self
+            .rows
+            .iter()
+            .zip(active)
+            .filter(|(_, &a)| a)
+            .map(|(r, _)| r)
+            .collect();
+        if rank_deficiency(&active_rows, n) == 0 {
+            if let Some(solution) = self.lagrange_ldlt(active, rho) {
+                self.linear_solver = "ldlt";
+                return Ok(solution);
+            }
+        }
+        self.linear_solver = "schur-pseudo-inverse";
+        // rank-deficient (or LDL^T refused): minimum-norm multipliers from the Schur complement
         let w = vec![rho; self.rows.len()];
         let f = self.factor(active, &w)?;
         let idx: Vec<usize> = (0..self.rows.len()).filter(|&i| active[i]).collect();
