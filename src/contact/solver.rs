@@ -356,7 +356,7 @@ impl Kernel<'_> {
             factor.solve_in_place(&mut r);
             x.iter_mut().zip(&r).for_each(|(a, d)| *a += d);
         }
-        if !(residual < 1e-10) {
+        if residual.is_nan() || residual >= 1e-10 {
             return None;
         }
         let forces = (0..m)
