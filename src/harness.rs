@@ -25,7 +25,7 @@ use crate::contact::solver::Termination;
 use crate::error::Result;
 use crate::model::{load, Model};
 use crate::post::for_each_quadrature_stress;
-use crate::scene::{DiscretizationSpec, EnforcementSpec};
+use crate::scene::{DiscretizationSpec, EnforcementSpec, MultiplierSpace};
 use crate::solve::{solve_static, Solution};
 use serde::Serialize;
 use std::path::Path;
@@ -138,6 +138,14 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             DiscretizationSpec::NodeToSurface { passes, .. } => (
                 "node_to_surface",
                 Some(*passes),
+                Some(base.bodies[pair.slave.0].name.clone()),
+            ),
+            DiscretizationSpec::Mortar { multiplier } => (
+                match multiplier {
+                    MultiplierSpace::Standard => "mortar",
+                    MultiplierSpace::Dual => "dual_mortar",
+                },
+                None,
                 Some(base.bodies[pair.slave.0].name.clone()),
             ),
         };

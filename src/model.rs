@@ -75,6 +75,8 @@ pub struct ContactPair {
     pub master: MasterSide,
     pub discretization: DiscretizationSpec,
     pub enforcement: EnforcementSpec,
+    /// A tied (glued) interface instead of frictionless contact.
+    pub tied: bool,
 }
 
 impl ContactPair {
@@ -560,6 +562,7 @@ impl Model {
                 master,
                 discretization: spec.discretization.clone(),
                 enforcement: spec.enforcement.clone(),
+                tied: spec.interaction == crate::scene::Interaction::Tied,
             });
         }
         if let Some(sweep) = &case.sweep {

@@ -84,6 +84,31 @@ pub struct ContactSpec {
     pub master: MasterSpec,
     pub discretization: DiscretizationSpec,
     pub enforcement: EnforcementSpec,
+    /// `frictionless` contact (default) or a `tied` (glued) interface.
+    #[serde(default)]
+    pub interaction: Interaction,
+}
+
+/// What a pair enforces.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Interaction {
+    /// Unilateral, frictionless contact: `g >= 0`, `lambda >= 0`, `g lambda = 0`.
+    #[default]
+    Frictionless,
+    /// Both displacement components continuous across the interface (bilateral).
+    Tied,
+}
+
+/// The multiplier space of a mortar discretization.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MultiplierSpace {
+    /// The slave shape functions.
+    #[default]
+    Standard,
+    /// Biorthogonal (dual) functions: `D` is diagonal.
+    Dual,
 }
 
 /// Which normal defines the gap of a node-to-surface constraint.
@@ -114,6 +139,11 @@ pub enum DiscretizationSpec {
         passes: u8,
         #[serde(default)]
         normal: NormalChoice,
+    },
+    /// Segment-based mortar: weighted gaps `D x_s - M x_m` per slave node.
+    Mortar {
+        #[serde(default)]
+        multiplier: MultiplierSpace,
     },
 }
 

@@ -34,6 +34,8 @@ DISCRETIZATIONS = [
     {"discretization": {"kind": "node_to_surface", "passes": 1}, "slave": "punch"},
     {"discretization": {"kind": "node_to_surface", "passes": 1}, "slave": "foundation"},
     {"discretization": {"kind": "node_to_surface", "passes": 2}},
+    {"discretization": {"kind": "mortar", "multiplier": "standard"}, "slave": "punch"},
+    {"discretization": {"kind": "mortar", "multiplier": "dual"}, "slave": "punch"},
 ]
 
 

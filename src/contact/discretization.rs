@@ -15,6 +15,9 @@
 //! * **Two-pass**: the rows of the pass with the roles swapped are appended (pass 2).
 //! * **Rigid masters**: a line `g = n . (x_s - p)` or a circle `g = |x_s - c| - R` with
 //!   `n = (x_s - c)/|x_s - c|`; only slave dofs appear.
+//! * **Mortar** (standard and dual, segment-based integration): see [`super::mortar`].
+//! * **Tied** pairs use the same weights with one bilateral row per global direction
+//!   (`e_x`, `e_y`) and zero initial gap: the interface keeps its initial geometry.
 //!
 //! Every row carries the slave node's tributary area, so penalty forces (`kappa A g`) do not
 //! depend on the mesh. Geometry is evaluated in the reference configuration (small strain).
@@ -28,102 +31,203 @@ use crate::scene::{DiscretizationSpec, NormalChoice, RigidSurface};
 /// Tolerance on the facet parameter for "inside the facet".
 const INSIDE: f64 = 1e-9;
 
+/// Collects rows: one row along `nu` for frictionless pairs, two bilateral rows (x and y) with
+/// zero initial gap for tied pairs.
+pub(crate) struct Rows<'a> {
+    pub model: &'a Model,
+    pub tied: bool,
+    pub out: Vec<Constraint>,
+}
+
+impl Rows<'_> {
+    #[allow(clippy::too_many_arguments)]
+    pub fn push(
+        &mut self,
+        slave: &Surface,
+        node: usize,
+        nu: [f64; 2],
+        g0: f64,
+        slave_terms: &[(usize, f64)],
+        master: Option<(usize, &[(usize, f64)])>,
+        area: f64,
+        pass: u8,
+    ) {
+        if self.tied {
+            for e in [[1.0, 0.0], [0.0, 1.0]] {
+                let r = weighted_row(
+                    self.model,
+                    slave,
+                    node,
+                    e,
+                    0.0,
+                    slave_terms,
+                    master,
+                    area,
+                    pass,
+                    true,
+                );
+                self.out.push(r);
+            }
+        } else {
+            let r = weighted_row(
+                self.model,
+                slave,
+                node,
+                nu,
+                g0,
+                slave_terms,
+                master,
+                area,
+                pass,
+                false,
+            );
+            self.out.push(r);
+        }
+    }
+
+    /// A node-based row: the slave node against master nodes with weights (`None`: rigid).
+    fn node(
+        &mut self,
+        slave: &Surface,
+        node: usize,
+        nu: [f64; 2],
+        g0: f64,
+        master: Option<(&Surface, &[usize], &[f64])>,
+        pass: u8,
+    ) {
+        let terms: Vec<(usize, f64)> = master
+            .map(|(_, n, w)| n.iter().copied().zip(w.iter().copied()).collect())
+            .unwrap_or_default();
+        let area = slave.nodes[&node].area;
+        self.push(
+            slave,
+            node,
+            nu,
+            g0,
+            &[(node, 1.0)],
+            master.map(|(m, _, _)| (m.body, terms.as_slice())),
+            area,
+            pass,
+        );
+    }
+}
+
 /// The constraint rows of `pair`, or the reason the discretization does not apply.
 pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>, String> {
     let slave_body = &model.bodies[pair.slave.0];
     let slave = Surface::new(pair.slave.0, slave_body, &pair.slave.1, model.thickness);
+    let mut rows = Rows {
+        model,
+        tied: pair.tied,
+        out: Vec::new(),
+    };
     match (&pair.discretization, &pair.master) {
         (_, MasterSide::Rigid(rigid)) => match pair.discretization {
             DiscretizationSpec::NodeToSurface { passes: 1, .. } => {
-                Ok(rigid_rows(model, &slave, rigid))
+                rigid_rows(&mut rows, &slave, rigid)?
             }
             DiscretizationSpec::NodeToNode => {
-                Err("node-to-node needs a master body with nodes, not a rigid surface".into())
+                return Err(
+                    "node-to-node needs a master body with nodes, not a rigid surface".into(),
+                )
             }
-            _ => Err(
-                "two passes need a master body; a rigid surface has no nodes to act as slaves"
-                    .into(),
-            ),
+            DiscretizationSpec::Mortar { .. } => {
+                return Err("mortar needs a master body with facets, not a rigid surface".into())
+            }
+            _ => {
+                return Err(
+                    "two passes need a master body; a rigid surface has no nodes to act as slaves"
+                        .into(),
+                )
+            }
         },
         (DiscretizationSpec::NodeToNode, MasterSide::Body { body, facets }) => {
             let master = Surface::new(*body, &model.bodies[*body], facets, model.thickness);
-            node_to_node(model, &slave, &master)
+            node_to_node(&mut rows, &slave, &master)?;
         }
         (
             DiscretizationSpec::NodeToSurface { passes, normal },
             MasterSide::Body { body, facets },
         ) => {
             let master = Surface::new(*body, &model.bodies[*body], facets, model.thickness);
-            let mut rows = node_to_surface(model, &slave, &master, *normal, 1);
+            node_to_surface(&mut rows, &slave, &master, *normal, 1);
             if *passes == 2 {
-                rows.extend(node_to_surface(model, &master, &slave, *normal, 2));
+                node_to_surface(&mut rows, &master, &slave, *normal, 2);
             }
-            Ok(rows)
+        }
+        (DiscretizationSpec::Mortar { multiplier }, MasterSide::Body { body, facets }) => {
+            let master = Surface::new(*body, &model.bodies[*body], facets, model.thickness);
+            super::mortar::mortar_rows(&mut rows, &slave, &master, *multiplier)?;
         }
     }
+    Ok(rows.out)
 }
 
-fn owner(dofs: &[usize], coeffs: &[f64], slave_dofs: usize) -> usize {
-    let k = (0..slave_dofs)
-        .max_by(|&a, &b| coeffs[a].abs().total_cmp(&coeffs[b].abs()))
-        .expect("a slave dof");
-    dofs[k]
-}
-
-/// A row `nu . (u_s - sum_b w_b u_b)` with zero coefficients dropped.
+/// A row `g = g0 + nu . (sum_k a_k u_k - sum_l b_l u_l)` over slave terms `(node, a_k)` (the
+/// row's own node first) and master terms `(node, b_l)` of body `master.0`; zero coefficients
+/// are dropped. The owner (for elimination) is the row's own node's dof with the largest `|nu_i|`.
 #[allow(clippy::too_many_arguments)]
-fn row(
+pub(crate) fn weighted_row(
     model: &Model,
     slave: &Surface,
     node: usize,
     nu: [f64; 2],
     g0: f64,
-    master: Option<(&Surface, &[usize], &[f64])>,
+    slave_terms: &[(usize, f64)],
+    master: Option<(usize, &[(usize, f64)])>,
+    area: f64,
     pass: u8,
+    bilateral: bool,
 ) -> Constraint {
     let sb = &model.bodies[slave.body];
     let mut dofs = Vec::new();
     let mut coeffs = Vec::new();
-    for i in 0..2 {
-        if nu[i].abs() > 1e-14 {
-            dofs.push(sb.dof(node, i));
-            coeffs.push(nu[i]);
-        }
-    }
-    let slave_dofs = dofs.len();
-    if let Some((m, nodes, weights)) = master {
-        let mb = &model.bodies[m.body];
-        for (&n, &w) in nodes.iter().zip(weights) {
-            for i in 0..2 {
-                let c = -w * nu[i];
-                if c.abs() > 1e-14 {
-                    dofs.push(mb.dof(n, i));
+    let mut push = |dof: usize, c: f64| {
+        if c.abs() > 1e-14 {
+            match dofs.iter().position(|&d| d == dof) {
+                Some(k) => coeffs[k] += c,
+                None => {
+                    dofs.push(dof);
                     coeffs.push(c);
                 }
             }
         }
+    };
+    for &(n, a) in slave_terms {
+        for i in 0..2 {
+            push(sb.dof(n, i), a * nu[i]);
+        }
     }
-    let owner = owner(&dofs, &coeffs, slave_dofs);
+    if let Some((mb, terms)) = master {
+        let mb = &model.bodies[mb];
+        for &(n, b) in terms {
+            for i in 0..2 {
+                push(mb.dof(n, i), -b * nu[i]);
+            }
+        }
+    }
+    let comp = if nu[0].abs() > nu[1].abs() { 0 } else { 1 };
+    let owner = sb.dof(node, comp);
+    let data = slave.nodes[&node];
     Constraint {
         dofs,
         coeffs,
         g0,
-        area: slave.nodes[&node].area,
+        area,
         normal: nu,
+        slave_normal: data.normal,
         slave_body: slave.body,
         slave_node: node,
         point: sb.mesh.nodes[node],
         pass,
         owner,
         pair: 0,
+        bilateral,
     }
 }
 
-fn node_to_node(
-    model: &Model,
-    slave: &Surface,
-    master: &Surface,
-) -> Result<Vec<Constraint>, String> {
+fn node_to_node(rows: &mut Rows, slave: &Surface, master: &Surface) -> Result<(), String> {
+    let model = rows.model;
     let mb = &model.bodies[master.body];
     let sb = &model.bodies[slave.body];
     let tol = 1e-9 * mb.mesh.size();
@@ -134,12 +238,10 @@ fn node_to_node(
             .map(|&n| [mb.mesh.nodes[n], mb.mesh.nodes[n]])
             .collect(),
     );
-    let mut rows = Vec::new();
     let mut used = vec![false; master_nodes.len()];
     for &s in slave.nodes.keys() {
         let p = sb.mesh.nodes[s];
-        let hit = grid.query(p, tol).into_iter().next();
-        let Some(k) = hit else {
+        let Some(k) = grid.query(p, tol).into_iter().next() else {
             return Err(format!(
                 "the interface nodes do not match: slave node at ({}, {}) has no master node there",
                 p[0], p[1]
@@ -150,7 +252,7 @@ fn node_to_node(
         let n = master.nodes[&m].normal;
         let x = mb.mesh.nodes[m];
         let g0 = n[0] * (p[0] - x[0]) + n[1] * (p[1] - x[1]);
-        rows.push(row(model, slave, s, n, g0, Some((master, &[m], &[1.0])), 1));
+        rows.node(slave, s, n, g0, Some((master, &[m], &[1.0])), 1);
     }
     if let Some(k) = used.iter().position(|u| !u) {
         let x = mb.mesh.nodes[master_nodes[k]];
@@ -159,23 +261,23 @@ fn node_to_node(
             x[0], x[1]
         ));
     }
-    Ok(rows)
+    Ok(())
 }
 
 fn node_to_surface(
-    model: &Model,
+    rows: &mut Rows,
     slave: &Surface,
     master: &Surface,
     normal: NormalChoice,
     pass: u8,
-) -> Vec<Constraint> {
+) {
+    let model = rows.model;
     let sb = &model.bodies[slave.body];
     let mb = &model.bodies[master.body];
     let grid = BucketGrid::new(master.boxes());
     let radius = master.facet_size();
     let tol = 1e-12 * mb.mesh.size();
     let kind = master.kind;
-    let mut rows = Vec::new();
     for (&s, data) in &slave.nodes {
         let p = sb.mesh.nodes[s];
         let candidates = grid.query(p, radius);
@@ -210,15 +312,14 @@ fn node_to_surface(
             let (n, _) = edge_shape(kind, xi);
             let g0 = nu[0] * (p[0] - x[0]) + nu[1] * (p[1] - x[1]);
             let k = kind.node_count();
-            rows.push(row(
-                model,
+            rows.node(
                 slave,
                 s,
                 nu,
                 g0,
                 Some((master, &master.facets[f], &n[..k])),
                 pass,
-            ));
+            );
             continue;
         }
         // corner condition: the nearest vertex of the candidate facets
@@ -241,40 +342,31 @@ fn node_to_surface(
                 master.nodes[&v].normal
             };
             let g0 = nu[0] * d[0] + nu[1] * d[1];
-            rows.push(row(
-                model,
-                slave,
-                s,
-                nu,
-                g0,
-                Some((master, &[v], &[1.0])),
-                pass,
-            ));
+            rows.node(slave, s, nu, g0, Some((master, &[v], &[1.0])), pass);
         }
     }
-    rows
 }
 
-fn rigid_rows(model: &Model, slave: &Surface, rigid: &RigidSurface) -> Vec<Constraint> {
-    let sb = &model.bodies[slave.body];
-    slave
-        .nodes
-        .keys()
-        .map(|&s| {
-            let p = sb.mesh.nodes[s];
-            let (nu, g0) = match *rigid {
-                RigidSurface::Line { point, normal } => {
-                    let l = (normal[0] * normal[0] + normal[1] * normal[1]).sqrt();
-                    let n = [normal[0] / l, normal[1] / l];
-                    (n, n[0] * (p[0] - point[0]) + n[1] * (p[1] - point[1]))
+fn rigid_rows(rows: &mut Rows, slave: &Surface, rigid: &RigidSurface) -> Result<(), String> {
+    let sb = &rows.model.bodies[slave.body];
+    for &s in slave.nodes.keys() {
+        let p = sb.mesh.nodes[s];
+        let (nu, g0) = match *rigid {
+            RigidSurface::Line { point, normal } => {
+                let l = (normal[0] * normal[0] + normal[1] * normal[1]).sqrt();
+                let n = [normal[0] / l, normal[1] / l];
+                (n, n[0] * (p[0] - point[0]) + n[1] * (p[1] - point[1]))
+            }
+            RigidSurface::Circle { centre, radius } => {
+                let d = [p[0] - centre[0], p[1] - centre[1]];
+                let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                if l <= 1e-12 * radius {
+                    return Err(format!("slave node at ({}, {}) sits at the centre of the rigid circle, where the normal is undefined", p[0], p[1]));
                 }
-                RigidSurface::Circle { centre, radius } => {
-                    let d = [p[0] - centre[0], p[1] - centre[1]];
-                    let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
-                    ([d[0] / l, d[1] / l], l - radius)
-                }
-            };
-            row(model, slave, s, nu, g0, None, 1)
-        })
-        .collect()
+                ([d[0] / l, d[1] / l], l - radius)
+            }
+        };
+        rows.node(slave, s, nu, g0, None, 1);
+    }
+    Ok(())
 }

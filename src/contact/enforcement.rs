@@ -121,7 +121,7 @@ pub fn elimination_obstacle(rows: &[Constraint], prescribed: &[Option<f64>]) -> 
         }
         if count[&r.owner] > 1 {
             return Some(format!(
-                "the slave dof of the constraint at ({}, {}) also appears in another constraint (a two-pass or shared node), so no constraint owns it",
+                "the slave dof of the constraint at ({}, {}) also appears in another constraint (two-pass rows, or standard mortar rows whose D is not diagonal), so no constraint owns it",
                 r.point[0], r.point[1]
             ));
         }

@@ -33,6 +33,7 @@
 pub mod discretization;
 pub mod enforcement;
 pub mod geometry;
+pub mod mortar;
 pub mod search;
 pub mod solver;
 
@@ -48,8 +49,11 @@ pub struct Constraint {
     /// Tributary area of the slave node (length x thickness); 1 for lumped node-to-node pairs
     /// on a surface without facets.
     pub area: f64,
-    /// Unit normal along which the gap is measured (points from master to slave).
+    /// Unit direction along which the gap is measured (points from master to slave; `e_x` or
+    /// `e_y` for tied rows).
     pub normal: [f64; 2],
+    /// Outward unit normal of the slave surface at the slave node (zero for rigid slaves).
+    pub slave_normal: [f64; 2],
     /// Body and local node of the slave node, and its reference position.
     pub slave_body: usize,
     pub slave_node: usize,
@@ -60,6 +64,8 @@ pub struct Constraint {
     pub owner: usize,
     /// Index of the contact pair in the model.
     pub pair: usize,
+    /// A tie: always active, its force may have either sign.
+    pub bilateral: bool,
 }
 
 impl Constraint {

@@ -575,7 +575,11 @@ impl Kernel<'_> {
     fn active_set_loop(&mut self, method: Method, rows: &[Constraint]) -> LoopResult {
         let nrows = self.rows.len();
         let gap_tol = self.gap_tol();
-        let mut active: Vec<bool> = self.rows.iter().map(|r| r.g0 <= gap_tol).collect();
+        let mut active: Vec<bool> = rows
+            .iter()
+            .zip(self.rows)
+            .map(|(c, r)| c.bilateral || r.g0 <= gap_tol)
+            .collect();
         let kappa_w = |kappa: f64| -> Vec<f64> { rows.iter().map(|r| kappa * r.area).collect() };
         let owners: Vec<usize> = rows.iter().map(|r| self.sys.eq[r.owner]).collect();
         let mut lambda_k = vec![0.0; nrows];
@@ -675,7 +679,13 @@ impl Kernel<'_> {
                     // Uzawa: lambda_k <- max(0, lambda_k - kappa A g)
                     let uzawa = |lk: &mut Vec<f64>| {
                         for i in 0..nrows {
-                            lk[i] = (lk[i] - kappa * rows[i].area * gaps[i]).max(0.0);
+                            let update = lk[i] - kappa * rows[i].area * gaps[i];
+                            // ties carry forces of either sign; contact only compression
+                            lk[i] = if rows[i].bilateral {
+                                update
+                            } else {
+                                update.max(0.0)
+                            };
                         }
                     };
                     if !done && (update == MultiplierUpdate::PerIteration || stable) {
