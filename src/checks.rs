@@ -37,7 +37,8 @@ fn relative(got: f64, value: f64) -> f64 {
 }
 
 /// Max over the rows of `pair` (all pairs if `None`) of `|lambda_i / A_i - p_i| / scale`,
-/// with `p_i = -n . sigma_exact . n` the exact contact pressure at the slave node and `scale`
+/// with `p_i = nu . sigma_exact . n_s` the exact traction along the row's direction (for
+/// contact, `nu = -n_s` and `p_i` is the contact pressure) and `scale`
 /// the given one or, if `None`, `max |sigma_exact|` at the node. Infinite when the solve
 /// produced no contact state.
 pub fn pressure_error(
@@ -58,8 +59,10 @@ pub fn pressure_error(
         let scale = scale
             .unwrap_or_else(|| s.iter().fold(0.0f64, |m, v| m.max(v.abs())))
             .max(f64::MIN_POSITIVE);
-        let n = r.normal;
-        let p = -(n[0] * (s[0] * n[0] + s[2] * n[1]) + n[1] * (s[2] * n[0] + s[1] * n[1]));
+        // the exact force per area along the row's direction nu on the slave surface (outward
+        // normal n_s): nu . sigma . n_s (= -n.sigma.n = p for contact, where nu = -n_s)
+        let (nu, ns) = (r.normal, r.slave_normal);
+        let p = nu[0] * (s[0] * ns[0] + s[2] * ns[1]) + nu[1] * (s[2] * ns[0] + s[1] * ns[1]);
         let e = (state.forces[i] / r.area - p).abs() / scale;
         worst = if e.is_nan() || e > worst { e } else { worst };
     }
@@ -118,10 +121,24 @@ pub fn force_balance(model: &Model, solution: &Solution) -> f64 {
     net.max(solution.relative_residual)
 }
 
-/// Judge every check of the model (names were resolved when the model was built).
+/// Judge every check of the model (names were resolved when the model was built). A contact
+/// solve that did not converge adds a failing check of its own, so that no declared check can
+/// pass on an unconverged solution.
 pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
     let u = &solution.u;
-    model
+    let convergence = solution
+        .contact
+        .as_ref()
+        .and_then(|c| match &c.termination {
+            crate::contact::solver::Termination::Converged => None,
+            t => Some(CheckResult {
+                check: format!("the contact solve converged (it ended: {t:?})"),
+                error: f64::INFINITY,
+                tol: 0.0,
+                passed: false,
+            }),
+        });
+    let declared: Vec<CheckResult> = model
         .checks
         .iter()
         .map(|check| {
@@ -193,5 +210,6 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
             };
             CheckResult { check: check_name, error, tol, passed: error <= tol }
         })
-        .collect()
+        .collect();
+    convergence.into_iter().chain(declared).collect()
 }

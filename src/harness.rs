@@ -34,6 +34,8 @@ use std::time::Instant;
 /// One cell of the patch table.
 #[derive(Clone, Debug, Serialize)]
 pub struct Cell {
+    /// `patch` or `tied` (the sweep's catalogue).
+    pub catalogue: String,
     pub case: String,
     pub mesh: String,
     pub nu: f64,
@@ -157,6 +159,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 name(e)
             ));
             let mut cell = Cell {
+                catalogue: sweep.catalogue.clone(),
                 case: base.name.clone(),
                 mesh: sweep.mesh.clone(),
                 nu,

@@ -239,7 +239,7 @@ fn check(paths: &[PathBuf]) -> ExitCode {
 
 fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
     let paths = if paths.is_empty() {
-        vec![PathBuf::from("cases/patch")]
+        vec![PathBuf::from("cases/patch"), PathBuf::from("cases/tied")]
     } else {
         paths.to_vec()
     };
@@ -283,23 +283,49 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let report = contact_patch::report::patch_report(&cells, start.elapsed().as_secs_f64());
-    let json = serde_json::to_string_pretty(&cells).expect("cells serialize") + "\n";
-    let written = std::fs::create_dir_all(out)
-        .and_then(|_| write_replacing(&out.join("patch-table.json"), &json))
-        .and_then(|_| write_replacing(&out.join("patch-table.md"), &report));
-    if let Err(e) = written {
-        eprintln!("error: {}: writing the tables failed: {e}", out.display());
+    let seconds = start.elapsed().as_secs_f64();
+    if let Err(e) = std::fs::create_dir_all(out) {
+        eprintln!("error: {}: creating the folder failed: {e}", out.display());
         return ExitCode::from(2);
     }
-    println!("{}", contact_patch::report::seed_summary(&cells));
-    println!(
-        "{} cells in {:.2}s; wrote {} and {}",
-        cells.len(),
-        start.elapsed().as_secs_f64(),
-        out.join("patch-table.md").display(),
-        out.join("patch-table.json").display()
-    );
+    let mut catalogues: Vec<String> = cells.iter().map(|c| c.catalogue.clone()).collect();
+    catalogues.sort();
+    catalogues.dedup();
+    for catalogue in catalogues {
+        let part: Vec<_> = cells
+            .iter()
+            .filter(|c| c.catalogue == catalogue)
+            .cloned()
+            .collect();
+        let report = match catalogue.as_str() {
+            "tied" => contact_patch::report::tied_report(&part),
+            _ => contact_patch::report::patch_report(&part, seconds),
+        };
+        let json = serde_json::to_string_pretty(&part).expect("cells serialize") + "\n";
+        let (md_path, json_path) = (
+            out.join(format!("{catalogue}-table.md")),
+            out.join(format!("{catalogue}-table.json")),
+        );
+        if let Err(e) =
+            write_replacing(&json_path, &json).and_then(|_| write_replacing(&md_path, &report))
+        {
+            eprintln!("error: {}: writing the tables failed: {e}", out.display());
+            return ExitCode::from(2);
+        }
+        if catalogue == "patch" {
+            println!("{}", contact_patch::report::seed_summary(&part));
+        }
+        println!(
+            "{catalogue}: {} cells ({} pass, {} fail, {} n/a); wrote {} and {}",
+            part.len(),
+            part.iter().filter(|c| c.verdict == "pass").count(),
+            part.iter().filter(|c| c.verdict == "fail").count(),
+            part.iter().filter(|c| c.verdict == "n/a").count(),
+            md_path.display(),
+            json_path.display()
+        );
+    }
+    println!("{} cells in {seconds:.2}s", cells.len());
     ExitCode::SUCCESS
 }
 

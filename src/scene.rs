@@ -195,6 +195,10 @@ pub struct SweepDiscretization {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SweepSpec {
+    /// Which table the cells go to: `patch` (default, `reports/patch-table.*`) or `tied`
+    /// (`reports/tied-table.*`).
+    #[serde(default = "patch_catalogue")]
+    pub catalogue: String,
     /// Label of the mesh in tables (e.g. "A").
     pub mesh: String,
     pub discretizations: Vec<SweepDiscretization>,
@@ -206,6 +210,10 @@ pub struct SweepSpec {
     pub pressure: f64,
     /// Tolerance of the patch-test verdict (relative to the pressure).
     pub tol: f64,
+}
+
+fn patch_catalogue() -> String {
+    "patch".into()
 }
 
 fn thousand() -> f64 {

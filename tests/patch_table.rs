@@ -70,3 +70,39 @@ fn patch_table() {
         );
     });
 }
+
+/// Tied patch tests: mortar and dual mortar ties reproduce every constant stress (normal,
+/// parallel, shear) across the non-matching meshes B, C and E with every exact method; the
+/// grid is a snapshot too (it records which node-to-surface ties fail and by how much).
+#[test]
+fn tied_table() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/tied");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "json"))
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 9, "meshes B, C, E x three stress states");
+    let cells: Vec<Cell> = files
+        .iter()
+        .flat_map(|f| run_sweep(f, &mut |_| {}).unwrap())
+        .collect();
+    for c in cells
+        .iter()
+        .filter(|c| c.discretization.contains("mortar") && c.verdict != "n/a")
+    {
+        assert_eq!(c.verdict, "pass", "{c:?}");
+        assert!(c.force_balance.unwrap() <= 1e-12, "momentum: {c:?}");
+    }
+    assert!(
+        cells
+            .iter()
+            .any(|c| c.discretization == "node_to_surface" && c.verdict == "fail"),
+        "node-to-surface ties are expected to fail somewhere"
+    );
+    let mut settings = insta::Settings::clone_current();
+    settings.set_snapshot_path("../snapshots");
+    settings.set_prepend_module_to_snapshot(false);
+    settings.bind(|| insta::assert_snapshot!("tied_table", grid_markdown(&cells, false)));
+}

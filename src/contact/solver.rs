@@ -654,20 +654,25 @@ impl Kernel<'_> {
             let max_active_gap = (0..nrows)
                 .filter(|&i| active[i])
                 .fold(0.0f64, |m, i| m.max(gaps[i].abs()));
+            // ties (bilateral rows) stay active whatever the sign of their force
             let new_active: Vec<bool> = match method {
                 Method::Lagrange | Method::Elimination | Method::PerturbedTangent { .. } => (0
                     ..nrows)
                     .map(|i| {
-                        if active[i] {
-                            forces[i] >= -force_tol
-                        } else {
-                            gaps[i] < -gap_tol
-                        }
+                        rows[i].bilateral
+                            || if active[i] {
+                                forces[i] >= -force_tol
+                            } else {
+                                gaps[i] < -gap_tol
+                            }
                     })
                     .collect(),
                 Method::Regularized { kappa } | Method::AugmentedLagrange { kappa, .. } => (0
                     ..nrows)
-                    .map(|i| lambda_k[i] - kappa * rows[i].area * gaps[i] > force_tol)
+                    .map(|i| {
+                        rows[i].bilateral
+                            || lambda_k[i] - kappa * rows[i].area * gaps[i] > force_tol
+                    })
                     .collect(),
             };
             let stable = new_active == active;
