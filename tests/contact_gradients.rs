@@ -174,3 +174,59 @@ fn rigid_surface_rows_are_gap_gradients() {
         assert_eq!(check(&m, disc, 1e-6, 1e-7, false), 3, "{rigid}");
     }
 }
+
+/// Mortar rows are the derivatives of the weighted gap `nu . (D x_s - M x_m) / A` where the
+/// interface is closed (there the derivatives of `D`, `M` and of the segmentation multiply a
+/// zero gap), on the non-nested meshes C (Line2) and E (Line3), both multiplier spaces.
+#[test]
+fn mortar_rows_are_weighted_gap_gradients_where_closed() {
+    use contact_patch::scene::MultiplierSpace;
+    for mesh in ["C", "E"] {
+        let text = std::fs::read_to_string(format!(
+            "{}/cases/patch/patch-{mesh}-nu0.3.json",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap();
+        let m = Model::build(&parse(&text, mesh).unwrap(), mesh).unwrap();
+        for multiplier in [MultiplierSpace::Standard, MultiplierSpace::Dual] {
+            let n = check(
+                &m,
+                DiscretizationSpec::Mortar { multiplier },
+                1e-6,
+                1e-7,
+                true,
+            );
+            assert!(n >= 2, "{mesh} {multiplier:?}: {n} rows checked");
+        }
+    }
+}
+
+/// Linear momentum: every mortar row's weights satisfy `sum_k D_jk = sum_l M_jl`, so its
+/// slave and master forces cancel exactly (checked on a curved, open interface where nothing
+/// else cancels).
+#[test]
+fn mortar_rows_conserve_linear_momentum() {
+    use contact_patch::scene::MultiplierSpace;
+    for element in ["Q4", "Q9"] {
+        let mut m = two_blocks(element, 0.03, 0.02);
+        for multiplier in [MultiplierSpace::Standard, MultiplierSpace::Dual] {
+            m.contact[0].discretization = DiscretizationSpec::Mortar { multiplier };
+            let rows = constraints(&m, &m.contact[0]).unwrap();
+            assert!(rows.len() >= 3);
+            for r in &rows {
+                let (mut fx, mut fy) = (0.0, 0.0);
+                for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
+                    if d % 2 == 0 {
+                        fx += c
+                    } else {
+                        fy += c
+                    }
+                }
+                assert!(
+                    fx.abs() < 1e-13 && fy.abs() < 1e-13,
+                    "{element} {multiplier:?}: net force ({fx}, {fy}) of row {r:?}"
+                );
+            }
+        }
+    }
+}
