@@ -30,6 +30,7 @@ pub mod error;
 pub mod exact;
 pub mod fe;
 pub mod harness;
+pub mod layer;
 pub mod mesh;
 pub mod model;
 pub mod output;
@@ -40,5 +41,6 @@ pub mod scene;
 pub mod solid;
 pub mod solve;
 pub mod sparse;
+pub mod svg;
 
 pub use error::{Error, Result};

@@ -45,6 +45,23 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// The seed's tied layer: node-to-surface and mortar ties against one body, under refinement;
+    /// writes reports/tied-layer.md, SVG plots and .vtu files.
+    #[command(
+        name = "tied-layer",
+        after_help = "Example:\n  contact-patch tied-layer --levels 1,2,4,8"
+    )]
+    TiedLayer {
+        /// Folder with the tied-layer cases.
+        #[arg(long, default_value = "cases/tied-layer")]
+        cases: PathBuf,
+        /// Refinement levels (each multiplies every division).
+        #[arg(long, value_delimiter = ',', default_value = "1,2,4,8")]
+        levels: Vec<usize>,
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
     /// Run the checks declared in cases; exit 0 only when every check of every case passes.
     #[command(
         after_help = "Example:\n  contact-patch check cases/patch-single cases/convergence/cantilever-q4.json\n\nFolders are searched recursively for *.json case files."
@@ -62,6 +79,7 @@ fn main() -> ExitCode {
         Command::Run { case, out } => run(&case, out),
         Command::Check { paths } => check(&paths),
         Command::Table { paths, out } => table(&paths, &out),
+        Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
     }
 }
 
@@ -334,4 +352,71 @@ fn write_replacing(path: &Path, text: &str) -> std::io::Result<()> {
     let tmp = path.with_extension("partial");
     std::fs::write(&tmp, text)?;
     std::fs::rename(&tmp, path)
+}
+
+fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
+    if levels.is_empty() || levels.contains(&0) {
+        eprintln!("error: --levels needs positive integers, e.g. 1,2,4,8");
+        return ExitCode::from(2);
+    }
+    let plot_level = levels[levels.len() / 2];
+    let mut studies = Vec::new();
+    for element in ["q4", "q9"] {
+        match contact_patch::layer::study(cases, element, levels, plot_level) {
+            Ok(s) => studies.push((element.to_string(), s)),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        }
+    }
+    let result = (|| -> contact_patch::Result<Vec<String>> {
+        let io = |p: &Path, e| contact_patch::Error::io(p.display(), "writing", e);
+        std::fs::create_dir_all(out).map_err(|e| io(out, e))?;
+        let mut files = Vec::new();
+        for (element, study) in &studies {
+            for (stem, svg) in contact_patch::layer::plots(element, plot_level, &study.curves) {
+                let name = format!("{stem}.svg");
+                std::fs::write(out.join(&name), svg).map_err(|e| io(&out.join(&name), e))?;
+                files.push(name);
+            }
+            for (name, model, solution) in &study.solved {
+                let outcome = contact_patch::run::Outcome {
+                    checks: contact_patch::checks::evaluate(model, solution),
+                    model: model.clone(),
+                    solution: solution.clone(),
+                };
+                contact_patch::output::write_run(
+                    &out.join("tied-layer").join(format!("{element}-{name}")),
+                    &outcome,
+                )?;
+            }
+        }
+        let report = contact_patch::layer::report(&studies, levels, plot_level, &files);
+        write_replacing(&out.join("tied-layer.md"), &report)
+            .map_err(|e| io(&out.join("tied-layer.md"), e))?;
+        let runs: Vec<_> = studies.iter().flat_map(|(_, s)| s.runs.clone()).collect();
+        let json = serde_json::to_string_pretty(&runs).expect("runs serialize") + "\n";
+        write_replacing(&out.join("tied-layer.json"), &json)
+            .map_err(|e| io(&out.join("tied-layer.json"), e))?;
+        Ok(files)
+    })();
+    match result {
+        Ok(_) => {
+            for (_, study) in &studies {
+                for r in &study.runs {
+                    println!(
+                        "{} level {} {:>16}: {:>6} dofs, du {:.2e}, ds {:.2e}",
+                        r.element, r.level, r.variant, r.dofs, r.du, r.ds
+                    );
+                }
+            }
+            println!("wrote {}", out.join("tied-layer.md").display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
 }

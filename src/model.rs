@@ -793,7 +793,7 @@ impl Model {
                 add(&v);
             }
         }
-        let (eig, vecs) = crate::contact::solver::jacobi_eigen(&g, nm);
+        let (eig, vecs) = crate::contact::solver::symmetric_eigen(&g, nm);
         let max = eig.iter().fold(0.0f64, |a, &e| a.max(e.abs()));
         if let Some(k) = (0..nm).find(|&k| eig[k].abs() <= 1e-10 * max.max(f64::MIN_POSITIVE)) {
             // the body that moves most in the free mode

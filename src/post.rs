@@ -109,3 +109,101 @@ pub fn relative_l2_displacement_error(model: &Model, u: &[f64], exact: &ExactFie
         err.sqrt()
     }
 }
+
+/// Finds the cell of a body that contains a point: a bucket grid over the cells' bounding
+/// boxes gives the candidates, the isoparametric map is inverted by Newton's method in each,
+/// and the first cell whose reference domain contains the result (within `1e-9`) is taken.
+pub struct CellLocator<'a> {
+    body: &'a Body,
+    grid: crate::contact::search::BucketGrid,
+}
+
+impl<'a> CellLocator<'a> {
+    pub fn new(body: &'a Body) -> Self {
+        let mesh = &body.mesh;
+        let boxes = (0..mesh.cell_count())
+            .map(|c| {
+                let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+                for &n in mesh.cell(c) {
+                    for i in 0..2 {
+                        lo[i] = lo[i].min(mesh.nodes[n][i]);
+                        hi[i] = hi[i].max(mesh.nodes[n][i]);
+                    }
+                }
+                [lo, hi]
+            })
+            .collect();
+        CellLocator {
+            body,
+            grid: crate::contact::search::BucketGrid::new(boxes),
+        }
+    }
+
+    /// The cell containing `p` and the natural coordinates of `p` in it.
+    pub fn locate(&self, p: [f64; 2]) -> Option<(usize, [f64; 2])> {
+        let mesh = &self.body.mesh;
+        let kind = mesh.kind;
+        let tol = 1e-9;
+        let triangle = matches!(
+            kind,
+            crate::fe::ElementKind::T3 | crate::fe::ElementKind::T6
+        );
+        let nn = kind.node_count();
+        for c in self.grid.query(p, 1e-9 * mesh.size()) {
+            let coords = mesh.cell_coords(c);
+            let mut xi = kind.centre();
+            for _ in 0..30 {
+                let (mut n, mut dn) = (
+                    [0.0; crate::fe::MAX_NODES],
+                    [[0.0; 2]; crate::fe::MAX_NODES],
+                );
+                kind.shape(xi, &mut n[..nn], &mut dn[..nn]);
+                let mut x = [0.0; 2];
+                let mut j = [[0.0; 2]; 2];
+                for a in 0..nn {
+                    for i in 0..2 {
+                        x[i] += n[a] * coords[a][i];
+                        for k in 0..2 {
+                            j[i][k] += coords[a][i] * dn[a][k];
+                        }
+                    }
+                }
+                let r = [p[0] - x[0], p[1] - x[1]];
+                let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+                let d = [
+                    (j[1][1] * r[0] - j[0][1] * r[1]) / det,
+                    (-j[1][0] * r[0] + j[0][0] * r[1]) / det,
+                ];
+                xi = [xi[0] + d[0], xi[1] + d[1]];
+                if !(d[0].abs() + d[1].abs() > 1e-13) {
+                    break;
+                }
+            }
+            let inside = if triangle {
+                xi[0] >= -tol && xi[1] >= -tol && xi[0] + xi[1] <= 1.0 + tol
+            } else {
+                xi[0].abs() <= 1.0 + tol && xi[1].abs() <= 1.0 + tol
+            };
+            if inside {
+                return Some((c, xi));
+            }
+        }
+        None
+    }
+
+    /// Displacement and stress at the point `p` (if it lies in the body).
+    pub fn sample(&self, u: &[f64], p: [f64; 2]) -> Option<([f64; 2], [f64; 3])> {
+        let body = self.body;
+        let (c, xi) = self.locate(p)?;
+        let coords = body.mesh.cell_coords(c);
+        let pv = point_values(body.mesh.kind, &coords, xi);
+        let mut ue = Vec::with_capacity(MAX_DOFS);
+        cell_displacements(body, u, c, &mut ue);
+        let mut uh = [0.0; 2];
+        for a in 0..body.mesh.kind.node_count() {
+            uh[0] += pv.n[a] * ue[2 * a];
+            uh[1] += pv.n[a] * ue[2 * a + 1];
+        }
+        Some((uh, stress_at(body, u, c, xi).0))
+    }
+}

@@ -117,7 +117,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
     progress("assembling");
     let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.dofs.clone()).collect();
     let sys = assemble(model, &blocks);
-    let eq_rows: Vec<EqRow> = rows
+    let mut eq_rows: Vec<EqRow> = rows
         .iter()
         .map(|r| {
             let mut out = EqRow {
@@ -137,6 +137,33 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
             out
         })
         .collect();
+    // A row on prescribed dofs only holds by itself when its gap is zero (e.g. a tie row along
+    // a roller); it is dropped, since as a constraint it would only make the multiplier system
+    // singular. If its gap is not zero the data contradict each other.
+    let size = model
+        .bodies
+        .iter()
+        .map(|b| b.mesh.size())
+        .fold(0.0, f64::max);
+    if let Some((r, e)) = rows
+        .iter()
+        .zip(&eq_rows)
+        .find(|(_, e)| e.eqs.is_empty() && e.g0.abs() > 1e-12 * size)
+    {
+        return Err(Error::invalid(
+            &model.source,
+            format!("contact '{}'", model.contact[r.pair].name),
+            format!("the constraint of the slave node at ({}, {}) involves only prescribed dofs and their values violate it (gap {:.3e})", r.point[0], r.point[1], e.g0),
+            "make the supports of the two sides agree at this node, or remove one of them",
+        ));
+    }
+    let keep: Vec<bool> = eq_rows.iter().map(|e| !e.eqs.is_empty()).collect();
+    let mut k = 0;
+    rows.retain(|_| {
+        k += 1;
+        keep[k - 1]
+    });
+    eq_rows.retain(|e| !e.eqs.is_empty());
     timings.assembly = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -727,7 +754,7 @@ fn pseudo_solve(s: &[f64], r: &[f64], m: usize) -> std::result::Result<Vec<f64>,
     if m == 0 {
         return Ok(Vec::new());
     }
-    let (eig, v) = jacobi_eigen(s, m);
+    let (eig, v) = symmetric_eigen(s, m);
     let max = eig.iter().fold(0.0f64, |a, &e| a.max(e.abs()));
     let mut x = vec![0.0; m];
     let mut residual_in_null = 0.0f64;
@@ -750,7 +777,29 @@ fn pseudo_solve(s: &[f64], r: &[f64], m: usize) -> std::result::Result<Vec<f64>,
     Ok(x)
 }
 
-/// Eigenvalues and eigenvectors (columns of `v`, row-major) of a symmetric matrix.
+/// Eigenvalues and eigenvectors (columns of `v`, row-major) of a symmetric `m x m` matrix
+/// (row-major): faer's self-adjoint eigensolver, with cyclic Jacobi rotations as the fallback
+/// should it report a failure.
+pub fn symmetric_eigen(s: &[f64], m: usize) -> (Vec<f64>, Vec<f64>) {
+    let a = faer::Mat::<f64>::from_fn(m, m, |i, j| s[i * m + j]);
+    match a.self_adjoint_eigen(faer::Side::Lower) {
+        Ok(evd) => {
+            let (u, d) = (evd.U(), evd.S().column_vector());
+            let eig = (0..m).map(|k| d[k]).collect();
+            let mut v = vec![0.0; m * m];
+            for i in 0..m {
+                for k in 0..m {
+                    v[i * m + k] = u[(i, k)];
+                }
+            }
+            (eig, v)
+        }
+        Err(_) => jacobi_eigen(s, m),
+    }
+}
+
+/// Eigenvalues and eigenvectors (columns of `v`, row-major) of a symmetric matrix by cyclic
+/// Jacobi rotations.
 pub fn jacobi_eigen(s: &[f64], m: usize) -> (Vec<f64>, Vec<f64>) {
     let mut a = s.to_vec();
     let mut v = vec![0.0; m * m];
@@ -818,7 +867,7 @@ fn rank_deficiency(rows: &[&EqRow], n: usize) -> usize {
             dense[e] = 0.0;
         }
     }
-    let (eig, _) = jacobi_eigen(&g, m);
+    let (eig, _) = symmetric_eigen(&g, m);
     let max = eig.iter().fold(0.0f64, |a, &e| a.max(e.abs()));
     eig.iter().filter(|e| e.abs() <= 1e-10 * max).count()
 }
@@ -839,6 +888,13 @@ mod tests {
             }
         }
         let (eig, vecs) = jacobi_eigen(&s, 3);
+        let (eig2, _) = symmetric_eigen(&s, 3);
+        let mut sorted = eig.clone();
+        sorted.sort_by(f64::total_cmp);
+        assert!(
+            sorted.iter().zip(&eig2).all(|(a, b)| (a - b).abs() < 1e-12),
+            "{sorted:?} vs {eig2:?}"
+        );
         assert_eq!(eig.iter().filter(|e| e.abs() < 1e-12).count(), 1);
         for k in 0..3 {
             for i in 0..3 {
