@@ -175,7 +175,7 @@ impl<'a> CellLocator<'a> {
                     (-j[1][0] * r[0] + j[0][0] * r[1]) / det,
                 ];
                 xi = [xi[0] + d[0], xi[1] + d[1]];
-                if !(d[0].abs() + d[1].abs() > 1e-13) {
+                if d[0].is_nan() || d[0].abs() + d[1].abs() <= 1e-13 {
                     break;
                 }
             }
