@@ -431,6 +431,23 @@ pub enum ExactSpec {
 pub struct Physics {
     #[serde(default)]
     pub kinematics: Kinematics,
+    /// Where contact gaps, normals and projections are evaluated.
+    #[serde(default)]
+    pub contact_geometry: ContactGeometry,
+}
+
+/// The configuration in which the contact geometry is evaluated.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactGeometry {
+    /// Once, in the reference configuration (small sliding; the consistent choice for small
+    /// strain and the one the patch test assumes).
+    #[default]
+    Reference,
+    /// Re-evaluated in the current configuration `x = X + u` (finite sliding): the search,
+    /// projections, normals and weights are redone at the last solution and the contact problem
+    /// re-solved until the displacement stops changing.
+    Current,
 }
 
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

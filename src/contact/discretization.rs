@@ -10,8 +10,9 @@
 //!   normals** `nu = -n_s` (the slave surface's nodal normal, reversed) and `xi` is where the
 //!   ray from the slave node along `nu` meets the facet (Taylor 2004: smoother sliding).
 //!   **Corner condition**: a slave node that projects inside no facet but lies in the wedge
-//!   outside a convex master corner is held against the corner vertex, along the direction
-//!   from the vertex to the node (or the vertex's averaged normal when it sits on it).
+//!   outside a convex master corner (a vertex shared by two facets) is held against the corner
+//!   vertex, along the direction from the vertex to the node (or the vertex's averaged normal
+//!   when it sits on it). A slave node beyond a free end of the master surface gets no row.
 //! * **Two-pass**: the rows of the pass with the roles swapped are appended (pass 2).
 //! * **Rigid masters**: a line `g = n . (x_s - p)` or a circle `g = |x_s - c| - R` with
 //!   `n = (x_s - c)/|x_s - c|`; only slave dofs appear.
@@ -322,10 +323,20 @@ fn node_to_surface(
             );
             continue;
         }
-        // corner condition: the nearest vertex of the candidate facets
+        // corner condition: the nearest vertex shared by two candidate facets (a slave node
+        // beyond the free end of the master surface has slid off it and gets no row)
+        let shared = |v: usize| {
+            master
+                .facets
+                .iter()
+                .filter(|f| f[0] == v || f[1] == v)
+                .count()
+                >= 2
+        };
         let vertex = candidates
             .iter()
             .flat_map(|&f| [master.facets[f][0], master.facets[f][1]])
+            .filter(|&v| shared(v))
             .min_by(|&a, &b| {
                 let d = |n: usize| {
                     (mb.mesh.nodes[n][0] - p[0]).powi(2) + (mb.mesh.nodes[n][1] - p[1]).powi(2)

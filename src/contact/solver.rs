@@ -22,7 +22,7 @@ use super::enforcement::{elimination_obstacle, Method};
 use super::Constraint;
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::scene::MultiplierUpdate;
+use crate::scene::{ContactGeometry, MultiplierUpdate};
 use crate::solve::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
 use crate::sparse::{Cholesky, PatternBuilder};
 use std::collections::HashSet;
@@ -56,6 +56,8 @@ pub struct ContactState {
     /// augmented Lagrangian, elimination), `ldlt` (Lagrange, independent rows) or
     /// `schur-pseudo-inverse` (Lagrange, dependent rows).
     pub linear_solver: &'static str,
+    /// Evaluations of the contact geometry (1 in the reference configuration).
+    pub geometry_updates: usize,
 }
 
 /// Most linear solves of one contact solve.
@@ -85,12 +87,66 @@ impl EqRow {
 
 /// Solve the contact problem of `model` (all pairs share one enforcement method).
 pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
-    let mut timings = Timings::default();
-    let t = Instant::now();
-    progress("contact search");
+    match model.physics.contact_geometry {
+        ContactGeometry::Reference => solve_at(model, None, progress),
+        ContactGeometry::Current => {
+            // fixed point on the geometry: rows linearized at the last solution u_k,
+            // g(u) = g(X + u_k) + c(X + u_k) . (u - u_k)
+            let mut u = vec![0.0; model.dof_count];
+            for update in 1..=MAX_GEOMETRY_UPDATES {
+                let mut solution = solve_at(model, Some(&u), progress)?;
+                let scale = solution
+                    .u
+                    .iter()
+                    .fold(0.0f64, |m, v| m.max(v.abs()))
+                    .max(f64::MIN_POSITIVE);
+                let change = solution
+                    .u
+                    .iter()
+                    .zip(&u)
+                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+                    / scale;
+                let state = solution.contact.as_mut().expect("a contact solve");
+                state.geometry_updates = update;
+                if change <= 1e-12 || state.termination != Termination::Converged {
+                    return Ok(solution);
+                }
+                if update == MAX_GEOMETRY_UPDATES {
+                    state.termination = Termination::IterationLimit;
+                    return Ok(solution);
+                }
+                u = solution.u;
+            }
+            unreachable!("the loop returns")
+        }
+    }
+}
+
+/// Most re-evaluations of the contact geometry with `contact_geometry: current`.
+pub const MAX_GEOMETRY_UPDATES: usize = 50;
+
+/// The contact rows of every pair, evaluated at `X + u` (reference configuration if `None`)
+/// and linearized there.
+fn rows_at(model: &Model, u: Option<&[f64]>) -> Result<Vec<Constraint>> {
+    let moved;
+    let geometry = match u {
+        None => model,
+        Some(u) => {
+            let mut m = model.clone();
+            for b in &mut m.bodies {
+                let offset = b.dof_offset;
+                for (n, p) in b.mesh.nodes.iter_mut().enumerate() {
+                    p[0] += u[offset + 2 * n];
+                    p[1] += u[offset + 2 * n + 1];
+                }
+            }
+            moved = m;
+            &moved
+        }
+    };
     let mut rows = Vec::new();
-    for (k, pair) in model.contact.iter().enumerate() {
-        let r = constraints(model, pair).map_err(|reason| {
+    for (k, pair) in geometry.contact.iter().enumerate() {
+        let r = constraints(geometry, pair).map_err(|reason| {
             Error::invalid(
                 &model.source,
                 format!("contact '{}'", pair.name),
@@ -100,9 +156,27 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
         })?;
         rows.extend(r.into_iter().map(|mut c| {
             c.pair = k;
+            if let Some(u) = u {
+                c.g0 -= c
+                    .dofs
+                    .iter()
+                    .zip(&c.coeffs)
+                    .map(|(&d, &w)| w * u[d])
+                    .sum::<f64>();
+                c.point = model.bodies[c.slave_body].mesh.nodes[c.slave_node];
+            }
             c
         }));
     }
+    Ok(rows)
+}
+
+/// One contact solve with the rows of `rows_at(model, u)`.
+fn solve_at(model: &Model, u: Option<&[f64]>, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+    let mut timings = Timings::default();
+    let t = Instant::now();
+    progress("contact search");
+    let mut rows = rows_at(model, u)?;
     let method = Method::from_spec(&model.contact[0].enforcement);
     if method == Method::Elimination {
         if let Some(why) = elimination_obstacle(&rows, &model.prescribed) {
@@ -217,6 +291,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
         iterations,
         rank_deficiency,
         linear_solver,
+        geometry_updates: 1,
     });
     Ok(solution)
 }
