@@ -307,6 +307,29 @@ impl LdltFactor {
     }
 }
 
+/// Solve `A x = b` for the symmetric matrix whose upper triangle is `values` by sparse LU with
+/// partial pivoting (both triangles are expanded); `None` if LU fails or the result is not
+/// finite.
+pub fn lu_solve(pattern: &SymmetricPattern, values: &[f64], b: &[f64]) -> Option<Vec<f64>> {
+    use faer::sparse::{SparseColMat, Triplet};
+    let mut triplets = Vec::with_capacity(2 * pattern.nnz());
+    for j in 0..pattern.n {
+        for k in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+            let i = pattern.row_idx[k];
+            triplets.push(Triplet::new(i, j, values[k]));
+            if i != j {
+                triplets.push(Triplet::new(j, i, values[k]));
+            }
+        }
+    }
+    let a = SparseColMat::<usize, f64>::try_new_from_triplets(pattern.n, pattern.n, &triplets).ok()?;
+    let lu = a.sp_lu().ok()?;
+    let mut rhs = Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
+    lu.solve_in_place(rhs.as_mut());
+    let x: Vec<f64> = (0..b.len()).map(|i| rhs[(i, 0)]).collect();
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

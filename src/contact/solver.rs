@@ -53,8 +53,8 @@ pub struct ContactState {
     /// Number of dependent rows among the active constraints (rank deficiency of `B B^T`).
     pub rank_deficiency: usize,
     /// The linear solver of the last iteration: `cholesky` (penalty-type, perturbed tangent,
-    /// augmented Lagrangian, elimination), `ldlt` (Lagrange, independent rows) or
-    /// `schur-pseudo-inverse` (Lagrange, dependent rows).
+    /// augmented Lagrangian, elimination), `ldlt` (Lagrange, independent rows), `lu` (Lagrange,
+    /// when LDL^T refuses) or `schur-pseudo-inverse` (Lagrange, dependent rows).
     pub linear_solver: &'static str,
     /// Evaluations of the contact geometry (1 in the reference configuration).
     pub geometry_updates: usize,
@@ -399,15 +399,19 @@ impl Kernel<'_> {
         values
     }
 
-    /// Lagrange multipliers from the saddle-point system
-    /// `[[K + rho B^T B, -B^T], [-B, 0]] [u; lambda] = [f - rho B^T g0; g0]` (inactive rows:
-    /// `-lambda_i = 0`), factored by LDL^T with multipliers ordered last, plus two steps of
-    /// iterative refinement. `None` when the refined residual is not small (the caller falls
-    /// back to the Schur complement).
+    /// Lagrange multipliers from the saddle-point system, scaled so that both blocks share the
+    /// stiffness scale `rho` (`lambda = rho mu`):
+    /// `[[K + rho B^T B, -rho B^T], [-rho B, 0]] [u; mu] = [f - rho B^T g0; rho g0]`
+    /// (inactive rows: `-rho mu_i = 0`), factored by LDL^T with multipliers ordered last, then
+    /// refined. The residual is judged block by block: equilibrium against the force scale,
+    /// gap rows against the model size. If LDL^T refuses, sparse LU of the same matrix is
+    /// tried; `None` when neither gives a small residual (the caller falls back to the Schur
+    /// complement, which also handles dependent rows).
     fn lagrange_ldlt(&mut self, active: &[bool], rho: f64) -> Option<(Vec<f64>, Vec<f64>)> {
         let t = Instant::now();
         let n = self.sys.n;
         let m = self.rows.len();
+        let size = self.model.bodies.iter().map(|b| b.mesh.size()).fold(0.0, f64::max);
         let saddle = self.saddle.as_ref()?;
         let w = vec![rho; m];
         let k = self.augmented(active, &w);
@@ -418,52 +422,59 @@ impl Kernel<'_> {
         let mut rhs = self.sys.rhs.clone();
         rhs.resize(n + m, 0.0);
         for (i, row) in self.rows.iter().enumerate() {
-            let diag = saddle
-                .pattern
-                .position(n + i, n + i)
-                .expect("diagonal stored");
+            let diag = saddle.pattern.position(n + i, n + i).expect("diagonal stored");
             if active[i] {
                 for (&e, &c) in row.eqs.iter().zip(&row.coeffs) {
-                    values[saddle.pattern.position(e, n + i).expect("coupling stored")] = -c;
+                    values[saddle.pattern.position(e, n + i).expect("coupling stored")] = -rho * c;
                 }
                 row.add_to(-rho * row.g0, &mut rhs);
-                rhs[n + i] = row.g0;
+                rhs[n + i] = rho * row.g0;
             } else {
-                values[diag] = -1.0;
+                values[diag] = -rho;
             }
         }
         let mut signs = vec![1i8; n + m];
         signs[n..].iter_mut().for_each(|s| *s = -1);
-        let scale = k.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let factor = saddle
-            .ldlt
-            .factor(&saddle.pattern, &values, &signs, 1e-13 * scale)
-            .ok()?;
-        self.factorizations += t.elapsed().as_secs_f64();
-        let mut x = rhs.clone();
-        factor.solve_in_place(&mut x);
-        let norm = rhs
-            .iter()
-            .fold(0.0f64, |a, v| a.max(v.abs()))
-            .max(f64::MIN_POSITIVE);
-        let mut r = vec![0.0; n + m];
-        let mut residual = f64::INFINITY;
-        for _ in 0..3 {
-            saddle.pattern.mul(&values, &x, &mut r);
+        let force_scale = rhs[..n].iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        // residual of x, block by block: (equilibrium / forces, gaps / size)
+        let residual = |x: &[f64], r: &mut Vec<f64>| -> (f64, f64) {
+            saddle.pattern.mul(&values, x, r);
             r.iter_mut().zip(&rhs).for_each(|(a, b)| *a = b - *a);
-            residual = r.iter().fold(0.0f64, |a, v| a.max(v.abs())) / norm;
-            if residual < 1e-15 {
-                break;
+            let forces = x[n..].iter().fold(force_scale, |a, v| a.max((rho * v).abs())).max(f64::MIN_POSITIVE);
+            let ru = r[..n].iter().fold(0.0f64, |a, v| a.max(v.abs())) / forces;
+            let rg = r[n..].iter().fold(0.0f64, |a, v| a.max(v.abs())) / rho / size;
+            (ru, rg)
+        };
+        let small = |(ru, rg): (f64, f64)| ru <= 1e-11 && rg <= 1e-13;
+        let mut r = vec![0.0; n + m];
+        let mut solved = None;
+        if let Ok(factor) = saddle.ldlt.factor(&saddle.pattern, &values, &signs, 1e-13 * rho) {
+            let mut x = rhs.clone();
+            factor.solve_in_place(&mut x);
+            for _ in 0..3 {
+                let res = residual(&x, &mut r);
+                if small(res) {
+                    solved = Some((x.clone(), "ldlt"));
+                    break;
+                }
+                factor.solve_in_place(&mut r);
+                x.iter_mut().zip(&r).for_each(|(a, d)| *a += d);
             }
-            factor.solve_in_place(&mut r);
-            x.iter_mut().zip(&r).for_each(|(a, d)| *a += d);
+            if solved.is_none() && small(residual(&x, &mut r)) {
+                solved = Some((x, "ldlt"));
+            }
         }
-        if residual.is_nan() || residual >= 1e-10 {
-            return None;
+        if solved.is_none() {
+            if let Some(x) = crate::sparse::lu_solve(&saddle.pattern, &values, &rhs) {
+                if small(residual(&x, &mut r)) {
+                    solved = Some((x, "lu"));
+                }
+            }
         }
-        let forces = (0..m)
-            .map(|i| if active[i] { x[n + i] } else { 0.0 })
-            .collect();
+        self.factorizations += t.elapsed().as_secs_f64();
+        let (mut x, solver) = solved?;
+        self.linear_solver = solver;
+        let forces = (0..m).map(|i| if active[i] { rho * x[n + i] } else { 0.0 }).collect();
         x.truncate(n);
         Some((x, forces))
     }
@@ -507,7 +518,6 @@ impl Kernel<'_> {
             .collect();
         if rank_deficiency(&active_rows, n) == 0 {
             if let Some(solution) = self.lagrange_ldlt(active, rho) {
-                self.linear_solver = "ldlt";
                 return Ok(solution);
             }
         }
