@@ -61,8 +61,11 @@ pub fn pressure_error(
             .max(f64::MIN_POSITIVE);
         // the exact force per area along the row's direction nu on the slave surface (outward
         // normal n_s): nu . sigma . n_s (= -n.sigma.n = p for contact, where nu = -n_s)
+        // (for a row whose force direction `normal` is not a unit vector, the multiplier that
+        // reproduces the traction is normal . sigma . n_s / |normal|^2)
         let (nu, ns) = (r.normal, r.slave_normal);
-        let p = nu[0] * (s[0] * ns[0] + s[2] * ns[1]) + nu[1] * (s[2] * ns[0] + s[1] * ns[1]);
+        let p = (nu[0] * (s[0] * ns[0] + s[2] * ns[1]) + nu[1] * (s[2] * ns[0] + s[1] * ns[1]))
+            / (nu[0] * nu[0] + nu[1] * nu[1]);
         let e = (state.forces[i] / r.area - p).abs() / scale;
         worst = if e.is_nan() || e > worst { e } else { worst };
     }

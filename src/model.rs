@@ -77,6 +77,8 @@ pub struct ContactPair {
     pub enforcement: EnforcementSpec,
     /// A tied (glued) interface instead of frictionless contact.
     pub tied: bool,
+    /// Candidate distance of the search (`None`: the largest master facet).
+    pub search_distance: Option<f64>,
 }
 
 impl ContactPair {
@@ -546,6 +548,16 @@ impl Model {
                 &self.source,
                 &format!("{at}.enforcement"),
             )?;
+            if let Some(d) = spec.search_distance {
+                if !(d.is_finite() && d > 0.0) {
+                    return Err(Error::invalid(
+                        &self.source,
+                        format!("{at}.search_distance"),
+                        format!("the search distance must be positive, got {d}"),
+                        "give a distance larger than the initial gaps",
+                    ));
+                }
+            }
             if let Some(first) = self.contact.first() {
                 if first.enforcement != spec.enforcement {
                     return Err(Error::invalid(
@@ -563,6 +575,7 @@ impl Model {
                 discretization: spec.discretization.clone(),
                 enforcement: spec.enforcement.clone(),
                 tied: spec.interaction == crate::scene::Interaction::Tied,
+                search_distance: spec.search_distance,
             });
         }
         if let Some(sweep) = &case.sweep {

@@ -87,6 +87,10 @@ pub struct ContactSpec {
     /// `frictionless` contact (default) or a `tied` (glued) interface.
     #[serde(default)]
     pub interaction: Interaction,
+    /// How far from the master surface a slave node is still a contact candidate (default:
+    /// the largest master facet). Node-to-surface and mortar only.
+    #[serde(default)]
+    pub search_distance: Option<f64>,
 }
 
 /// What a pair enforces.

@@ -322,7 +322,8 @@ pub fn lu_solve(pattern: &SymmetricPattern, values: &[f64], b: &[f64]) -> Option
             }
         }
     }
-    let a = SparseColMat::<usize, f64>::try_new_from_triplets(pattern.n, pattern.n, &triplets).ok()?;
+    let a =
+        SparseColMat::<usize, f64>::try_new_from_triplets(pattern.n, pattern.n, &triplets).ok()?;
     let lu = a.sp_lu().ok()?;
     let mut rhs = Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
     lu.solve_in_place(rhs.as_mut());

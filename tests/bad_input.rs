@@ -337,3 +337,28 @@ fn elimination_that_does_not_apply_says_why() {
         ],
     );
 }
+
+#[test]
+fn a_pair_whose_bodies_are_out_of_reach_is_reported_not_ignored() {
+    // the punch starts 1.5 above the base (facets of length 1): no candidate within reach
+    let far = CONTACT.replace("\"y\": [1, 2]", "\"y\": [2.5, 3.5]");
+    assert_rejected(
+        &far,
+        &[
+            "contact 'c'",
+            "no slave node lies within the search distance",
+            "could never act",
+        ],
+    );
+    // with a search distance that reaches, the case is valid (the gap stays open)
+    let reach = far.replace(
+        "\"enforcement\": {\"kind\": \"lagrange\"}",
+        "\"enforcement\": {\"kind\": \"lagrange\"}, \"search_distance\": 2.0",
+    );
+    let (code, stderr, _) = run(&reach);
+    assert_ne!(code, 2, "{stderr}");
+    assert_rejected(
+        &reach.replace("\"search_distance\": 2.0", "\"search_distance\": -1"),
+        &["search_distance", "must be positive"],
+    );
+}

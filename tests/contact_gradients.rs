@@ -3,8 +3,10 @@
 //! `c_k = dg/dx_k`, measured by re-running the discretization on meshes whose nodes moved by
 //! `+-h` (central differences). Geometry is curved or tilted and the gaps are non-zero, so the
 //! closest-point terms are exercised. With master normals (and rigid surfaces) the identity is
-//! exact at any gap; with slave normals it holds where the gap vanishes, which is where the
-//! small-strain rows are used.
+//! exact at any gap, because the closest point makes `x_s - x_m` normal to the facet. With
+//! slave normals the row freezes the normal: it is exact for the slave node's own dofs and the
+//! master's at any gap (`x_s - x_m` is parallel to the unit normal), while the nodes that tilt
+//! the slave normal add `-g (n_m . dnu) / (n_m . nu)`, which vanishes where the gap is closed.
 
 use contact_patch::contact::discretization::constraints;
 use contact_patch::contact::Constraint;
@@ -45,6 +47,18 @@ fn find(rows: &[Constraint], r: &Constraint) -> Constraint {
 /// at the ends of the interface (the lowest and highest x of their pass) are skipped: there
 /// the gap has a kink where the projection leaves the master surface.
 fn check(model: &Model, disc: DiscretizationSpec, h: f64, tol: f64, only_closed: bool) -> usize {
+    check_dofs(model, disc, h, tol, only_closed, false)
+}
+
+/// As `check`; with `frozen_normal`, the other nodes of the slave body are not perturbed.
+fn check_dofs(
+    model: &Model,
+    disc: DiscretizationSpec,
+    h: f64,
+    tol: f64,
+    only_closed: bool,
+    frozen_normal: bool,
+) -> usize {
     let mut model = model.clone();
     model.contact[0].discretization = disc.clone();
     let rows = constraints(&model, &model.contact[0]).unwrap();
@@ -63,6 +77,9 @@ fn check(model: &Model, disc: DiscretizationSpec, h: f64, tol: f64, only_closed:
     {
         for (bi, body) in model.bodies.iter().enumerate() {
             for n in 0..body.mesh.nodes.len() {
+                if frozen_normal && bi == r.slave_body && n != r.slave_node {
+                    continue;
+                }
                 for i in 0..2 {
                     let gap_at = |delta: f64| {
                         let mut m = model.clone();
@@ -108,6 +125,23 @@ fn node_to_surface_master_normal_rows_are_gap_gradients() {
             check(&m, two, 1e-6, 1e-7, false) >= 4,
             "{element}: two-pass rows"
         );
+    }
+}
+
+#[test]
+fn node_to_surface_slave_normal_rows_are_gap_gradients_on_tilted_faces() {
+    for element in ["Q4", "Q9"] {
+        let m = two_blocks(element, 0.03, 0.08);
+        for passes in [1, 2] {
+            let disc = DiscretizationSpec::NodeToSurface {
+                passes,
+                normal: NormalChoice::Slave,
+            };
+            assert!(
+                check_dofs(&m, disc, 1e-6, 1e-7, false, true) >= 2 * passes as usize,
+                "{element} {passes}"
+            );
+        }
     }
 }
 

@@ -9,7 +9,10 @@ use std::time::Instant;
 
 #[test]
 fn patch_b_passes_at_every_scale() {
-    let path = format!("{}/cases/patch/patch-B-nu0.3.json", env!("CARGO_MANIFEST_DIR"));
+    let path = format!(
+        "{}/cases/patch/patch-B-nu0.3.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
     let text = std::fs::read_to_string(&path).unwrap();
     for e in [1e3, 1e6, 1e9, 2e11] {
         let scale = e / 1000.0;
@@ -21,24 +24,61 @@ fn patch_b_passes_at_every_scale() {
         let stress = [0.0, -10.0 * scale, 0.0];
         case.exact = Some(contact_patch::scene::ExactSpec::UniformStress { stress });
         case.checks = vec![
-            Check::UniformStress { body: None, stress, tol: 1e-10 },
-            Check::ContactPressure { pair: "interface".into(), tol: 1e-10 },
+            Check::UniformStress {
+                body: None,
+                stress,
+                tol: 1e-10,
+            },
+            Check::ContactPressure {
+                pair: "interface".into(),
+                tol: 1e-10,
+            },
             Check::ForceBalance { tol: 1e-12 },
         ];
         for (disc, enforcement) in [
-            (DiscretizationSpec::NodeToSurface { passes: 1, normal: Default::default() }, EnforcementSpec::Lagrange),
-            (DiscretizationSpec::Mortar { multiplier: MultiplierSpace::Standard }, EnforcementSpec::Lagrange),
-            (DiscretizationSpec::NodeToSurface { passes: 1, normal: Default::default() }, EnforcementSpec::Penalty { kappa: 10.0 * e }),
-            (DiscretizationSpec::Mortar { multiplier: MultiplierSpace::Dual }, EnforcementSpec::Elimination),
+            (
+                DiscretizationSpec::NodeToSurface {
+                    passes: 1,
+                    normal: Default::default(),
+                },
+                EnforcementSpec::Lagrange,
+            ),
+            (
+                DiscretizationSpec::Mortar {
+                    multiplier: MultiplierSpace::Standard,
+                },
+                EnforcementSpec::Lagrange,
+            ),
+            (
+                DiscretizationSpec::NodeToSurface {
+                    passes: 1,
+                    normal: Default::default(),
+                },
+                EnforcementSpec::Penalty { kappa: 10.0 * e },
+            ),
+            (
+                DiscretizationSpec::Mortar {
+                    multiplier: MultiplierSpace::Dual,
+                },
+                EnforcementSpec::Elimination,
+            ),
         ] {
             let mut c = case.clone();
             c.contact[0].discretization = disc.clone();
             c.contact[0].enforcement = enforcement.clone();
             let model = Model::build(&c, &path).unwrap();
             let o = run_model(model, 0.0, Instant::now(), &mut |_| {}).unwrap();
-            assert!(o.passed(), "E = {e}, {disc:?}, {enforcement:?}: {:#?}", o.checks);
+            assert!(
+                o.passed(),
+                "E = {e}, {disc:?}, {enforcement:?}: {:#?}",
+                o.checks
+            );
             if enforcement == EnforcementSpec::Lagrange {
-                assert_eq!(o.solution.contact.as_ref().unwrap().linear_solver, "ldlt", "E = {e}, {disc:?}");
+                assert_eq!(
+                    o.solution.contact.as_ref().unwrap().linear_solver,
+                    "ldlt",
+                    "E = {e}, {disc:?}"
+                );
             }
         }
     }

@@ -8,7 +8,9 @@
 //!   `nu` on the slave dofs and `-N_b(xi) nu` on the facet's dofs. With **master normals**
 //!   `xi` is the closest point and `nu` the facet's outward normal there; with **slave
 //!   normals** `nu = -n_s` (the slave surface's nodal normal, reversed) and `xi` is where the
-//!   ray from the slave node along `nu` meets the facet (Taylor 2004: smoother sliding).
+//!   ray from the slave node along `nu` meets the facet (Taylor 2004: smoother sliding); the
+//!   row is then the gradient of that ray gap with the slave normal frozen,
+//!   `n_m / (n_m . nu)` in place of `nu`.
 //!   **Corner condition**: a slave node that projects inside no facet but lies in the wedge
 //!   outside a convex master corner (a vertex shared by two facets) is held against the corner
 //!   vertex, along the direction from the vertex to the node (or the vertex's averaged normal
@@ -37,6 +39,8 @@ const INSIDE: f64 = 1e-9;
 pub(crate) struct Rows<'a> {
     pub model: &'a Model,
     pub tied: bool,
+    /// How far from the master surface a slave node is still a candidate.
+    pub search_distance: Option<f64>,
     pub out: Vec<Constraint>,
 }
 
@@ -120,6 +124,7 @@ pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>,
     let mut rows = Rows {
         model,
         tied: pair.tied,
+        search_distance: pair.search_distance,
         out: Vec::new(),
     };
     match (&pair.discretization, &pair.master) {
@@ -160,6 +165,20 @@ pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>,
             let master = Surface::new(*body, &model.bodies[*body], facets, model.thickness);
             super::mortar::mortar_rows(&mut rows, &slave, &master, *multiplier)?;
         }
+    }
+    if rows.out.is_empty() {
+        return Err(format!(
+            "no slave node lies within the search distance ({}) of the master surface, so the pair could never act",
+            pair.search_distance.map(|d| d.to_string()).unwrap_or_else(|| "the largest master facet".into())
+        ));
+    }
+    if let Some(bad) = rows.out.iter().find(|r| {
+        !(r.g0.is_finite() && r.coeffs.iter().all(|c| c.is_finite()) && r.dofs.contains(&r.owner))
+    }) {
+        return Err(format!(
+            "the constraint of the slave node at ({}, {}) is degenerate (no finite normal)",
+            bad.point[0], bad.point[1]
+        ));
     }
     Ok(rows.out)
 }
@@ -276,7 +295,7 @@ fn node_to_surface(
     let sb = &model.bodies[slave.body];
     let mb = &model.bodies[master.body];
     let grid = BucketGrid::new(master.boxes());
-    let radius = master.facet_size();
+    let radius = rows.search_distance.unwrap_or_else(|| master.facet_size());
     let tol = 1e-12 * mb.mesh.size();
     let kind = master.kind;
     for (&s, data) in &slave.nodes {
@@ -309,14 +328,20 @@ fn node_to_surface(
         }
         if let Some((_, f, xi, nu)) = best {
             let coords = &master.coords[f];
-            let (x, _) = facet_point(kind, coords, xi);
+            let (x, t) = facet_point(kind, coords, xi);
             let (n, _) = edge_shape(kind, xi);
             let g0 = nu[0] * (p[0] - x[0]) + nu[1] * (p[1] - x[1]);
+            // the gradient of g = nu . (x_s - x_m(xi)) with xi on the ray along nu: moving the
+            // master point along the facet does not change g, so dg = n_m . (dx_s - sum N dx_m)
+            // / (n_m . nu) (= nu for master normals, where nu = n_m)
+            let n_m = unit_normal(t);
+            let c = n_m[0] * nu[0] + n_m[1] * nu[1];
+            let grad = [n_m[0] / c, n_m[1] / c];
             let k = kind.node_count();
             rows.node(
                 slave,
                 s,
-                nu,
+                grad,
                 g0,
                 Some((master, &master.facets[f], &n[..k])),
                 pass,

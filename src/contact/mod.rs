@@ -49,8 +49,10 @@ pub struct Constraint {
     /// Tributary area of the slave node (length x thickness); 1 for lumped node-to-node pairs
     /// on a surface without facets.
     pub area: f64,
-    /// Unit direction along which the gap is measured (points from master to slave; `e_x` or
-    /// `e_y` for tied rows).
+    /// The gradient of the gap with respect to the slave node's displacement (points from
+    /// master to slave): the unit normal for master normals, rigid surfaces and mortar,
+    /// `n_m / (n_m . nu)` for slave normals, `e_x` or `e_y` for tied rows. The row's force on
+    /// the slave node is `lambda * normal`.
     pub normal: [f64; 2],
     /// Outward unit normal of the slave surface at the slave node (zero for rigid slaves).
     pub slave_normal: [f64; 2],

@@ -66,7 +66,7 @@ pub(crate) fn mortar_rows(
     let (ks, km) = (slave.kind, master.kind);
     let (ns, nm) = (ks.node_count(), km.node_count());
     let grid = BucketGrid::new(master.boxes());
-    let radius = master.facet_size();
+    let radius = rows.search_distance.unwrap_or_else(|| master.facet_size());
     let gauss = gauss_legendre(if ks == EdgeKind::Line3 || km == EdgeKind::Line3 {
         4
     } else {

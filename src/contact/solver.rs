@@ -411,7 +411,12 @@ impl Kernel<'_> {
         let t = Instant::now();
         let n = self.sys.n;
         let m = self.rows.len();
-        let size = self.model.bodies.iter().map(|b| b.mesh.size()).fold(0.0, f64::max);
+        let size = self
+            .model
+            .bodies
+            .iter()
+            .map(|b| b.mesh.size())
+            .fold(0.0, f64::max);
         let saddle = self.saddle.as_ref()?;
         let w = vec![rho; m];
         let k = self.augmented(active, &w);
@@ -422,7 +427,10 @@ impl Kernel<'_> {
         let mut rhs = self.sys.rhs.clone();
         rhs.resize(n + m, 0.0);
         for (i, row) in self.rows.iter().enumerate() {
-            let diag = saddle.pattern.position(n + i, n + i).expect("diagonal stored");
+            let diag = saddle
+                .pattern
+                .position(n + i, n + i)
+                .expect("diagonal stored");
             if active[i] {
                 for (&e, &c) in row.eqs.iter().zip(&row.coeffs) {
                     values[saddle.pattern.position(e, n + i).expect("coupling stored")] = -rho * c;
@@ -440,7 +448,10 @@ impl Kernel<'_> {
         let residual = |x: &[f64], r: &mut Vec<f64>| -> (f64, f64) {
             saddle.pattern.mul(&values, x, r);
             r.iter_mut().zip(&rhs).for_each(|(a, b)| *a = b - *a);
-            let forces = x[n..].iter().fold(force_scale, |a, v| a.max((rho * v).abs())).max(f64::MIN_POSITIVE);
+            let forces = x[n..]
+                .iter()
+                .fold(force_scale, |a, v| a.max((rho * v).abs()))
+                .max(f64::MIN_POSITIVE);
             let ru = r[..n].iter().fold(0.0f64, |a, v| a.max(v.abs())) / forces;
             let rg = r[n..].iter().fold(0.0f64, |a, v| a.max(v.abs())) / rho / size;
             (ru, rg)
@@ -448,7 +459,10 @@ impl Kernel<'_> {
         let small = |(ru, rg): (f64, f64)| ru <= 1e-11 && rg <= 1e-13;
         let mut r = vec![0.0; n + m];
         let mut solved = None;
-        if let Ok(factor) = saddle.ldlt.factor(&saddle.pattern, &values, &signs, 1e-13 * rho) {
+        if let Ok(factor) = saddle
+            .ldlt
+            .factor(&saddle.pattern, &values, &signs, 1e-13 * rho)
+        {
             let mut x = rhs.clone();
             factor.solve_in_place(&mut x);
             for _ in 0..3 {
@@ -474,7 +488,9 @@ impl Kernel<'_> {
         self.factorizations += t.elapsed().as_secs_f64();
         let (mut x, solver) = solved?;
         self.linear_solver = solver;
-        let forces = (0..m).map(|i| if active[i] { rho * x[n + i] } else { 0.0 }).collect();
+        let forces = (0..m)
+            .map(|i| if active[i] { rho * x[n + i] } else { 0.0 })
+            .collect();
         x.truncate(n);
         Some((x, forces))
     }
