@@ -6,17 +6,21 @@
 //!   `|sigma - sigma_exact| / p`.
 //! * `pressure_error`: max over the rows of `|lambda_i / A_i - p_i| / p`.
 //! * `force_balance`: net contact force and moment, and the equilibrium residual.
+//! * `load_error`: the total interaction force (all rows, both passes) against the exact
+//!   traction integrated over the interface.
 //! * Exact methods (Lagrange, elimination, perturbed tangent, augmented Lagrangian) pass when
-//!   the stress error and, if the multipliers are unique (no rank deficiency), the pressure
-//!   error are within the sweep's tolerance, the force balance within 1e-12, and the active-set
-//!   loop converged.
+//!   the stress error, the load error and, if the rows are independent, the pressure error are
+//!   within the sweep's tolerance, the force balance within 1e-12, and the active-set loop
+//!   converged.
 //! * Penalty-type methods (penalty, perturbed Lagrangian) satisfy the gap only approximately;
-//!   they run at `kappa` and at `penalty_factor * kappa` and are judged on the stress error: a
+//!   they run at `kappa` and at `penalty_factor * kappa` (both runs must converge and carry the
+//!   load) and are judged on the stress error: a
 //!   pass when it is round-off at both (`round-off`) or falls at least `penalty_factor / 10`
 //!   times (`1/kappa`, a consistent method converging as the penalty grows); a fail when it
 //!   does not fall (`no fall`: a consistency failure).
-//! * **Stability**: `rank_deficiency` counts dependent active constraints; a singular
-//!   multiplier system fails the stability half of the test even when the displacements pass.
+//! * **Stability** (its own column, next to the consistency verdict): `rank_deficiency` counts
+//!   dependent active constraints; for the methods with a multiplier system (Lagrange,
+//!   elimination) a singular one is `unstable` even when the displacements pass.
 //! * `n/a` cells say why the combination does not apply.
 
 use crate::contact::discretization::constraints;
@@ -44,6 +48,8 @@ pub struct Cell {
     pub slave: Option<String>,
     pub enforcement: String,
     pub kappa: Option<f64>,
+    /// The sweep's load scale (errors are relative to it).
+    pub pressure: f64,
     pub verdict: String,
     pub stress_error: Option<f64>,
     /// Penalty-type methods: the stress error at `penalty_factor * kappa`.
@@ -52,8 +58,15 @@ pub struct Cell {
     pub penalty_trend: Option<String>,
     pub pressure_error: Option<f64>,
     pub force_balance: Option<f64>,
+    /// `|F - F_exact| / (p A)`: the total interaction force on the pass-1 slave body (all rows,
+    /// both passes) against the exact traction integrated over its interface nodes, relative
+    /// to the sweep's pressure times the interface area.
+    pub load_error: Option<f64>,
     pub max_penetration: Option<f64>,
     pub rank_deficiency: Option<usize>,
+    /// Stability of the multiplier system: `stable`, `unstable` (dependent constraints, the
+    /// multipliers are not unique) or `-` (the method has no multiplier system).
+    pub stability: String,
     pub newton_iterations: Option<usize>,
     pub termination: Option<String>,
     /// `cholesky`, `ldlt` or `schur-pseudo-inverse` (see `contact::solver::ContactState`).
@@ -67,8 +80,9 @@ struct Measured {
     stress_error: f64,
     pressure_error: f64,
     force_balance: f64,
+    load_error: f64,
     max_penetration: f64,
-    rank_deficiency: usize,
+    rank_deficiency: Option<usize>,
     iterations: usize,
     termination: Termination,
     linear_solver: &'static str,
@@ -96,9 +110,31 @@ fn measure(model: &Model, solution: &Solution, pressure: f64) -> Measured {
     let pressure_error = exact
         .map(|e| crate::checks::pressure_error(solution, e, None, Some(pressure.abs())))
         .unwrap_or(f64::NAN);
+    // total interaction force on the pass-1 slave body, and its exact value
+    let (mut f, mut f_exact, mut length) = ([0.0f64; 2], [0.0f64; 2], 0.0f64);
+    let mut seen = std::collections::HashSet::new();
+    for (r, &lambda) in state.rows.iter().zip(&state.forces) {
+        let sign = if r.pass == 1 { 1.0 } else { -1.0 };
+        for k in 0..2 {
+            f[k] += sign * lambda * r.normal[k];
+        }
+        if r.pass == 1 && seen.insert((r.slave_body, r.slave_node)) {
+            length += r.area;
+            if let Some(e) = exact {
+                let s = e.stress(r.point);
+                let n = r.slave_normal;
+                f_exact[0] += r.area * (s[0] * n[0] + s[2] * n[1]);
+                f_exact[1] += r.area * (s[2] * n[0] + s[1] * n[1]);
+            }
+        }
+    }
+    // relative to the load scale p x (interface area): a zero exact force (parallel stress
+    // across a tie) is judged too
+    let load_error = (f[0] - f_exact[0]).hypot(f[1] - f_exact[1]) / (pressure.abs() * length);
     Measured {
         stress_error,
         pressure_error,
+        load_error,
         force_balance: crate::checks::force_balance(model, solution),
         max_penetration: state.gaps.iter().fold(0.0f64, |m, &g| m.max(-g)),
         rank_deficiency: state.rank_deficiency,
@@ -168,14 +204,17 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 slave: slave.clone(),
                 enforcement: name(e).into(),
                 kappa: kappa(e),
+                pressure: sweep.pressure,
                 verdict: "n/a".into(),
                 stress_error: None,
                 stress_error_stiff: None,
                 penalty_trend: None,
                 pressure_error: None,
                 force_balance: None,
+                load_error: None,
                 max_penetration: None,
                 rank_deficiency: None,
+                stability: "-".into(),
                 newton_iterations: None,
                 termination: None,
                 linear_solver: None,
@@ -218,8 +257,9 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             cell.stress_error = Some(m.stress_error);
             cell.pressure_error = Some(m.pressure_error);
             cell.force_balance = Some(m.force_balance);
+            cell.load_error = Some(m.load_error);
             cell.max_penetration = Some(m.max_penetration);
-            cell.rank_deficiency = Some(m.rank_deficiency);
+            cell.rank_deficiency = m.rank_deficiency;
             cell.newton_iterations = Some(m.iterations);
             cell.linear_solver = Some(m.linear_solver.to_string());
             cell.termination = Some(match &m.termination {
@@ -240,12 +280,24 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             if !balanced {
                 notes.push(format!("force balance {:.1e}", m.force_balance));
             }
-            let unique = m.rank_deficiency == 0;
+            let multipliers = matches!(e, EnforcementSpec::Lagrange | EnforcementSpec::Elimination);
+            let dependent = m.rank_deficiency.unwrap_or(0);
+            let unique = dependent == 0;
+            cell.stability = match (multipliers, unique) {
+                (false, _) => "-".into(),
+                (true, true) => "stable".into(),
+                (true, false) => "unstable".into(),
+            };
             if !unique {
-                notes.push(format!(
-                    "multipliers not unique: {} dependent constraints (fails stability)",
-                    m.rank_deficiency
-                ));
+                notes.push(if multipliers {
+                    format!("multipliers not unique: {dependent} dependent constraints (fails stability)")
+                } else {
+                    format!("{dependent} dependent constraints (no multiplier system for them to make singular)")
+                });
+            }
+            let loaded = m.load_error <= sweep.tol;
+            if !loaded {
+                notes.push(format!("total contact force off by {:.1e}", m.load_error));
             }
             let pass = if let (Some(k), true) = (
                 kappa(e),
@@ -260,7 +312,14 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 let s2 = solve_static(&stiff, &mut |_| {});
                 cell.time_ms += start.elapsed().as_secs_f64() * 1e3;
                 let e2 = match s2 {
-                    Ok(s) => measure(&stiff, &s, sweep.pressure).stress_error,
+                    Ok(s) => {
+                        let m2 = measure(&stiff, &s, sweep.pressure);
+                        if m2.termination == Termination::Converged {
+                            m2.stress_error
+                        } else {
+                            f64::INFINITY
+                        }
+                    }
                     Err(_) => f64::INFINITY,
                 };
                 cell.stress_error_stiff = Some(e2);
@@ -276,10 +335,12 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                     "kappa = {k:e}: stress error {trend} as kappa grows {}x",
                     sweep.penalty_factor
                 ));
-                converged && balanced && trend != "no fall"
+                converged && balanced && loaded && trend != "no fall"
             } else {
+                // dependent rows make the individual forces arbitrary: then only their total
+                // (the load error) is judged
                 let pressure_ok = !unique || m.pressure_error <= sweep.tol;
-                converged && balanced && m.stress_error <= sweep.tol && pressure_ok
+                converged && balanced && loaded && m.stress_error <= sweep.tol && pressure_ok
             };
             cell.verdict = if pass { "pass" } else { "fail" }.into();
             cell.note = notes.join("; ");
@@ -356,17 +417,17 @@ pub const SEED_ROW: [(&str, &str); 7] = [
 
 /// The full grid as a Markdown table; `with_time` adds the time column (not in snapshots).
 pub fn grid_markdown(cells: &[Cell], with_time: bool) -> String {
-    let mut s = String::from("| mesh | nu | discretization | passes | slave | enforcement | verdict | stress error | at 1000 kappa | trend | pressure error | rank def. | iterations |");
+    let mut s = String::from("| mesh | nu | discretization | passes | slave | enforcement | verdict | stress error | at 1000 kappa | trend | pressure error | load error | rank def. | stability | iterations |");
     s += if with_time {
         " time ms | note |\n"
     } else {
         " note |\n"
     };
-    s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+    s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
     s += if with_time { "---|---|\n" } else { "---|\n" };
     for c in cells {
         s += &format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             c.mesh,
             c.nu,
             c.discretization,
@@ -378,9 +439,11 @@ pub fn grid_markdown(cells: &[Cell], with_time: bool) -> String {
             rounded(c.stress_error_stiff),
             c.penalty_trend.as_deref().unwrap_or("-"),
             rounded(c.pressure_error),
+            rounded(c.load_error),
             c.rank_deficiency
                 .map(|r| r.to_string())
                 .unwrap_or("-".into()),
+            c.stability,
             c.newton_iterations
                 .map(|r| r.to_string())
                 .unwrap_or("-".into()),

@@ -45,7 +45,7 @@ pub struct ContactSummary {
     pub linear_solver: String,
     pub constraints: usize,
     pub active: usize,
-    pub rank_deficiency: usize,
+    pub rank_deficiency: Option<usize>,
     /// Sum of the contact forces acting on the slave bodies, `[x, y]`.
     pub total_force: [f64; 2],
     /// Largest `lambda_i / A_i` (nodal contact pressure).
