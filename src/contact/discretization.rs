@@ -202,8 +202,15 @@ pub(crate) fn weighted_row(
     let sb = &model.bodies[slave.body];
     let mut dofs = Vec::new();
     let mut coeffs = Vec::new();
+    // coefficients below 1e-12 of the row's largest weight are round-off of exact zeros (mortar
+    // integrals of disjoint supports); kept, they could pin a dof on their own
+    let largest = slave_terms
+        .iter()
+        .chain(master.map(|m| m.1).unwrap_or(&[]))
+        .fold(0.0f64, |a, t| a.max(t.1.abs()))
+        * nu[0].abs().max(nu[1].abs());
     let mut push = |dof: usize, c: f64| {
-        if c.abs() > 1e-14 {
+        if c.abs() > 1e-12 * largest {
             match dofs.iter().position(|&d| d == dof) {
                 Some(k) => coeffs[k] += c,
                 None => {

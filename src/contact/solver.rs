@@ -213,6 +213,13 @@ fn solve_at(model: &Model, u: Option<&[f64]>, progress: &mut dyn FnMut(&str)) ->
                     }
                 }
             }
+            // a row whose free part is round-off of its full gradient acts on prescribed dofs only
+            let full = r.coeffs.iter().fold(0.0f64, |a, c| a.max(c.abs()));
+            let free = out.coeffs.iter().fold(0.0f64, |a, c| a.max(c.abs()));
+            if free <= 1e-12 * full {
+                out.eqs.clear();
+                out.coeffs.clear();
+            }
             out
         })
         .collect();
