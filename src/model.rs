@@ -745,6 +745,17 @@ impl Model {
         let bodies: Vec<usize> = (0..self.bodies.len()).filter(|&b| in_contact[b]).collect();
         let nm = 3 * bodies.len();
         // modal value of dof d: (mode index, value) for the body owning it
+        // centre and size of each body in contact, computed once
+        let frames: Vec<([f64; 2], f64)> = bodies
+            .iter()
+            .map(|&b| {
+                let [lo, hi] = self.bodies[b].mesh.bounding_box();
+                (
+                    [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])],
+                    self.bodies[b].mesh.size(),
+                )
+            })
+            .collect();
         let mode_of = |d: usize| -> Option<(usize, [f64; 3])> {
             let (k, &b) = bodies.iter().enumerate().find(|(_, &b)| {
                 let body = &self.bodies[b];
@@ -753,9 +764,7 @@ impl Model {
             let body = &self.bodies[b];
             let local = d - body.dof_offset;
             let p = body.mesh.nodes[local / 2];
-            let [lo, hi] = body.mesh.bounding_box();
-            let c = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-            let s = body.mesh.size();
+            let (c, s) = frames[k];
             let comp = local % 2;
             let rot = [-(p[1] - c[1]) / s, (p[0] - c[0]) / s][comp];
             Some((

@@ -2,8 +2,8 @@
 //!
 //! Building the grid is O(n) in the number of facets, a query is O(1) on average for
 //! quasi-uniform surfaces, so the search over all slave nodes is O(n) (better than the
-//! n log n the harness asks for). The cell size is the largest facet extent, so a facet
-//! overlaps at most a 2 x 2 block of cells.
+//! n log n the harness asks for). The cell size is the largest item's extent (at least the
+//! mean spacing of the items), so a facet overlaps at most a 2 x 2 block of cells.
 
 use std::collections::HashMap;
 
@@ -17,11 +17,27 @@ pub struct BucketGrid {
 impl BucketGrid {
     /// `boxes[i] = [min, max]` of item `i`.
     pub fn new(boxes: Vec<[[f64; 2]; 2]>) -> Self {
+        // cell size: the largest item, but no smaller than the mean spacing of the items over
+        // their bounding box (points have no extent), so the grid follows the data's units
         let extent = boxes
             .iter()
             .map(|b| (b[1][0] - b[0][0]).max(b[1][1] - b[0][1]))
             .fold(0.0f64, f64::max);
-        let cell = if extent > 0.0 { extent } else { 1.0 };
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for b in &boxes {
+            for i in 0..2 {
+                lo[i] = lo[i].min(b[0][i]);
+                hi[i] = hi[i].max(b[1][i]);
+            }
+        }
+        let span = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+        let spacing = if boxes.is_empty() || !span.is_finite() {
+            0.0
+        } else {
+            span / boxes.len() as f64
+        };
+        let cell = extent.max(spacing);
+        let cell = if cell > 0.0 { cell } else { 1.0 };
         let mut grid = BucketGrid {
             cell,
             buckets: HashMap::new(),
