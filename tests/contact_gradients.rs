@@ -264,3 +264,67 @@ fn mortar_rows_conserve_linear_momentum() {
         }
     }
 }
+
+/// The corner condition: a slave node above a convex kink of the master surface projects into
+/// neither facet and is held against the shared vertex along the vertex-to-node direction;
+/// that row is the gradient of the distance to the vertex.
+#[test]
+fn corner_rows_are_gap_gradients() {
+    // the lower surface peaks at (6, 5.05); the upper block gets a node right above it
+    let mut m = two_blocks("Q4", 0.03, 0.0);
+    let upper = m.body_index("upper").unwrap();
+    let at6 = m.bodies[upper]
+        .mesh
+        .nodes
+        .iter()
+        .position(|p| (p[0] - 6.5).abs() < 1e-12 && p[1] < 5.1)
+        .unwrap();
+    m.bodies[upper].mesh.nodes[at6] = [6.0, 5.12];
+    let rows = constraints(&m, &m.contact[0]).unwrap();
+    let corner = rows
+        .iter()
+        .find(|r| r.slave_node == at6)
+        .expect("a row for the node above the peak");
+    let lower = m.body_index("lower").unwrap();
+    let master_nodes: std::collections::BTreeSet<usize> = corner
+        .dofs
+        .iter()
+        .filter(|&&d| {
+            d >= m.bodies[lower].dof_offset
+                && d < m.bodies[lower].dof_offset + m.bodies[lower].dof_count()
+        })
+        .map(|d| (d - m.bodies[lower].dof_offset) / 2)
+        .collect();
+    assert_eq!(
+        master_nodes.len(),
+        1,
+        "a corner row acts on the shared vertex only: {corner:?}"
+    );
+    let v = *master_nodes.iter().next().unwrap();
+    assert!((m.bodies[lower].mesh.nodes[v][0] - 6.0).abs() < 1e-12);
+    // central differences of that row's gap against the slave node and the vertex
+    let h = 1e-6;
+    for (b, n) in [(upper, at6), (lower, v)] {
+        for i in 0..2 {
+            let gap_at = |delta: f64| {
+                let mut mm = m.clone();
+                mm.bodies[b].mesh.nodes[n][i] += delta;
+                constraints(&mm, &mm.contact[0])
+                    .unwrap()
+                    .into_iter()
+                    .find(|r| r.slave_node == at6)
+                    .unwrap()
+                    .g0
+            };
+            let fd = (gap_at(h) - gap_at(-h)) / (2.0 * h);
+            let dof = m.bodies[b].dof(n, i);
+            let c = corner
+                .dofs
+                .iter()
+                .position(|&d| d == dof)
+                .map(|k| corner.coeffs[k])
+                .unwrap_or(0.0);
+            assert!((fd - c).abs() < 1e-7, "dof {dof}: fd {fd} vs {c}");
+        }
+    }
+}
