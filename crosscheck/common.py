@@ -17,6 +17,12 @@ The definitions mirror the Rust sources:
 
 Each solver receives supports as (node coordinates, component, values) and loads as
 (facet box, traction function), and finds its own dofs and facets geometrically.
+
+Contact (src/contact/): a single-body case may declare frictionless pairs of the body against a
+rigid line or circle with node-to-surface rows and a penalty (`RigidContact`); a two-body case
+may tie its bodies with a mortar pair (`TiedCase`). `Sampler` evaluates a nodal field of one of
+our .vtu meshes at arbitrary points (as `src/post.rs::CellLocator`), for the distances of the
+tied-layer and two-block studies.
 """
 
 import json
@@ -131,24 +137,33 @@ def in_box(points, box):
 
 
 class Problem:
-    """One case with one body, resolved on the body's .vtu mesh."""
+    """One body of a case, resolved on the body's .vtu mesh. Without `body` the case must have
+    exactly one body (and may have rigid contact pairs); with `body` (a name) the supports and
+    loads of that body are taken and the rest of the case is left to the caller (`TiedCase`)."""
 
-    def __init__(self, case_path, out_dir):
+    def __init__(self, case_path, out_dir, body=None):
         self.case_path = Path(case_path)
         self.case = json.loads(self.case_path.read_text())
         self.name = self.case["name"]
         c = self.case
         bodies = c.get("bodies", [])
-        if len(bodies) != 1:
-            raise Unsupported(f"{len(bodies)} bodies (only single-body cases are cross-checked)")
+        self.multi = body is not None
+        if body is None and len(bodies) != 1:
+            raise Unsupported(f"{len(bodies)} bodies (two-body cases are cross-checked as ties)")
         for key in c:
             if key not in {"name", "description", "analysis", "materials", "bodies", "exact",
-                           "supports", "loads", "checks", "physics"}:
+                           "supports", "loads", "checks", "physics", "contact"}:
                 raise Unsupported(f"case section {key!r}")
         physics = c.get("physics", {}) or {}
         if any(k != "kinematics" or v != "small_strain" for k, v in physics.items()):
             raise Unsupported(f"physics {physics}")
-        body = bodies[0]
+        if body is None:
+            body = bodies[0]
+        else:
+            found = [b for b in bodies if b["name"] == body]
+            if not found:
+                raise Unsupported(f"no body {body!r}")
+            body = found[0]
         self.body = body["name"]
         an = c["analysis"]
         self.thickness = float(an.get("thickness", 1.0))
@@ -174,6 +189,8 @@ class Problem:
         self.facet_set_specs = dict(body.get("facet_sets", {}) or {})
         self.supports = self._supports()
         self.loads = self._loads()
+        self.contact = [] if self.multi else [RigidContact(p, self)
+                                              for p in c.get("contact", []) or []]
 
     # --- sets -----------------------------------------------------------------------------
     def _side_box(self, name):
@@ -227,6 +244,8 @@ class Problem:
         out = []
         for s in self.case.get("supports", []):
             if s["body"] != self.body:
+                if self.multi:
+                    continue
                 raise Unsupported(f"support on body {s['body']!r}")
             nodes = self.node_set(s["set"])
             if len(nodes) == 0:
@@ -249,6 +268,8 @@ class Problem:
         out = []
         for ld in self.case.get("loads", []):
             if ld["body"] != self.body:
+                if self.multi:
+                    continue
                 raise Unsupported(f"load on body {ld['body']!r}")
             if "body_force" in ld:
                 out.append(Load(None, "body_force", [float(v) for v in ld["body_force"]]))
@@ -277,6 +298,236 @@ class Problem:
         if d.max() > self.tol:
             raise RuntimeError(f"{self.name}: node match distance {d.max():.3e} > {self.tol:.3e}")
         return ids, float(d.max())
+
+
+# Edges of each element in our (= VTK) node order: [start, end(, mid)], counter-clockwise
+# (src/fe.rs), so the outward normal of an edge is its tangent turned clockwise.
+EDGES = {
+    "Q4": [(0, 1), (1, 2), (2, 3), (3, 0)],
+    "Q9": [(0, 1, 4), (1, 2, 5), (2, 3, 6), (3, 0, 7)],
+    "T3": [(0, 1), (1, 2), (2, 0)],
+    "T6": [(0, 1, 3), (1, 2, 4), (2, 0, 5)],
+}
+
+# The nodal weights of our contact rows (src/contact/geometry.rs): A_a = t int N_a ds, which on a
+# straight Line2 edge is half the length at each end (the trapezoidal rule at the nodes) and on
+# a Line3 edge 1/6, 2/3, 1/6 of the length (Simpson's rule at the nodes). A penalty term
+# int kappa (g)_- (v . n) ds evaluated with that rule gives exactly our rows' forces
+# kappa A_a (g_a)_- n_a. Points and weights on the reference edge [0, 1]:
+NODAL_RULE = {
+    "Q4": ([0.0, 1.0], [0.5, 0.5]),
+    "T3": ([0.0, 1.0], [0.5, 0.5]),
+    "Q9": ([0.0, 0.5, 1.0], [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0]),
+    "T6": ([0.0, 0.5, 1.0], [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0]),
+}
+
+
+class RigidContact:
+    """A frictionless pair of the body's facet set against a rigid line or circle with
+    node-to-surface rows and a penalty (src/contact/discretization.rs, `rigid_rows`).
+
+    Small strain: the geometry is the reference one, so at a slave point X the gap is linear,
+    g(u) = g0(X) + n(X) . u, with n the unit normal of the rigid surface at X:
+    line through p with normal n: g0 = n . (X - p); circle (c, R): n = (X - c)/|X - c|,
+    g0 = |X - c| - R (the gap |X + u - c| - R linearized at u = 0, as our rows are).
+    `gap(x, y, ux, uy, sqrt)` works on numpy arrays and UFL expressions alike."""
+
+    def __init__(self, spec, pb):
+        self.name = spec["name"]
+        sl = spec["slave"]
+        if sl["body"] != pb.body:
+            raise Unsupported(f"contact '{self.name}': slave body {sl['body']!r}")
+        self.set = sl["set"]
+        self.box = pb.facet_box(sl["set"])
+        rigid = (spec.get("master") or {}).get("rigid")
+        if rigid is None:
+            raise Unsupported(f"contact '{self.name}' between bodies in a one-body case")
+        self.kind = rigid["kind"]
+        if self.kind == "line":
+            n = np.asarray(rigid["normal"], dtype=float)
+            self.normal = n / np.linalg.norm(n)
+            self.point = np.asarray(rigid["point"], dtype=float)
+        elif self.kind == "circle":
+            self.centre = np.asarray(rigid["centre"], dtype=float)
+            self.radius = float(rigid["radius"])
+        else:
+            raise Unsupported(f"rigid surface kind {self.kind!r}")
+        inter = spec.get("interaction", "frictionless")
+        if inter != "frictionless":
+            raise Unsupported(f"contact '{self.name}': interaction {inter!r} against a rigid surface")
+        disc = spec["discretization"]
+        if disc.get("kind") != "node_to_surface" or int(disc.get("passes", 1)) != 1:
+            raise Unsupported(f"contact '{self.name}': discretization {disc}")
+        enf = spec["enforcement"]
+        # penalty and perturbed Lagrangian give identical numbers with node rows
+        # (src/contact/enforcement.rs); the references solve the penalty problem.
+        if enf.get("kind") not in ("penalty", "perturbed_lagrange"):
+            raise Unsupported(f"contact '{self.name}': enforcement {enf.get('kind')!r} "
+                              "(the cross-check solves penalty problems)")
+        self.kappa = float(enf["kappa"])
+        self.rule = NODAL_RULE[pb.element]
+
+    def gap(self, x, y, ux, uy, sqrt):
+        """(g, nx, ny) at reference point (x, y) for displacement (ux, uy)."""
+        if self.kind == "line":
+            nx, ny = float(self.normal[0]), float(self.normal[1])
+            g0 = nx * (x - float(self.point[0])) + ny * (y - float(self.point[1]))
+        else:
+            dx, dy = x - float(self.centre[0]), y - float(self.centre[1])
+            length = sqrt(dx * dx + dy * dy)
+            nx, ny = dx / length, dy / length
+            g0 = length - self.radius
+        return g0 + nx * ux + ny * uy, nx, ny
+
+    def hertz(self, pb, load):
+        """Hertz's plane-strain half-width and peak pressure for a rigid cylinder
+        (benchmarks.md s. 3; 1/E* = (1 - nu^2)/E with the rigid side's term zero), load per
+        unit thickness `load`; None for a line."""
+        if self.kind != "circle":
+            return None
+        E, nu = pb.material.E, pb.material.nu
+        estar = E / (1.0 - nu * nu) if pb.material.plane == "strain" else E
+        a = math.sqrt(4.0 * load * self.radius / (math.pi * estar))
+        return {"P": load, "R": self.radius, "E_star": estar, "a": a,
+                "p0": 2.0 * load / (math.pi * a)}
+
+
+def boundary_facets(pb):
+    """Boundary facets of a body's .vtu mesh: a list of node tuples [start, end(, mid)]
+    (counter-clockwise around their cell), one per edge that belongs to one cell only."""
+    count, first = {}, {}
+    for cell in pb.cells:
+        for e in EDGES[pb.element]:
+            nodes = tuple(int(cell[i]) for i in e)
+            key = tuple(sorted(nodes[:2]))
+            count[key] = count.get(key, 0) + 1
+            first.setdefault(key, nodes)
+    return [first[k] for k, c in count.items() if c == 1]
+
+
+def facets_in_box(pb, box):
+    """The boundary facets (node tuples) whose nodes all lie in `box`."""
+    return [f for f in boundary_facets(pb) if in_box(pb.points[list(f)], box).all()]
+
+
+class TiedCase:
+    """A two-body case whose bodies are tied by one mortar pair (interaction `tied`,
+    discretization `mortar`, exact enforcement). Each body is a `Problem` with its own supports
+    and loads; the pair's slave and master facet boxes select the interface."""
+
+    def __init__(self, case_path, out_dir):
+        case = json.loads(Path(case_path).read_text())
+        self.name = case["name"]
+        names = [b["name"] for b in case.get("bodies", [])]
+        if len(names) != 2:
+            raise Unsupported(f"{len(names)} bodies (ties are cross-checked between two bodies)")
+        pairs = case.get("contact", []) or []
+        if len(pairs) != 1:
+            raise Unsupported(f"{len(pairs)} contact pairs (one tie expected)")
+        pair = pairs[0]
+        if pair.get("interaction") != "tied":
+            raise Unsupported("a two-body pair that is not a tie")
+        disc = pair["discretization"]
+        if disc.get("kind") != "mortar":
+            raise Unsupported(f"tie discretization {disc.get('kind')!r} (mortar only)")
+        self.multiplier = disc.get("multiplier", "standard")
+        if self.multiplier not in ("standard", "dual"):
+            raise Unsupported(f"multiplier {self.multiplier!r}")
+        enf = pair["enforcement"]["kind"]
+        if enf not in ("lagrange", "elimination"):
+            raise Unsupported(f"tie enforcement {enf!r} (exact enforcement only)")
+        self.bodies = {n: Problem(case_path, out_dir, body=n) for n in names}
+        self.order = names
+        sl, ma = pair["slave"], pair["master"]
+        if ma.get("rigid") is not None:
+            raise Unsupported("a tie to a rigid surface")
+        self.slave, self.master = sl["body"], ma["body"]
+        self.slave_set, self.master_set = sl["set"], ma["set"]
+        self.element = {n: pb.element for n, pb in self.bodies.items()}
+
+
+# --- sampling a nodal field at points (the tied-layer and two-block distances) ----------------
+def _line_shape(s, order):
+    if order == 1:
+        return [0.5 * (1 - s), 0.5 * (1 + s)], [-0.5 + 0 * s, 0.5 + 0 * s]
+    # nodes at -1, +1, 0
+    return ([0.5 * s * (s - 1), 0.5 * s * (s + 1), 1 - s * s],
+            [s - 0.5, s + 0.5, -2 * s])
+
+
+# (i, j) indices of each node of Q4 / Q9 into the 1D node lists [-1, +1(, 0)]
+_Q_IJ = {"Q4": [(0, 0), (1, 0), (1, 1), (0, 1)],
+         "Q9": [(0, 0), (1, 0), (1, 1), (0, 1), (2, 0), (1, 2), (2, 1), (0, 2), (2, 2)]}
+
+
+def quad_shape(element, xi, eta):
+    """Shape functions (nn, m) and derivatives d/dxi, d/deta of Q4 / Q9 (our node order)."""
+    order = 1 if element == "Q4" else 2
+    lx, dlx = _line_shape(xi, order)
+    ly, dly = _line_shape(eta, order)
+    ij = _Q_IJ[element]
+    n = np.array([lx[i] * ly[j] for i, j in ij])
+    dxi = np.array([dlx[i] * ly[j] for i, j in ij])
+    deta = np.array([lx[i] * dly[j] for i, j in ij])
+    return n, dxi, deta
+
+
+class Sampler:
+    """Evaluates nodal fields of a quadrilateral .vtu mesh at points: the candidate cells are the
+    nearest cell centres, the isoparametric map is inverted by Newton's method, and the first
+    cell whose reference square holds the point (within 1e-9) is taken (src/post.rs)."""
+
+    def __init__(self, points, cells, element):
+        from scipy.spatial import cKDTree
+
+        if element not in _Q_IJ:
+            raise Unsupported(f"sampling on {element} cells")
+        self.points, self.cells, self.element = np.asarray(points), np.asarray(cells), element
+        self.tree = cKDTree(self.points[self.cells].mean(axis=1))
+
+    def locate(self, P):
+        P = np.asarray(P, dtype=float)
+        k = min(12, len(self.cells))
+        _, cand = self.tree.query(P, k=k)
+        cand = cand.reshape(len(P), k)
+        cell = np.full(len(P), -1)
+        xi = np.zeros((len(P), 2))
+        for r in range(k):
+            todo = np.flatnonzero(cell < 0)
+            if len(todo) == 0:
+                break
+            c = cand[todo, r]
+            X = self.points[self.cells[c]]          # (m, nn, 2)
+            a = np.zeros(len(todo))
+            b = np.zeros(len(todo))
+            for _ in range(30):
+                n, dxi, deta = quad_shape(self.element, a, b)   # (nn, m)
+                x = np.einsum("am,mad->md", n, X)
+                j11 = np.einsum("am,ma->m", dxi, X[:, :, 0])
+                j12 = np.einsum("am,ma->m", deta, X[:, :, 0])
+                j21 = np.einsum("am,ma->m", dxi, X[:, :, 1])
+                j22 = np.einsum("am,ma->m", deta, X[:, :, 1])
+                rx, ry = P[todo, 0] - x[:, 0], P[todo, 1] - x[:, 1]
+                det = j11 * j22 - j12 * j21
+                da = (j22 * rx - j12 * ry) / det
+                db = (-j21 * rx + j11 * ry) / det
+                a, b = a + da, b + db
+                if np.all(np.abs(da) + np.abs(db) <= 1e-13):
+                    break
+            inside = (np.abs(a) <= 1 + 1e-9) & (np.abs(b) <= 1 + 1e-9)
+            hit = todo[inside]
+            cell[hit] = c[inside]
+            xi[hit, 0], xi[hit, 1] = a[inside], b[inside]
+        if (cell < 0).any():
+            bad = P[np.flatnonzero(cell < 0)[0]]
+            raise RuntimeError(f"sample point ({bad[0]}, {bad[1]}) is outside the mesh")
+        return cell, xi
+
+    def values(self, U, P):
+        """The field U (one row per .vtu point) at the points P (m, 2)."""
+        cell, xi = self.locate(P)
+        n, _, _ = quad_shape(self.element, xi[:, 0], xi[:, 1])   # (nn, m)
+        return np.einsum("am,mad->md", n, np.asarray(U)[self.cells[cell]])
 
 
 def write_reference(path, problem, solver, u_on_vtu, extra):

@@ -12,8 +12,12 @@
 # 4. solves the same cases on the meshes our tool wrote with DOLFINx and scikit-fem;
 # 5. writes reports/crosscheck.md and reports/crosscheck.json; exits 1 when any verdict fails.
 #
-# Default cases: cases/patch-single, cases/convergence (single-body elasticity) and
-# crosscheck/cases (cross-check-only cases).
+# Default cases: cases/patch-single, cases/convergence (single-body elasticity),
+# crosscheck/cases (cross-check-only elasticity cases), crosscheck/cases/contact (penalty
+# contact with rigid surfaces), and the studies that crosscheck/studies.py generates into the
+# run folder: the tied layer (cases/tied-layer at levels 1, 2, 4, 8) and the two blocks
+# (crosscheck/cases/two-block at levels 1, 2, 4, and its fine one-body reference). With CASE
+# arguments only those cases run (no studies).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
@@ -75,8 +79,13 @@ else
 fi
 if [ "$#" -gt 0 ]; then
     CASES=("$@")
+    rm -f "$OUT/studies.json"
 else
-    CASES=(cases/patch-single/*.json cases/convergence/*.json crosscheck/cases/*.json)
+    CASES=(cases/patch-single/*.json cases/convergence/*.json crosscheck/cases/*.json
+           crosscheck/cases/contact/*.json)
+    "$PY" crosscheck/studies.py "$OUT" > "$OUT/study-cases.txt"
+    mapfile -t STUDY_CASES < "$OUT/study-cases.txt"
+    CASES+=("${STUDY_CASES[@]}")
 fi
 dups="$(for c in "${CASES[@]}"; do basename "$c" .json; done | sort | uniq -d)"
 if [ -n "$dups" ]; then
