@@ -647,37 +647,6 @@ def write_md(path, report):
         lines += ["", "## Errors", ""]
         lines += [f"- {c}, {s}: {m}" for c, s, m in errs]
 
-    # Hertz
-    lines += ["", "## Hertz: rigid cylinder on a block (plane strain)", ""]
-    if report["hertz"]:
-        lines += [
-            "benchmarks.md s. 3 with a rigid cylinder: E* = E/(1 - nu^2), a = sqrt(4 P R/(pi "
-            "E*)), p0 = 2P/(pi a), P the applied load per unit thickness. The peak nodal "
-            "pressure of each code must be within 3% of p0 and the half-width of its active "
-            "zone (half the distance between its end nodes) within one node spacing of a. The "
-            "discrete peak pressure is a nodal value of a penalty solution on a finite block, "
-            "so it is not expected to match p0 more closely than that.",
-            "",
-            "| case | P | R | E* | a | p0 | quantity | Hertz | ours | DOLFINx | scikit-fem "
-            "| worst error | bound | verdict |",
-            "|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---|---|",
-        ]
-        for h in report["hertz"]:
-            for i, r in enumerate(h["rows"]):
-                head = (f"| {h['case']} | {h['P']:.4g} | {h['R']:.4g} | {h['E_star']:.4g} | "
-                        f"{h['a']:.4f} | {h['p0']:.4f} |" if i == 0 else "| | | | | | |")
-                errs_r = [r.get(f"err_{k}") for k in ("ours", *SOLVERS)]
-                worst = max((x for x in errs_r if x is not None), default=None)
-                wtxt = ("n/a" if worst is None else
-                        f"{worst:.2%}" if r["error"] == "relative to p0" else f"{worst:.4f}")
-                cells = " | ".join("n/a" if r.get(k) is None else f"{r[k]:.4f}"
-                                   for k in ("ours", *SOLVERS))
-                verdict = "pass" if r["verdict"] == "pass" else "**FAIL**"
-                lines.append(f"{head} {r['quantity']} | {r['hertz']:.4f} | {cells} | {wtxt} "
-                             f"| {r['bound_text']} | {verdict} |")
-    else:
-        lines.append("No cylinder case in this run.")
-
     # studies
     lines += ["", "## Studies", ""]
     if not tl and not tb:
@@ -763,6 +732,37 @@ def write_md(path, report):
                 + (" " + "; ".join(s["problems"]) if s.get("problems") else ""))
         lines += ["", STUDY_NOTE_NITSCHE, ""]
 
+    # Hertz
+    lines += ["", "## Hertz: rigid cylinder on a block (plane strain)", ""]
+    if report["hertz"]:
+        lines += [
+            "benchmarks.md s. 3 with a rigid cylinder: E* = E/(1 - nu^2), a = sqrt(4 P R/(pi "
+            "E*)), p0 = 2P/(pi a), P the applied load per unit thickness. The peak nodal "
+            "pressure of each code must be within 3% of p0 and the half-width of its active "
+            "zone (half the distance between its end nodes) within one node spacing of a. The "
+            "discrete peak pressure is a nodal value of a penalty solution on a finite block, "
+            "so it is not expected to match p0 more closely than that.",
+            "",
+            "| case | P | R | E* | a | p0 | quantity | Hertz | ours | DOLFINx | scikit-fem "
+            "| worst error | bound | verdict |",
+            "|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---|---|",
+        ]
+        for h in report["hertz"]:
+            for i, r in enumerate(h["rows"]):
+                head = (f"| {h['case']} | {h['P']:.4g} | {h['R']:.4g} | {h['E_star']:.4g} | "
+                        f"{h['a']:.4f} | {h['p0']:.4f} |" if i == 0 else "| | | | | | |")
+                errs_r = [r.get(f"err_{k}") for k in ("ours", *SOLVERS)]
+                worst = max((x for x in errs_r if x is not None), default=None)
+                wtxt = ("n/a" if worst is None else
+                        f"{worst:.2%}" if r["error"] == "relative to p0" else f"{worst:.4f}")
+                cells = " | ".join("n/a" if r.get(k) is None else f"{r[k]:.4f}"
+                                   for k in ("ours", *SOLVERS))
+                verdict = "pass" if r["verdict"] == "pass" else "**FAIL**"
+                lines.append(f"{head} {r['quantity']} | {r['hertz']:.4f} | {cells} | {wtxt} "
+                             f"| {r['bound_text']} | {verdict} |")
+    else:
+        lines.append("No cylinder case in this run.")
+
     lines += [
         "## Cases",
         "",
@@ -794,7 +794,14 @@ def write_md(path, report):
          "report, ") + f"{report['report_seconds']:.0f} s for the report.",
         "",
     ]
-    Path(path).write_text("\n".join(lines))
+    tidy = []
+    for line in lines:       # one blank line before each heading, never two in a row
+        if line.startswith("#") and tidy and tidy[-1] != "":
+            tidy.append("")
+        if line == "" and tidy and tidy[-1] == "":
+            continue
+        tidy.append(line)
+    Path(path).write_text("\n".join(tidy))
 
 
 def main(argv):
