@@ -111,11 +111,7 @@ pub fn force_balance(model: &Model, solution: &Solution) -> f64 {
             }
         }
     }
-    let size = model
-        .bodies
-        .iter()
-        .map(|b| b.mesh.size())
-        .fold(0.0, f64::max);
+    let size = model.size();
     let net = if total > 0.0 {
         fx.abs().max(fy.abs()).max(moment.abs() / size) / total
     } else {

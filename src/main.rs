@@ -83,6 +83,18 @@ fn main() -> ExitCode {
     }
 }
 
+/// A progress bar over `len` cases on a terminal, nothing when piped.
+fn progress_bar(len: usize) -> Option<ProgressBar> {
+    std::io::stderr().is_terminal().then(|| {
+        let b = ProgressBar::new(len as u64);
+        b.set_style(
+            ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed} {msg}")
+                .expect("valid template"),
+        );
+        b
+    })
+}
+
 fn spinner() -> Option<ProgressBar> {
     if !std::io::stderr().is_terminal() {
         return None;
@@ -185,14 +197,7 @@ fn check(paths: &[PathBuf]) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = ProgressBar::new(cases.len() as u64);
-        b.set_style(
-            ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed} {msg}")
-                .expect("valid template"),
-        );
-        b
-    });
+    let bar = progress_bar(cases.len());
     let mut failures: Vec<(String, String)> = Vec::new();
     let mut errors = 0;
     for case in &cases {
@@ -268,14 +273,7 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = ProgressBar::new(cases.len() as u64);
-        b.set_style(
-            ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed} {msg}")
-                .expect("valid template"),
-        );
-        b
-    });
+    let bar = progress_bar(cases.len());
     let start = std::time::Instant::now();
     let mut cells = Vec::new();
     for case in &cases {

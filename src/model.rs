@@ -167,6 +167,14 @@ pub fn parse(text: &str, source: &str) -> Result<Case> {
 }
 
 impl Model {
+    /// The largest body's size (a length scale for geometric tolerances).
+    pub fn size(&self) -> f64 {
+        self.bodies
+            .iter()
+            .map(|b| b.mesh.size())
+            .fold(0.0, f64::max)
+    }
+
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)
     }

@@ -6,19 +6,26 @@ use contact_patch::harness::{grid_markdown, run_sweep, Cell};
 use contact_patch::report::seed_summary;
 use std::path::Path;
 
-fn catalogue() -> Vec<Cell> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/patch");
+/// The cells of every case in `cases/<folder>` (expecting `count` cases).
+fn sweep_folder(folder: &str, count: usize) -> Vec<Cell> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("cases")
+        .join(folder);
     let mut files: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|x| x == "json"))
         .collect();
     files.sort();
-    assert_eq!(files.len(), 15, "meshes A-E at three values of nu");
+    assert_eq!(files.len(), count, "cases in {folder}");
     files
         .iter()
         .flat_map(|f| run_sweep(f, &mut |_| {}).unwrap())
         .collect()
+}
+
+fn catalogue() -> Vec<Cell> {
+    sweep_folder("patch", 15) // meshes A-E at three values of nu
 }
 
 #[test]
@@ -105,18 +112,7 @@ fn patch_table() {
 /// grid is a snapshot too (it records which node-to-surface ties fail and by how much).
 #[test]
 fn tied_table() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/tied");
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "json"))
-        .collect();
-    files.sort();
-    assert_eq!(files.len(), 9, "meshes B, C, E x three stress states");
-    let cells: Vec<Cell> = files
-        .iter()
-        .flat_map(|f| run_sweep(f, &mut |_| {}).unwrap())
-        .collect();
+    let cells = sweep_folder("tied", 9); // meshes B, C, E x three stress states
     for c in cells
         .iter()
         .filter(|c| c.discretization.contains("mortar") && c.verdict != "n/a")

@@ -226,11 +226,7 @@ fn solve_at(model: &Model, u: Option<&[f64]>, progress: &mut dyn FnMut(&str)) ->
     // A row on prescribed dofs only holds by itself when its gap is zero (e.g. a tie row along
     // a roller); it is dropped, since as a constraint it would only make the multiplier system
     // singular. If its gap is not zero the data contradict each other.
-    let size = model
-        .bodies
-        .iter()
-        .map(|b| b.mesh.size())
-        .fold(0.0, f64::max);
+    let size = model.size();
     if let Some((r, e)) = rows
         .iter()
         .zip(&eq_rows)
@@ -370,12 +366,7 @@ impl Kernel<'_> {
     /// Gap below which a row counts as closed when the active set starts and when a row is
     /// activated: `1e-14` times the model size.
     fn gap_tol(&self) -> f64 {
-        let size = self
-            .model
-            .bodies
-            .iter()
-            .map(|b| b.mesh.size())
-            .fold(0.0, f64::max);
+        let size = self.model.size();
         1e-14 * size
     }
 
@@ -435,12 +426,7 @@ impl Kernel<'_> {
         let t = Instant::now();
         let n = self.sys.n;
         let m = self.rows.len();
-        let size = self
-            .model
-            .bodies
-            .iter()
-            .map(|b| b.mesh.size())
-            .fold(0.0, f64::max);
+        let size = self.model.size();
         let saddle = self.saddle.as_ref()?;
         let w = vec![rho; m];
         let k = self.augmented(active, &w);
@@ -727,12 +713,7 @@ impl Kernel<'_> {
     fn active_set_loop(&mut self, method: Method, rows: &[Constraint]) -> LoopResult {
         let nrows = self.rows.len();
         let gap_tol = self.gap_tol();
-        let size = self
-            .model
-            .bodies
-            .iter()
-            .map(|b| b.mesh.size())
-            .fold(0.0, f64::max);
+        let size = self.model.size();
         let mut active: Vec<bool> = rows
             .iter()
             .zip(self.rows)
