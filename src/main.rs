@@ -206,7 +206,7 @@ fn check(paths: &[PathBuf]) -> ExitCode {
         }
         match run_case(case, &mut |_| {}) {
             Ok(outcome) => {
-                let (pass, fail): (Vec<_>, Vec<_>) = outcome.checks.iter().partition(|c| c.passed);
+                let fail: Vec<_> = outcome.checks.iter().filter(|c| !c.passed).collect();
                 let line = format!(
                     "{} ({} checks, {:.3}s)",
                     case.display(),
@@ -220,7 +220,6 @@ fn check(paths: &[PathBuf]) -> ExitCode {
                     )),
                     None => println!("{} {line}", if fail.is_empty() { "pass" } else { "FAIL" }),
                 }
-                let _ = pass;
                 for c in fail {
                     failures.push((
                         case.display().to_string(),

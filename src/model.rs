@@ -652,8 +652,7 @@ impl Model {
                 }
                 Check::Reaction { body, set, tol, .. } => {
                     let b = self.find_body(body, &at)?;
-                    let nodes = self.find_node_set(b, set, &at)?;
-                    let _ = nodes;
+                    self.find_node_set(b, set, &at)?;
                     *tol
                 }
                 Check::Displacement { body, tol, .. } => {

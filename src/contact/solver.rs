@@ -264,16 +264,13 @@ fn solve_at(model: &Model, u: Option<&[f64]>, progress: &mut dyn FnMut(&str)) ->
         linear_solver: "cholesky",
         cache: None,
         factorizations: 0.0,
-        solves: 0.0,
     };
     let state = kernel.active_set_loop(method, &rows);
     let (x, forces, active, termination, iterations) = state;
     let linear_solver = kernel.linear_solver;
     let factor_time = kernel.factorizations;
-    let solve_time = kernel.solves;
     timings.factorization = factor_time;
     timings.solve = (t.elapsed().as_secs_f64() - factor_time).max(0.0);
-    let _ = solve_time;
 
     let u = sys.expand(&x);
     let mut contact_force = vec![0.0; model.dof_count];
@@ -357,7 +354,6 @@ struct Kernel<'a> {
     /// The last Cholesky factorization with its active set and weights.
     cache: Option<(Vec<bool>, Vec<f64>, std::rc::Rc<crate::sparse::Factor>)>,
     factorizations: f64,
-    solves: f64,
 }
 
 type LoopResult = (Vec<f64>, Vec<f64>, Vec<bool>, Termination, usize);
