@@ -305,6 +305,13 @@ fn node_to_surface(
     let radius = rows.search_distance.unwrap_or_else(|| master.facet_size());
     let tol = 1e-12 * mb.mesh.size();
     let kind = master.kind;
+    // how many master facets end at each vertex (a corner needs two)
+    let mut facets_at: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+    for f in &master.facets {
+        for v in [f[0], f[1]] {
+            *facets_at.entry(v).or_default() += 1;
+        }
+    }
     for (&s, data) in &slave.nodes {
         let p = sb.mesh.nodes[s];
         let candidates = grid.query(p, radius);
@@ -357,14 +364,7 @@ fn node_to_surface(
         }
         // corner condition: the nearest vertex shared by two candidate facets (a slave node
         // beyond the free end of the master surface has slid off it and gets no row)
-        let shared = |v: usize| {
-            master
-                .facets
-                .iter()
-                .filter(|f| f[0] == v || f[1] == v)
-                .count()
-                >= 2
-        };
+        let shared = |v: usize| facets_at.get(&v).is_some_and(|&n| n >= 2);
         let vertex = candidates
             .iter()
             .flat_map(|&f| [master.facets[f][0], master.facets[f][1]])

@@ -76,8 +76,9 @@ pub(crate) fn mortar_rows(
     // D[j][k] over slave nodes, M[j][l] over master nodes
     let mut d: BTreeMap<usize, BTreeMap<usize, f64>> = BTreeMap::new();
     let mut m: BTreeMap<usize, BTreeMap<usize, f64>> = BTreeMap::new();
+    let slave_boxes = slave.boxes();
     for (f, coords) in slave.coords.iter().enumerate() {
-        let [lo, hi] = slave.boxes()[f];
+        let [lo, hi] = slave_boxes[f];
         let centre = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
         let reach = 0.5 * ((hi[0] - lo[0]).hypot(hi[1] - lo[1])) + radius;
         let candidates = grid.query(centre, reach);
