@@ -29,7 +29,7 @@ use crate::contact::solver::Termination;
 use crate::error::Result;
 use crate::model::{load, Model};
 use crate::post::for_each_quadrature_stress;
-use crate::scene::{DiscretizationSpec, EnforcementSpec, MultiplierSpace};
+use crate::scene::{Catalogue, DiscretizationSpec, EnforcementSpec, MultiplierSpace};
 use crate::solve::{solve_static, Solution};
 use serde::Serialize;
 use std::path::Path;
@@ -39,7 +39,7 @@ use std::time::Instant;
 #[derive(Clone, Debug, Serialize)]
 pub struct Cell {
     /// `patch` or `tied` (the sweep's catalogue).
-    pub catalogue: String,
+    pub catalogue: Catalogue,
     pub case: String,
     pub mesh: String,
     pub nu: f64,
@@ -195,7 +195,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 name(e)
             ));
             let mut cell = Cell {
-                catalogue: sweep.catalogue.clone(),
+                catalogue: sweep.catalogue,
                 case: base.name.clone(),
                 mesh: sweep.mesh.clone(),
                 nu,

@@ -72,7 +72,7 @@ fn refine(case: &Case, k: usize) -> Case {
         if let MeshSpec::Block(block) = &mut b.mesh {
             for breaks in [&mut block.x, &mut block.y] {
                 if let Breaks::Uniform(u) = breaks {
-                    u.divisions *= k;
+                    u.divisions = u.divisions.saturating_mul(k);
                 }
             }
         }

@@ -34,6 +34,7 @@ pub mod layer;
 pub mod mesh;
 pub mod model;
 pub mod output;
+pub mod paths;
 pub mod post;
 pub mod report;
 pub mod run;

@@ -2,7 +2,9 @@
 
 use clap::{Parser, Subcommand};
 use contact_patch::output::write_run;
+use contact_patch::paths::{file_name, OutputFolder, ReportFolder};
 use contact_patch::run::{run_case, Outcome};
+use contact_patch::scene::Catalogue;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -108,6 +110,14 @@ fn spinner() -> Option<ProgressBar> {
 }
 
 fn run(case: &Path, out: Option<PathBuf>) -> ExitCode {
+    // A given output folder is checked before the solve, so that a refusal costs nothing.
+    let given = match out.as_deref().map(OutputFolder::new).transpose() {
+        Ok(folder) => folder,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
     let bar = spinner();
     let mut progress = |stage: &str| {
         if let Some(b) = &bar {
@@ -115,10 +125,17 @@ fn run(case: &Path, out: Option<PathBuf>) -> ExitCode {
         }
     };
     let result = run_case(case, &mut progress).and_then(|outcome| {
-        let dir = out.unwrap_or_else(|| Path::new("out").join(&outcome.model.name));
+        let folder = match given {
+            Some(folder) => folder,
+            None => OutputFolder::new(&Path::new("out").join(file_name(
+                "case name",
+                &outcome.model.name,
+                "",
+            )?))?,
+        };
         progress("writing output");
-        write_run(&dir, &outcome)?;
-        Ok((outcome, dir))
+        write_run(&folder, &outcome)?;
+        Ok((outcome, folder))
     });
     if let Some(b) = bar {
         b.finish_and_clear();
@@ -128,9 +145,9 @@ fn run(case: &Path, out: Option<PathBuf>) -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::from(2)
         }
-        Ok((outcome, dir)) => {
+        Ok((outcome, folder)) => {
             print_outcome(&outcome);
-            println!("output: {}", dir.display());
+            println!("output: {}", folder.path().display());
             if outcome.passed() {
                 ExitCode::SUCCESS
             } else {
@@ -204,7 +221,7 @@ fn check(paths: &[PathBuf]) -> ExitCode {
         if let Some(b) = &bar {
             b.set_message(case.display().to_string());
         }
-        match run_case(case, &mut |_| {}) {
+        match guarded(case, || run_case(case, &mut |_| {})) {
             Ok(outcome) => {
                 let fail: Vec<_> = outcome.checks.iter().filter(|c| !c.passed).collect();
                 let line = format!(
@@ -259,11 +276,30 @@ fn check(paths: &[PathBuf]) -> ExitCode {
     ExitCode::from(if errors > 0 { 2 } else { 1 })
 }
 
+/// Run `job` on one case, turning a panic (a bug, never expected) into an error so that a
+/// command over many cases reports every case.
+fn guarded<T>(case: &Path, job: impl FnOnce() -> contact_patch::Result<T>) -> Result<T, String> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(job)) {
+        Ok(result) => result.map_err(|e| e.to_string()),
+        Err(_) => Err(format!(
+            "{}: internal error (a bug in contact-patch; please report it with this case)",
+            case.display()
+        )),
+    }
+}
+
 fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
     let paths = if paths.is_empty() {
         vec![PathBuf::from("cases/patch"), PathBuf::from("cases/tied")]
     } else {
         paths.to_vec()
+    };
+    let folder = match ReportFolder::new(out) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
     };
     let cases = match collect_cases(&paths) {
         Ok(c) => c,
@@ -275,20 +311,23 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
     let bar = progress_bar(cases.len());
     let start = std::time::Instant::now();
     let mut cells = Vec::new();
+    let mut errors = Vec::new();
     for case in &cases {
         let mut progress = |m: &str| {
             if let Some(b) = &bar {
                 b.set_message(m.to_string());
             }
         };
-        match contact_patch::harness::run_sweep(case, &mut progress) {
+        match guarded(case, || {
+            contact_patch::harness::run_sweep(case, &mut progress)
+        }) {
             Ok(c) => cells.extend(c),
             Err(e) => {
-                if let Some(b) = &bar {
-                    b.finish_and_clear();
+                match &bar {
+                    Some(b) => b.println(format!("error: {e}")),
+                    None => eprintln!("error: {e}"),
                 }
-                eprintln!("error: {e}");
-                return ExitCode::from(2);
+                errors.push(case.display().to_string());
             }
         }
         if let Some(b) = &bar {
@@ -299,11 +338,7 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
         b.finish_and_clear();
     }
     let seconds = start.elapsed().as_secs_f64();
-    if let Err(e) = std::fs::create_dir_all(out) {
-        eprintln!("error: {}: creating the folder failed: {e}", out.display());
-        return ExitCode::from(2);
-    }
-    let mut catalogues: Vec<String> = cells.iter().map(|c| c.catalogue.clone()).collect();
+    let mut catalogues: Vec<Catalogue> = cells.iter().map(|c| c.catalogue).collect();
     catalogues.sort();
     catalogues.dedup();
     for catalogue in catalogues {
@@ -312,50 +347,71 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
             .filter(|c| c.catalogue == catalogue)
             .cloned()
             .collect();
-        let report = match catalogue.as_str() {
-            "tied" => contact_patch::report::tied_report(&part),
-            _ => contact_patch::report::patch_report(&part, seconds),
+        let report = match catalogue {
+            Catalogue::Tied => contact_patch::report::tied_report(&part),
+            Catalogue::Patch => contact_patch::report::patch_report(&part, seconds),
         };
         let json = serde_json::to_string_pretty(&part).expect("cells serialize") + "\n";
-        let (md_path, json_path) = (
-            out.join(format!("{catalogue}-table.md")),
-            out.join(format!("{catalogue}-table.json")),
+        let (md, js) = (
+            format!("{}-table.md", catalogue.name()),
+            format!("{}-table.json", catalogue.name()),
         );
-        if let Err(e) =
-            write_replacing(&json_path, &json).and_then(|_| write_replacing(&md_path, &report))
+        if let Err(e) = folder
+            .write_file(&js, &json)
+            .and_then(|_| folder.write_file(&md, &report))
         {
-            eprintln!("error: {}: writing the tables failed: {e}", out.display());
+            eprintln!("error: {e}");
             return ExitCode::from(2);
         }
-        if catalogue == "patch" {
+        if catalogue == Catalogue::Patch {
             println!("{}", contact_patch::report::seed_summary(&part));
         }
         println!(
-            "{catalogue}: {} cells ({} pass, {} fail, {} n/a); wrote {} and {}",
+            "{}: {} cells ({} pass, {} fail, {} n/a); wrote {} and {}",
+            catalogue.name(),
             part.len(),
             part.iter().filter(|c| c.verdict == "pass").count(),
             part.iter().filter(|c| c.verdict == "fail").count(),
             part.iter().filter(|c| c.verdict == "n/a").count(),
-            md_path.display(),
-            json_path.display()
+            folder.shown(&md).display(),
+            folder.shown(&js).display()
         );
     }
     println!("{} cells in {seconds:.2}s", cells.len());
-    ExitCode::SUCCESS
+    if errors.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        eprintln!(
+            "error: {} of {} cases could not be run (their cells are missing from the tables): {}",
+            errors.len(),
+            cases.len(),
+            errors.join(", ")
+        );
+        ExitCode::from(2)
+    }
 }
 
-/// Write a file under a temporary name and rename it into place.
-fn write_replacing(path: &Path, text: &str) -> std::io::Result<()> {
-    let tmp = path.with_extension("partial");
-    std::fs::write(&tmp, text)?;
-    std::fs::rename(&tmp, path)
-}
+/// The most refinement levels `tied-layer` accepts, and the largest level.
+const MAX_LEVELS: usize = 16;
+const MAX_LEVEL: usize = 64;
 
 fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
-    if levels.is_empty() || levels.contains(&0) {
-        eprintln!("error: --levels needs positive integers, e.g. 1,2,4,8");
+    if levels.is_empty()
+        || levels.len() > MAX_LEVELS
+        || levels.iter().any(|&k| k == 0 || k > MAX_LEVEL)
+    {
+        eprintln!(
+            "error: --levels: give 1 to {MAX_LEVELS} refinement levels, each from 1 to {MAX_LEVEL}, e.g. 1,2,4,8\n  hint: a level multiplies every division of the layer's meshes"
+        );
         return ExitCode::from(2);
     }
+    let folder = match ReportFolder::new(out) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
     let plot_level = levels[levels.len() / 2];
     let mut studies = Vec::new();
     for element in ["q4", "q9"] {
@@ -368,13 +424,12 @@ fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
         }
     }
     let result = (|| -> contact_patch::Result<Vec<String>> {
-        let io = |p: &Path, e| contact_patch::Error::io(p.display(), "writing", e);
-        std::fs::create_dir_all(out).map_err(|e| io(out, e))?;
+        let runs_folder = folder.sub_folder("tied-layer")?;
         let mut files = Vec::new();
         for (element, study) in &studies {
             for (stem, svg) in contact_patch::layer::plots(element, plot_level, &study.curves) {
                 let name = format!("{stem}.svg");
-                std::fs::write(out.join(&name), svg).map_err(|e| io(&out.join(&name), e))?;
+                folder.write_file(&name, &svg)?;
                 files.push(name);
             }
             for (name, model, solution) in &study.solved {
@@ -383,19 +438,17 @@ fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
                     model: model.clone(),
                     solution: solution.clone(),
                 };
-                contact_patch::output::write_run(
-                    &out.join("tied-layer").join(format!("{element}-{name}")),
+                write_run(
+                    &runs_folder.run_folder(&format!("{element}-{name}"))?,
                     &outcome,
                 )?;
             }
         }
         let report = contact_patch::layer::report(&studies, levels, plot_level, &files);
-        write_replacing(&out.join("tied-layer.md"), &report)
-            .map_err(|e| io(&out.join("tied-layer.md"), e))?;
+        folder.write_file("tied-layer.md", &report)?;
         let runs: Vec<_> = studies.iter().flat_map(|(_, s)| s.runs.clone()).collect();
         let json = serde_json::to_string_pretty(&runs).expect("runs serialize") + "\n";
-        write_replacing(&out.join("tied-layer.json"), &json)
-            .map_err(|e| io(&out.join("tied-layer.json"), e))?;
+        folder.write_file("tied-layer.json", &json)?;
         Ok(files)
     })();
     match result {
@@ -408,7 +461,7 @@ fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
                     );
                 }
             }
-            println!("wrote {}", out.join("tied-layer.md").display());
+            println!("wrote {}", folder.shown("tied-layer.md").display());
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -22,9 +22,10 @@ use crate::error::{Error, Result};
 use crate::exact::ExactField;
 use crate::fe::{point_values, ElementKind};
 use crate::mesh::{block, Facet, Mesh};
+use crate::paths::{name_problem, NAME_RULE};
 use crate::scene::{
-    Case, Check, DiscretizationSpec, EnforcementSpec, FacetSetSpec, MeshSpec, NodeSetSpec, Physics,
-    Plane, Prescribed, RigidSurface, SweepSpec, TractionSpec,
+    Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, MeshSpec,
+    NodeSetSpec, Physics, Plane, Prescribed, RigidSurface, SweepSpec, TractionSpec,
 };
 use crate::solid::{check_geometry, Elasticity};
 use std::path::Path;
@@ -136,6 +137,40 @@ pub fn load(path: &Path) -> Result<Model> {
 
 /// Parse case JSON; errors carry line, column and a hint.
 pub fn parse(text: &str, source: &str) -> Result<Case> {
+    let at_start = |message: &str, hint: &str| Error::Parse {
+        path: source.to_string(),
+        line: 1,
+        column: 1,
+        message: message.to_string(),
+        hint: hint.to_string(),
+    };
+    if text.starts_with('\u{feff}') {
+        return Err(at_start(
+            "the file starts with a byte-order mark (U+FEFF), which JSON does not allow",
+            "save the file as UTF-8 without a byte-order mark",
+        ));
+    }
+    match text.trim_start().chars().next() {
+        Some('{') => {}
+        Some('[') => {
+            return Err(at_start(
+                "the file holds an array; a case file holds one JSON object",
+                "write one case per file, as an object {\"name\": .., \"materials\": .., ..}",
+            ))
+        }
+        None => {
+            return Err(at_start(
+                "the file is empty",
+                "a case file holds one JSON object; see the cases under cases/",
+            ))
+        }
+        Some(_) => {
+            return Err(at_start(
+                "the file does not start with '{': a case file holds one JSON object",
+                "see the cases under cases/ for complete examples",
+            ))
+        }
+    }
     serde_json::from_str::<Case>(text).map_err(|e| {
         let message = e.to_string();
         // serde_json appends " at line L column C"; the location is reported separately.
@@ -188,6 +223,17 @@ impl Model {
         let invalid = |location: String, problem: String, hint: &str| {
             Error::invalid(source, location, problem, hint)
         };
+        let name_rule = |location: String, name: &str| match name_problem(name) {
+            None => Ok(()),
+            Some(problem) => Err(invalid(location, problem, NAME_RULE)),
+        };
+        name_rule("name".into(), &case.name)?;
+        for (bi, spec) in case.bodies.iter().enumerate() {
+            name_rule(format!("bodies[{bi}].name"), &spec.name)?;
+        }
+        for (k, spec) in case.contact.iter().enumerate() {
+            name_rule(format!("contact[{k}].name"), &spec.name)?;
+        }
         let plane = case.analysis.plane;
         let thickness = case.analysis.thickness;
         if !(thickness.is_finite() && thickness > 0.0) {
@@ -224,6 +270,7 @@ impl Model {
             ));
         }
 
+        check_size(case, source)?;
         let mut bodies: Vec<Body> = Vec::new();
         let mut offset = 0;
         for (bi, spec) in case.bodies.iter().enumerate() {
@@ -257,6 +304,34 @@ impl Model {
             bodies.push(body);
         }
 
+        match &case.exact {
+            Some(ExactSpec::UniformStress { stress }) if stress.iter().any(|v| !v.is_finite()) => {
+                return Err(invalid(
+                    "exact.stress".into(),
+                    format!("the stress must be finite, got {stress:?}"),
+                    "give three finite components [xx, yy, xy]",
+                ))
+            }
+            Some(ExactSpec::TimoshenkoCantilever {
+                load,
+                length,
+                depth,
+            }) if !(load.is_finite()
+                && *length > 0.0
+                && *depth > 0.0
+                && length.is_finite()
+                && depth.is_finite()) =>
+            {
+                return Err(invalid(
+                    "exact".into(),
+                    format!(
+                        "the cantilever needs a finite load and a positive, finite length and depth, got load {load}, length {length}, depth {depth}"
+                    ),
+                    "the exact solution divides by the depth and the length",
+                ))
+            }
+            _ => {}
+        }
         let exact = case.exact.as_ref().map(ExactField::from);
         let mut model = Model {
             name: case.name.clone(),
@@ -993,12 +1068,47 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {
     }
 }
 
+/// The node count of every mesh, from the spec alone (nothing is allocated), against
+/// `limits.nodes`.
+fn check_size(case: &Case, source: &str) -> Result<()> {
+    let limit = case.limits.nodes as u128;
+    let mut total: u128 = 0;
+    for (bi, spec) in case.bodies.iter().enumerate() {
+        let nodes = match &spec.mesh {
+            MeshSpec::Block(b) => {
+                let order = if b.element.is_quadratic() { 2 } else { 1 };
+                let along = |n: usize| order * n as u128 + 1;
+                along(b.x.intervals()) * along(b.y.intervals())
+            }
+            MeshSpec::Explicit(e) => e.nodes.len() as u128,
+        };
+        total = total.saturating_add(nodes);
+        if total > limit {
+            return Err(Error::invalid(
+                source,
+                format!("bodies[{bi}] '{}'.mesh", spec.name),
+                format!(
+                    "the meshes would have {total} nodes or more, above the limit of {limit}"
+                ),
+                "use fewer divisions, or raise \"limits\": {\"nodes\": N} if the machine has the memory",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Every cell must have a positive Jacobian at its nodes and quadrature points.
 fn check_cells(mesh: &Mesh, source: &str, at: &str) -> Result<()> {
     for c in 0..mesh.cell_count() {
         let coords = mesh.cell_coords(c);
         if let Err(bad) = check_geometry(mesh.kind, &coords) {
-            let what = if bad.inverted {
+            let overflow = !bad.det_j.is_finite()
+                || coords
+                    .iter()
+                    .any(|p| !(p[0] * p[0] + p[1] * p[1]).is_finite());
+            let what = if overflow {
+                "too large to compute with: its coordinates overflow"
+            } else if bad.inverted {
                 "inverted (negative Jacobian)"
             } else {
                 "degenerate (zero-area)"
@@ -1006,8 +1116,15 @@ fn check_cells(mesh: &Mesh, source: &str, at: &str) -> Result<()> {
             return Err(Error::invalid(
                 source,
                 format!("{at}: element {c} (nodes {:?})", mesh.cell(c)),
-                format!("the element is {what}: det J = {:.3e} at ({:.6}, {:.6})", bad.det_j, bad.at[0], bad.at[1]),
-                "list the corners counter-clockwise, keep every interior angle below 180 degrees and mid-side nodes near the middle of their sides",
+                format!(
+                    "the element is {what}: det J = {:.3e} at ({:.6}, {:.6})",
+                    bad.det_j, bad.at[0], bad.at[1]
+                ),
+                if !overflow {
+                    "list the corners counter-clockwise, keep every interior angle below 180 degrees and mid-side nodes near the middle of their sides"
+                } else {
+                    "coordinates must stay far below 1e154 (their squares must be finite); choose other length units"
+                },
             ));
         }
     }

@@ -1,7 +1,8 @@
 //! Run output: `summary.json` and one VTK XML unstructured grid (`<body>.vtu`) per body.
 //!
-//! The folder is written under a temporary name next to the target and renamed into place only
-//! when every file is complete, so a folder named like the target is always a whole run.
+//! The folder is an [`OutputFolder`]: written under a temporary name next to the target and
+//! renamed into place only when every file is complete, so a folder named like the target is
+//! always a whole run, and only a previous output is ever replaced (see [`crate::paths`]).
 //! The `.vtu` files are ASCII VTK XML (version 0.1) with point data `displacement` (3
 //! components, z = 0) and `stress` (`xx, yy, xy`, averaged at nodes), `stress_zz`, and cell
 //! data `stress` at cell centres; VTK cell types 9 (Q4), 28 (Q9), 5 (T3), 22 (T6), whose node
@@ -10,13 +11,14 @@
 use crate::checks::CheckResult;
 use crate::error::{Error, Result};
 use crate::model::Body;
+use crate::paths::{file_name, OutputFolder};
 use crate::post::{cell_stresses, nodal_stresses};
 use crate::run::Outcome;
 use crate::solve::Timings;
 use serde::Serialize;
 use std::fs;
 use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 #[derive(Serialize)]
 pub struct Summary {
@@ -177,8 +179,8 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
     }
 }
 
-/// Write `summary.json` and the `.vtu` files into `dir` (replaced as a whole).
-pub fn write_run(dir: &Path, outcome: &Outcome) -> Result<()> {
+/// Write `summary.json` and one `.vtu` file per body into `folder` (replaced as a whole).
+pub fn write_run(folder: &OutputFolder, outcome: &Outcome) -> Result<()> {
     let nodal: Vec<Vec<[f64; 3]>> = outcome
         .model
         .bodies
@@ -186,44 +188,16 @@ pub fn write_run(dir: &Path, outcome: &Outcome) -> Result<()> {
         .map(|b| nodal_stresses(b, &outcome.solution.u))
         .collect();
     let summary = summary(outcome, &nodal);
-    write_folder_atomically(dir, |tmp| {
+    folder.write(|tmp| {
         let path = tmp.join("summary.json");
         let text = serde_json::to_string_pretty(&summary).expect("the summary serializes");
         fs::write(&path, text + "\n").map_err(|e| Error::io(path.display(), "writing", e))?;
         for (b, s) in outcome.model.bodies.iter().zip(&nodal) {
-            let path = tmp.join(format!("{}.vtu", b.name));
+            let path = tmp.join(file_name("body name", &b.name, ".vtu")?);
             write_vtu(&path, b, &outcome.solution.u, s)?;
         }
         Ok(())
     })
-}
-
-/// Build a folder under a temporary name with `fill`, then move it to `dir`.
-pub fn write_folder_atomically(dir: &Path, fill: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let name = dir
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let parent = dir
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    fs::create_dir_all(parent)
-        .map_err(|e| Error::io(parent.display(), "creating the output folder", e))?;
-    let tmp: PathBuf = parent.join(format!(".{name}.partial-{}", std::process::id()));
-    if tmp.exists() {
-        let _ = fs::remove_dir_all(&tmp);
-    }
-    fs::create_dir(&tmp).map_err(|e| Error::io(tmp.display(), "creating the output folder", e))?;
-    if let Err(e) = fill(&tmp) {
-        let _ = fs::remove_dir_all(&tmp);
-        return Err(e);
-    }
-    if dir.exists() {
-        fs::remove_dir_all(dir)
-            .map_err(|e| Error::io(dir.display(), "replacing the previous output", e))?;
-    }
-    fs::rename(&tmp, dir).map_err(|e| Error::io(dir.display(), "moving the output into place", e))
 }
 
 /// One VTK XML unstructured grid for one body.

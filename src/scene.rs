@@ -42,6 +42,33 @@ pub struct Case {
     pub sweep: Option<SweepSpec>,
     #[serde(default)]
     pub checks: Vec<Check>,
+    /// Bounds on the work a case may ask for, checked before anything is allocated.
+    #[serde(default)]
+    pub limits: Limits,
+}
+
+/// Bounds on the size of a case, checked before meshing (a case may raise them).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Limits {
+    /// The most nodes all bodies together may have (default 2,000,000, 4 million dofs: four
+    /// times the 1M-dof case in `cases/large`).
+    #[serde(default = "default_max_nodes")]
+    pub nodes: usize,
+}
+
+pub const DEFAULT_MAX_NODES: usize = 2_000_000;
+
+fn default_max_nodes() -> usize {
+    DEFAULT_MAX_NODES
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            nodes: DEFAULT_MAX_NODES,
+        }
+    }
 }
 
 /// A facet set of a body.
@@ -201,8 +228,8 @@ pub struct SweepDiscretization {
 pub struct SweepSpec {
     /// Which table the cells go to: `patch` (default, `reports/patch-table.*`) or `tied`
     /// (`reports/tied-table.*`).
-    #[serde(default = "patch_catalogue")]
-    pub catalogue: String,
+    #[serde(default)]
+    pub catalogue: Catalogue,
     /// Label of the mesh in tables (e.g. "A").
     pub mesh: String,
     pub discretizations: Vec<SweepDiscretization>,
@@ -216,8 +243,24 @@ pub struct SweepSpec {
     pub tol: f64,
 }
 
-fn patch_catalogue() -> String {
-    "patch".into()
+/// The tables a sweep's cells go to; the name is the stem of the table's files.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Catalogue {
+    /// The contact patch test (`patch-table.*`).
+    #[default]
+    Patch,
+    /// The tied patch tests (`tied-table.*`).
+    Tied,
+}
+
+impl Catalogue {
+    pub fn name(self) -> &'static str {
+        match self {
+            Catalogue::Patch => "patch",
+            Catalogue::Tied => "tied",
+        }
+    }
 }
 
 fn thousand() -> f64 {
@@ -296,11 +339,37 @@ pub struct BlockSpec {
 }
 
 /// Element boundaries along one axis: an explicit list, or uniform divisions.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize)]
 #[serde(untagged)]
 pub enum Breaks {
     List(Vec<f64>),
     Uniform(UniformBreaks),
+}
+
+/// A list becomes [`Breaks::List`], an object [`Breaks::Uniform`]; anything else is refused
+/// with both shapes named (not serde's "did not match any variant of untagged enum").
+impl<'de> Deserialize<'de> for Breaks {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct BreaksVisitor;
+        impl<'de> serde::de::Visitor<'de> for BreaksVisitor {
+            type Value = Breaks;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(
+                    "the breaks of an axis: a list of increasing coordinates [x0, x1, ...] or \
+                     {\"from\": x0, \"to\": x1, \"divisions\": n}",
+                )
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Breaks, A::Error> {
+                Vec::<f64>::deserialize(serde::de::value::SeqAccessDeserializer::new(seq))
+                    .map(Breaks::List)
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Breaks, A::Error> {
+                UniformBreaks::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(Breaks::Uniform)
+            }
+        }
+        d.deserialize_any(BreaksVisitor)
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -308,10 +377,32 @@ pub enum Breaks {
 pub struct UniformBreaks {
     pub from: f64,
     pub to: f64,
+    #[serde(deserialize_with = "positive_count")]
     pub divisions: usize,
 }
 
+/// A count of at least 1, with a message that names what is allowed.
+fn positive_count<'de, D: serde::Deserializer<'de>>(d: D) -> Result<usize, D::Error> {
+    let value = serde_json::Value::deserialize(d)?;
+    match value.as_u64() {
+        Some(n) if n >= 1 => usize::try_from(n).map_err(|_| {
+            serde::de::Error::custom(format!("`divisions` {n} is too large (see `limits`)"))
+        }),
+        _ => Err(serde::de::Error::custom(format!(
+            "`divisions` must be a positive integer, got {value}"
+        ))),
+    }
+}
+
 impl Breaks {
+    /// The number of intervals, without building them.
+    pub fn intervals(&self) -> usize {
+        match self {
+            Breaks::List(v) => v.len().saturating_sub(1),
+            Breaks::Uniform(u) => u.divisions,
+        }
+    }
+
     pub fn values(&self) -> Vec<f64> {
         match self {
             Breaks::List(v) => v.clone(),

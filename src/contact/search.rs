@@ -12,6 +12,8 @@ pub struct BucketGrid {
     cell: f64,
     buckets: HashMap<(i64, i64), Vec<usize>>,
     boxes: Vec<[[f64; 2]; 2]>,
+    /// The smallest and largest bucket keys in use: a query never looks outside them.
+    key_range: [(i64, i64); 2],
 }
 
 impl BucketGrid {
@@ -42,6 +44,7 @@ impl BucketGrid {
             cell,
             buckets: HashMap::new(),
             boxes,
+            key_range: [(i64::MAX, i64::MAX), (i64::MIN, i64::MIN)],
         };
         for i in 0..grid.boxes.len() {
             let [lo, hi] = grid.boxes[i];
@@ -51,6 +54,9 @@ impl BucketGrid {
                     grid.buckets.entry((x, y)).or_default().push(i);
                 }
             }
+            let [kl, kh] = &mut grid.key_range;
+            *kl = (kl.0.min(a.0), kl.1.min(a.1));
+            *kh = (kh.0.max(b.0), kh.1.max(b.1));
         }
         grid
     }
@@ -63,24 +69,48 @@ impl BucketGrid {
     }
 
     /// Items whose box, grown by `radius`, contains `p` (sorted, without repeats).
+    ///
+    /// The cost is bounded by the number of buckets in use, whatever `radius` is: the query's
+    /// key range is clipped to the keys in use, and when it still spans more keys than there are
+    /// buckets, the buckets are visited instead of the keys.
     pub fn query(&self, p: [f64; 2], radius: f64) -> Vec<usize> {
         let (a, b) = (
             self.key([p[0] - radius, p[1] - radius]),
             self.key([p[0] + radius, p[1] + radius]),
         );
+        let [kl, kh] = self.key_range;
+        let (a, b) = (
+            (a.0.max(kl.0), a.1.max(kl.1)),
+            (b.0.min(kh.0), b.1.min(kh.1)),
+        );
         let mut out = Vec::new();
-        for x in a.0..=b.0 {
-            for y in a.1..=b.1 {
-                if let Some(items) = self.buckets.get(&(x, y)) {
-                    for &i in items {
-                        let [lo, hi] = self.boxes[i];
-                        if p[0] >= lo[0] - radius
-                            && p[0] <= hi[0] + radius
-                            && p[1] >= lo[1] - radius
-                            && p[1] <= hi[1] + radius
-                        {
-                            out.push(i);
-                        }
+        let mut visit = |items: &Vec<usize>| {
+            for &i in items {
+                let [lo, hi] = self.boxes[i];
+                if p[0] >= lo[0] - radius
+                    && p[0] <= hi[0] + radius
+                    && p[1] >= lo[1] - radius
+                    && p[1] <= hi[1] + radius
+                {
+                    out.push(i);
+                }
+            }
+        };
+        if a.0 > b.0 || a.1 > b.1 {
+            return out;
+        }
+        let keys = (b.0 as i128 - a.0 as i128 + 1) * (b.1 as i128 - a.1 as i128 + 1);
+        if keys > self.buckets.len() as i128 {
+            for (k, items) in &self.buckets {
+                if (a.0..=b.0).contains(&k.0) && (a.1..=b.1).contains(&k.1) {
+                    visit(items);
+                }
+            }
+        } else {
+            for x in a.0..=b.0 {
+                for y in a.1..=b.1 {
+                    if let Some(items) = self.buckets.get(&(x, y)) {
+                        visit(items);
                     }
                 }
             }
@@ -116,5 +146,18 @@ mod tests {
                 .collect();
             assert_eq!(grid.query(p, r), brute);
         }
+    }
+
+    #[test]
+    fn a_huge_radius_costs_no_more_than_the_buckets() {
+        let boxes: Vec<[[f64; 2]; 2]> = (0..100)
+            .map(|i| [[i as f64, 0.0], [i as f64 + 1.0, 0.0]])
+            .collect();
+        let grid = BucketGrid::new(boxes);
+        // At 9aead84 these visited (2r / cell)^2 keys: minutes at 1e4, never ending at 1e308.
+        for r in [1e4, 1e12, 1e308, f64::INFINITY] {
+            assert_eq!(grid.query([50.0, 3.0], r), (0..100).collect::<Vec<_>>());
+        }
+        assert!(grid.query([50.0, 300.0], 1.0).is_empty());
     }
 }
