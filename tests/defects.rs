@@ -1,0 +1,349 @@
+//! The reproducers of `tests/defects/` (copied from the defect report, see its README) for
+//! data loss, crashes, hangs and messages, each replayed inside a scratch folder that holds
+//! files which must survive.
+//!
+//! Layout of every replay: `scratch/keep.txt`, `scratch/a/keep.txt`, `scratch/a/b/keep.txt`,
+//! and the working folder `scratch/a/b/work/` (with `keep.txt` and the case file). The tool runs
+//! with `work/` as its current folder. Every file under `scratch/` outside the folder the tool
+//! may write is listed (path and content) before and after and must be unchanged; no
+//! temporary `.partial` or `.previous` folder may remain. A hang guard kills a run after
+//! `HANG_GUARD` (not a performance assertion: the runs take milliseconds).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const HANG_GUARD: Duration = Duration::from_secs(60);
+
+fn defect(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/defects");
+    std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| {
+            p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with(&format!("{name}-"))
+        })
+        .unwrap_or_else(|| panic!("no reproducer {name} in {}", dir.display()))
+}
+
+fn good_case() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/contact/signorini-block-on-rigid-line.json")
+}
+
+struct Scratch {
+    _root: tempfile::TempDir,
+    scratch: PathBuf,
+    work: PathBuf,
+}
+
+impl Scratch {
+    fn new() -> Scratch {
+        let root = tempfile::tempdir().unwrap();
+        let scratch = root.path().join("scratch");
+        let work = scratch.join("a/b/work");
+        std::fs::create_dir_all(&work).unwrap();
+        for dir in [&scratch, &scratch.join("a"), &scratch.join("a/b"), &work] {
+            std::fs::write(dir.join("keep.txt"), format!("{}", dir.display())).unwrap();
+        }
+        Scratch {
+            _root: root,
+            scratch,
+            work,
+        }
+    }
+
+    /// Copy `case` into the working folder as `name`, with `edit` applied to its JSON.
+    fn case(&self, case: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(case).unwrap()).unwrap();
+        edit(&mut v);
+        let path = self.work.join(name);
+        std::fs::write(&path, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+        path
+    }
+
+    /// Every file and folder under the scratch folder except under `allowed`, with contents.
+    fn listing(&self, allowed: &[PathBuf]) -> BTreeMap<PathBuf, Vec<u8>> {
+        fn walk(dir: &Path, allowed: &[PathBuf], out: &mut BTreeMap<PathBuf, Vec<u8>>) {
+            for e in std::fs::read_dir(dir).unwrap() {
+                let p = e.unwrap().path();
+                if allowed.iter().any(|a| p.starts_with(a)) {
+                    continue;
+                }
+                if p.is_dir() {
+                    out.insert(p.clone(), Vec::new());
+                    walk(&p, allowed, out);
+                } else {
+                    out.insert(p.clone(), std::fs::read(&p).unwrap());
+                }
+            }
+        }
+        let mut out = BTreeMap::new();
+        walk(&self.scratch, allowed, &mut out);
+        out
+    }
+
+    /// Run the tool in the working folder; `allowed` are the folders it may write (relative to
+    /// the working folder). Returns (exit code, stdout, stderr).
+    fn run(&self, args: &[&str], allowed: &[&str]) -> (i32, String, String) {
+        let allowed: Vec<PathBuf> = allowed.iter().map(|a| self.work.join(a)).collect();
+        let before = self.listing(&allowed);
+        let mut child = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+            .args(args)
+            .current_dir(&self.work)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if start.elapsed() > HANG_GUARD {
+                child.kill().unwrap();
+                panic!("{args:?} still running after {HANG_GUARD:?}");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let o = child.wait_with_output().unwrap();
+        let (stdout, stderr) = (
+            String::from_utf8_lossy(&o.stdout).into_owned(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        );
+        assert!(!stderr.contains("panicked"), "{args:?} panicked:\n{stderr}");
+        let after = self.listing(&allowed);
+        let changed: Vec<_> = before
+            .keys()
+            .chain(after.keys())
+            .filter(|k| before.get(*k) != after.get(*k))
+            .collect();
+        assert!(
+            changed.is_empty(),
+            "{args:?} changed files outside its output folder: {changed:?}\n{stderr}"
+        );
+        let leftovers: Vec<_> = self
+            .listing(&[])
+            .into_keys()
+            .filter(|p| {
+                let n = p.file_name().unwrap().to_string_lossy();
+                n.contains(".partial") || n.contains(".previous")
+            })
+            .collect();
+        assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+        (o.status.code().unwrap_or(-1), stdout, stderr)
+    }
+}
+
+fn assert_refused(result: (i32, String, String), needles: &[&str]) {
+    let (code, _, stderr) = result;
+    assert_eq!(code, 2, "exit code:\n{stderr}");
+    assert!(stderr.contains("error:"), "no message:\n{stderr}");
+    for n in needles {
+        assert!(stderr.contains(n), "message lacks {n:?}:\n{stderr}");
+    }
+}
+
+#[test]
+fn d04_case_named_dotdot_touches_nothing() {
+    let s = Scratch::new();
+    let case = s.case(&defect("D04"), "case.json", |_| {});
+    // Without --out the tool would write out/<name>; nothing may change anywhere.
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap()], &[]),
+        &["name", "'..'", "starts with '.'", "letters, digits"],
+    );
+    for name in ["../..", ".", "", "a/b", "~"] {
+        let case = s.case(&defect("D04"), "case.json", |v| v["name"] = name.into());
+        assert_refused(s.run(&["run", case.to_str().unwrap()], &[]), &["name"]);
+    }
+}
+
+#[test]
+fn d05_absolute_case_name_replaces_nothing() {
+    let s = Scratch::new();
+    let victim = s.scratch.join("victim");
+    std::fs::create_dir(&victim).unwrap();
+    std::fs::write(victim.join("thesis.tex"), "years of work").unwrap();
+    let case = s.case(&defect("D05"), "case.json", |v| {
+        v["name"] = victim.to_str().unwrap().into()
+    });
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap()], &[]),
+        &["name", "contains '/'"],
+    );
+}
+
+#[test]
+fn out_dot_dotdot_and_protected_folders_are_refused() {
+    let s = Scratch::new();
+    let case = good_case();
+    for out in [".", "..", "../..", "./", "sub/..", "/"] {
+        assert_refused(
+            s.run(&["run", case.to_str().unwrap(), "--out", out], &[]),
+            &["output folder"],
+        );
+        assert_refused(
+            s.run(&["table", case.to_str().unwrap(), "--out", out], &[]),
+            &["output folder"],
+        );
+    }
+}
+
+#[test]
+fn d06_body_name_cannot_escape() {
+    let s = Scratch::new();
+    let case = s.case(&defect("D06"), "case.json", |_| {});
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &["bodies[0].name", "'../escaped-body'"],
+    );
+    assert!(!s.work.join("o").exists());
+}
+
+#[test]
+fn d07_sweep_catalogue_cannot_escape() {
+    let s = Scratch::new();
+    let case = s.case(&defect("D07"), "case.json", |_| {});
+    assert_refused(
+        s.run(
+            &["table", case.to_str().unwrap(), "--out", "a/b/tables"],
+            &["a"],
+        ),
+        &["unknown variant `../../escaped`", "`patch` or `tied`"],
+    );
+}
+
+#[test]
+fn an_existing_folder_is_replaced_only_when_it_is_an_output() {
+    let s = Scratch::new();
+    let case = good_case();
+    let case = case.to_str().unwrap();
+    // A folder of the user's: refused, untouched (the listing covers it).
+    std::fs::create_dir(s.work.join("mine")).unwrap();
+    std::fs::write(s.work.join("mine/notes.txt"), "mine").unwrap();
+    assert_refused(
+        s.run(&["run", case, "--out", "mine"], &[]),
+        &["not a contact-patch output"],
+    );
+    // A regular file, and a path below a regular file: refused, nothing left behind.
+    assert_refused(
+        s.run(&["run", case, "--out", "keep.txt"], &[]),
+        &["not a folder"],
+    );
+    assert_refused(s.run(&["run", case, "--out", "keep.txt/sub"], &[]), &[]);
+    // A previous output: replaced; a file added to it afterwards makes it the user's again.
+    assert_eq!(s.run(&["run", case, "--out", "o"], &["o"]).0, 0);
+    assert_eq!(s.run(&["run", case, "--out", "o"], &["o"]).0, 0);
+    std::fs::write(s.work.join("o/extra.txt"), "added by the user").unwrap();
+    assert_refused(
+        s.run(&["run", case, "--out", "o"], &[]),
+        &["'extra.txt'", "did not write"],
+    );
+}
+
+#[test]
+fn d01_d02_huge_divisions_are_refused_before_allocation() {
+    let s = Scratch::new();
+    for d in ["D01", "D02"] {
+        let case = s.case(&defect(d), "case.json", |_| {});
+        assert_refused(
+            s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+            &[
+                "bodies[0] 'block'.mesh",
+                "nodes",
+                "limit of 2000000",
+                "limits",
+            ],
+        );
+    }
+    // The limit is the case's to raise: a small limit refuses a small mesh.
+    let case = s.case(&good_case(), "case.json", |v| {
+        v["limits"] = serde_json::json!({"nodes": 10})
+    });
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &["limit of 10"],
+    );
+}
+
+#[test]
+fn tied_layer_levels_are_bounded() {
+    let s = Scratch::new();
+    let cases = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/tied-layer");
+    for levels in ["100000", "0", "1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17"] {
+        assert_refused(
+            s.run(
+                &[
+                    "tied-layer",
+                    "--cases",
+                    cases.to_str().unwrap(),
+                    "--levels",
+                    levels,
+                    "--out",
+                    "r",
+                ],
+                &["r"],
+            ),
+            &["--levels"],
+        );
+    }
+}
+
+#[test]
+fn d03_huge_search_distance_finishes() {
+    let s = Scratch::new();
+    for distance in [1e4, 1e12, 1e308] {
+        let case = s.case(&defect("D03"), "case.json", |v| {
+            v["contact"][0]["search_distance"] = distance.into()
+        });
+        let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+        assert_eq!(code, 0, "search_distance {distance}:\n{stderr}");
+    }
+}
+
+#[test]
+fn check_over_a_folder_reports_every_case() {
+    let s = Scratch::new();
+    let folder = s.work.join("cases");
+    std::fs::create_dir(&folder).unwrap();
+    std::fs::copy(good_case(), folder.join("a-good.json")).unwrap();
+    std::fs::copy(defect("D01"), folder.join("b-huge.json")).unwrap();
+    std::fs::copy(good_case(), folder.join("c-good.json")).unwrap();
+    let (code, stdout, stderr) = s.run(&["check", "cases"], &[]);
+    assert_eq!(code, 2, "{stdout}\n{stderr}");
+    assert!(stdout.contains("pass cases/a-good.json"), "{stdout}");
+    assert!(stdout.contains("pass cases/c-good.json"), "{stdout}");
+    assert!(stdout.contains("| cases/b-huge.json | error:"), "{stdout}");
+    assert!(stdout.contains("1 of 3 cases failed"), "{stdout}");
+}
+
+#[test]
+fn messages_name_the_field_and_the_cause() {
+    let s = Scratch::new();
+    let run = |case: &Path| s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    // D15a: a negative count, not "untagged enum Breaks".
+    let (_, _, e) = run(&defect("D15a"));
+    assert!(!e.contains("untagged enum"), "{e}");
+    assert_refused(
+        run(&defect("D15a")),
+        &["`divisions` must be a positive integer, got -1"],
+    );
+    let case = s.case(&defect("D15a"), "case.json", |v| {
+        v["bodies"][0]["mesh"]["block"]["x"] = "wide".into()
+    });
+    assert_refused(run(&case), &["a list of increasing coordinates"]);
+    // D15b: a cantilever of depth 0, not a singular matrix.
+    assert_refused(run(&defect("D15b")), &["exact", "depth 0"]);
+    // D15c, D15d: a byte-order mark and a root array, named as such.
+    assert_refused(run(&defect("D15c")), &[":1:1:", "byte-order mark"]);
+    assert_refused(run(&defect("D15d")), &[":1:1:", "holds an array"]);
+    // Coordinates times 1e300: overflow, not a zero-area element.
+    let case = s.case(&good_case(), "case.json", |v| {
+        v["bodies"][0]["mesh"]["block"]["x"] = serde_json::json!([0.0, 1e300, 2e300])
+    });
+    let (_, _, e) = run(&case);
+    assert!(!e.contains("zero-area"), "{e}");
+    assert_refused(run(&case), &["overflow"]);
+}
