@@ -178,7 +178,9 @@ pub fn parse(text: &str, source: &str) -> Result<Case> {
             Some(k) => message[..k].to_string(),
             None => message,
         };
-        let hint = if message.starts_with("unknown field") {
+        let hint = if message.contains("is defined twice") {
+            "give every entry a unique name (JSON keeps only one of two equal keys)".to_string()
+        } else if message.starts_with("unknown field") {
             "remove or rename the field; the accepted names are listed above".to_string()
         } else if message.starts_with("missing field") {
             "add the field; see the cases under cases/ for complete examples".to_string()
@@ -650,6 +652,45 @@ impl Model {
                         "give every pair the same \"enforcement\"",
                     ));
                 }
+            }
+            let same_facets = |a: &[Facet], b: &[Facet]| {
+                let key = |f: &Facet| (f.cell, f.edge);
+                let mut a: Vec<_> = a.iter().map(key).collect();
+                let mut b: Vec<_> = b.iter().map(key).collect();
+                a.sort_unstable();
+                b.sort_unstable();
+                a == b
+            };
+            let repeated = self.contact.iter().find(|p| {
+                let same_slave = p.slave.0 == slave.0 && same_facets(&p.slave.1, &slave.1);
+                match (&p.master, &master) {
+                    (MasterSide::Rigid(a), MasterSide::Rigid(b)) => same_slave && a == b,
+                    (
+                        MasterSide::Body {
+                            body: pb,
+                            facets: pf,
+                        },
+                        MasterSide::Body { body: b, facets: f },
+                    ) => {
+                        (same_slave && pb == b && same_facets(pf, f))
+                            || (p.slave.0 == *b
+                                && same_facets(&p.slave.1, f)
+                                && *pb == slave.0
+                                && same_facets(pf, &slave.1))
+                    }
+                    _ => false,
+                }
+            });
+            if let Some(p) = repeated {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    format!(
+                        "the pair repeats the surfaces of pair '{}'; together they would enforce the same contact twice",
+                        p.name
+                    ),
+                    "remove one of the two pairs (a two-pass pair is \"passes\": 2 on one pair)",
+                ));
             }
             self.contact.push(ContactPair {
                 name: spec.name.clone(),

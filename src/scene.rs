@@ -22,6 +22,7 @@ pub struct Case {
     pub description: String,
     #[serde(default)]
     pub analysis: Analysis,
+    #[serde(deserialize_with = "unique_keys")]
     pub materials: BTreeMap<String, MaterialSpec>,
     pub bodies: Vec<BodySpec>,
     #[serde(default)]
@@ -69,6 +70,39 @@ impl Default for Limits {
             nodes: DEFAULT_MAX_NODES,
         }
     }
+}
+
+/// A JSON object as a map whose keys must differ: a repeated key is an error naming it, where
+/// serde's map would keep the last one silently.
+fn unique_keys<'de, D, V>(d: D) -> Result<BTreeMap<String, V>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    V: Deserialize<'de>,
+{
+    struct UniqueKeys<V>(std::marker::PhantomData<V>);
+    impl<'de, V: Deserialize<'de>> serde::de::Visitor<'de> for UniqueKeys<V> {
+        type Value = BTreeMap<String, V>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("an object of named entries")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            mut map: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut out = BTreeMap::new();
+            while let Some(key) = map.next_key::<String>()? {
+                if out.contains_key(&key) {
+                    return Err(serde::de::Error::custom(format!(
+                        "the name '{key}' is defined twice"
+                    )));
+                }
+                let value = map.next_value()?;
+                out.insert(key, value);
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_map(UniqueKeys(std::marker::PhantomData))
 }
 
 /// A facet set of a body.
@@ -312,9 +346,9 @@ pub struct BodySpec {
     pub name: String,
     pub material: String,
     pub mesh: MeshSpec,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "unique_keys")]
     pub node_sets: BTreeMap<String, NodeSetSpec>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "unique_keys")]
     pub facet_sets: BTreeMap<String, FacetSetSpec>,
 }
 

@@ -347,3 +347,60 @@ fn messages_name_the_field_and_the_cause() {
     assert!(!e.contains("zero-area"), "{e}");
     assert_refused(run(&case), &["overflow"]);
 }
+
+#[test]
+fn d20_floats_are_read_exactly() {
+    let text = std::fs::read_to_string(defect("D20")).unwrap();
+    let case = contact_patch::model::parse(&text, "D20").unwrap();
+    let v = serde_json::to_string(&case).unwrap();
+    assert!(
+        v.contains("1.6600000000000001"),
+        "the break 1.6600000000000001 was rounded"
+    );
+}
+
+#[test]
+fn duplicated_names_and_pairs_are_errors() {
+    let s = Scratch::new();
+    let run = |case: &Path| s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    // A repeated key in `materials` (JSON text: serde would keep the last one).
+    let text = std::fs::read_to_string(good_case()).unwrap().replacen(
+        "\"materials\": {",
+        "\"materials\": {\"m\": {\"E\": 1.0, \"nu\": 0.1},",
+        1,
+    );
+    let case = s.work.join("dup-material.json");
+    std::fs::write(&case, text).unwrap();
+    assert_refused(run(&case), &["the name 'm' is defined twice"]);
+    // A node set defined twice.
+    let text = std::fs::read_to_string(good_case()).unwrap().replacen(
+        "\"material\": \"m\",",
+        "\"material\": \"m\", \"node_sets\": {\"s\": {\"point\": [0, 0]}, \"s\": {\"point\": [0, 0]}},",
+        1,
+    );
+    let case = s.work.join("dup-set.json");
+    std::fs::write(&case, text).unwrap();
+    assert_refused(run(&case), &["the name 's' is defined twice"]);
+    // A contact pair repeated under a second name, and the same pair swapped.
+    let case = s.case(&defect("D12"), "dup-pair.json", |v| {
+        let mut copy = v["contact"][0].clone();
+        copy["name"] = "copy".into();
+        v["contact"].as_array_mut().unwrap().push(copy);
+    });
+    assert_refused(
+        run(&case),
+        &["contact[1] 'copy'", "repeats the surfaces of pair"],
+    );
+    let case = s.case(&defect("D12"), "swapped-pair.json", |v| {
+        let mut copy = v["contact"][0].clone();
+        copy["name"] = "swapped".into();
+        let (slave, master) = (copy["slave"].clone(), copy["master"].clone());
+        copy["slave"] = master;
+        copy["master"] = slave;
+        v["contact"].as_array_mut().unwrap().push(copy);
+    });
+    assert_refused(
+        run(&case),
+        &["contact[1] 'swapped'", "repeats the surfaces"],
+    );
+}
