@@ -158,6 +158,9 @@ fn run(case: &Path, out: Option<PathBuf>) -> ExitCode {
 }
 
 fn print_outcome(o: &Outcome) {
+    for w in &o.warnings {
+        eprintln!("warning: {w}");
+    }
     let t = &o.solution.timings;
     println!(
         "{}: {} dofs, {} equations; mesh {:.3}s, assembly {:.3}s, factorization {:.3}s, solve {:.3}s, total {:.3}s",
@@ -236,6 +239,9 @@ fn check(paths: &[PathBuf]) -> ExitCode {
                         if fail.is_empty() { "pass" } else { "FAIL" }
                     )),
                     None => println!("{} {line}", if fail.is_empty() { "pass" } else { "FAIL" }),
+                }
+                for w in &outcome.warnings {
+                    eprintln!("warning: {}: {w}", case.display());
                 }
                 for c in fail {
                     failures.push((
@@ -434,6 +440,7 @@ fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
             }
             for (name, model, solution) in &study.solved {
                 let outcome = contact_patch::run::Outcome {
+                    warnings: contact_patch::checks::warnings(model, solution),
                     checks: contact_patch::checks::evaluate(model, solution),
                     model: model.clone(),
                     solution: solution.clone(),

@@ -775,6 +775,28 @@ impl Model {
                     self.find_body(body, &at)?;
                     *tol
                 }
+                Check::MaxPenetration { pair, share } => {
+                    if let Some(pair) = pair {
+                        if !self.contact.iter().any(|p| p.name == *pair) {
+                            let known: Vec<&str> =
+                                self.contact.iter().map(|p| p.name.as_str()).collect();
+                            return Err(Error::invalid(
+                                &self.source,
+                                &at,
+                                format!("contact pair '{pair}' does not exist"),
+                                format!("use one of {known:?}"),
+                            ));
+                        }
+                    } else if self.contact.is_empty() {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "max_penetration needs contact pairs, and the case has none",
+                            "remove the check or add a pair",
+                        ));
+                    }
+                    *share
+                }
                 Check::ContactForce { pair, tol, .. }
                 | Check::MaxContactPressure { pair, tol, .. } => {
                     if !self.contact.iter().any(|p| p.name == *pair) {

@@ -9,6 +9,7 @@
 //! orders match ours.
 
 use crate::checks::CheckResult;
+use crate::contact::forces::pair_forces;
 use crate::error::{Error, Result};
 use crate::model::Body;
 use crate::paths::{file_name, OutputFolder};
@@ -33,13 +34,17 @@ pub struct Summary {
     pub bodies: Vec<BodySummary>,
     pub reactions: Vec<ReactionSummary>,
     pub checks: Vec<CheckResult>,
+    /// What the run says although no check failed (e.g. penetration beyond a share of the
+    /// contact element size).
+    pub warnings: Vec<String>,
     /// What the contact solve found (absent without contact).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact: Option<ContactSummary>,
     pub timings: Timings,
 }
 
-/// The contact solve in numbers.
+/// The contact solve in numbers (forces, pressures and penetrations from
+/// [`crate::contact::forces`]).
 #[derive(Serialize)]
 pub struct ContactSummary {
     pub termination: String,
@@ -48,14 +53,41 @@ pub struct ContactSummary {
     pub constraints: usize,
     pub active: usize,
     pub rank_deficiency: Option<usize>,
-    /// Sum of the contact forces acting on the slave bodies, `[x, y]`.
+    /// Sum over the pairs of the force each pair puts on its slave body, `[x, y]`.
     pub total_force: [f64; 2],
-    /// Largest `lambda_i / A_i` (nodal contact pressure).
+    /// Largest nodal contact pressure `-f_a . n_a / A_a` of any pair.
     pub max_pressure: f64,
     /// Extent `[min, max]` of the active slave nodes along x and y.
     pub active_extent: [[f64; 2]; 2],
-    /// Largest penetration (`-min g`, zero when no row penetrates).
+    /// Largest penetration (zero when nothing penetrates).
     pub max_penetration: f64,
+    /// Largest penetration relative to the contact element size at the node.
+    pub max_penetration_share: f64,
+    /// Per pair.
+    pub pairs: Vec<PairSummary>,
+}
+
+/// What one contact pair transmits.
+#[derive(Serialize)]
+pub struct PairSummary {
+    pub name: String,
+    /// Net force on the slave body and on the master (body or rigid surface), `[x, y]`.
+    pub force_on_slave: [f64; 2],
+    pub force_on_master: [f64; 2],
+    pub max_pressure: f64,
+    pub max_penetration: f64,
+    pub max_penetration_share: f64,
+    /// Body, node and position of the slave node with the largest share.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_penetration_at: Option<PointRef>,
+}
+
+/// A node named for a user: body name, node number, position.
+#[derive(Serialize)]
+pub struct PointRef {
+    pub body: String,
+    pub node: usize,
+    pub point: [f64; 2],
 }
 
 #[derive(Serialize)]
@@ -93,6 +125,7 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
         model,
         solution,
         checks,
+        ..
     } = outcome;
     let u = &solution.u;
     let bodies = model
@@ -131,21 +164,31 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
         })
         .collect();
     let contact = solution.contact.as_ref().map(|c| {
-        let mut total = [0.0; 2];
+        let forces = pair_forces(model, c);
         let mut extent = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
-        let mut max_pressure = 0.0f64;
-        for (i, r) in c.rows.iter().enumerate() {
+        for (r, _) in c.rows.iter().zip(&c.active).filter(|(_, &a)| a) {
             for k in 0..2 {
-                total[k] += c.forces[i] * r.normal[k];
-            }
-            if c.active[i] {
-                max_pressure = max_pressure.max(c.forces[i] / r.area);
-                for k in 0..2 {
-                    extent[k][0] = extent[k][0].min(r.point[k]);
-                    extent[k][1] = extent[k][1].max(r.point[k]);
-                }
+                extent[k][0] = extent[k][0].min(r.point[k]);
+                extent[k][1] = extent[k][1].max(r.point[k]);
             }
         }
+        let pairs: Vec<PairSummary> = forces
+            .iter()
+            .map(|f| PairSummary {
+                name: model.contact[f.pair].name.clone(),
+                force_on_slave: f.on_slave,
+                force_on_master: f.on_master,
+                max_pressure: f.max_pressure(),
+                max_penetration: f.penetration.depth,
+                max_penetration_share: f.penetration.share_of_element,
+                max_penetration_at: f.penetration.at.map(|(b, node, point)| PointRef {
+                    body: model.bodies[b].name.clone(),
+                    node,
+                    point,
+                }),
+            })
+            .collect();
+        let most = |get: fn(&PairSummary) -> f64| pairs.iter().map(get).fold(0.0, f64::max);
         ContactSummary {
             termination: match &c.termination {
                 crate::contact::solver::Termination::Singular(m) => format!("singular: {m}"),
@@ -156,10 +199,14 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
             constraints: c.rows.len(),
             active: c.active.iter().filter(|&&a| a).count(),
             rank_deficiency: c.rank_deficiency,
-            total_force: total,
-            max_pressure,
+            total_force: pairs.iter().fold([0.0; 2], |t, p| {
+                [t[0] + p.force_on_slave[0], t[1] + p.force_on_slave[1]]
+            }),
+            max_pressure: most(|p| p.max_pressure),
             active_extent: extent,
-            max_penetration: c.gaps.iter().fold(0.0f64, |m, &g| m.max(-g)),
+            max_penetration: most(|p| p.max_penetration),
+            max_penetration_share: most(|p| p.max_penetration_share),
+            pairs,
         }
     });
     Summary {
@@ -175,6 +222,7 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
         bodies,
         reactions,
         checks: checks.clone(),
+        warnings: outcome.warnings.clone(),
         timings: solution.timings.clone(),
     }
 }

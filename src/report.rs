@@ -96,7 +96,8 @@ fn two_pass_claims(cells: &[Cell]) -> String {
         s += "Lagrange solution of the two-pass constraints. The two passes' rows are dependent but\n";
         s += "consistent (the Lagrange system is singular yet solvable: its pseudo-inverse finds no\n";
         s += "residual in the null space), so the displacement they converge to is the exact one; only the\n";
-        s += "split of the force between dependent rows stays undetermined (pressure error, rank deficiency).\n";
+        s += "split of the force between dependent rows stays undetermined (rank deficiency); the nodal forces\n";
+        s += "B^T lambda, from which pressures are reported, do not depend on that split (pressure error 0).\n";
         s += "What the talk's failure shows up as here is cost: on mesh C the iteration needs several times\n";
         s += "as many linear solves as on B (the iterations columns). These verdicts hold at the kappa of this\n";
         s += "table on these coarse meshes: the iterative methods stop on a force criterion (the Uzawa update\n";
@@ -152,8 +153,8 @@ pub fn tied_report(cells: &[Cell]) -> String {
     s += "non-matching interface meshes B (nested), C (not nested) and E (quadratic), under a uniform\n";
     s += "normal (sigma_yy), parallel (sigma_xx, which contact cannot test) and shear (sigma_xy) stress of 10.\n";
     s += "Exact tractions on the outer boundary; the upper block is held only by the tie.\n";
-    s += "Errors are relative to the stress (10); `0` means below 1e-10. `pressure error` compares each\n";
-    s += "tie force per area with the exact traction along its direction.\n\n";
+    s += "Errors are relative to the stress (10); `0` means below 1e-10. `pressure error` compares the\n";
+    s += "traction at every interface node that carries ties (its nodal tie force over its area) with the exact one.\n\n";
     s += "## Summary (Lagrange multipliers)\n\n| mesh and stress | node-to-surface (upper slave) | node-to-surface (lower slave) | mortar | dual mortar |\n|---|---|---|---|---|\n";
     let mut meshes: Vec<&str> = cells.iter().map(|c| c.mesh.as_str()).collect();
     meshes.dedup();

@@ -1,6 +1,6 @@
 //! One run of one case: load and validate, solve, judge the checks, time every stage.
 
-use crate::checks::{evaluate, CheckResult};
+use crate::checks::{evaluate, warnings, CheckResult};
 use crate::error::Result;
 use crate::model::{load, Model};
 use crate::solve::{solve_static, Solution};
@@ -13,6 +13,8 @@ pub struct Outcome {
     pub model: Model,
     pub solution: Solution,
     pub checks: Vec<CheckResult>,
+    /// What the run should say although no check failed (see [`crate::checks::warnings`]).
+    pub warnings: Vec<String>,
 }
 
 impl Outcome {
@@ -40,9 +42,11 @@ pub fn run_model(
     let mut solution = solve_static(&model, progress)?;
     progress("checking");
     let checks = evaluate(&model, &solution);
+    let warnings = warnings(&model, &solution);
     solution.timings.mesh = mesh_time;
     solution.timings.total = start.elapsed().as_secs_f64();
     Ok(Outcome {
+        warnings,
         model,
         solution,
         checks,

@@ -636,8 +636,15 @@ pub enum Check {
         value: f64,
         tol: f64,
     },
-    /// The largest nodal contact pressure `lambda_i / A_i` of a pair (relative error).
+    /// The largest nodal contact pressure `-f_a . n_a / A_a` of a pair (relative error).
     MaxContactPressure { pair: String, value: f64, tol: f64 },
+    /// The largest penetration of a pair (all pairs without `pair`), relative to the contact
+    /// element size at the node, is at most `share`.
+    MaxPenetration {
+        #[serde(default)]
+        pair: Option<String>,
+        share: f64,
+    },
     /// Displacement component at the node nearest to `point`.
     Displacement {
         body: String,

@@ -32,6 +32,7 @@
 
 pub mod discretization;
 pub mod enforcement;
+pub mod forces;
 pub mod geometry;
 pub mod mortar;
 pub mod search;

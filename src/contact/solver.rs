@@ -60,6 +60,8 @@ pub struct ContactState {
     pub linear_solver: &'static str,
     /// Evaluations of the contact geometry (1 in the reference configuration).
     pub geometry_updates: usize,
+    /// The displacement the rows were linearized at (`None`: the reference configuration).
+    pub configuration: Option<Vec<f64>>,
 }
 
 /// Largest active set whose rank deficiency is measured for methods without multipliers.
@@ -178,6 +180,7 @@ fn rows_at(model: &Model, u: Option<&[f64]>) -> Result<Vec<Constraint>> {
 
 /// One contact solve with the rows of `rows_at(model, u)`.
 fn solve_at(model: &Model, u: Option<&[f64]>, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+    let configuration = u.map(|u| u.to_vec());
     let mut timings = Timings::default();
     let t = Instant::now();
     progress("contact search");
@@ -300,6 +303,7 @@ fn solve_at(model: &Model, u: Option<&[f64]>, progress: &mut dyn FnMut(&str)) ->
         rank_deficiency,
         linear_solver,
         geometry_updates: 1,
+        configuration,
     });
     Ok(solution)
 }
