@@ -170,14 +170,28 @@ pub fn force_balance(model: &Model, solution: &Solution) -> f64 {
 /// Penetration above this share of the contact element size makes a run warn.
 pub const PENETRATION_WARNING_SHARE: f64 = 0.05;
 
-/// What a run should say even when every check passes: penetration beyond
+/// What a run should say even when every check passes: slave nodes that slid off the master
+/// surface (contact geometry in the current configuration), and penetration beyond
 /// [`PENETRATION_WARNING_SHARE`] of the contact element size.
 pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
     let Some(state) = &solution.contact else {
         return Vec::new();
     };
-    pair_forces(model, state)
-        .iter()
+    let departures = state.departures.iter().map(|d| {
+        format!(
+            "contact '{}': slave node {} of body '{}' left the master surface at ({:.6}, {:.6}) \
+             (geometry update {}: no master facet under it, past the end of the master \
+             surface); it carries no contact force from there on",
+            model.contact[d.pair].name,
+            d.node,
+            model.bodies[d.body].name,
+            d.point[0],
+            d.point[1],
+            d.update
+        )
+    });
+    let penetrations = pair_forces(model, state)
+        .into_iter()
         .filter(|f| f.penetration.share_of_element > PENETRATION_WARNING_SHARE)
         .map(|f| {
             let at = f
@@ -197,8 +211,8 @@ pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
                  multipliers; a `max_penetration` check makes this a failure",
                 model.contact[f.pair].name, f.penetration.depth, f.penetration.share_of_element
             )
-        })
-        .collect()
+        });
+    departures.chain(penetrations).collect()
 }
 
 fn pair_of<'a>(forces: &'a [PairForces], model: &Model, name: &str) -> Option<&'a PairForces> {

@@ -70,3 +70,117 @@ fn current_configuration_contact_converges_to_a_consistent_state() {
         "current and reference geometry gave the same displacement ({diff})"
     );
 }
+
+/// `cases/patch/patch-{mesh}-nu0.3.json` with every support of the punch and the foundation's
+/// corner pin taken from the exact solution (so the bodies do not slide relative to each other),
+/// the pair's discretization (and slave body) replaced, solved in `geometry`; the stress error
+/// of the uniform-stress check, or `None` when the combination does not apply.
+fn patch_stress_error(mesh: &str, sweep_entry: usize, geometry: &str) -> Option<f64> {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("cases/patch/patch-{mesh}-nu0.3.json"));
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    v["physics"] = serde_json::json!({ "contact_geometry": geometry });
+    for s in v["supports"].as_array_mut().unwrap() {
+        for k in ["x", "y"] {
+            if s.get(k).is_some() && s["set"] != "bottom" {
+                s[k] = "exact".into();
+            }
+        }
+    }
+    let entry = v["sweep"]["discretizations"][sweep_entry].clone();
+    v["contact"][0]["discretization"] = entry["discretization"].clone();
+    if entry["slave"] == "foundation" {
+        let pair = &mut v["contact"][0];
+        let (s, m) = (pair["slave"].clone(), pair["master"].clone());
+        pair["slave"] = m;
+        pair["master"] = s;
+    }
+    v.as_object_mut().unwrap().remove("sweep");
+    let case = contact_patch::model::parse(&v.to_string(), "patch").unwrap();
+    let model = contact_patch::model::Model::build(&case, "patch").ok()?;
+    let o =
+        contact_patch::run::run_model(model, 0.0, std::time::Instant::now(), &mut |_| {}).ok()?;
+    o.checks
+        .iter()
+        .find(|c| c.check.starts_with("uniform stress"))
+        .map(|c| c.error)
+}
+
+#[test]
+fn patch_tests_pass_in_current_geometry_where_they_pass_in_reference_geometry() {
+    // Without relative sliding the patch test's exact state also satisfies the contact
+    // conditions measured in the deformed configuration; every combination must give the
+    // reference configuration's verdict (at 9aead84 the reproducers D10b (mesh A) and D16 were
+    // singular in current geometry and D10 (mesh B) 51 % wrong).
+    let mut compared = 0;
+    for mesh in ["A", "B", "C", "D", "E"] {
+        for entry in 0..6 {
+            let reference = patch_stress_error(mesh, entry, "reference");
+            let current = patch_stress_error(mesh, entry, "current");
+            let Some(reference) = reference else {
+                assert!(
+                    current.is_none(),
+                    "{mesh} entry {entry}: applies only in current geometry"
+                );
+                continue;
+            };
+            let current = current
+                .unwrap_or_else(|| panic!("{mesh} entry {entry}: refused in current geometry"));
+            assert_eq!(
+                reference <= 1e-10,
+                current <= 1e-10,
+                "{mesh} entry {entry}: reference {reference:e}, current {current:e}"
+            );
+            compared += 1;
+        }
+    }
+    assert!(compared >= 25, "only {compared} combinations compared");
+}
+
+#[test]
+fn slave_nodes_that_leave_the_master_surface_are_named() {
+    let defects = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/defects");
+    let find = |prefix: &str| {
+        std::fs::read_dir(&defects)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.file_name().unwrap().to_string_lossy().starts_with(prefix))
+            .unwrap()
+    };
+    // D17: the punch slides 1 past the end of the foundation's contact facets.
+    let o = run_case(&find("D17-"), &mut |_| {}).unwrap();
+    let departed: Vec<usize> = o
+        .solution
+        .contact
+        .as_ref()
+        .unwrap()
+        .departures
+        .iter()
+        .map(|d| d.node)
+        .collect();
+    assert_eq!(departed, [22, 24]);
+    assert!(
+        o.warnings
+            .iter()
+            .any(|w| w.contains("slave node 22 of body 'punch' left the master surface")),
+        "{:?}",
+        o.warnings
+    );
+    // D10: the end node slides 0.016 past the master's end (Poisson): it stays on the extended
+    // end facet instead of being dropped (a 51 % stress error at 9aead84). The bodies slide
+    // relative to each other (the punch is pinned at its corner), so the pressure band on the
+    // foundation shifts by that slide and the stress is no longer exactly uniform.
+    let o = run_case(&find("D10-"), &mut |_| {}).unwrap();
+    assert!(o.solution.contact.as_ref().unwrap().departures.is_empty());
+    let error = o
+        .checks
+        .iter()
+        .find(|c| c.check.starts_with("uniform stress"))
+        .unwrap()
+        .error;
+    assert!(error < 1e-2, "stress error {error}");
+    // D16: flush contact, singular at 9aead84 in current geometry.
+    let o = run_case(&find("D16-"), &mut |_| {}).unwrap();
+    assert!(o.passed(), "{:?}", o.checks);
+}

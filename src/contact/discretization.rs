@@ -34,6 +34,13 @@ use crate::scene::{DiscretizationSpec, NormalChoice, RigidSurface};
 /// Tolerance on the facet parameter for "inside the facet".
 const INSIDE: f64 = 1e-9;
 
+/// How far (in facet parameter, a quarter of the facet) a free end of a master surface is
+/// extended along its own curve: a slave node that has slid just past the end of the master's
+/// facet set (the punch of a patch test widening by Poisson's effect, in the current
+/// configuration) still projects onto it, with the facet's interpolation extrapolated, which is
+/// exact for straight masters. Farther out a node has left the surface.
+pub(crate) const END_EXTENSION: f64 = 0.25;
+
 /// Collects rows: one row along `nu` for frictionless pairs, two bilateral rows (x and y) with
 /// zero initial gap for tied pairs.
 pub(crate) struct Rows<'a> {
@@ -330,10 +337,26 @@ fn node_to_surface(
                     (ray_point(kind, coords, p, nu), nu)
                 }
             };
-            if xi.is_nan() || xi.abs() > 1.0 + INSIDE {
+            if xi.is_nan() {
                 continue;
             }
-            let xi = xi.clamp(-1.0, 1.0);
+            // past an end: accepted only at a free end of the master surface, within the
+            // extension (then the facet is extrapolated), else clamped within round-off
+            let free_end = |v: usize| facets_at.get(&v).is_some_and(|&n| n == 1);
+            let master_facet = &master.facets[f];
+            let xi = if xi > 1.0 + INSIDE {
+                if !(free_end(master_facet[1]) && xi <= 1.0 + END_EXTENSION) {
+                    continue;
+                }
+                xi
+            } else if xi < -1.0 - INSIDE {
+                if !(free_end(master_facet[0]) && xi >= -1.0 - END_EXTENSION) {
+                    continue;
+                }
+                xi
+            } else {
+                xi.clamp(-1.0, 1.0)
+            };
             let (x, _) = facet_point(kind, coords, xi);
             let d = ((p[0] - x[0]).powi(2) + (p[1] - x[1]).powi(2)).sqrt();
             if best.is_none_or(|b| d < b.0 - tol) {

@@ -62,6 +62,8 @@ pub struct ContactState {
     pub geometry_updates: usize,
     /// The displacement the rows were linearized at (`None`: the reference configuration).
     pub configuration: Option<Vec<f64>>,
+    /// Slave nodes that left the master surface during the geometry updates.
+    pub departures: Vec<Departure>,
 }
 
 /// Largest active set whose rank deficiency is measured for methods without multipliers.
@@ -95,13 +97,46 @@ impl EqRow {
 /// Solve the contact problem of `model` (all pairs share one enforcement method).
 pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
     match model.physics.contact_geometry {
-        ContactGeometry::Reference => solve_at(model, None, progress),
+        ContactGeometry::Reference => solve_at(model, None, None, progress),
         ContactGeometry::Current => {
             // fixed point on the geometry: rows linearized at the last solution u_k,
-            // g(u) = g(X + u_k) + c(X + u_k) . (u - u_k)
+            // g(u) = g(X + u_k) + c(X + u_k) . (u - u_k); each update starts from the active
+            // set of the last one (rows are matched by their identity, `RowKey`)
             let mut u = vec![0.0; model.dof_count];
+            let mut previous: Option<HashSet<RowKey>> = None;
+            let mut departures: Vec<Departure> = Vec::new();
             for update in 1..=MAX_GEOMETRY_UPDATES {
-                let mut solution = solve_at(model, Some(&u), progress)?;
+                let mut solution = solve_at(model, Some(&u), previous.as_ref(), progress)?;
+                let state = solution.contact.as_mut().expect("a contact solve");
+                if let Some(previous) = &previous {
+                    for (pair, _, body, node, _) in slid_off(previous, &state.rows) {
+                        let b = &model.bodies[body];
+                        let x = b.mesh.nodes[node];
+                        let departure = Departure {
+                            pair,
+                            body,
+                            node,
+                            point: [x[0] + u[b.dof(node, 0)], x[1] + u[b.dof(node, 1)]],
+                            update,
+                        };
+                        if !departures
+                            .iter()
+                            .any(|d: &Departure| d.body == body && d.node == node)
+                        {
+                            departures.push(departure);
+                        }
+                    }
+                }
+                state.departures = departures.clone();
+                previous = Some(
+                    state
+                        .rows
+                        .iter()
+                        .zip(&state.active)
+                        .filter(|(_, &a)| a)
+                        .map(|(r, _)| row_key(r))
+                        .collect(),
+                );
                 let scale = solution
                     .u
                     .iter()
@@ -127,6 +162,40 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
             unreachable!("the loop returns")
         }
     }
+}
+
+/// A row's identity across geometry updates: pair, pass, slave body and node, and for ties the
+/// direction (0 = x, 1 = y).
+type RowKey = (usize, u8, usize, usize, u8);
+
+fn row_key(r: &Constraint) -> RowKey {
+    let direction = u8::from(r.bilateral && r.normal[1].abs() > r.normal[0].abs());
+    (r.pair, r.pass, r.slave_body, r.slave_node, direction)
+}
+
+/// The rows active in `previous` that have no row in `rows` (their slave nodes left the master
+/// surface), in order.
+fn slid_off(previous: &HashSet<RowKey>, rows: &[Constraint]) -> Vec<RowKey> {
+    let now: HashSet<RowKey> = rows.iter().map(row_key).collect();
+    let mut lost: Vec<RowKey> = previous
+        .iter()
+        .filter(|k| !now.contains(k))
+        .copied()
+        .collect();
+    lost.sort();
+    lost
+}
+
+/// A slave node that was in contact at one geometry update and found no master facet at a
+/// later one (it slid past the end of the master surface): it carries no contact force.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Departure {
+    pub pair: usize,
+    pub body: usize,
+    pub node: usize,
+    /// Where it was when it left (current configuration of that update).
+    pub point: [f64; 2],
+    pub update: usize,
 }
 
 /// Most re-evaluations of the contact geometry with `contact_geometry: current`.
@@ -178,8 +247,14 @@ fn rows_at(model: &Model, u: Option<&[f64]>) -> Result<Vec<Constraint>> {
     Ok(rows)
 }
 
-/// One contact solve with the rows of `rows_at(model, u)`.
-fn solve_at(model: &Model, u: Option<&[f64]>, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+/// One contact solve with the rows of `rows_at(model, u)`; `previous` (the active rows of the
+/// last geometry update) starts the active set together with the rows closed at `u`.
+fn solve_at(
+    model: &Model,
+    u: Option<&[f64]>,
+    previous: Option<&HashSet<RowKey>>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Solution> {
     let configuration = u.map(|u| u.to_vec());
     let mut timings = Timings::default();
     let t = Instant::now();
@@ -254,7 +329,16 @@ fn solve_at(model: &Model, u: Option<&[f64]>, progress: &mut dyn FnMut(&str)) ->
     let t = Instant::now();
     progress("contact iterations");
     let chol = Cholesky::analyse(&sys.pattern).map_err(|e| sys.factor_error(model, e))?;
+    let initial_active = match (previous, u) {
+        (Some(previous), Some(u)) => Some(
+            rows.iter()
+                .map(|r| previous.contains(&row_key(r)) || r.gap(u) <= 1e-14 * size)
+                .collect(),
+        ),
+        _ => None,
+    };
     let mut kernel = Kernel {
+        initial_active,
         model,
         sys: &sys,
         rows: &eq_rows,
@@ -304,6 +388,7 @@ fn solve_at(model: &Model, u: Option<&[f64]>, progress: &mut dyn FnMut(&str)) ->
         linear_solver,
         geometry_updates: 1,
         configuration,
+        departures: Vec::new(),
     });
     Ok(solution)
 }
@@ -358,6 +443,8 @@ struct Kernel<'a> {
     /// The last Cholesky factorization with its active set and weights.
     cache: Option<(Vec<bool>, Vec<f64>, std::rc::Rc<crate::sparse::Factor>)>,
     factorizations: f64,
+    /// The first active set, when a geometry update starts from the last one's.
+    initial_active: Option<Vec<bool>>,
 }
 
 type LoopResult = (Vec<f64>, Vec<f64>, Vec<bool>, Termination, usize);
@@ -717,7 +804,11 @@ impl Kernel<'_> {
         let mut active: Vec<bool> = rows
             .iter()
             .zip(self.rows)
-            .map(|(c, r)| c.bilateral || r.g0 <= gap_tol)
+            .enumerate()
+            .map(|(i, (c, r))| match &self.initial_active {
+                Some(initial) => c.bilateral || initial[i],
+                None => c.bilateral || r.g0 <= gap_tol,
+            })
             .collect();
         let kappa_w = |kappa: f64| -> Vec<f64> { rows.iter().map(|r| kappa * r.area).collect() };
         let owners: Vec<usize> = rows.iter().map(|r| self.sys.eq[r.owner]).collect();
