@@ -14,7 +14,8 @@
 //!   **Corner condition**: a slave node that projects inside no facet but lies in the wedge
 //!   outside a convex master corner (a vertex shared by two facets) is held against the corner
 //!   vertex, along the direction from the vertex to the node (or the vertex's averaged normal
-//!   when it sits on it). A slave node beyond a free end of the master surface gets no row.
+//!   when it sits on it). A free end of the master surface is extended by a quarter facet
+//!   along its own curve ([`END_EXTENSION`]); a slave node beyond that gets no row.
 //! * **Two-pass**: the rows of the pass with the roles swapped are appended (pass 2).
 //! * **Rigid masters**: a line `g = n . (x_s - p)` or a circle `g = |x_s - c| - R` with
 //!   `n = (x_s - c)/|x_s - c|`; only slave dofs appear.
