@@ -26,13 +26,13 @@
 //! * `n/a` cells say why the combination does not apply.
 
 use crate::contact::discretization::constraints;
-use crate::contact::enforcement::{elimination_obstacle, kappa, name, scaled};
+use crate::contact::enforcement::method;
 use crate::contact::forces::pair_forces;
 use crate::contact::solver::Termination;
 use crate::error::Result;
 use crate::model::{load, Model};
 use crate::post::for_each_quadrature_stress;
-use crate::scene::{Catalogue, DiscretizationSpec, EnforcementSpec, MultiplierSpace};
+use crate::scene::{Catalogue, DiscretizationSpec, MultiplierSpace};
 use crate::solve::{solve_static, Solution};
 use serde::Serialize;
 use std::path::Path;
@@ -204,7 +204,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 "{} {disc_name} {} {}",
                 sweep.mesh,
                 passes.map(|p| format!("{p}p")).unwrap_or_default(),
-                name(e)
+                method(e).name()
             ));
             let mut cell = Cell {
                 catalogue: sweep.catalogue,
@@ -214,8 +214,8 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 discretization: disc_name.into(),
                 passes,
                 slave: slave.clone(),
-                enforcement: name(e).into(),
-                kappa: kappa(e),
+                enforcement: method(e).name().into(),
+                kappa: method(e).kappa(),
                 pressure: sweep.pressure,
                 verdict: "n/a".into(),
                 stress_error: None,
@@ -244,12 +244,10 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                     continue;
                 }
             };
-            if *e == EnforcementSpec::Elimination {
-                if let Some(why) = elimination_obstacle(&rows, &model.prescribed) {
-                    cell.note = why;
-                    cells.push(cell);
-                    continue;
-                }
+            if let Some(why) = method(e).obstacle(&rows, &model.prescribed) {
+                cell.note = why;
+                cells.push(cell);
+                continue;
             }
             let start = Instant::now();
             let solved = solve_static(&model, &mut |_| {});
@@ -292,7 +290,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             if !balanced {
                 notes.push(format!("force balance {:.1e}", m.force_balance));
             }
-            let multipliers = matches!(e, EnforcementSpec::Lagrange | EnforcementSpec::Elimination);
+            let multipliers = method(e).has_multiplier_system();
             let dependent = m.rank_deficiency.unwrap_or(0);
             let unique = dependent == 0;
             cell.stability = match (multipliers, unique) {
@@ -311,15 +309,9 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             if !loaded {
                 notes.push(format!("total contact force off by {:.1e}", m.load_error));
             }
-            let pass = if let (Some(k), true) = (
-                kappa(e),
-                matches!(
-                    e,
-                    EnforcementSpec::Penalty { .. } | EnforcementSpec::PerturbedLagrange { .. }
-                ),
-            ) {
+            let pass = if let (Some(k), true) = (method(e).kappa(), method(e).penalty_like()) {
                 let mut stiff = model.clone();
-                stiff.contact[0].enforcement = scaled(e, sweep.penalty_factor);
+                stiff.contact[0].enforcement = method(e).scaled(sweep.penalty_factor);
                 let start = Instant::now();
                 let s2 = solve_static(&stiff, &mut |_| {});
                 cell.time_ms += start.elapsed().as_secs_f64() * 1e3;

@@ -995,7 +995,7 @@ impl Model {
 }
 
 fn validate_enforcement(e: &EnforcementSpec, source: &str, at: &str) -> Result<()> {
-    if let Some(kappa) = crate::contact::enforcement::kappa(e) {
+    if let Some(kappa) = crate::contact::enforcement::method(e).kappa() {
         if !(kappa.is_finite() && kappa > 0.0) {
             return Err(Error::invalid(
                 source,

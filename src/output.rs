@@ -9,6 +9,7 @@
 //! orders match ours.
 
 use crate::checks::CheckResult;
+use crate::contact::enforcement::method;
 use crate::contact::forces::pair_forces;
 use crate::error::{Error, Result};
 use crate::model::Body;
@@ -52,6 +53,9 @@ pub struct ContactSummary {
     pub linear_solver: String,
     pub constraints: usize,
     pub active: usize,
+    /// Multipliers the enforcement methods added to the linear system (Lagrange: one per
+    /// active row; methods that eliminate or regularize them: none).
+    pub multiplier_unknowns: usize,
     pub rank_deficiency: Option<usize>,
     /// Sum over the pairs of the force each pair puts on its slave body, `[x, y]`.
     pub total_force: [f64; 2],
@@ -198,6 +202,13 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
             linear_solver: c.linear_solver.to_string(),
             constraints: c.rows.len(),
             active: c.active.iter().filter(|&&a| a).count(),
+            multiplier_unknowns: c
+                .rows
+                .iter()
+                .zip(&c.active)
+                .filter(|(_, &a)| a)
+                .map(|(r, _)| method(&model.contact[r.pair].enforcement).unknowns_per_row())
+                .sum(),
             rank_deficiency: c.rank_deficiency,
             total_force: pairs.iter().fold([0.0; 2], |t, p| {
                 [t[0] + p.force_on_slave[0], t[1] + p.force_on_slave[1]]

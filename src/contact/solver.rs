@@ -18,7 +18,7 @@
 //! so the displacement is still returned when it exists.
 
 use super::discretization::constraints;
-use super::enforcement::{elimination_obstacle, Method};
+use super::enforcement::{method, Method};
 use super::Constraint;
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -260,17 +260,16 @@ fn solve_at(
     let t = Instant::now();
     progress("contact search");
     let mut rows = rows_at(model, u)?;
-    let method = Method::from_spec(&model.contact[0].enforcement);
-    if method == Method::Elimination {
-        if let Some(why) = elimination_obstacle(&rows, &model.prescribed) {
-            return Err(Error::invalid(
-                &model.source,
-                format!("contact '{}'", model.contact[0].name),
-                format!("constraint elimination does not apply: {why}"),
-                "use another enforcement method for this pair",
-            ));
-        }
+    let enforcement = method(&model.contact[0].enforcement);
+    if let Some(why) = enforcement.obstacle(&rows, &model.prescribed) {
+        return Err(Error::invalid(
+            &model.source,
+            format!("contact '{}'", model.contact[0].name),
+            format!("{} does not apply: {why}", enforcement.title()),
+            "use another enforcement method for this pair",
+        ));
     }
+    let method = enforcement.kernel();
     progress("assembling");
     let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.dofs.clone()).collect();
     let sys = assemble(model, &blocks);

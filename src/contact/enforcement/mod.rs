@@ -1,0 +1,91 @@
+//! The enforcement axis: the six methods a user names, as parameters of one kernel.
+//!
+//! Every method solves, on the active set, linear systems with the matrix
+//! `M = K + sum_i w_i b_i b_i^T` (`b_i` the gradient row of constraint `i`), factored by sparse
+//! Cholesky with one symbolic analysis for the whole solve:
+//!
+//! | method | weights `w_i` | multipliers | residual |
+//! |---|---|---|---|
+//! | Lagrange | `rho` (augmentation only) | Schur complement `B M^-1 B^T`, pseudo-inverse | `g = 0` |
+//! | perturbed Lagrangian | `kappa A_i` | `lambda = -kappa A g` | `g + lambda/(kappa A) = 0` |
+//! | penalty | `kappa A_i` | eliminated | same solution as perturbed Lagrangian |
+//! | perturbed tangent | `kappa A_i` | Newton update | `g = 0` with the perturbed tangent |
+//! | augmented Lagrangian | `kappa A_i` | Uzawa `lambda_k <- lambda_k - kappa A g` | `g = 0` in the limit |
+//! | elimination | none | from the residual at the owned dof | `g = 0` exactly |
+//!
+//! With node-based rows the perturbation matrix `C = diag(1/(kappa A_i))` is diagonal, so the
+//! perturbed Lagrangian and the penalty method give identical numbers (Taylor 2004 notes they
+//! differ in general, e.g. for mortar multipliers with a consistent `C`).
+
+use super::Constraint;
+use crate::scene::{EnforcementSpec, MultiplierUpdate};
+
+mod augmented_lagrange;
+mod elimination;
+mod lagrange;
+mod penalty;
+mod perturbed_lagrange;
+mod perturbed_tangent;
+
+/// The questions the harness, the reports and the solver ask of an enforcement method. Each
+/// method answers them in its own module; nothing else classifies methods.
+pub trait Enforcement {
+    /// The short name tables show.
+    fn name(&self) -> &'static str;
+    /// The method's name in prose (messages, reports).
+    fn title(&self) -> &'static str;
+    /// Whether the method solves a multiplier system (Lagrange multipliers, constraint
+    /// elimination), whose singularity is a stability failure.
+    fn has_multiplier_system(&self) -> bool;
+    /// Whether the converged gap is only approximately zero and depends on the penalty (judged
+    /// by the trend of the error as kappa grows).
+    fn penalty_like(&self) -> bool;
+    /// The penalty parameter, if the method has one.
+    fn kappa(&self) -> Option<f64>;
+    /// The same method with its penalty multiplied by `factor` (unchanged without one).
+    fn scaled(&self, factor: f64) -> EnforcementSpec;
+    /// Unknowns the method adds per active row to the linear system (multipliers).
+    fn unknowns_per_row(&self) -> usize;
+    /// What the solver runs.
+    fn kernel(&self) -> Method;
+    /// Why the method cannot treat `rows`, if it cannot.
+    fn obstacle(&self, _rows: &[Constraint], _prescribed: &[Option<f64>]) -> Option<String> {
+        None
+    }
+}
+
+/// The enforcement method of `spec`.
+pub fn method(spec: &EnforcementSpec) -> Box<dyn Enforcement> {
+    match *spec {
+        EnforcementSpec::Lagrange => Box::new(lagrange::Lagrange),
+        EnforcementSpec::PerturbedLagrange { kappa } => {
+            Box::new(perturbed_lagrange::PerturbedLagrange { kappa })
+        }
+        EnforcementSpec::Penalty { kappa } => Box::new(penalty::Penalty { kappa }),
+        EnforcementSpec::PerturbedTangent { kappa } => {
+            Box::new(perturbed_tangent::PerturbedTangent { kappa })
+        }
+        EnforcementSpec::AugmentedLagrange { kappa, update } => {
+            Box::new(augmented_lagrange::AugmentedLagrange { kappa, update })
+        }
+        EnforcementSpec::Elimination => Box::new(elimination::Elimination),
+    }
+}
+
+/// What the solver does for one enforcement method.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Method {
+    Lagrange,
+    /// Penalty-regularized methods: perturbed Lagrangian and penalty.
+    Regularized {
+        kappa: f64,
+    },
+    PerturbedTangent {
+        kappa: f64,
+    },
+    AugmentedLagrange {
+        kappa: f64,
+        update: MultiplierUpdate,
+    },
+    Elimination,
+}

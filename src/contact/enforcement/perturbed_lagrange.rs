@@ -1,0 +1,41 @@
+//! Perturbed Lagrangian: `g_i + lambda_i / (kappa A_i) = 0`, a multiplier per row regularized by
+//! the perturbation `C = diag(1 / (kappa A_i))`. With a diagonal `C` the multipliers can be
+//! eliminated and the numbers are the penalty method's; Taylor 2004 notes the two are "not always
+//! same" (a consistent, non-diagonal `C` for standard mortar multipliers differs).
+
+use super::{Enforcement, Method};
+use crate::scene::EnforcementSpec;
+
+pub struct PerturbedLagrange {
+    pub kappa: f64,
+}
+
+impl Enforcement for PerturbedLagrange {
+    fn name(&self) -> &'static str {
+        "perturbed_lagrange"
+    }
+    fn title(&self) -> &'static str {
+        "the perturbed Lagrangian"
+    }
+    fn has_multiplier_system(&self) -> bool {
+        false
+    }
+    fn penalty_like(&self) -> bool {
+        true
+    }
+    fn kappa(&self) -> Option<f64> {
+        Some(self.kappa)
+    }
+    fn scaled(&self, factor: f64) -> EnforcementSpec {
+        EnforcementSpec::PerturbedLagrange {
+            kappa: self.kappa * factor,
+        }
+    }
+    fn unknowns_per_row(&self) -> usize {
+        // eliminated with the diagonal perturbation
+        0
+    }
+    fn kernel(&self) -> Method {
+        Method::Regularized { kappa: self.kappa }
+    }
+}
