@@ -21,7 +21,7 @@
 use crate::contact::forces::{pair_forces, PairForces};
 use crate::model::{MasterSide, Model};
 use crate::post::{for_each_quadrature_stress, relative_l2_displacement_error};
-use crate::scene::Check;
+use crate::scene::{Check, Interaction};
 use crate::solve::Solution;
 use serde::Serialize;
 
@@ -112,7 +112,7 @@ pub fn pressure_error(
         if pair.is_some_and(|k| k != pf.pair) {
             continue;
         }
-        let tied = model.contact[pf.pair].tied;
+        let tied = model.contact[pf.pair].interaction == Interaction::Tied;
         for n in pf.nodes.iter().filter(|n| n.carries_rows) {
             let body = &model.bodies[n.body];
             let s = exact.stress(body.mesh.nodes[n.node]);

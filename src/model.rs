@@ -24,8 +24,8 @@ use crate::fe::{point_values, ElementKind};
 use crate::mesh::{block, Facet, Mesh};
 use crate::paths::{name_problem, NAME_RULE};
 use crate::scene::{
-    Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, MeshSpec,
-    NodeSetSpec, Physics, Plane, Prescribed, RigidSurface, SweepSpec, TractionSpec,
+    Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, Interaction,
+    MeshSpec, NodeSetSpec, Physics, Plane, Prescribed, RigidSurface, SweepSpec, TractionSpec,
 };
 use crate::solid::{check_geometry, Elasticity};
 use std::path::Path;
@@ -76,8 +76,8 @@ pub struct ContactPair {
     pub master: MasterSide,
     pub discretization: DiscretizationSpec,
     pub enforcement: EnforcementSpec,
-    /// A tied (glued) interface instead of frictionless contact.
-    pub tied: bool,
+    /// The contact model: frictionless contact or a tied (glued) interface.
+    pub interaction: Interaction,
     /// Candidate distance of the search (`None`: the largest master facet).
     pub search_distance: Option<f64>,
 }
@@ -698,7 +698,7 @@ impl Model {
                 master,
                 discretization: spec.discretization.clone(),
                 enforcement: spec.enforcement.clone(),
-                tied: spec.interaction == crate::scene::Interaction::Tied,
+                interaction: spec.interaction,
                 search_distance: spec.search_distance,
             });
         }

@@ -30,7 +30,7 @@ use super::geometry::{closest_point, edge_shape, facet_point, ray_point, unit_no
 use super::search::BucketGrid;
 use super::Constraint;
 use crate::model::{ContactPair, MasterSide, Model};
-use crate::scene::{DiscretizationSpec, NormalChoice, RigidSurface};
+use crate::scene::{DiscretizationSpec, Interaction, NormalChoice, RigidSurface};
 
 /// Tolerance on the facet parameter for "inside the facet".
 const INSIDE: f64 = 1e-9;
@@ -131,7 +131,7 @@ pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>,
     let slave = Surface::new(pair.slave.0, slave_body, &pair.slave.1, model.thickness);
     let mut rows = Rows {
         model,
-        tied: pair.tied,
+        tied: pair.interaction == Interaction::Tied,
         search_distance: pair.search_distance,
         out: Vec::new(),
     };
