@@ -404,6 +404,21 @@ impl Model {
             })
     }
 
+    fn find_pair(&self, name: &str, location: &str) -> Result<usize> {
+        self.contact
+            .iter()
+            .position(|p| p.name == name)
+            .ok_or_else(|| {
+                let known: Vec<&str> = self.contact.iter().map(|p| p.name.as_str()).collect();
+                Error::invalid(
+                    &self.source,
+                    location,
+                    format!("contact pair '{name}' does not exist"),
+                    format!("use one of {known:?}"),
+                )
+            })
+    }
+
     fn require_exact(&self, location: &str) -> Result<ExactField> {
         self.exact.clone().ok_or_else(|| {
             Error::invalid(
@@ -777,16 +792,7 @@ impl Model {
                 }
                 Check::MaxPenetration { pair, share } => {
                     if let Some(pair) = pair {
-                        if !self.contact.iter().any(|p| p.name == *pair) {
-                            let known: Vec<&str> =
-                                self.contact.iter().map(|p| p.name.as_str()).collect();
-                            return Err(Error::invalid(
-                                &self.source,
-                                &at,
-                                format!("contact pair '{pair}' does not exist"),
-                                format!("use one of {known:?}"),
-                            ));
-                        }
+                        self.find_pair(pair, &at)?;
                     } else if self.contact.is_empty() {
                         return Err(Error::invalid(
                             &self.source,
@@ -799,29 +805,11 @@ impl Model {
                 }
                 Check::ContactForce { pair, tol, .. }
                 | Check::MaxContactPressure { pair, tol, .. } => {
-                    if !self.contact.iter().any(|p| p.name == *pair) {
-                        let known: Vec<&str> =
-                            self.contact.iter().map(|p| p.name.as_str()).collect();
-                        return Err(Error::invalid(
-                            &self.source,
-                            &at,
-                            format!("contact pair '{pair}' does not exist"),
-                            format!("use one of {known:?}"),
-                        ));
-                    }
+                    self.find_pair(pair, &at)?;
                     *tol
                 }
                 Check::ContactPressure { pair, tol } => {
-                    if !self.contact.iter().any(|p| p.name == *pair) {
-                        let known: Vec<&str> =
-                            self.contact.iter().map(|p| p.name.as_str()).collect();
-                        return Err(Error::invalid(
-                            &self.source,
-                            &at,
-                            format!("contact pair '{pair}' does not exist"),
-                            format!("use one of {known:?}"),
-                        ));
-                    }
+                    self.find_pair(pair, &at)?;
                     self.require_exact(&at)?;
                     *tol
                 }

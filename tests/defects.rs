@@ -9,26 +9,14 @@
 //! temporary `.partial` or `.previous` folder may remain. A hang guard kills a run after
 //! `HANG_GUARD` (not a performance assertion: the runs take milliseconds).
 
+mod common;
+use common::defect;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 const HANG_GUARD: Duration = Duration::from_secs(60);
-
-fn defect(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/defects");
-    std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|p| {
-            p.file_name()
-                .unwrap()
-                .to_string_lossy()
-                .starts_with(&format!("{name}-"))
-        })
-        .unwrap_or_else(|| panic!("no reproducer {name} in {}", dir.display()))
-}
 
 fn good_case() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/contact/signorini-block-on-rigid-line.json")

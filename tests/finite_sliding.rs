@@ -3,6 +3,8 @@
 //! configuration must satisfy the contact conditions: no penetration, and zero gap wherever a
 //! row carries force.
 
+mod common;
+use common::defect;
 use contact_patch::contact::discretization::constraints;
 use contact_patch::run::run_case;
 use std::path::Path;
@@ -140,16 +142,8 @@ fn patch_tests_pass_in_current_geometry_where_they_pass_in_reference_geometry() 
 
 #[test]
 fn slave_nodes_that_leave_the_master_surface_are_named() {
-    let defects = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/defects");
-    let find = |prefix: &str| {
-        std::fs::read_dir(&defects)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .find(|p| p.file_name().unwrap().to_string_lossy().starts_with(prefix))
-            .unwrap()
-    };
     // D17: the punch slides 1 past the end of the foundation's contact facets.
-    let o = run_case(&find("D17-"), &mut |_| {}).unwrap();
+    let o = run_case(&defect("D17"), &mut |_| {}).unwrap();
     let departed: Vec<usize> = o
         .solution
         .contact
@@ -171,7 +165,7 @@ fn slave_nodes_that_leave_the_master_surface_are_named() {
     // end facet instead of being dropped (a 51 % stress error at 9aead84). The bodies slide
     // relative to each other (the punch is pinned at its corner), so the pressure band on the
     // foundation shifts by that slide and the stress is no longer exactly uniform.
-    let o = run_case(&find("D10-"), &mut |_| {}).unwrap();
+    let o = run_case(&defect("D10"), &mut |_| {}).unwrap();
     assert!(o.solution.contact.as_ref().unwrap().departures.is_empty());
     let error = o
         .checks
@@ -181,6 +175,6 @@ fn slave_nodes_that_leave_the_master_surface_are_named() {
         .error;
     assert!(error < 1e-2, "stress error {error}");
     // D16: flush contact, singular at 9aead84 in current geometry.
-    let o = run_case(&find("D16-"), &mut |_| {}).unwrap();
+    let o = run_case(&defect("D16"), &mut |_| {}).unwrap();
     assert!(o.passed(), "{:?}", o.checks);
 }

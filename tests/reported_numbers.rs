@@ -2,23 +2,11 @@
 //! `tests/defects/README.md`): each reproducer run through the tool, its `summary.json` and
 //! check verdicts held to what the interface really carries.
 
+mod common;
+use common::defect;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
-
-fn defect(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/defects");
-    std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|p| {
-            p.file_name()
-                .unwrap()
-                .to_string_lossy()
-                .starts_with(&format!("{name}-"))
-        })
-        .unwrap_or_else(|| panic!("no reproducer {name}"))
-}
 
 /// Run the case (after `edit`), returning (exit code, stderr, summary.json).
 fn run(case: &Path, edit: impl FnOnce(&mut Value)) -> (i32, String, Value) {
