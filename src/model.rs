@@ -25,7 +25,8 @@ use crate::mesh::{block, Facet, Mesh};
 use crate::paths::{name_problem, NAME_RULE};
 use crate::scene::{
     Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, Interaction,
-    MeshSpec, NodeSetSpec, Physics, Plane, Prescribed, RigidSurface, SweepSpec, TractionSpec,
+    MeshSpec, NodeSetSpec, Physics, Plane, Prescribed, RigidSurface, SolverSpec, SweepSpec,
+    TractionSpec, MAX_SOLVER_COUNT,
 };
 use crate::solid::{check_geometry, Elasticity};
 use std::path::Path;
@@ -124,6 +125,8 @@ pub struct Model {
     pub contact: Vec<ContactPair>,
     /// The case's sweep (used by `contact-patch table`).
     pub sweep: Option<SweepSpec>,
+    /// Load steps, limits and tolerances of the solve.
+    pub solver: SolverSpec,
 }
 
 /// Read, parse and validate a case file.
@@ -212,6 +215,19 @@ impl Model {
             .fold(0.0, f64::max)
     }
 
+    /// The same model under the load factor `t`: external forces and prescribed values times
+    /// `t`.
+    pub fn with_load_factor(&self, t: f64) -> Model {
+        let mut m = self.clone();
+        for f in &mut m.external_force {
+            *f *= t;
+        }
+        for v in m.prescribed.iter_mut().flatten() {
+            *v *= t;
+        }
+        m
+    }
+
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)
     }
@@ -273,6 +289,31 @@ impl Model {
         }
 
         check_size(case, source)?;
+        let counts = [
+            ("solver.load_steps", case.solver.load_steps),
+            ("solver.max_iterations", case.solver.max_iterations),
+            (
+                "solver.max_geometry_updates",
+                case.solver.max_geometry_updates,
+            ),
+        ];
+        for (field, n) in counts {
+            if !(1..=MAX_SOLVER_COUNT).contains(&n) {
+                return Err(invalid(
+                    field.into(),
+                    format!("must be from 1 to {MAX_SOLVER_COUNT}, got {n}"),
+                    "the defaults (1 load step, 200 iterations, 50 geometry updates) suit most cases",
+                ));
+            }
+        }
+        let tol = case.solver.geometry_tolerance;
+        if !(tol.is_finite() && tol > 0.0) {
+            return Err(invalid(
+                "solver.geometry_tolerance".into(),
+                format!("must be a positive number, got {tol}"),
+                "the default is 1e-12",
+            ));
+        }
         let mut bodies: Vec<Body> = Vec::new();
         let mut offset = 0;
         for (bi, spec) in case.bodies.iter().enumerate() {
@@ -351,6 +392,7 @@ impl Model {
             support_sets: Vec::new(),
             contact: Vec::new(),
             sweep: case.sweep.clone(),
+            solver: case.solver.clone(),
         };
         model.apply_supports(case)?;
         model.apply_loads(case)?;

@@ -69,6 +69,8 @@ pub struct ContactSummary {
     pub max_penetration_share: f64,
     /// Per pair.
     pub pairs: Vec<PairSummary>,
+    /// The load steps: load factor, termination, iterations and geometry updates of each.
+    pub steps: Vec<crate::contact::solver::StepRecord>,
 }
 
 /// What one contact pair transmits.
@@ -218,6 +220,7 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
             max_penetration: most(|p| p.max_penetration),
             max_penetration_share: most(|p| p.max_penetration_share),
             pairs,
+            steps: c.steps.clone(),
         }
     });
     Summary {

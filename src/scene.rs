@@ -46,6 +46,55 @@ pub struct Case {
     /// Bounds on the work a case may ask for, checked before anything is allocated.
     #[serde(default)]
     pub limits: Limits,
+    /// Load steps, iteration limits and tolerances of the solve.
+    #[serde(default)]
+    pub solver: SolverSpec,
+}
+
+/// How the solve proceeds: the load applied in equal steps, each converged before the next
+/// starts from its state, with limits per case instead of global constants.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    /// Number of equal load steps (load factor `k / n` at step `k`); default 1.
+    #[serde(default = "one_step")]
+    pub load_steps: usize,
+    /// Most linear solves of the active-set loop in one step; default 200.
+    #[serde(default = "two_hundred")]
+    pub max_iterations: usize,
+    /// Most re-evaluations of the contact geometry in one step (current geometry); default 50.
+    #[serde(default = "fifty")]
+    pub max_geometry_updates: usize,
+    /// Relative change of the displacement below which the geometry updates stop; default 1e-12.
+    #[serde(default = "geometry_tolerance")]
+    pub geometry_tolerance: f64,
+}
+
+/// The most load steps, iterations or geometry updates a case may ask for.
+pub const MAX_SOLVER_COUNT: usize = 100_000;
+
+fn one_step() -> usize {
+    1
+}
+fn two_hundred() -> usize {
+    200
+}
+fn fifty() -> usize {
+    50
+}
+fn geometry_tolerance() -> f64 {
+    1e-12
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        SolverSpec {
+            load_steps: one_step(),
+            max_iterations: two_hundred(),
+            max_geometry_updates: fifty(),
+            geometry_tolerance: geometry_tolerance(),
+        }
+    }
 }
 
 /// Bounds on the size of a case, checked before meshing (a case may raise them).

@@ -64,13 +64,12 @@ pub struct ContactState {
     pub configuration: Option<Vec<f64>>,
     /// Slave nodes that left the master surface during the geometry updates.
     pub departures: Vec<Departure>,
+    /// The load steps so far (the last one is this state's).
+    pub steps: Vec<StepRecord>,
 }
 
 /// Largest active set whose rank deficiency is measured for methods without multipliers.
 pub const RANK_CHECK_LIMIT: usize = 500;
-
-/// Most linear solves of one contact solve.
-pub const MAX_ITERATIONS: usize = 200;
 
 /// A row in equation space: free equations, coefficients, gap with prescribed values folded in.
 struct EqRow {
@@ -94,18 +93,87 @@ impl EqRow {
     }
 }
 
-/// Solve the contact problem of `model` (all pairs share one enforcement method).
+/// One converged (or stopped) load step.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct StepRecord {
+    pub step: usize,
+    pub load_factor: f64,
+    pub termination: Termination,
+    /// Linear solves of the step's active-set loop (its last geometry update).
+    pub iterations: usize,
+    pub geometry_updates: usize,
+}
+
+/// Solve the contact problem of `model` (all pairs share one enforcement method) in the load
+/// steps of `model.solver`: step `k` of `n` applies the load factor `k / n` and starts from the
+/// active set of step `k - 1` (the only state frictionless contact has to carry). The solve stops
+/// at the first step that does not converge; its termination is the solve's.
 pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+    let n = model.solver.load_steps;
+    let mut previous: Option<HashSet<RowKey>> = None;
+    let mut records: Vec<StepRecord> = Vec::new();
+    let mut start: Option<Vec<f64>> = None;
+    let mut departures: Vec<Departure> = Vec::new();
+    let mut step = 1;
+    loop {
+        let t = step as f64 / n as f64;
+        let scaled;
+        let at = if n == 1 {
+            model
+        } else {
+            scaled = model.with_load_factor(t);
+            &scaled
+        };
+        let mut solution = solve_step(at, previous.take(), start.take(), progress)?;
+        let state = solution.contact.as_mut().expect("a contact solve");
+        records.push(StepRecord {
+            step,
+            load_factor: t,
+            termination: state.termination.clone(),
+            iterations: state.iterations,
+            geometry_updates: state.geometry_updates,
+        });
+        state.steps = records.clone();
+        departures.append(&mut state.departures);
+        state.departures = departures.clone();
+        if step == n || state.termination != Termination::Converged {
+            return Ok(solution);
+        }
+        previous = Some(active_keys(state));
+        start = Some(solution.u);
+        step += 1;
+    }
+}
+
+/// The identities of the active rows of `state`.
+fn active_keys(state: &ContactState) -> HashSet<RowKey> {
+    state
+        .rows
+        .iter()
+        .zip(&state.active)
+        .filter(|(_, &a)| a)
+        .map(|(r, _)| row_key(r))
+        .collect()
+}
+
+/// One load step, starting from the active rows `previous` and (current geometry) the
+/// configuration `start` of the last step, if given.
+fn solve_step(
+    model: &Model,
+    mut previous: Option<HashSet<RowKey>>,
+    start: Option<Vec<f64>>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Solution> {
     match model.physics.contact_geometry {
-        ContactGeometry::Reference => solve_at(model, None, None, progress),
+        ContactGeometry::Reference => solve_at(model, None, previous.as_ref(), progress),
         ContactGeometry::Current => {
             // fixed point on the geometry: rows linearized at the last solution u_k,
             // g(u) = g(X + u_k) + c(X + u_k) . (u - u_k); each update starts from the active
             // set of the last one (rows are matched by their identity, `RowKey`)
-            let mut u = vec![0.0; model.dof_count];
-            let mut previous: Option<HashSet<RowKey>> = None;
+            let mut u = start.unwrap_or_else(|| vec![0.0; model.dof_count]);
             let mut departures: Vec<Departure> = Vec::new();
-            for update in 1..=MAX_GEOMETRY_UPDATES {
+            let max_updates = model.solver.max_geometry_updates;
+            for update in 1..=max_updates {
                 let mut solution = solve_at(model, Some(&u), previous.as_ref(), progress)?;
                 let state = solution.contact.as_mut().expect("a contact solve");
                 if let Some(previous) = &previous {
@@ -128,15 +196,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
                     }
                 }
                 state.departures = departures.clone();
-                previous = Some(
-                    state
-                        .rows
-                        .iter()
-                        .zip(&state.active)
-                        .filter(|(_, &a)| a)
-                        .map(|(r, _)| row_key(r))
-                        .collect(),
-                );
+                previous = Some(active_keys(state));
                 let scale = solution
                     .u
                     .iter()
@@ -150,10 +210,12 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
                     / scale;
                 let state = solution.contact.as_mut().expect("a contact solve");
                 state.geometry_updates = update;
-                if change <= 1e-12 || state.termination != Termination::Converged {
+                if change <= model.solver.geometry_tolerance
+                    || state.termination != Termination::Converged
+                {
                     return Ok(solution);
                 }
-                if update == MAX_GEOMETRY_UPDATES {
+                if update == max_updates {
                     state.termination = Termination::IterationLimit;
                     return Ok(solution);
                 }
@@ -197,9 +259,6 @@ pub struct Departure {
     pub point: [f64; 2],
     pub update: usize,
 }
-
-/// Most re-evaluations of the contact geometry with `contact_geometry: current`.
-pub const MAX_GEOMETRY_UPDATES: usize = 50;
 
 /// The contact rows of every pair, evaluated at `X + u` (reference configuration if `None`)
 /// and linearized there.
@@ -328,14 +387,14 @@ fn solve_at(
     let t = Instant::now();
     progress("contact iterations");
     let chol = Cholesky::analyse(&sys.pattern).map_err(|e| sys.factor_error(model, e))?;
-    let initial_active = match (previous, u) {
-        (Some(previous), Some(u)) => Some(
-            rows.iter()
-                .map(|r| previous.contains(&row_key(r)) || r.gap(u) <= 1e-14 * size)
-                .collect(),
-        ),
-        _ => None,
-    };
+    let initial_active = previous.map(|previous| {
+        rows.iter()
+            .map(|r| {
+                let gap = u.map_or(r.g0, |u| r.gap(u));
+                previous.contains(&row_key(r)) || gap <= 1e-14 * size
+            })
+            .collect()
+    });
     let mut kernel = Kernel {
         initial_active,
         model,
@@ -388,6 +447,7 @@ fn solve_at(
         geometry_updates: 1,
         configuration,
         departures: Vec::new(),
+        steps: Vec::new(),
     });
     Ok(solution)
 }
@@ -816,7 +876,8 @@ impl Kernel<'_> {
         let mut forces = vec![0.0; nrows];
         let mut seen: HashSet<Vec<bool>> = HashSet::new();
         seen.insert(active.clone());
-        for it in 1..=MAX_ITERATIONS {
+        let max_iterations = self.model.solver.max_iterations;
+        for it in 1..=max_iterations {
             let step = match method {
                 Method::Lagrange => self.lagrange(&active),
                 Method::Elimination => self.eliminate(&active, &owners),
@@ -951,7 +1012,7 @@ impl Kernel<'_> {
             forces,
             active,
             Termination::IterationLimit,
-            MAX_ITERATIONS,
+            max_iterations,
         )
     }
 }
