@@ -71,6 +71,9 @@ pub struct ContactSummary {
     pub pairs: Vec<PairSummary>,
     /// The load steps: load factor, termination, iterations and geometry updates of each.
     pub steps: Vec<crate::contact::solver::StepRecord>,
+    /// Every iteration: residual, active rows, status changes, largest gap violation,
+    /// multiplier change, linear solver, time.
+    pub history: Vec<crate::contact::solver::IterationRecord>,
 }
 
 /// What one contact pair transmits.
@@ -221,6 +224,7 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
             max_penetration_share: most(|p| p.max_penetration_share),
             pairs,
             steps: c.steps.clone(),
+            history: c.history.clone(),
         }
     });
     Summary {

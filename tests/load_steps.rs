@@ -82,3 +82,34 @@ fn load_steps_and_limits_are_validated() {
         assert!(e.contains(&format!("solver.{field}")), "{e}");
     }
 }
+
+#[test]
+fn the_history_records_every_iteration() {
+    let o = solve(
+        "cases/contact/block-on-rigid-cylinder-augmented-lagrange.json",
+        2,
+    );
+    let state = o.solution.contact.as_ref().unwrap();
+    let h = &state.history;
+    // every linear solve of both steps, numbered within its step
+    let total: usize = state.steps.iter().map(|s| s.iterations).sum();
+    assert_eq!(h.len(), total);
+    for s in &state.steps {
+        let of_step: Vec<_> = h.iter().filter(|r| r.step == s.step).collect();
+        assert_eq!(of_step.len(), s.iterations);
+        assert!(of_step
+            .iter()
+            .enumerate()
+            .all(|(k, r)| r.iteration == k + 1));
+        // the last iteration of a converged step changes no status and leaves no penetration
+        let last = of_step.last().unwrap();
+        assert_eq!(last.status_changes, 0);
+        assert!(last.max_gap_violation <= 1e-12, "{last:?}");
+    }
+    // the first iteration of step 1 starts from the rows closed at zero displacement, so the
+    // active set grows: the count that shows chattering is not zero there
+    assert!(h[0].status_changes > 0);
+    assert!(h
+        .iter()
+        .all(|r| r.residual <= 1e-10 && r.linear_solver == "cholesky"));
+}

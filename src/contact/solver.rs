@@ -66,6 +66,8 @@ pub struct ContactState {
     pub departures: Vec<Departure>,
     /// The load steps so far (the last one is this state's).
     pub steps: Vec<StepRecord>,
+    /// Every iteration of every geometry update of every load step.
+    pub history: Vec<IterationRecord>,
 }
 
 /// Largest active set whose rank deficiency is measured for methods without multipliers.
@@ -114,6 +116,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
     let mut records: Vec<StepRecord> = Vec::new();
     let mut start: Option<Vec<f64>> = None;
     let mut departures: Vec<Departure> = Vec::new();
+    let mut history: Vec<IterationRecord> = Vec::new();
     let mut step = 1;
     loop {
         let t = step as f64 / n as f64;
@@ -134,6 +137,12 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
             geometry_updates: state.geometry_updates,
         });
         state.steps = records.clone();
+        for r in &mut state.history {
+            r.step = step;
+            r.geometry_update = r.geometry_update.max(1);
+        }
+        history.append(&mut state.history);
+        state.history = history.clone();
         departures.append(&mut state.departures);
         state.departures = departures.clone();
         if step == n || state.termination != Termination::Converged {
@@ -172,6 +181,7 @@ fn solve_step(
             // set of the last one (rows are matched by their identity, `RowKey`)
             let mut u = start.unwrap_or_else(|| vec![0.0; model.dof_count]);
             let mut departures: Vec<Departure> = Vec::new();
+            let mut history: Vec<IterationRecord> = Vec::new();
             let max_updates = model.solver.max_geometry_updates;
             for update in 1..=max_updates {
                 let mut solution = solve_at(model, Some(&u), previous.as_ref(), progress)?;
@@ -196,6 +206,11 @@ fn solve_step(
                     }
                 }
                 state.departures = departures.clone();
+                for r in &mut state.history {
+                    r.geometry_update = update;
+                }
+                history.append(&mut state.history);
+                state.history = history.clone();
                 previous = Some(active_keys(state));
                 let scale = solution
                     .u
@@ -397,6 +412,7 @@ fn solve_at(
     });
     let mut kernel = Kernel {
         initial_active,
+        history: Vec::new(),
         model,
         sys: &sys,
         rows: &eq_rows,
@@ -413,6 +429,7 @@ fn solve_at(
     let state = kernel.active_set_loop(method, &rows);
     let (x, forces, active, termination, iterations) = state;
     let linear_solver = kernel.linear_solver;
+    let history = std::mem::take(&mut kernel.history);
     let factor_time = kernel.factorizations;
     timings.factorization = factor_time;
     timings.solve = (t.elapsed().as_secs_f64() - factor_time).max(0.0);
@@ -448,6 +465,7 @@ fn solve_at(
         configuration,
         departures: Vec::new(),
         steps: Vec::new(),
+        history,
     });
     Ok(solution)
 }
@@ -504,6 +522,31 @@ struct Kernel<'a> {
     factorizations: f64,
     /// The first active set, when a geometry update starts from the last one's.
     initial_active: Option<Vec<bool>>,
+    /// One record per iteration.
+    history: Vec<IterationRecord>,
+}
+
+/// What one iteration of the active-set loop did (the solve's history, in `summary.json`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct IterationRecord {
+    /// Load step and geometry update (1-based) the iteration belongs to.
+    pub step: usize,
+    pub geometry_update: usize,
+    pub iteration: usize,
+    /// `max |K u - f - B^T lambda|` over the free equations, relative to the largest of
+    /// `|f|` and `|B^T lambda|`.
+    pub residual: f64,
+    /// Active rows during the iteration, and how many changed status after it (the count that
+    /// exposes chattering).
+    pub active: usize,
+    pub status_changes: usize,
+    /// Largest penetration `-g` of a contact row after the iteration.
+    pub max_gap_violation: f64,
+    /// Largest change of a row force from the previous iteration (the first iteration of a
+    /// geometry update or step counts from zero).
+    pub multiplier_change: f64,
+    pub linear_solver: &'static str,
+    pub seconds: f64,
 }
 
 type LoopResult = (Vec<f64>, Vec<f64>, Vec<bool>, Termination, usize);
@@ -514,6 +557,38 @@ impl Kernel<'_> {
     fn gap_tol(&self) -> f64 {
         let size = self.model.size();
         1e-14 * size
+    }
+
+    /// `max |K x - f - B^T lambda|` over the free equations relative to the largest of `|f|`
+    /// and `|B^T lambda|` (forces of inactive rows are zero).
+    fn equilibrium_residual(&self, x: &[f64], forces: &[f64], active: &[bool]) -> f64 {
+        let mut r = vec![0.0; self.sys.n];
+        self.sys.pattern.mul(&self.sys.k, x, &mut r);
+        let mut contact = vec![0.0; self.sys.n];
+        for (i, row) in self.rows.iter().enumerate() {
+            if active[i] {
+                row.add_to(forces[i], &mut contact);
+            }
+        }
+        let scale = self
+            .sys
+            .rhs
+            .iter()
+            .chain(&contact)
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(f64::MIN_POSITIVE);
+        r.iter()
+            .zip(&self.sys.rhs)
+            .zip(&contact)
+            .fold(0.0f64, |m, ((k, f), c)| {
+                let e = (k - f - c).abs();
+                if e.is_nan() || e > m {
+                    e
+                } else {
+                    m
+                }
+            })
+            / scale
     }
 
     /// Factor `K + sum_active w_i b_i b_i^T`.
@@ -878,6 +953,8 @@ impl Kernel<'_> {
         seen.insert(active.clone());
         let max_iterations = self.model.solver.max_iterations;
         for it in 1..=max_iterations {
+            let iteration_start = Instant::now();
+            let previous_forces = forces.clone();
             let step = match method {
                 Method::Lagrange => self.lagrange(&active),
                 Method::Elimination => self.eliminate(&active, &owners),
@@ -972,6 +1049,27 @@ impl Kernel<'_> {
                     .collect(),
             };
             let stable = new_active == active;
+            self.history.push(IterationRecord {
+                step: 0,
+                geometry_update: 0,
+                iteration: it,
+                residual: self.equilibrium_residual(&x, &forces, &active),
+                active: active.iter().filter(|&&a| a).count(),
+                status_changes: new_active
+                    .iter()
+                    .zip(&active)
+                    .filter(|(a, b)| a != b)
+                    .count(),
+                max_gap_violation: (0..nrows)
+                    .filter(|&i| !rows[i].bilateral)
+                    .fold(0.0f64, |m, i| m.max(-gaps[i])),
+                multiplier_change: forces
+                    .iter()
+                    .zip(&previous_forces)
+                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())),
+                linear_solver: self.linear_solver,
+                seconds: iteration_start.elapsed().as_secs_f64(),
+            });
             let converged = match method {
                 Method::Lagrange | Method::Elimination | Method::Regularized { .. } => stable,
                 Method::PerturbedTangent { kappa } => stable && gaps_closed(kappa),
