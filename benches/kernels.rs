@@ -1,9 +1,11 @@
 //! Criterion benchmarks of the element kernels and of the global assembly.
 //!
 //! Representative configurations, not sweeps: one stiffness per element kind on a distorted
-//! cell, and full assembly (pattern + values), kernels + scatter, and factorization of a 50 x 50 Q4 plane-strain block (5,202
-//! dofs). Compare the figures as ratios within one run (e.g. Q9 vs Q4 kernel, factorization vs
-//! assembly), never as absolute times across machines.
+//! cell, and full assembly (pattern + values), kernels + scatter, and factorization of a 50 x 50
+//! Q4 plane-strain block (5,202 dofs), by `sparse::Cholesky` and by faer's high-level `Llt`
+//! side by side. Compare the figures as ratios within one run (e.g. Q9 vs Q4 kernel,
+//! factorization vs assembly, `numeric_cholesky` vs `numeric_cholesky_faer_llt`), never as
+//! absolute times across machines.
 
 use contact_patch::fe::ElementKind;
 use contact_patch::model::{parse, Model};
@@ -76,6 +78,14 @@ fn assembly(c: &mut Criterion) {
             });
         })
     });
+    // the factorizations below read the assembled values whatever benchmarks a filter selects
+    values.iter_mut().for_each(|v| *v = 0.0);
+    let mut eqs = Vec::with_capacity(MAX_DOFS);
+    for_each_element_stiffness(&model, |dofs, ke| {
+        eqs.clear();
+        eqs.extend(dofs.iter().map(|&d| eq[d]));
+        pattern.scatter(&eqs, ke, &mut values);
+    });
     let chol = Cholesky::analyse(pattern).unwrap();
     group.bench_function("symbolic_cholesky", |b| {
         b.iter(|| Cholesky::analyse(black_box(pattern)).unwrap())
@@ -83,6 +93,22 @@ fn assembly(c: &mut Criterion) {
     group.bench_function("numeric_cholesky", |b| {
         b.iter(|| chol.factor(pattern, black_box(&values)).unwrap())
     });
+    // the same factorization through faer's high-level `Llt` (what `Cholesky` used before it
+    // read the permutation): the ratio of the two is the cost of the low-level path
+    let symbolic =
+        faer::sparse::linalg::solvers::SymbolicLlt::try_new(pattern.symbolic(), faer::Side::Upper)
+            .unwrap();
+    group.bench_function("numeric_cholesky_faer_llt", |b| {
+        b.iter(|| {
+            faer::sparse::linalg::solvers::Llt::try_new_with_symbolic(
+                symbolic.clone(),
+                faer::sparse::SparseColMatRef::new(pattern.symbolic(), black_box(&values)),
+                faer::Side::Upper,
+            )
+            .unwrap()
+        })
+    });
+    println!("factorization path: supernodal = {}", chol.is_supernodal());
     group.finish();
 }
 

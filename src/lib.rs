@@ -37,6 +37,7 @@ pub mod output;
 pub mod paths;
 pub mod post;
 pub mod report;
+pub mod rigid;
 pub mod run;
 pub mod scene;
 pub mod solid;

@@ -880,96 +880,12 @@ impl Model {
         Ok(())
     }
 
-    /// Every body must be held against translation in x and y and rotation: by its supports,
-    /// or, for a body in contact, by its supports together with the contact constraints (all
-    /// assumed closed) and the supports of the bodies it touches.
+    /// Every rigid mode of every body must be held by the prescribed dofs and the contact rows
+    /// together, every candidate row counted as closed (see [`crate::rigid`]).
     fn check_rigid_modes(&self) -> Result<()> {
-        let in_contact: Vec<bool> = (0..self.bodies.len())
-            .map(|b| {
-                self.contact.iter().any(|p| {
-                    p.slave.0 == b
-                        || matches!(&p.master, MasterSide::Body { body, .. } if *body == b)
-                })
-            })
-            .collect();
-        if in_contact.iter().any(|&c| c) {
-            self.check_rigid_modes_with_contact(&in_contact)?;
-        }
-        for (bi, body) in self.bodies.iter().enumerate() {
-            if in_contact[bi] {
-                continue;
-            }
-            if let Some(mode) = free_rigid_mode(body, &self.prescribed) {
-                return Err(Error::invalid(
-                    &self.source,
-                    format!("body '{}'", body.name),
-                    format!("the body is not held against rigid motion: it can {mode}"),
-                    "add supports (e.g. \"y\": 0 on a side and \"x\": 0 at one corner) so that it can neither translate nor rotate",
-                ));
-            }
-        }
-        Ok(())
-    }
-}
-
-impl Model {
-    /// The rigid modes of all bodies in contact (3 per body) must be restrained by the prescribed
-    /// dofs and the contact rows together: the Gram matrix of the restraints, expressed in the
-    /// modal coordinates, must be non-singular.
-    fn check_rigid_modes_with_contact(&self, in_contact: &[bool]) -> Result<()> {
-        let bodies: Vec<usize> = (0..self.bodies.len()).filter(|&b| in_contact[b]).collect();
-        let nm = 3 * bodies.len();
-        // modal value of dof d: (mode index, value) for the body owning it
-        // centre and size of each body in contact, computed once
-        let frames: Vec<([f64; 2], f64)> = bodies
-            .iter()
-            .map(|&b| {
-                let [lo, hi] = self.bodies[b].mesh.bounding_box();
-                (
-                    [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])],
-                    self.bodies[b].mesh.size(),
-                )
-            })
-            .collect();
-        let mode_of = |d: usize| -> Option<(usize, [f64; 3])> {
-            let (k, &b) = bodies.iter().enumerate().find(|(_, &b)| {
-                let body = &self.bodies[b];
-                d >= body.dof_offset && d < body.dof_offset + body.dof_count()
-            })?;
-            let body = &self.bodies[b];
-            let local = d - body.dof_offset;
-            let p = body.mesh.nodes[local / 2];
-            let (c, s) = frames[k];
-            let comp = local % 2;
-            let rot = [-(p[1] - c[1]) / s, (p[0] - c[0]) / s][comp];
-            Some((
-                3 * k,
-                [
-                    if comp == 0 { 1.0 } else { 0.0 },
-                    if comp == 1 { 1.0 } else { 0.0 },
-                    rot,
-                ],
-            ))
-        };
-        let mut g = vec![0.0; nm * nm];
-        let mut add = |v: &[f64]| {
-            for a in 0..nm {
-                for b in 0..nm {
-                    g[a * nm + b] += v[a] * v[b];
-                }
-            }
-        };
-        for d in 0..self.dof_count {
-            if self.prescribed[d].is_some() {
-                if let Some((base, m)) = mode_of(d) {
-                    let mut v = vec![0.0; nm];
-                    v[base..base + 3].copy_from_slice(&m);
-                    add(&v);
-                }
-            }
-        }
+        let mut rows = Vec::new();
         for pair in &self.contact {
-            let rows =
+            rows.extend(
                 crate::contact::discretization::constraints(self, pair).map_err(|reason| {
                     Error::invalid(
                         &self.source,
@@ -977,50 +893,34 @@ impl Model {
                         format!("the discretization does not apply: {reason}"),
                         "choose another discretization for this pair",
                     )
-                })?;
-            for r in rows {
-                let mut v = vec![0.0; nm];
-                for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
-                    if let Some((base, m)) = mode_of(d) {
-                        for i in 0..3 {
-                            v[base + i] += c * m[i];
-                        }
-                    }
-                }
-                add(&v);
-            }
+                })?,
+            );
         }
-        let (eig, vecs) = crate::contact::solver::symmetric_eigen(&g, nm);
-        let max = eig.iter().fold(0.0f64, |a, &e| a.max(e.abs()));
-        if let Some(k) = (0..nm).find(|&k| eig[k].abs() <= 1e-10 * max.max(f64::MIN_POSITIVE)) {
-            // the body that moves most in the free mode
-            let (kb, _) = (0..bodies.len())
-                .map(|j| {
-                    (
-                        j,
-                        (0..3)
-                            .map(|i| vecs[(3 * j + i) * nm + k].powi(2))
-                            .sum::<f64>(),
-                    )
-                })
-                .max_by(|a, b| a.1.total_cmp(&b.1))
-                .expect("a body");
-            let comps: Vec<f64> = (0..3).map(|i| vecs[(3 * kb + i) * nm + k]).collect();
-            let what = if comps[2].abs() > comps[0].abs().max(comps[1].abs()) {
-                "rotate"
-            } else if comps[0].abs() > comps[1].abs() {
-                "translate in x"
-            } else {
-                "translate in y"
-            };
-            return Err(Error::invalid(
-                &self.source,
-                format!("body '{}'", self.bodies[bodies[kb]].name),
-                format!("the body is not held against rigid motion even with every contact closed: it can {what}"),
+        let rows: Vec<&crate::contact::Constraint> = rows.iter().collect();
+        let Some(free) = crate::rigid::free_rigid_mode(self, &rows) else {
+            return Ok(());
+        };
+        let in_contact = self.contact.iter().any(|p| {
+            p.slave.0 == free.body
+                || matches!(&p.master, MasterSide::Body { body, .. } if *body == free.body)
+        });
+        let (problem, hint) = if in_contact {
+            (
+                format!("the body is not held against rigid motion even with every contact closed: it can {} ({})", free.motion(), free.why),
                 "add supports; frictionless contact holds a body only along the contact normals (e.g. fix u_x at one node of a punch)",
-            ));
-        }
-        Ok(())
+            )
+        } else {
+            (
+                format!("the body is not held against rigid motion: it can {} ({})", free.motion(), free.why),
+                "add supports (e.g. \"y\": 0 on a side and \"x\": 0 at one corner) so that it can neither translate nor rotate",
+            )
+        };
+        Err(Error::invalid(
+            &self.source,
+            format!("body '{}'", self.bodies[free.body].name),
+            problem,
+            hint,
+        ))
     }
 }
 
@@ -1036,52 +936,6 @@ fn validate_enforcement(e: &EnforcementSpec, source: &str, at: &str) -> Result<(
         }
     }
     Ok(())
-}
-
-/// The first rigid-body mode (translation x, translation y, rotation) that the prescribed dofs
-/// of `body` do not restrain, described in words.
-///
-/// Restraint is measured by the Gram matrix `G_kl = sum_{d prescribed} m_k(d) m_l(d)` of the
-/// three modes `m` restricted to prescribed dofs (rotation about the body's centre, scaled by its
-/// size): the body is held iff `G` is non-singular.
-pub fn free_rigid_mode(body: &Body, prescribed: &[Option<f64>]) -> Option<&'static str> {
-    let mesh = &body.mesh;
-    let [lo, hi] = mesh.bounding_box();
-    let c = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-    let scale = mesh.size();
-    let mut g = [[0.0f64; 3]; 3];
-    for (n, p) in mesh.nodes.iter().enumerate() {
-        for comp in 0..2 {
-            if prescribed[body.dof(n, comp)].is_none() {
-                continue;
-            }
-            let rot = [-(p[1] - c[1]) / scale, (p[0] - c[0]) / scale];
-            let m = [
-                if comp == 0 { 1.0 } else { 0.0 },
-                if comp == 1 { 1.0 } else { 0.0 },
-                rot[comp],
-            ];
-            for k in 0..3 {
-                for l in 0..3 {
-                    g[k][l] += m[k] * m[l];
-                }
-            }
-        }
-    }
-    if g[0][0] == 0.0 {
-        return Some("translate in x (no node has u_x prescribed)");
-    }
-    if g[1][1] == 0.0 {
-        return Some("translate in y (no node has u_y prescribed)");
-    }
-    let det = g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1])
-        - g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0])
-        + g[0][2] * (g[1][0] * g[2][1] - g[1][1] * g[2][0]);
-    let trace = g[0][0] + g[1][1] + g[2][2];
-    if det <= 1e-12 * trace.powi(3) {
-        return Some("rotate (the prescribed components all lie along one line of action)");
-    }
-    None
 }
 
 fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {

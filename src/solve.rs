@@ -114,22 +114,38 @@ impl LinearSystem {
         u
     }
 
-    /// The error for a stiffness that cannot be factored.
-    pub fn singular(&self, model: &Model, equation: Option<usize>) -> Error {
-        let where_ = equation
-            .and_then(|e| self.eq.iter().position(|&x| x == e))
+    /// The global dof of equation `e`.
+    pub fn dof_of(&self, e: usize) -> Option<usize> {
+        self.eq.iter().position(|&x| x == e)
+    }
+
+    /// The error for a stiffness that cannot be factored: `equation` is where the first bad
+    /// pivot was found (in the caller's numbering), `what` says what was wrong with it.
+    pub fn singular(&self, model: &Model, equation: Option<usize>, what: &str) -> Error {
+        let dof = equation.and_then(|e| self.dof_of(e));
+        let where_ = dof
             .map(|d| describe_dof(model, d))
             .unwrap_or_else(|| "an unknown equation".into());
+        let hint = match dof.and_then(|d| orphan_node(model, d)) {
+            Some((body, node)) => format!(
+                "node {node} of body '{body}' belongs to no cell, so nothing holds it: remove it from the node list or use it in a cell"
+            ),
+            None => "a part of a body may be disconnected from the supports (a mechanism), or a body held only by contact lost it; add supports or connect it".into(),
+        };
         Error::Solver {
             path: model.source.clone(),
-            problem: format!("the stiffness matrix is singular or not positive definite (first bad pivot at {where_})"),
-            hint: "a part of a body may be disconnected from the supports (a mechanism), or a body held only by contact lost it; add supports or connect it".into(),
+            problem: format!(
+                "the stiffness matrix is singular or not positive definite ({what} at {where_})"
+            ),
+            hint,
         }
     }
 
     pub fn factor_error(&self, model: &Model, e: FactorError) -> Error {
         match e {
-            FactorError::NotPositiveDefinite { equation } => self.singular(model, Some(equation)),
+            FactorError::NotPositiveDefinite { equation } => {
+                self.singular(model, Some(equation), "first bad pivot")
+            }
             FactorError::Other(msg) => Error::Solver {
                 path: model.source.clone(),
                 problem: format!("the factorization failed: {msg}"),
@@ -137,6 +153,17 @@ impl LinearSystem {
             },
         }
     }
+}
+
+/// The body and node of global dof `d` when that node belongs to no cell.
+fn orphan_node(model: &Model, d: usize) -> Option<(String, usize)> {
+    let body = model
+        .bodies
+        .iter()
+        .find(|b| d >= b.dof_offset && d < b.dof_offset + b.dof_count())?;
+    let node = (d - body.dof_offset) / 2;
+    let used = (0..body.mesh.cell_count()).any(|c| body.mesh.cell(c).contains(&node));
+    (!used).then(|| (body.name.clone(), node))
 }
 
 /// Assemble `K_ff` and the right-hand side. `extra_blocks` (global dofs) are added to the
@@ -230,7 +257,7 @@ pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Sol
         timings.solve = t.elapsed().as_secs_f64();
     }
     if x.iter().any(|v| !v.is_finite()) {
-        return Err(sys.singular(model, None));
+        return Err(sys.singular(model, None, "a non-finite solution"));
     }
     let u = sys.expand(&x);
     let t = Instant::now();

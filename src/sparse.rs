@@ -7,17 +7,23 @@
 //! reducing ordering and elimination tree) is computed once and reused for every numeric
 //! factorization with the same pattern (Newton iterations, penalty sweeps).
 //!
+//! Cholesky: `P A P^T = L L^T` with `P` the AMD ordering, through faer's low-level API so that
+//! the permutation is ours to read: elimination step `k` belongs to the original equation
+//! `fwd[k]`. A failing pivot is an error naming that original equation; faer's failing index
+//! is `k + 1` on its simplicial path and `k` on its supernodal path.
+//!
 //! Saddle-point systems `[[K, -B^T], [-B, 0]]` (Lagrange multipliers) are factored as
 //! `P A P^T = L D L^T` with faer's supernodal/simplicial LDL^T and the expected pivot signs
 //! (+ for displacements, - for multipliers) given to its dynamic regularization; the ordering is
 //! plain AMD, so the solve is followed by a few steps of iterative refinement.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltError;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, LdltRef, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky, LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering,
 };
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, Par, Side};
 use std::sync::Arc;
@@ -136,56 +142,126 @@ impl SymmetricPattern {
     }
 }
 
-/// Why a factorization failed.
+/// Why a factorization failed. Every equation is in the caller's numbering (the fill-reducing
+/// permutation is undone).
 #[derive(Debug, Clone, PartialEq)]
 pub enum FactorError {
-    /// The matrix is not positive definite: pivot `equation` was not positive.
+    /// The matrix is not positive definite: the pivot of `equation` was not positive.
     NotPositiveDefinite { equation: usize },
     /// Out of memory or another non-numerical failure.
     Other(String),
 }
 
-/// Sparse Cholesky `A = L L^T` with the symbolic analysis done once per pattern.
+impl FactorError {
+    /// The same error with its equation renumbered by `map` (e.g. from a reduced system).
+    pub fn map_equation(self, map: impl Fn(usize) -> usize) -> FactorError {
+        match self {
+            FactorError::NotPositiveDefinite { equation } => FactorError::NotPositiveDefinite {
+                equation: map(equation),
+            },
+            other => other,
+        }
+    }
+}
+
+/// Original equation of elimination step `k`.
+fn original(symbolic: &SymbolicCholesky<usize>, k: usize) -> usize {
+    symbolic.perm().map_or(k, |p| p.arrays().0[k])
+}
+
+/// Sparse Cholesky `A = L L^T` with the symbolic analysis (AMD ordering, elimination tree,
+/// supernodes) done once per pattern and shared by every numeric factorization.
 pub struct Cholesky {
-    symbolic: SymbolicLlt<usize>,
+    symbolic: Arc<SymbolicCholesky<usize>>,
 }
 
 impl Cholesky {
     /// Analyse the pattern (ordering, elimination tree, supernodes).
     pub fn analyse(pattern: &SymmetricPattern) -> Result<Self, FactorError> {
-        let symbolic = SymbolicLlt::try_new(pattern.symbolic(), Side::Upper)
-            .map_err(|e| FactorError::Other(format!("{e:?}")))?;
-        Ok(Cholesky { symbolic })
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.symbolic(),
+            Side::Upper,
+            SymmetricOrdering::Amd,
+            Default::default(),
+        )
+        .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+        Ok(Cholesky {
+            symbolic: Arc::new(symbolic),
+        })
     }
 
-    /// Numeric factorization of the matrix with this pattern and `values`.
+    /// Whether the numeric factorization works on supernodes (dense blocks) rather than
+    /// column by column; faer decides from the pattern.
+    pub fn is_supernodal(&self) -> bool {
+        matches!(self.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_))
+    }
+
+    /// Numeric factorization of the matrix with this pattern and `values`. A pivot that is not
+    /// positive is an error naming its equation.
     pub fn factor(
         &self,
         pattern: &SymmetricPattern,
         values: &[f64],
     ) -> Result<Factor, FactorError> {
+        let sym = &*self.symbolic;
+        let mut l = Vec::new();
+        l.try_reserve_exact(sym.len_val())
+            .map_err(|e| FactorError::Other(format!("{e}")))?;
+        l.resize(sym.len_val(), 0.0);
+        let par = faer::get_global_parallelism();
+        let mut mem =
+            MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()))
+                .map_err(|e| FactorError::Other(format!("{e:?}")))?;
         let mat = SparseColMatRef::new(pattern.symbolic(), values);
-        Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Upper)
-            .map(|llt| Factor { llt })
-            .map_err(|e| match e {
-                faer::sparse::linalg::LltError::Numeric(
-                    faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index },
-                ) => FactorError::NotPositiveDefinite { equation: index },
-                other => FactorError::Other(format!("{other:?}")),
-            })
+        let result = sym.factorize_numeric_llt(
+            &mut l,
+            mat,
+            Side::Upper,
+            Default::default(),
+            par,
+            MemStack::new(&mut mem),
+            Default::default(),
+        );
+        if let Err(e) = result {
+            return Err(match e {
+                LltError::NonPositivePivot { index } => {
+                    // faer's failing index is 1-based on the simplicial path and 0-based on
+                    // the supernodal one, both in elimination order
+                    let k = match sym.raw() {
+                        SymbolicCholeskyRaw::Simplicial(_) => index - 1,
+                        SymbolicCholeskyRaw::Supernodal(_) => index,
+                    };
+                    FactorError::NotPositiveDefinite {
+                        equation: original(sym, k),
+                    }
+                }
+            });
+        }
+        Ok(Factor {
+            symbolic: self.symbolic.clone(),
+            values: l,
+        })
     }
 }
 
 /// A numeric factorization, ready to solve.
 pub struct Factor {
-    llt: Llt<usize, f64>,
+    symbolic: Arc<SymbolicCholesky<usize>>,
+    values: Vec<f64>,
 }
 
 impl Factor {
     /// Solve `A x = b` in place.
     pub fn solve_in_place(&self, b: &mut [f64]) {
+        let par = faer::get_global_parallelism();
         let mut rhs = Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
-        self.llt.solve_in_place(rhs.as_mut());
+        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, par));
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            rhs.as_mut(),
+            par,
+            MemStack::new(&mut mem),
+        );
         for (i, v) in b.iter_mut().enumerate() {
             *v = rhs[(i, 0)];
         }
@@ -425,5 +501,59 @@ mod tests {
         pattern.scatter(&[0, usize::MAX, 1], &ke, &mut values);
         assert_eq!(values[pattern.position(0, 1).unwrap()], -1.0);
         assert_eq!(values[pattern.position(1, 1).unwrap()], 2.0);
+    }
+
+    /// A `side x side` grid whose equations couple with their 8 neighbours (diagonally
+    /// dominant, so positive definite), except `loose`, which couples with nothing and has the
+    /// diagonal `value`.
+    fn grid_with_loose_equation(
+        side: usize,
+        loose: usize,
+        value: f64,
+    ) -> (SymmetricPattern, Vec<f64>) {
+        let n = side * side;
+        let mut pb = PatternBuilder::new(n);
+        let mut blocks = Vec::new();
+        for j in 0..side {
+            for i in 0..side {
+                for (di, dj) in [(1, 0), (0, 1), (1, 1)] {
+                    let (a, b) = (j * side + i, (j + dj) * side + i + di);
+                    if i + di < side && j + dj < side && a != loose && b != loose {
+                        pb.add_block(&[a, b]);
+                        blocks.push([a, b]);
+                    }
+                }
+            }
+        }
+        let p = pb.build();
+        let mut v = vec![0.0; p.nnz()];
+        for [a, b] in blocks {
+            p.scatter(&[a, b], &[1.0, -1.0, -1.0, 1.0], &mut v);
+        }
+        for e in 0..n {
+            v[p.position(e, e).unwrap()] += if e == loose { value } else { 0.5 };
+        }
+        (p, v)
+    }
+
+    #[test]
+    fn a_failing_pivot_is_named_by_its_equation_on_both_paths() {
+        // faer counts the failing pivot from 1 on its simplicial path and from 0 on its
+        // supernodal path, both in the fill-reducing order
+        for (side, supernodal) in [(5, false), (150, true)] {
+            let loose = side * side / 2 + 3;
+            for value in [-1.0, 0.0] {
+                let (p, v) = grid_with_loose_equation(side, loose, value);
+                let chol = Cholesky::analyse(&p).unwrap();
+                assert_eq!(chol.is_supernodal(), supernodal);
+                assert_eq!(
+                    chol.factor(&p, &v).err(),
+                    Some(FactorError::NotPositiveDefinite { equation: loose }),
+                    "side {side}, value {value}"
+                );
+            }
+            let (p, v) = grid_with_loose_equation(side, loose, 1.0);
+            assert!(Cholesky::analyse(&p).unwrap().factor(&p, &v).is_ok());
+        }
     }
 }

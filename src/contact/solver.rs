@@ -902,9 +902,18 @@ impl Kernel<'_> {
             }
         }
         let chol = Cholesky::analyse(&rp).map_err(|e| format!("{e:?}"))?;
-        let f = chol
-            .factor(&rp, &values)
-            .map_err(|e| self.sys.factor_error(self.model, e).to_string())?;
+        // a failing pivot is named by its equation of the reduced system: map it back
+        let mut eq_of_reduced = vec![0; nr];
+        for e in 0..n {
+            if reduced[e] != usize::MAX {
+                eq_of_reduced[reduced[e]] = e;
+            }
+        }
+        let f = chol.factor(&rp, &values).map_err(|e| {
+            self.sys
+                .factor_error(self.model, e.map_equation(|q| eq_of_reduced[q]))
+                .to_string()
+        })?;
         self.factorizations += t.elapsed().as_secs_f64();
         f.solve_in_place(&mut rb);
         let mut x = constant.clone();
