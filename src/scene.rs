@@ -68,6 +68,15 @@ pub struct SolverSpec {
     /// Relative change of the displacement below which the geometry updates stop; default 1e-12.
     #[serde(default = "geometry_tolerance")]
     pub geometry_tolerance: f64,
+    /// Newton's geometric term of the contact forces in the geometry updates (current geometry,
+    /// rows that provide their second derivative): `true` (default) for quadratic convergence,
+    /// `false` for the plain fixed point (to compare).
+    #[serde(default = "yes")]
+    pub geometric_stiffness: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// The most load steps, iterations or geometry updates a case may ask for.
@@ -93,6 +102,7 @@ impl Default for SolverSpec {
             max_iterations: two_hundred(),
             max_geometry_updates: fifty(),
             geometry_tolerance: geometry_tolerance(),
+            geometric_stiffness: true,
         }
     }
 }

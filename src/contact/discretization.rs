@@ -414,6 +414,34 @@ fn node_to_surface(
     }
 }
 
+/// The second derivative of a row's gap with respect to its slave node's displacement
+/// (`2 x 2`, row-major), where the row's master makes it non-zero: against a rigid circle,
+/// `g = |x_s - c| - R` gives `d2g/dx_s2 = (I - n n^T) / |x_s - c|` at the slave position `x_s`
+/// (in the configuration the row is linearized in). Rigid lines and ties are affine (`None`);
+/// node-to-surface and mortar rows against deformable masters do not provide theirs yet (their
+/// geometry is then updated by a fixed point, see [`super::solver`]).
+pub fn gap_second_derivative(model: &Model, row: &Constraint, x_s: [f64; 2]) -> Option<[f64; 4]> {
+    let MasterSide::Rigid(RigidSurface::Circle { centre, .. }) = model.contact[row.pair].master
+    else {
+        return None;
+    };
+    if row.bilateral {
+        return None;
+    }
+    let d = [x_s[0] - centre[0], x_s[1] - centre[1]];
+    let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+    if l == 0.0 {
+        return None;
+    }
+    let n = [d[0] / l, d[1] / l];
+    Some([
+        (1.0 - n[0] * n[0]) / l,
+        -n[0] * n[1] / l,
+        -n[1] * n[0] / l,
+        (1.0 - n[1] * n[1]) / l,
+    ])
+}
+
 fn rigid_rows(rows: &mut Rows, slave: &Surface, rigid: &RigidSurface) -> Result<(), String> {
     let sb = &rows.model.bodies[slave.body];
     for &s in slave.nodes.keys() {

@@ -17,7 +17,7 @@
 //! of a two-pass discretization), and the pseudo-inverse picks the minimum-norm multipliers,
 //! so the displacement is still returned when it exists.
 
-use super::discretization::constraints;
+use super::discretization::{constraints, gap_second_derivative};
 use super::enforcement::{method, Method};
 use super::Constraint;
 use crate::error::{Error, Result};
@@ -25,7 +25,7 @@ use crate::model::Model;
 use crate::scene::{ContactGeometry, MultiplierUpdate};
 use crate::solve::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
 use crate::sparse::{Cholesky, PatternBuilder};
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
 /// Why the active-set loop stopped.
@@ -68,6 +68,9 @@ pub struct ContactState {
     pub steps: Vec<StepRecord>,
     /// Every iteration of every geometry update of every load step.
     pub history: Vec<IterationRecord>,
+    /// Relative change of the displacement at each geometry update of the last step (current
+    /// geometry): how the geometry iteration converged.
+    pub geometry_changes: Vec<f64>,
 }
 
 /// Largest active set whose rank deficiency is measured for methods without multipliers.
@@ -104,6 +107,10 @@ pub struct StepRecord {
     /// Linear solves of the step's active-set loop (its last geometry update).
     pub iterations: usize,
     pub geometry_updates: usize,
+    /// Relative change of the displacement at each geometry update (current geometry; empty in
+    /// the reference configuration): quadratic decay where the rows provide their second
+    /// derivative (Newton), linear where the geometry is a fixed point.
+    pub geometry_changes: Vec<f64>,
 }
 
 /// Solve the contact problem of `model` (all pairs share one enforcement method) in the load
@@ -135,6 +142,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
             termination: state.termination.clone(),
             iterations: state.iterations,
             geometry_updates: state.geometry_updates,
+            geometry_changes: std::mem::take(&mut state.geometry_changes),
         });
         state.steps = records.clone();
         for r in &mut state.history {
@@ -174,7 +182,7 @@ fn solve_step(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Solution> {
     match model.physics.contact_geometry {
-        ContactGeometry::Reference => solve_at(model, None, previous.as_ref(), progress),
+        ContactGeometry::Reference => solve_at(model, None, previous.as_ref(), None, progress),
         ContactGeometry::Current => {
             // fixed point on the geometry: rows linearized at the last solution u_k,
             // g(u) = g(X + u_k) + c(X + u_k) . (u - u_k); each update starts from the active
@@ -182,9 +190,17 @@ fn solve_step(
             let mut u = start.unwrap_or_else(|| vec![0.0; model.dof_count]);
             let mut departures: Vec<Departure> = Vec::new();
             let mut history: Vec<IterationRecord> = Vec::new();
+            let mut forces: Option<HashMap<RowKey, f64>> = None;
+            let mut changes: Vec<f64> = Vec::new();
             let max_updates = model.solver.max_geometry_updates;
             for update in 1..=max_updates {
-                let mut solution = solve_at(model, Some(&u), previous.as_ref(), progress)?;
+                let mut solution = solve_at(
+                    model,
+                    Some(&u),
+                    previous.as_ref(),
+                    forces.as_ref(),
+                    progress,
+                )?;
                 let state = solution.contact.as_mut().expect("a contact solve");
                 if let Some(previous) = &previous {
                     for (pair, _, body, node, _) in slid_off(previous, &state.rows) {
@@ -212,6 +228,14 @@ fn solve_step(
                 history.append(&mut state.history);
                 state.history = history.clone();
                 previous = Some(active_keys(state));
+                forces = Some(
+                    state
+                        .rows
+                        .iter()
+                        .zip(&state.forces)
+                        .map(|(r, &f)| (row_key(r), f))
+                        .collect(),
+                );
                 let scale = solution
                     .u
                     .iter()
@@ -225,6 +249,8 @@ fn solve_step(
                     / scale;
                 let state = solution.contact.as_mut().expect("a contact solve");
                 state.geometry_updates = update;
+                changes.push(change);
+                state.geometry_changes = changes.clone();
                 if change <= model.solver.geometry_tolerance
                     || state.termination != Termination::Converged
                 {
@@ -321,12 +347,53 @@ fn rows_at(model: &Model, u: Option<&[f64]>) -> Result<Vec<Constraint>> {
     Ok(rows)
 }
 
+/// Newton's geometric term of the contact forces, for the rows whose gap has a second
+/// derivative `H` (see [`gap_second_derivative`]): with the contact force `lambda n(u)` on the
+/// slave node, `n(u) ~ n(u_k) + H (u - u_k)`, so equilibrium linearized at `u_k` with the
+/// forces `lambda_k` of the last geometry update reads
+/// `(K - lambda_k H) u = f + B_k^T lambda - lambda_k H u_k`. With it the geometry updates are
+/// Newton iterations (quadratic convergence) instead of a fixed point.
+fn add_geometric_stiffness(
+    model: &Model,
+    rows: &[Constraint],
+    u: &[f64],
+    forces: &HashMap<RowKey, f64>,
+    sys: &mut LinearSystem,
+) {
+    for r in rows {
+        let Some(&lambda) = forces.get(&row_key(r)) else {
+            continue;
+        };
+        if lambda == 0.0 {
+            continue;
+        }
+        let b = &model.bodies[r.slave_body];
+        let dofs = [b.dof(r.slave_node, 0), b.dof(r.slave_node, 1)];
+        let x = b.mesh.nodes[r.slave_node];
+        let x_s = [x[0] + u[dofs[0]], x[1] + u[dofs[1]]];
+        let Some(h) = gap_second_derivative(model, r, x_s) else {
+            continue;
+        };
+        let eqs = [sys.eq[dofs[0]], sys.eq[dofs[1]]];
+        if eqs.contains(&NO_EQUATION) {
+            continue;
+        }
+        let block: Vec<f64> = h.iter().map(|v| -lambda * v).collect();
+        sys.pattern.scatter(&eqs, &block, &mut sys.k);
+        for a in 0..2 {
+            sys.rhs[eqs[a]] -= lambda * (h[2 * a] * u[dofs[0]] + h[2 * a + 1] * u[dofs[1]]);
+        }
+    }
+}
+
 /// One contact solve with the rows of `rows_at(model, u)`; `previous` (the active rows of the
-/// last geometry update) starts the active set together with the rows closed at `u`.
+/// last geometry update) starts the active set together with the rows closed at `u`;
+/// `previous_forces` (of the last geometry update) give Newton's geometric term.
 fn solve_at(
     model: &Model,
     u: Option<&[f64]>,
     previous: Option<&HashSet<RowKey>>,
+    previous_forces: Option<&HashMap<RowKey, f64>>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Solution> {
     let configuration = u.map(|u| u.to_vec());
@@ -346,7 +413,10 @@ fn solve_at(
     let method = enforcement.kernel();
     progress("assembling");
     let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.dofs.clone()).collect();
-    let sys = assemble(model, &blocks);
+    let mut sys = assemble(model, &blocks);
+    if let (Some(u), Some(forces), true) = (u, previous_forces, model.solver.geometric_stiffness) {
+        add_geometric_stiffness(model, &rows, u, forces, &mut sys);
+    }
     let mut eq_rows: Vec<EqRow> = rows
         .iter()
         .map(|r| {
@@ -466,6 +536,7 @@ fn solve_at(
         departures: Vec::new(),
         steps: Vec::new(),
         history,
+        geometry_changes: Vec::new(),
     });
     Ok(solution)
 }
