@@ -2,7 +2,13 @@
 //!
 //! * A failing pivot is named by the node it belongs to in the user's numbering, on faer's
 //!   simplicial and supernodal paths alike (D09).
+//! * A non-finite number anywhere is an error (exit 2) naming where it appeared, and no output
+//!   is written (D08).
+//! * A body whose rigid motion the active set leaves free is brought into contact (D23a, D23b,
+//!   D22) or refused with the body, the motion and why (D11a/D11b), the same for both
+//!   numberings.
 
+use contact_patch::contact::solver::Termination;
 use contact_patch::model::{parse, Model};
 use contact_patch::run::{run_model, Outcome};
 use contact_patch::solve::assemble;
@@ -41,6 +47,23 @@ fn solve(case: &Value, source: &str) -> contact_patch::Result<Outcome> {
     run_model(model(case, source), 0.0, Instant::now(), &mut |_| {})
 }
 
+fn termination(o: &Outcome) -> &Termination {
+    &o.solution
+        .contact
+        .as_ref()
+        .expect("a contact solve")
+        .termination
+}
+
+/// The message of a `Singular` termination, without the case's source (the first line's
+/// `SOURCE: ` prefix).
+fn refusal(o: &Outcome, source: &str) -> String {
+    match termination(o) {
+        Termination::Singular(msg) => msg.replacen(source, "CASE", 1),
+        t => panic!("expected a refusal, got {t:?}"),
+    }
+}
+
 #[test]
 fn d09_names_the_unconnected_node_on_the_simplicial_path() {
     let case = read(&defect("D09"));
@@ -56,8 +79,9 @@ fn d09_names_the_unconnected_node_on_the_simplicial_path() {
 }
 
 /// A Q4 grid `n x n` on `[0, n]^2` held at the left side, with extra nodes that belong to no
-/// cell inserted at `stray` (index, coordinates).
-fn grid_case(n: usize, stray: &[(usize, [f64; 2])]) -> Value {
+/// cell inserted at `stray` (index, coordinates), and optionally a second grid (a part that
+/// floats free) to the right of `float_from`.
+fn grid_case(n: usize, stray: &[(usize, [f64; 2])], float_from: Option<f64>) -> Value {
     let mut nodes: Vec<[f64; 2]> = Vec::new();
     let mut cells: Vec<[usize; 4]> = Vec::new();
     let mut block = |x0: f64| {
@@ -75,6 +99,9 @@ fn grid_case(n: usize, stray: &[(usize, [f64; 2])]) -> Value {
         }
     };
     block(0.0);
+    if let Some(x0) = float_from {
+        block(x0);
+    }
     for &(at, p) in stray {
         nodes.insert(at, p);
         for c in &mut cells {
@@ -94,7 +121,7 @@ fn grid_case(n: usize, stray: &[(usize, [f64; 2])]) -> Value {
 
 #[test]
 fn a_failing_pivot_on_the_supernodal_path_names_its_node() {
-    let case = grid_case(60, &[(1900, [20.5, 31.25])]);
+    let case = grid_case(60, &[(1900, [20.5, 31.25])], None);
     let m = model(&case, "grid");
     let pattern = assemble(&m, &[]).pattern;
     assert!(Cholesky::analyse(&pattern).unwrap().is_supernodal());
@@ -102,11 +129,162 @@ fn a_failing_pivot_on_the_supernodal_path_names_its_node() {
     assert!(e.contains("node 1900 at (20.5, 31.25)"), "{e}");
     assert!(e.contains("belongs to no cell"), "{e}");
     // the same on the simplicial path
-    let case = grid_case(3, &[(5, [0.5, 1.25])]);
+    let case = grid_case(3, &[(5, [0.5, 1.25])], None);
     let m = model(&case, "small");
     assert!(!Cholesky::analyse(&assemble(&m, &[]).pattern)
         .unwrap()
         .is_supernodal());
     let e = solve(&case, "small").unwrap_err().to_string();
     assert!(e.contains("node 5 at (0.5, 1.25)"), "{e}");
+}
+
+#[test]
+fn a_part_that_floats_free_is_refused_and_located() {
+    // before: the round-off pivots of the floating part passed and the run answered
+    for n in [6, 40] {
+        let case = grid_case(n, &[], Some(2.0 * n as f64));
+        let e = solve(&case, "float").unwrap_err().to_string();
+        assert!(e.contains("singular"), "{e}");
+        let x: f64 = e
+            .split(" at (")
+            .nth(1)
+            .and_then(|s| s.split(',').next())
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_else(|| panic!("no coordinates in {e}"));
+        assert!(
+            x >= 2.0 * n as f64,
+            "the named node is not in the floating part: {e}"
+        );
+    }
+}
+
+#[test]
+fn d08_non_finite_results_are_an_error_naming_where() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |case: &Path, out: &Path| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+            .args([
+                "run",
+                case.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap()
+    };
+    let out = dir.path().join("out");
+    let result = run(&defect("D08"), &out);
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert_eq!(result.status.code(), Some(2), "{stderr}");
+    for needle in [
+        "is not finite",
+        "body 'block', node",
+        "contact iteration 1",
+        "rescale the units",
+    ] {
+        assert!(stderr.contains(needle), "{needle:?} missing from {stderr}");
+    }
+    assert!(!out.exists(), "an output folder was written");
+    // the same load without contact: the static solve refuses too
+    let mut case = read(&defect("D08"));
+    case["contact"] = json!([]);
+    case["supports"] = json!([{"body": "block", "set": "bottom", "y": 0.0},
+                              {"body": "block", "set": "bottom_left", "x": 0.0}]);
+    let path = dir.path().join("static.json");
+    std::fs::write(&path, case.to_string()).unwrap();
+    let result = run(&path, &out);
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert_eq!(result.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("is not finite"), "{stderr}");
+    assert!(!out.exists(), "an output folder was written");
+}
+
+#[test]
+fn d11_two_numberings_give_the_same_diagnosed_refusal() {
+    let a = solve(&read(&defect("D11a")), "D11a").unwrap();
+    let b = solve(&read(&defect("D11b")), "D11b").unwrap();
+    let (ra, rb) = (refusal(&a, "D11a"), refusal(&b, "D11b"));
+    assert_eq!(ra, rb);
+    for needle in [
+        "not unique",
+        "body 'block' can rotate about (0, 4)",
+        "only one node (0, 0)",
+        "stay open",
+        "hint: hold this motion with a support",
+    ] {
+        assert!(ra.contains(needle), "{needle:?} missing from {ra}");
+    }
+    assert!(!a.passed() && !b.passed());
+}
+
+#[test]
+fn d23a_a_body_across_a_gap_is_brought_into_contact() {
+    let o = solve(&read(&defect("D23a")), "D23a").unwrap();
+    assert_eq!(termination(&o), &Termination::Converged);
+    let c = o.solution.contact.as_ref().unwrap();
+    // the closest points: the two bottom nodes nearest x = 0, at x = -+4/7
+    let mut closed: Vec<f64> = c
+        .rows
+        .iter()
+        .zip(&c.active)
+        .filter(|(_, &a)| a)
+        .map(|(r, _)| r.point[0])
+        .collect();
+    closed.sort_by(f64::total_cmp);
+    assert_eq!(closed.len(), 2, "{closed:?}");
+    assert!((closed[0] + 4.0 / 7.0).abs() < 1e-12 && (closed[1] - 4.0 / 7.0).abs() < 1e-12);
+    let total: f64 = c
+        .forces
+        .iter()
+        .zip(&c.rows)
+        .map(|(f, r)| f * r.normal[1])
+        .sum();
+    assert!((total - 4.0).abs() < 1e-12, "{total}");
+}
+
+#[test]
+fn d23b_and_d22_converge_symmetrically() {
+    // D23b (Q9): node-to-surface rows close at the mid-side nodes (x = -+0.1, -+0.3); the
+    // corner node at x = 0 carries no compression
+    for (name, nodes) in [("D23b", 4), ("D22", 3)] {
+        let o = solve(&read(&defect(name)), name).unwrap();
+        assert_eq!(termination(&o), &Termination::Converged, "{name}");
+        let c = o.solution.contact.as_ref().unwrap();
+        let closed: Vec<f64> = c
+            .rows
+            .iter()
+            .zip(&c.active)
+            .filter(|(_, &a)| a)
+            .map(|(r, _)| r.point[0])
+            .collect();
+        assert_eq!(closed.len(), nodes, "{name}: {closed:?}");
+        for x in &closed {
+            assert!(
+                closed.iter().any(|y| (x + y).abs() < 1e-12),
+                "{name}: the contact zone is not symmetric: {closed:?}"
+            );
+        }
+        let total: f64 = c
+            .forces
+            .iter()
+            .zip(&c.rows)
+            .map(|(f, r)| f * r.normal[1])
+            .sum();
+        assert!((total - 4.0).abs() < 1e-8, "{name}: {total}");
+    }
+}
+
+#[test]
+fn a_body_pulled_off_its_contact_is_refused() {
+    let mut case = read(&defect("D23a"));
+    case["loads"][0]["pressure"] = json!(-0.5);
+    let o = solve(&case, "pull").unwrap();
+    let msg = refusal(&o, "pull");
+    for needle in [
+        "the loads push body 'block' to translate in y",
+        "no contact row can stop that motion",
+        "no node has u_y prescribed",
+    ] {
+        assert!(msg.contains(needle), "{needle:?} missing from {msg}");
+    }
 }
