@@ -78,6 +78,10 @@ pub struct ContactState {
 /// Largest active set whose rank deficiency is measured for methods without multipliers.
 pub const RANK_CHECK_LIMIT: usize = 500;
 
+/// Most steps of iterative refinement of one LDL^T solve (it stops earlier once the correction
+/// no longer halves or reaches round-off).
+pub const MAX_REFINEMENT: usize = 10;
+
 /// Most linear solves of one contact solve.
 pub const MAX_ITERATIONS: usize = 200;
 
@@ -550,8 +554,7 @@ impl Kernel<'_> {
             if !force_scale.is_finite() || x.iter().any(|v| !v.is_finite()) {
                 return (f64::NAN, f64::NAN);
             }
-            saddle.pattern.mul(&values, x, r);
-            r.iter_mut().zip(&rhs).for_each(|(a, b)| *a = b - *a);
+            saddle.pattern.residual_accurate(&values, x, &rhs, r);
             let forces = x[n..]
                 .iter()
                 .fold(force_scale, |a, v| a.max((rho * v).abs()))
@@ -601,16 +604,27 @@ impl Kernel<'_> {
                         return Err(StepError::Fatal(error));
                     }
                 }
-                for _ in 0..3 {
-                    let res = residual(&x, &mut r);
-                    if small(res) {
-                        solved = Some((x.clone(), "ldlt"));
+                // iterative refinement with an accurate residual, while the correction at
+                // least halves and is above round-off of x: the answer converges to the
+                // solution of the stored matrix to about working precision, so that it does
+                // not depend on the elimination order (the numbering)
+                let mut res = residual(&x, &mut r);
+                let mut last_step = f64::INFINITY;
+                for _ in 0..MAX_REFINEMENT {
+                    factor.solve_in_place(&mut r);
+                    let step = crate::solve::max_abs(&r);
+                    // (a NaN step stops too)
+                    if step.is_nan() || step >= 0.5 * last_step {
                         break;
                     }
-                    factor.solve_in_place(&mut r);
                     x.iter_mut().zip(&r).for_each(|(a, d)| *a += d);
+                    last_step = step;
+                    res = residual(&x, &mut r);
+                    if step <= f64::EPSILON * crate::solve::max_abs(&x) {
+                        break;
+                    }
                 }
-                if solved.is_none() && small(residual(&x, &mut r)) {
+                if small(res) {
                     solved = Some((x, "ldlt"));
                 }
             }
