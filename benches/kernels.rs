@@ -94,7 +94,7 @@ fn assembly(c: &mut Criterion) {
         b.iter(|| chol.factor(pattern, black_box(&values)).unwrap())
     });
     // the same factorization through faer's high-level `Llt` (what `Cholesky` used before it
-    // read the permutation): the ratio of the two is the cost of the low-level path
+    // read the pivots and the permutation): the ratio of the two is the cost of those checks
     let symbolic =
         faer::sparse::linalg::solvers::SymbolicLlt::try_new(pattern.symbolic(), faer::Side::Upper)
             .unwrap();

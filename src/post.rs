@@ -79,6 +79,34 @@ pub fn nodal_stresses(body: &Body, u: &[f64]) -> Vec<[f64; 3]> {
         .collect()
 }
 
+/// `Ok` when every nodal stress of every body (what the output writes) is finite, else the
+/// error naming the first node where one is not.
+pub fn check_finite_stresses(model: &Model, u: &[f64]) -> crate::Result<()> {
+    for body in &model.bodies {
+        let stresses = nodal_stresses(body, u);
+        if let Some((n, s)) = stresses
+            .iter()
+            .enumerate()
+            .find(|(_, s)| s.iter().any(|v| !v.is_finite()))
+        {
+            let value = s
+                .iter()
+                .copied()
+                .find(|v| !v.is_finite())
+                .unwrap_or(f64::NAN);
+            let p = body.mesh.nodes[n];
+            return Err(crate::solve::non_finite_at(
+                model,
+                "the nodal stress",
+                value,
+                &format!("body '{}', node {n} at ({}, {})", body.name, p[0], p[1]),
+                "when the stresses were computed from the displacement",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Relative L2 error of the displacement of all bodies against `exact`.
 pub fn relative_l2_displacement_error(model: &Model, u: &[f64], exact: &ExactField) -> f64 {
     let (mut err, mut norm) = (0.0, 0.0);

@@ -40,6 +40,7 @@ pub fn run_model(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Outcome> {
     let mut solution = solve_static(&model, progress)?;
+    crate::post::check_finite_stresses(&model, &solution.u)?;
     progress("checking");
     let checks = evaluate(&model, &solution);
     let warnings = warnings(&model, &solution);

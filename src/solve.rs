@@ -6,6 +6,11 @@
 //! refinement). Reactions are the residual of
 //! the full system, `r = K u - f`, evaluated element by element; at free dofs it is the
 //! equilibrium error (reported as `residual`), at prescribed dofs it is the support reaction.
+//!
+//! Every number a run reports must be finite: the assembled loads, stiffness and right-hand
+//! side, each solution and the reactions are checked, and the first non-finite value is an
+//! error naming its dof (body, node, component, coordinates) and the stage it appeared at.
+//! Maxima propagate NaN (`max_abs`), so that a NaN can never pass as a zero residual.
 
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -146,11 +151,43 @@ impl LinearSystem {
             FactorError::NotPositiveDefinite { equation } => {
                 self.singular(model, Some(equation), "first bad pivot")
             }
+            FactorError::ZeroPivot {
+                equation,
+                ratio,
+                regularized,
+            } => {
+                let what = if regularized > 0 {
+                    format!("{regularized} pivot(s) needed regularization, the first")
+                } else {
+                    format!("a pivot is zero relative to its diagonal (ratio {ratio:.1e})")
+                };
+                match self.singular(model, Some(equation), &what) {
+                    Error::Solver {
+                        path,
+                        problem,
+                        hint,
+                    } => Error::Solver {
+                        path,
+                        problem,
+                        hint: format!("{hint}; a penalty far stiffer than the bodies (kappa above about 1e10 E / h) also makes the matrix singular to working precision"),
+                    },
+                    other => other,
+                }
+            }
             FactorError::Other(msg) => Error::Solver {
                 path: model.source.clone(),
                 problem: format!("the factorization failed: {msg}"),
                 hint: "the problem may be too large for the memory of this machine".into(),
             },
+        }
+    }
+
+    /// `Ok` when every entry of `x` (one per equation) is finite, else the error naming the
+    /// first non-finite one: `what` names the vector, `stage` when it was computed.
+    pub fn check_finite(&self, model: &Model, x: &[f64], what: &str, stage: &str) -> Result<()> {
+        match x.iter().position(|v| !v.is_finite()) {
+            None => Ok(()),
+            Some(e) => Err(non_finite(model, what, x[e], self.dof_of(e), stage)),
         }
     }
 }
@@ -164,6 +201,42 @@ fn orphan_node(model: &Model, d: usize) -> Option<(String, usize)> {
     let node = (d - body.dof_offset) / 2;
     let used = (0..body.mesh.cell_count()).any(|c| body.mesh.cell(c).contains(&node));
     (!used).then(|| (body.name.clone(), node))
+}
+
+/// The largest `|v|`, or NaN when a value is NaN (`f64::max` would drop it).
+pub fn max_abs<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
+    values.into_iter().fold(0.0f64, |m, v| {
+        if m.is_nan() || v.is_nan() {
+            f64::NAN
+        } else {
+            m.max(v.abs())
+        }
+    })
+}
+
+/// The error for a non-finite `value` of `what` at global dof `dof`, computed at `stage`.
+pub fn non_finite(model: &Model, what: &str, value: f64, dof: Option<usize>, stage: &str) -> Error {
+    let at = dof.map_or_else(|| "an unknown dof".into(), |d| describe_dof(model, d));
+    non_finite_at(model, what, value, &at, stage)
+}
+
+/// The error for a non-finite `value` of `what` at the place `at` (in words).
+pub fn non_finite_at(model: &Model, what: &str, value: f64, at: &str, stage: &str) -> Error {
+    let moduli = model
+        .bodies
+        .iter()
+        .map(|b| b.material.youngs_modulus)
+        .fold(0.0f64, f64::max);
+    let loads = max_abs(&model.external_force);
+    Error::Solver {
+        path: model.source.clone(),
+        problem: format!(
+            "{what} is not finite ({value}) at {at}, first seen {stage}; the results would hold NaN or infinity"
+        ),
+        hint: format!(
+            "the loads (nodal forces up to {loads:.3e}), prescribed values or moduli (E up to {moduli:.3e}) are beyond double precision (about 1e308, with products of two such numbers): rescale the units (e.g. N and mm) so that they stay far from it"
+        ),
+    }
 }
 
 /// Assemble `K_ff` and the right-hand side. `extra_blocks` (global dofs) are added to the
@@ -231,6 +304,7 @@ pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Sol
     let t = Instant::now();
     progress("assembling");
     let sys = assemble(model, &[]);
+    sys.check_assembled(model)?;
     timings.assembly = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -245,59 +319,124 @@ pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Sol
         let t = Instant::now();
         progress("solving");
         factor.solve_in_place(&mut x);
+        sys.check_finite(model, &x, "the displacement", "in the solve of K u = f")?;
         // two steps of iterative refinement: on ill-conditioned meshes they bring the solution
         // from about cond(K) eps down to the accuracy of the residual
         let mut r = vec![0.0; sys.n];
-        for _ in 0..2 {
+        for step in 1..=2 {
             sys.pattern.mul(&sys.k, &x, &mut r);
             r.iter_mut().zip(&sys.rhs).for_each(|(a, b)| *a = b - *a);
             factor.solve_in_place(&mut r);
             x.iter_mut().zip(&r).for_each(|(a, d)| *a += d);
+            sys.check_finite(
+                model,
+                &x,
+                "the displacement",
+                &format!("in step {step} of the iterative refinement"),
+            )?;
         }
         timings.solve = t.elapsed().as_secs_f64();
     }
-    if x.iter().any(|v| !v.is_finite()) {
-        return Err(sys.singular(model, None, "a non-finite solution"));
-    }
     let u = sys.expand(&x);
     let t = Instant::now();
-    let mut solution = finish(model, &sys, u, &[], timings);
+    let mut solution = finish(model, &sys, u, &[], timings)?;
     solution.timings.solve += t.elapsed().as_secs_f64();
     Ok(solution)
 }
 
+impl LinearSystem {
+    /// `Ok` when the external forces, the assembled stiffness and the right-hand side
+    /// `f_f - K_fp u_p` are finite, else the error naming the first dof where they are not.
+    pub fn check_assembled(&self, model: &Model) -> Result<()> {
+        if let Some(d) = model.external_force.iter().position(|v| !v.is_finite()) {
+            return Err(non_finite(
+                model,
+                "the external force",
+                model.external_force[d],
+                Some(d),
+                "when the loads were assembled",
+            ));
+        }
+        for j in 0..self.n {
+            let column = self.pattern.col_ptr[j]..self.pattern.col_ptr[j + 1];
+            if let Some(k) = column.clone().find(|&k| !self.k[k].is_finite()) {
+                return Err(non_finite(
+                    model,
+                    "the stiffness",
+                    self.k[k],
+                    self.dof_of(j),
+                    "when the stiffness was assembled",
+                ));
+            }
+        }
+        self.check_finite(
+            model,
+            &self.rhs,
+            "the right-hand side f - K u_prescribed",
+            "when the prescribed values were moved to the right-hand side",
+        )
+    }
+}
+
 /// Reactions and the equilibrium residual of `u`, given contact nodal forces `contact_force`
-/// (global, possibly empty).
+/// (global, possibly empty). Every one of them must be finite: the error names the first dof
+/// where one is not.
 pub fn finish(
     model: &Model,
     sys: &LinearSystem,
     u: Vec<f64>,
     contact_force: &[f64],
     timings: Timings,
-) -> Solution {
+) -> Result<Solution> {
+    if let Some(d) = u.iter().position(|v| !v.is_finite()) {
+        return Err(non_finite(
+            model,
+            "the displacement",
+            u[d],
+            Some(d),
+            "in the solution",
+        ));
+    }
+    if let Some(d) = contact_force.iter().position(|v| !v.is_finite()) {
+        return Err(non_finite(
+            model,
+            "the contact force",
+            contact_force[d],
+            Some(d),
+            "in the nodal contact forces of the solution",
+        ));
+    }
     let mut reactions = residual(model, &u);
     for (r, c) in reactions.iter_mut().zip(contact_force) {
         *r -= c;
     }
+    if let Some(d) = reactions.iter().position(|v| !v.is_finite()) {
+        return Err(non_finite(
+            model,
+            "the reaction K u - f",
+            reactions[d],
+            Some(d),
+            "in the reactions of the solution",
+        ));
+    }
     let eq = &sys.eq;
-    let scale = model
-        .external_force
-        .iter()
-        .chain(contact_force)
-        .chain(
+    let scale = max_abs(
+        model.external_force.iter().chain(contact_force).chain(
             reactions
                 .iter()
                 .enumerate()
                 .filter(|(d, _)| eq[*d] == NO_EQUATION)
                 .map(|(_, r)| r),
-        )
-        .fold(0.0f64, |m, v| m.max(v.abs()));
-    let worst = reactions
-        .iter()
-        .enumerate()
-        .filter(|(d, _)| eq[*d] != NO_EQUATION)
-        .fold(0.0f64, |m, (_, r)| m.max(r.abs()));
-    Solution {
+        ),
+    );
+    let worst = max_abs(
+        reactions
+            .iter()
+            .enumerate()
+            .filter(|(d, _)| eq[*d] != NO_EQUATION)
+            .map(|(_, r)| r),
+    );
+    Ok(Solution {
         u,
         reactions,
         equations: sys.n,
@@ -305,7 +444,7 @@ pub fn finish(
         relative_residual: if scale > 0.0 { worst / scale } else { worst },
         timings,
         contact: None,
-    }
+    })
 }
 
 /// `K u - f`, element by element.
@@ -341,4 +480,18 @@ pub fn describe_dof(model: &Model, dof: usize) -> String {
         }
     }
     format!("dof {dof}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_largest_magnitude_keeps_nan() {
+        assert_eq!(max_abs(&[1.0, -3.0, 2.0]), 3.0);
+        assert!(max_abs(&[1.0, f64::NAN, 2.0]).is_nan());
+        assert!(max_abs(&[f64::NAN, 1.0]).is_nan());
+        assert_eq!(max_abs(&[1.0, f64::NEG_INFINITY]), f64::INFINITY);
+        assert_eq!(max_abs(&[]), 0.0);
+    }
 }

@@ -16,12 +16,25 @@
 //! null eigenvalues are the rank deficiency of the multiplier system (duplicated constraints
 //! of a two-pass discretization), and the pseudo-inverse picks the minimum-norm multipliers,
 //! so the displacement is still returned when it exists.
+//!
+//! Rigid modes: before each solve the rigid modes of every body are tested against the
+//! prescribed dofs and the ACTIVE rows ([`crate::rigid`], three modes per body). The first
+//! active set closes, besides the rows with zero gap, the rows at the smallest gap of a body that
+//! could otherwise move, until its modes are held (closest points first). A later set that
+//! leaves a motion `m` free is solved with springs `S = STABILIZATION K_ee` on the bodies it
+//! moves and with the load's component along `m` removed, so that the iterate carries no
+//! arbitrary rigid motion and only chooses the next set; if the load pushes along `m`, the body
+//! is moved along the push until its first open row closes. A set that leaves a motion free is
+//! never `Converged`: the loop ends with `Singular` naming the body, the mode and why. The
+//! factorizations report pivots that are zero relative to the matrix or needed regularization
+//! ([`crate::sparse`]), and a non-finite iterate is an error naming where it appeared.
 
 use super::discretization::{constraints, gap_second_derivative};
 use super::enforcement::{method, Method};
 use super::Constraint;
 use crate::error::{Error, Result};
 use crate::model::Model;
+use crate::rigid::{FreeMode, RigidModes};
 use crate::scene::{ContactGeometry, MultiplierUpdate};
 use crate::solve::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
 use crate::sparse::{Cholesky, PatternBuilder};
@@ -75,6 +88,10 @@ pub struct ContactState {
 
 /// Largest active set whose rank deficiency is measured for methods without multipliers.
 pub const RANK_CHECK_LIMIT: usize = 500;
+
+/// Most steps of iterative refinement of one LDL^T solve (it stops earlier once the correction
+/// no longer halves or reaches round-off).
+pub const MAX_REFINEMENT: usize = 10;
 
 /// A row in equation space: free equations, coefficients, gap with prescribed values folded in.
 struct EqRow {
@@ -414,6 +431,22 @@ fn solve_at(
     progress("assembling");
     let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.dofs.clone()).collect();
     let mut sys = assemble(model, &blocks);
+    sys.check_assembled(model)?;
+    if let Some(r) = rows
+        .iter()
+        .find(|r| !r.g0.is_finite() || r.coeffs.iter().any(|c| !c.is_finite()))
+    {
+        return Err(crate::solve::non_finite_at(
+            model,
+            "the contact gap or its gradient",
+            r.g0,
+            &format!(
+                "the slave node at ({}, {}) of contact '{}'",
+                r.point[0], r.point[1], model.contact[r.pair].name
+            ),
+            "when the contact rows were evaluated",
+        ));
+    }
     if let (Some(u), Some(forces), true) = (u, previous_forces, model.solver.geometric_stiffness) {
         add_geometric_stiffness(model, &rows, u, forces, &mut sys);
     }
@@ -480,12 +513,25 @@ fn solve_at(
             })
             .collect()
     });
+    let mut eq_dof = vec![0; sys.n];
+    for (d, &e) in sys.eq.iter().enumerate() {
+        if e != NO_EQUATION {
+            eq_dof[e] = d;
+        }
+    }
     let mut kernel = Kernel {
         initial_active,
         history: Vec::new(),
         model,
         sys: &sys,
         rows: &eq_rows,
+        constraints: &rows,
+        modes: RigidModes::new(model),
+        eq_dof,
+        k: sys.k.clone(),
+        rhs: sys.rhs.clone(),
+        free: None,
+        iteration: 0,
         chol,
         saddle: if method == Method::Lagrange {
             Saddle::new(&sys, &eq_rows)
@@ -496,7 +542,7 @@ fn solve_at(
         cache: None,
         factorizations: 0.0,
     };
-    let state = kernel.active_set_loop(method, &rows);
+    let state = kernel.active_set_loop(method, &rows)?;
     let (x, forces, active, termination, iterations) = state;
     let linear_solver = kernel.linear_solver;
     let history = std::mem::take(&mut kernel.history);
@@ -521,7 +567,7 @@ fn solve_at(
     let multipliers = matches!(method, Method::Lagrange | Method::Elimination);
     let rank_deficiency = (multipliers || active_rows.len() <= RANK_CHECK_LIMIT)
         .then(|| rank_deficiency(&active_rows, sys.n));
-    let mut solution = finish(model, &sys, u, &contact_force, timings);
+    let mut solution = finish(model, &sys, u, &contact_force, timings)?;
     solution.contact = Some(ContactState {
         rows,
         active,
@@ -584,6 +630,21 @@ struct Kernel<'a> {
     model: &'a Model,
     sys: &'a LinearSystem,
     rows: &'a [EqRow],
+    /// The same rows in global dofs (rigid-mode test, messages).
+    constraints: &'a [Constraint],
+    modes: RigidModes<'a>,
+    /// Global dof of each equation.
+    eq_dof: Vec<usize>,
+    /// The stiffness of the current solve: `K_ff`, plus the stabilizing springs while a rigid
+    /// motion is free (see [`Kernel::prepare`]).
+    k: Vec<f64>,
+    /// The right-hand side of the current solve: `f_f - K_fp u_p`, without its component
+    /// along the free rigid motions while they are stabilized.
+    rhs: Vec<f64>,
+    /// The rigid motions the current active set leaves free, if any.
+    free: Option<Free>,
+    /// The iteration of the active-set loop (for messages).
+    iteration: usize,
     chol: Cholesky,
     /// Built only for Lagrange multipliers.
     saddle: Option<Saddle>,
@@ -621,6 +682,39 @@ pub struct IterationRecord {
 }
 
 type LoopResult = (Vec<f64>, Vec<f64>, Vec<bool>, Termination, usize);
+
+/// Springs `STABILIZATION K_ee` hold a free rigid motion while the active set leaves it free:
+/// small enough to leave the elastic part of the iterate unchanged to about this relative
+/// amount, large enough that the pivots of the motion stay far above round-off
+/// ([`crate::sparse::TINY_PIVOT`]).
+pub const STABILIZATION: f64 = 1e-8;
+
+/// A load component along a free motion larger than this share of the load pushes the body
+/// (below it, it is round-off of a balanced load).
+const PUSH: f64 = 1e-8;
+
+/// The rigid motions an active set leaves free, in equation space.
+struct Free {
+    /// The body that moves most, its mode, and why.
+    mode: FreeMode,
+    /// The motions `m_k`, orthonormal in the inner product `a^T S b` of the springs `S`.
+    motions: Vec<Vec<f64>>,
+}
+
+/// Why a linear solve of the active-set loop failed: a singular system ends the loop with
+/// [`Termination::Singular`], a fatal error (a non-finite value) ends the run.
+enum StepError {
+    Singular(String),
+    Fatal(Error),
+}
+
+impl From<String> for StepError {
+    fn from(msg: String) -> Self {
+        StepError::Singular(msg)
+    }
+}
+
+type Step<T> = std::result::Result<T, StepError>;
 
 impl Kernel<'_> {
     /// Gap below which a row counts as closed when the active set starts and when a row is
@@ -689,7 +783,7 @@ impl Kernel<'_> {
 
     /// Values of `K + sum_active w_i b_i b_i^T` on the stiffness pattern.
     fn augmented(&self, active: &[bool], w: &[f64]) -> Vec<f64> {
-        let mut values = self.sys.k.clone();
+        let mut values = self.k.clone();
         for (i, row) in self.rows.iter().enumerate() {
             if !active[i] || w[i] == 0.0 {
                 continue;
@@ -711,22 +805,26 @@ impl Kernel<'_> {
     /// `[[K + rho B^T B, -rho B^T], [-rho B, 0]] [u; mu] = [f - rho B^T g0; rho g0]`
     /// (inactive rows: `-rho mu_i = 0`), factored by LDL^T with multipliers ordered last, then
     /// refined. The residual is judged block by block: equilibrium against the force scale,
-    /// gap rows against the model size. If LDL^T refuses, sparse LU of the same matrix is
-    /// tried; `None` when neither gives a small residual (the caller falls back to the Schur
-    /// complement, which also handles dependent rows).
-    fn lagrange_ldlt(&mut self, active: &[bool], rho: f64) -> Option<(Vec<f64>, Vec<f64>)> {
+    /// gap rows against the model size; a non-finite iterate or scale never passes. A pivot
+    /// that needed regularization or is zero relative to the matrix means the system is
+    /// singular: that is an error naming the equation. If LDL^T fails otherwise, sparse LU of
+    /// the same matrix is tried; `None` when neither gives a small residual (the caller falls
+    /// back to the Schur complement, which also handles dependent rows).
+    fn lagrange_ldlt(&mut self, active: &[bool], rho: f64) -> Step<Option<(Vec<f64>, Vec<f64>)>> {
         let t = Instant::now();
         let n = self.sys.n;
         let m = self.rows.len();
         let size = self.model.size();
-        let saddle = self.saddle.as_ref()?;
+        let Some(saddle) = self.saddle.as_ref() else {
+            return Ok(None);
+        };
         let w = vec![rho; m];
         let k = self.augmented(active, &w);
         let mut values = vec![0.0; saddle.pattern.nnz()];
         for (p, &v) in saddle.k_positions.iter().zip(&k) {
             values[*p] += v;
         }
-        let mut rhs = self.sys.rhs.clone();
+        let mut rhs = self.rhs.clone();
         rhs.resize(n + m, 0.0);
         for (i, row) in self.rows.iter().enumerate() {
             let diag = saddle
@@ -745,40 +843,92 @@ impl Kernel<'_> {
         }
         let mut signs = vec![1i8; n + m];
         signs[n..].iter_mut().for_each(|s| *s = -1);
-        let force_scale = rhs[..n].iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        // residual of x, block by block: (equilibrium / forces, gaps / size)
+        let force_scale = crate::solve::max_abs(&rhs[..n]);
+        // residual of x, block by block: (equilibrium / forces, gaps / size); NaN when x or the
+        // scale is not finite, so that it never passes
         let residual = |x: &[f64], r: &mut Vec<f64>| -> (f64, f64) {
-            saddle.pattern.mul(&values, x, r);
-            r.iter_mut().zip(&rhs).for_each(|(a, b)| *a = b - *a);
+            if !force_scale.is_finite() || x.iter().any(|v| !v.is_finite()) {
+                return (f64::NAN, f64::NAN);
+            }
+            saddle.pattern.residual_accurate(&values, x, &rhs, r);
             let forces = x[n..]
                 .iter()
                 .fold(force_scale, |a, v| a.max((rho * v).abs()))
                 .max(f64::MIN_POSITIVE);
-            let ru = r[..n].iter().fold(0.0f64, |a, v| a.max(v.abs())) / forces;
-            let rg = r[n..].iter().fold(0.0f64, |a, v| a.max(v.abs())) / rho / size;
+            let ru = crate::solve::max_abs(&r[..n]) / forces;
+            let rg = crate::solve::max_abs(&r[n..]) / rho / size;
             (ru, rg)
         };
         let small = |(ru, rg): (f64, f64)| ru <= 1e-11 && rg <= 1e-13;
         let mut r = vec![0.0; n + m];
         let mut solved = None;
-        if let Ok(factor) = saddle
+        match saddle
             .ldlt
-            .factor(&saddle.pattern, &values, &signs, 1e-13 * rho)
+            .factor(&saddle.pattern, &values, &signs, 1e-13 * rho, rho)
         {
-            let mut x = rhs.clone();
-            factor.solve_in_place(&mut x);
-            for _ in 0..3 {
-                let res = residual(&x, &mut r);
-                if small(res) {
-                    solved = Some((x.clone(), "ldlt"));
-                    break;
+            Ok(factor) => {
+                let mut x = rhs.clone();
+                factor.solve_in_place(&mut x);
+                // a finite matrix and right-hand side with a non-finite solution or residual:
+                // the numbers overflow, which no other solver can mend
+                saddle.pattern.mul(&values, &x, &mut r);
+                r.iter_mut().zip(&rhs).for_each(|(a, b)| *a = b - *a);
+                let stage = format!("in the LDL^T solve of contact iteration {}", self.iteration);
+                for (v, what) in [(&x, "the solution"), (&r, "the residual K u - f")] {
+                    if let Some(e) = v.iter().position(|v| !v.is_finite()) {
+                        let error = if e < n {
+                            crate::solve::non_finite(
+                                self.model,
+                                what,
+                                v[e],
+                                self.sys.dof_of(e),
+                                &stage,
+                            )
+                        } else {
+                            let c = &self.constraints[e - n];
+                            crate::solve::non_finite_at(
+                                self.model,
+                                &format!("{what} (contact force row)"),
+                                v[e],
+                                &format!(
+                                    "the slave node at ({}, {}) of contact '{}'",
+                                    c.point[0], c.point[1], self.model.contact[c.pair].name
+                                ),
+                                &stage,
+                            )
+                        };
+                        return Err(StepError::Fatal(error));
+                    }
                 }
-                factor.solve_in_place(&mut r);
-                x.iter_mut().zip(&r).for_each(|(a, d)| *a += d);
+                // iterative refinement with an accurate residual, while the correction at
+                // least halves and is above round-off of x: the answer converges to the
+                // solution of the stored matrix to about working precision, so that it does
+                // not depend on the elimination order (the numbering)
+                let mut res = residual(&x, &mut r);
+                let mut last_step = f64::INFINITY;
+                for _ in 0..MAX_REFINEMENT {
+                    factor.solve_in_place(&mut r);
+                    let step = crate::solve::max_abs(&r);
+                    // (a NaN step stops too)
+                    if step.is_nan() || step >= 0.5 * last_step {
+                        break;
+                    }
+                    x.iter_mut().zip(&r).for_each(|(a, d)| *a += d);
+                    last_step = step;
+                    res = residual(&x, &mut r);
+                    if step <= f64::EPSILON * crate::solve::max_abs(&x) {
+                        break;
+                    }
+                }
+                if small(res) {
+                    solved = Some((x, "ldlt"));
+                }
             }
-            if solved.is_none() && small(residual(&x, &mut r)) {
-                solved = Some((x, "ldlt"));
+            Err(e @ crate::sparse::FactorError::ZeroPivot { .. }) => {
+                self.factorizations += t.elapsed().as_secs_f64();
+                return Err(StepError::Singular(self.saddle_error(e)));
             }
+            Err(_) => {}
         }
         if solved.is_none() {
             if let Some(x) = crate::sparse::lu_solve(&saddle.pattern, &values, &rhs) {
@@ -788,24 +938,42 @@ impl Kernel<'_> {
             }
         }
         self.factorizations += t.elapsed().as_secs_f64();
-        let (mut x, solver) = solved?;
+        let Some((mut x, solver)) = solved else {
+            return Ok(None);
+        };
         self.linear_solver = solver;
         let forces = (0..m)
             .map(|i| if active[i] { rho * x[n + i] } else { 0.0 })
             .collect();
         x.truncate(n);
-        Some((x, forces))
+        Ok(Some((x, forces)))
+    }
+
+    /// The message for a singular saddle-point matrix: an equation below `n` is a
+    /// displacement, above it the multiplier of a contact row.
+    fn saddle_error(&self, e: crate::sparse::FactorError) -> String {
+        let n = self.sys.n;
+        match e {
+            crate::sparse::FactorError::ZeroPivot { equation, .. } if equation >= n => {
+                let r = &self.constraints[equation - n];
+                Error::Solver {
+                    path: self.model.source.clone(),
+                    problem: format!(
+                        "the multiplier system is singular at the contact row of the slave node at ({}, {}) of contact '{}'",
+                        r.point[0], r.point[1], self.model.contact[r.pair].name
+                    ),
+                    hint: "the active constraints may depend on each other (a node constrained twice)".into(),
+                }
+                .to_string()
+            }
+            e => self.sys.factor_error(self.model, e).to_string(),
+        }
     }
 
     /// Penalty-type solve: `M u = rhs + sum_active b_i (lambda_k,i - w_i g0_i)`.
-    fn regularized(
-        &mut self,
-        active: &[bool],
-        w: &[f64],
-        lambda_k: &[f64],
-    ) -> std::result::Result<Vec<f64>, String> {
+    fn regularized(&mut self, active: &[bool], w: &[f64], lambda_k: &[f64]) -> Step<Vec<f64>> {
         let f = self.factor(active, w)?;
-        let mut x = self.sys.rhs.clone();
+        let mut x = self.rhs.clone();
         for (i, row) in self.rows.iter().enumerate() {
             if active[i] {
                 row.add_to(lambda_k[i] - w[i] * row.g0, &mut x);
@@ -817,7 +985,7 @@ impl Kernel<'_> {
 
     /// Lagrange multipliers: LDL^T of the saddle-point system when the active rows are
     /// independent, else the Schur complement of the augmented system with a pseudo-inverse.
-    fn lagrange(&mut self, active: &[bool]) -> std::result::Result<(Vec<f64>, Vec<f64>), String> {
+    fn lagrange(&mut self, active: &[bool]) -> Step<(Vec<f64>, Vec<f64>)> {
         let n = self.sys.n;
         // rho: the stiffness scale, so that M stays well conditioned
         let mut rho = 0.0f64;
@@ -835,7 +1003,7 @@ impl Kernel<'_> {
             .map(|(r, _)| r)
             .collect();
         if rank_deficiency(&active_rows, n) == 0 {
-            if let Some(solution) = self.lagrange_ldlt(active, rho) {
+            if let Some(solution) = self.lagrange_ldlt(active, rho)? {
                 return Ok(solution);
             }
         }
@@ -844,7 +1012,7 @@ impl Kernel<'_> {
         let w = vec![rho; self.rows.len()];
         let f = self.factor(active, &w)?;
         let idx: Vec<usize> = (0..self.rows.len()).filter(|&i| active[i]).collect();
-        let mut z0 = self.sys.rhs.clone();
+        let mut z0 = self.rhs.clone();
         for &i in &idx {
             self.rows[i].add_to(-rho * self.rows[i].g0, &mut z0);
         }
@@ -888,11 +1056,7 @@ impl Kernel<'_> {
     }
 
     /// Constraint elimination: each active row solved for its owned equation.
-    fn eliminate(
-        &mut self,
-        active: &[bool],
-        owners: &[usize],
-    ) -> std::result::Result<(Vec<f64>, Vec<f64>), String> {
+    fn eliminate(&mut self, active: &[bool], owners: &[usize]) -> Step<(Vec<f64>, Vec<f64>)> {
         let n = self.sys.n;
         // map: equation -> (reduced terms, constant)
         let mut is_owner = vec![usize::MAX; n];
@@ -948,7 +1112,7 @@ impl Kernel<'_> {
         for j in 0..n {
             for k in p.col_ptr[j]..p.col_ptr[j + 1] {
                 let i = p.row_idx[k];
-                let kij = self.sys.k[k];
+                let kij = self.k[k];
                 let pairs: &[(usize, usize)] = if i == j { &[(i, j)] } else { &[(i, j), (j, i)] };
                 for &(r, c) in pairs {
                     for &(pr, a) in &terms[r] {
@@ -964,10 +1128,10 @@ impl Kernel<'_> {
         }
         // rhs: T^T (rhs - K t)
         let mut kt = vec![0.0; n];
-        p.mul(&self.sys.k, &constant, &mut kt);
+        p.mul(&self.k, &constant, &mut kt);
         let mut rb = vec![0.0; nr];
         for e in 0..n {
-            let v = self.sys.rhs[e] - kt[e];
+            let v = self.rhs[e] - kt[e];
             for &(q, a) in &terms[e] {
                 rb[q] += a * v;
             }
@@ -995,7 +1159,7 @@ impl Kernel<'_> {
         }
         // forces from the residual at the owned equations: (K x - rhs)_o = c_o lambda
         let mut kx = vec![0.0; n];
-        p.mul(&self.sys.k, &x, &mut kx);
+        p.mul(&self.k, &x, &mut kx);
         let mut forces = vec![0.0; self.rows.len()];
         for (i, row) in self.rows.iter().enumerate() {
             if active[i] {
@@ -1005,14 +1169,168 @@ impl Kernel<'_> {
                     .iter()
                     .position(|&q| q == o)
                     .expect("the owner is in its row");
-                forces[i] = (kx[o] - self.sys.rhs[o]) / row.coeffs[k];
+                forces[i] = (kx[o] - self.rhs[o]) / row.coeffs[k];
             }
         }
         Ok((x, forces))
     }
 
-    fn active_set_loop(&mut self, method: Method, rows: &[Constraint]) -> LoopResult {
-        let nrows = self.rows.len();
+    /// Prepare the solve of the active set `active`: if the prescribed dofs and the active rows
+    /// leave a rigid motion free (see [`crate::rigid`]), the matrix would be singular on it. It
+    /// is then stabilized: springs `S = STABILIZATION K_ee` on the equations of the bodies it
+    /// moves, and the load's component along the free motions removed from the right-hand side,
+    /// `f' = f - sum_k S m_k (m_k . f)` with `m_k` orthonormal in `S`, so that the iterate
+    /// satisfies `m_k^T S u = 0` (no arbitrary rigid motion) and only serves to choose the next
+    /// active set. Otherwise `K` and `f` are restored.
+    fn prepare(&mut self, active: &[bool]) {
+        let basis = self.modes.free_motions(
+            self.constraints
+                .iter()
+                .zip(active)
+                .filter(|(_, &a)| a)
+                .map(|(r, _)| (&r.dofs[..], &r.coeffs[..])),
+        );
+        if basis.is_empty() {
+            if self.free.take().is_some() {
+                self.k = self.sys.k.clone();
+                self.rhs = self.sys.rhs.clone();
+                self.cache = None;
+            }
+            return;
+        }
+        let active_rows: Vec<&Constraint> = self
+            .constraints
+            .iter()
+            .zip(active)
+            .filter(|(_, &a)| a)
+            .map(|(r, _)| r)
+            .collect();
+        let mode = self.modes.describe(&basis, &active_rows);
+        let n = self.sys.n;
+        let nb = self.model.bodies.len();
+        let moved: Vec<bool> = (0..nb)
+            .map(|b| {
+                basis
+                    .iter()
+                    .any(|q| (0..3).any(|k| q[3 * b + k].abs() > 1e-12))
+            })
+            .collect();
+        let mut springs = vec![0.0; n];
+        for e in 0..n {
+            if let Some((b, _)) = self.modes.at(self.eq_dof[e]) {
+                if moved[b] {
+                    let p = self.sys.pattern.col_ptr[e + 1] - 1; // the diagonal closes the column
+                    springs[e] = STABILIZATION * self.sys.k[p];
+                }
+            }
+        }
+        // the motions in equation space, orthonormalized in a^T S b (modified Gram-Schmidt)
+        let dot_s = |a: &[f64], b: &[f64]| -> f64 {
+            a.iter()
+                .zip(b)
+                .zip(&springs)
+                .map(|((x, y), s)| x * y * s)
+                .sum()
+        };
+        let mut motions: Vec<Vec<f64>> = Vec::new();
+        for q in &basis {
+            let mut m: Vec<f64> = self
+                .eq_dof
+                .iter()
+                .map(|&d| self.modes.displacement(q, d))
+                .collect();
+            for prev in &motions {
+                let c = dot_s(&m, prev);
+                m.iter_mut().zip(prev).for_each(|(a, p)| *a -= c * p);
+            }
+            let norm = dot_s(&m, &m).sqrt();
+            if norm > 0.0 {
+                m.iter_mut().for_each(|v| *v /= norm);
+                motions.push(m);
+            }
+        }
+        let mut k = self.sys.k.clone();
+        for e in 0..n {
+            k[self.sys.pattern.col_ptr[e + 1] - 1] += springs[e];
+        }
+        let mut rhs = self.sys.rhs.clone();
+        for m in &motions {
+            let c: f64 = m.iter().zip(&self.sys.rhs).map(|(a, b)| a * b).sum();
+            for e in 0..n {
+                rhs[e] -= c * springs[e] * m[e];
+            }
+        }
+        self.k = k;
+        self.rhs = rhs;
+        self.cache = None;
+        self.free = Some(Free { mode, motions });
+    }
+
+    /// After a stabilized solve: if the loads push along the free motions (a component above
+    /// `PUSH` of the load), the body moves rigidly along the push `d = sum_k m_k (m_k . f)` until
+    /// the first open row closes: `x <- x + t d` with `t` the smallest `g_i / (-b_i . d)` over
+    /// the rows that `d` closes. Returns the rows that closed (to be activated); an error when
+    /// no row stops the motion.
+    fn push_to_contact(
+        &self,
+        x: &mut [f64],
+        active: &[bool],
+    ) -> std::result::Result<Vec<usize>, String> {
+        let Some(free) = &self.free else {
+            return Ok(Vec::new());
+        };
+        let f = &self.sys.rhs;
+        let f_norm = f.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let mut d = vec![0.0; self.sys.n];
+        let mut pushed = false;
+        for m in &free.motions {
+            let c: f64 = m.iter().zip(f).map(|(a, b)| a * b).sum();
+            let m_norm = m.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if c.abs() > PUSH * f_norm * m_norm {
+                pushed = true;
+            }
+            d.iter_mut().zip(m).for_each(|(a, v)| *a += c * v);
+        }
+        if !pushed {
+            return Ok(Vec::new());
+        }
+        let d_norm = d.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let closing: Vec<(usize, f64)> = (0..self.rows.len())
+            .filter(|&i| !active[i])
+            .filter_map(|i| {
+                let rate = self.rows[i].dot(&d);
+                (rate < -1e-12 * d_norm).then(|| {
+                    let gap = self.rows[i].g0 + self.rows[i].dot(x);
+                    (i, (gap / -rate).max(0.0))
+                })
+            })
+            .collect();
+        let Some(t) = closing.iter().map(|c| c.1).min_by(f64::total_cmp) else {
+            let name = &self.model.bodies[free.mode.body].name;
+            return Err(Error::Solver {
+                path: self.model.source.clone(),
+                problem: format!(
+                    "the loads push body '{name}' to {} ({}), and no contact row can stop that motion",
+                    free.mode.motion(), free.mode.why
+                ),
+                hint: "add a support that holds this motion, or check the direction of the loads and of the contact normals".into(),
+            }
+            .to_string());
+        };
+        x.iter_mut().zip(&d).for_each(|(a, v)| *a += t * v);
+        Ok(closing
+            .iter()
+            .filter(|c| c.1 <= t + 1e-9 * t.abs().max(f64::MIN_POSITIVE))
+            .map(|c| c.0)
+            .collect())
+    }
+
+    /// The first active set: the closed rows (gap within `gap_tol`) and the ties; then, while a
+    /// body can move rigidly, the rows of that body that would hold the free motion and lie
+    /// at its smallest open gap (within `1e-9` of the model size) are closed too, level by
+    /// level: a body held only by contact across a gap is brought into contact at its closest
+    /// points, the same ones whatever the numbering of its nodes.
+    fn first_active_set(&self, rows: &[Constraint]) -> Vec<bool> {
         let gap_tol = self.gap_tol();
         let size = self.model.size();
         let mut active: Vec<bool> = rows
@@ -1024,6 +1342,112 @@ impl Kernel<'_> {
                 None => c.bilateral || r.g0 <= gap_tol,
             })
             .collect();
+        loop {
+            let basis = self.modes.free_motions(
+                rows.iter()
+                    .zip(&active)
+                    .filter(|(_, &a)| a)
+                    .map(|(r, _)| (&r.dofs[..], &r.coeffs[..])),
+            );
+            if basis.is_empty() {
+                return active;
+            }
+            // open rows that restrain a free motion: |N^T a_i| > 1e-8 |a_i|
+            let holding: Vec<usize> = (0..rows.len())
+                .filter(|&i| !active[i])
+                .filter(|&i| {
+                    let a = self.modes.restraint(&rows[i].dofs, &rows[i].coeffs);
+                    let norm = a.iter().map(|v| v * v).sum::<f64>().sqrt();
+                    let seen = basis
+                        .iter()
+                        .map(|q| q.iter().zip(&a).map(|(x, y)| x * y).sum::<f64>().powi(2))
+                        .sum::<f64>()
+                        .sqrt();
+                    seen > 1e-8 * norm
+                })
+                .collect();
+            let Some(smallest) = holding
+                .iter()
+                .map(|&i| self.rows[i].g0)
+                .min_by(f64::total_cmp)
+            else {
+                return active;
+            };
+            for &i in &holding {
+                if self.rows[i].g0 <= smallest + 1e-9 * size {
+                    active[i] = true;
+                }
+            }
+        }
+    }
+
+    /// The refusal when the active-set loop settles on a set that leaves a rigid motion free:
+    /// the answer would be one of a family that differ by that motion.
+    fn not_unique(&self, active: &[bool], gaps: &[f64]) -> String {
+        let free = &self.free.as_ref().expect("a free motion").mode;
+        let body = &self.model.bodies[free.body];
+        let range = body.dof_offset..body.dof_offset + body.dof_count();
+        let open: Vec<usize> = (0..self.rows.len())
+            .filter(|&i| !active[i] && self.constraints[i].dofs.iter().any(|d| range.contains(d)))
+            .collect();
+        let open_text = match open.iter().min_by(|&&a, &&b| gaps[a].total_cmp(&gaps[b])) {
+            None => "it has no other contact rows".to_string(),
+            Some(&i) => {
+                let p = self.constraints[i].point;
+                format!(
+                    "its other {} contact row(s) stay open (the smallest gap {:.3e} at ({}, {}))",
+                    open.len(),
+                    gaps[i],
+                    p[0],
+                    p[1]
+                )
+            }
+        };
+        Error::Solver {
+            path: self.model.source.clone(),
+            problem: format!(
+                "the solution is not unique: body '{}' can {} ({}); at the end of the active-set iterations {open_text}, so the equilibrium does not fix this motion and any answer would be arbitrary",
+                body.name, free.motion(), free.why
+            ),
+            hint: "hold this motion with a support (e.g. prescribe u_x at a second node off the line of action of the first, or u_y at a node away from the contact), or bring more of the body into contact (a finer mesh at the contact, a larger load)".into(),
+        }
+        .to_string()
+    }
+
+    /// `Err` naming the first non-finite entry of the iterate `x` or of the contact `forces`.
+    fn check_iterate(&self, x: &[f64], forces: &[f64], it: usize) -> Result<()> {
+        let stage = format!(
+            "in contact iteration {it} (linear solver {})",
+            self.linear_solver
+        );
+        self.sys
+            .check_finite(self.model, x, "the displacement", &stage)?;
+        if let Some(i) = forces.iter().position(|v| !v.is_finite()) {
+            let r = &self.constraints[i];
+            return Err(crate::solve::non_finite_at(
+                self.model,
+                "the contact force",
+                forces[i],
+                &format!(
+                    "the slave node at ({}, {}) of contact '{}'",
+                    r.point[0], r.point[1], self.model.contact[r.pair].name
+                ),
+                &stage,
+            ));
+        }
+        Ok(())
+    }
+
+    /// The active-set loop. Before each solve the rigid modes are tested with the active rows
+    /// ([`Kernel::prepare`]); a set that leaves one free is solved stabilized and never counts
+    /// as converged: if the loop settles on it, it ends with [`Termination::Singular`] saying
+    /// which body, which mode and why. A non-finite iterate is an error naming where it
+    /// appeared.
+    fn active_set_loop(&mut self, method: Method, rows: &[Constraint]) -> Result<LoopResult> {
+        let nrows = self.rows.len();
+        let gap_tol = self.gap_tol();
+        let size = self.model.size();
+        let mut active = self.first_active_set(rows);
         let kappa_w = |kappa: f64| -> Vec<f64> { rows.iter().map(|r| kappa * r.area).collect() };
         let owners: Vec<usize> = rows.iter().map(|r| self.sys.eq[r.owner]).collect();
         let mut lambda_k = vec![0.0; nrows];
@@ -1035,7 +1459,9 @@ impl Kernel<'_> {
         for it in 1..=max_iterations {
             let iteration_start = Instant::now();
             let previous_forces = forces.clone();
-            let step = match method {
+            self.iteration = it;
+            self.prepare(&active);
+            let step: Step<(Vec<f64>, Vec<f64>)> = match method {
                 Method::Lagrange => self.lagrange(&active),
                 Method::Elimination => self.eliminate(&active, &owners),
                 Method::Regularized { kappa } | Method::AugmentedLagrange { kappa, .. } => {
@@ -1060,7 +1486,7 @@ impl Kernel<'_> {
                     self.sys.pattern.mul(&self.sys.k, &x, &mut ku);
                     let mut b = vec![0.0; self.sys.n];
                     for j in 0..self.sys.n {
-                        b[j] = self.sys.rhs[j] - ku[j];
+                        b[j] = self.rhs[j] - ku[j];
                     }
                     for (i, row) in self.rows.iter().enumerate() {
                         if active[i] {
@@ -1085,16 +1511,24 @@ impl Kernel<'_> {
                                 .collect();
                             Ok((xn, f))
                         }
-                        Err(e) => Err(e),
+                        Err(e) => Err(e.into()),
                     }
                 }
             };
             let (xn, fnew) = match step {
                 Ok(v) => v,
-                Err(msg) => return (x, forces, active, Termination::Singular(msg), it),
+                Err(StepError::Singular(msg)) => {
+                    return Ok((x, forces, active, Termination::Singular(msg), it))
+                }
+                Err(StepError::Fatal(e)) => return Err(e),
             };
+            self.check_iterate(&xn, &fnew, it)?;
             x = xn;
             forces = fnew;
+            let closing = match self.push_to_contact(&mut x, &active) {
+                Ok(c) => c,
+                Err(msg) => return Ok((x, forces, active, Termination::Singular(msg), it)),
+            };
             let gaps: Vec<f64> = self.rows.iter().map(|r| r.g0 + r.dot(&x)).collect();
             let fmax = forces.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             let force_tol = 1e-10 * fmax;
@@ -1128,6 +1562,10 @@ impl Kernel<'_> {
                     })
                     .collect(),
             };
+            let mut new_active = new_active;
+            for i in closing {
+                new_active[i] = true;
+            }
             let stable = new_active == active;
             self.history.push(IterationRecord {
                 step: 0,
@@ -1174,24 +1612,28 @@ impl Kernel<'_> {
                 }
             };
             if converged {
-                return (x, forces, active, Termination::Converged, it);
+                if self.free.is_some() {
+                    let msg = self.not_unique(&active, &gaps);
+                    return Ok((x, forces, active, Termination::Singular(msg), it));
+                }
+                return Ok((x, forces, active, Termination::Converged, it));
             }
             let cycles = matches!(
                 method,
                 Method::Lagrange | Method::Elimination | Method::Regularized { .. }
             );
             if cycles && !stable && !seen.insert(new_active.clone()) {
-                return (x, forces, active, Termination::ActiveSetCycling, it);
+                return Ok((x, forces, active, Termination::ActiveSetCycling, it));
             }
             active = new_active;
         }
-        (
+        Ok((
             x,
             forces,
             active,
             Termination::IterationLimit,
             max_iterations,
-        )
+        ))
     }
 }
 
