@@ -25,15 +25,17 @@
 //!   elimination) a singular one is `unstable` even when the displacements pass.
 //! * `n/a` cells say why the combination does not apply.
 
+use crate::admit::load;
+use crate::analysis::solve_static;
 use crate::contact::discretization::constraints;
 use crate::contact::enforcement::method;
 use crate::contact::forces::pair_forces;
 use crate::contact::solver::Termination;
 use crate::error::Result;
-use crate::model::{load, Model};
+use crate::model::Model;
 use crate::post::for_each_quadrature_stress;
 use crate::scene::{Catalogue, DiscretizationSpec, MultiplierSpace};
-use crate::solve::{solve_static, Solution};
+use crate::solve::Solution;
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;

@@ -11,11 +11,13 @@
 //! Both meshes converge to the same continuum solution, so a consistent tie shows distances
 //! that shrink under refinement.
 
+use crate::admit::admit;
+use crate::analysis::solve_static;
 use crate::error::{Error, Result};
 use crate::model::{parse, Model};
 use crate::post::CellLocator;
 use crate::scene::{Breaks, Case, DiscretizationSpec, MeshSpec, MultiplierSpace, NormalChoice};
-use crate::solve::{solve_static, Solution};
+use crate::solve::Solution;
 use crate::svg::{line_plot, Series};
 use serde::Serialize;
 use std::path::Path;
@@ -157,7 +159,10 @@ pub fn study(dir: &Path, element: &str, levels: &[usize], plot_level: usize) -> 
         solved: Vec::new(),
     };
     for &k in levels {
-        let one_model = Model::build(&refine(&one, k), &one_path.display().to_string())?;
+        let one_model = admit(Model::build(
+            &refine(&one, k),
+            &one_path.display().to_string(),
+        )?)?;
         let one_solution = solve_static(&one_model, &mut |_| {})?;
         let reference = lines(&one_model, &one_solution, "body")?;
         out.runs.push(LayerRun {
@@ -173,7 +178,10 @@ pub fn study(dir: &Path, element: &str, levels: &[usize], plot_level: usize) -> 
             out.solved
                 .push(("one-body".into(), one_model.clone(), one_solution.clone()));
         }
-        let base = Model::build(&refine(&tied, k), &tied_path.display().to_string())?;
+        let base = admit(Model::build(
+            &refine(&tied, k),
+            &tied_path.display().to_string(),
+        )?)?;
         for (name, disc) in variants() {
             let mut model = base.clone();
             model.contact[0].discretization = disc;

@@ -24,8 +24,11 @@
 //! plug into the opt-in [`scene::Physics`] section and into the equation numbering of
 //! [`solve`]; a scene that does not ask for them never builds them.
 
+pub mod admit;
+pub mod analysis;
 pub mod checks;
 pub mod contact;
+pub mod dense;
 pub mod error;
 pub mod exact;
 pub mod fe;

@@ -11,12 +11,12 @@
 //! * body force `b`: `f_a = int_cell N_a b t_h dA`,
 //!
 //! each with a Gauss rule exact for polynomial data on straight edges and affine cells
-//! (Line2: 3 points, Line3: 4 points). Finally it verifies that every body is held against
-//! its three rigid-body modes, so that an unconstrained body is reported by name instead of
-//! surfacing as a singular matrix.
+//! (Line2: 3 points, Line3: 4 points).
 //!
-//! Everything that can be wrong in a case is found here and reported as `Error::Invalid` (what,
-//! where, how to fix it); nothing later needs to re-validate.
+//! Everything that can be wrong in the case's data is found here and reported as
+//! `Error::Invalid` (what, where, how to fix it); what needs the contact rows (a body that no
+//! support or contact can hold against a rigid motion) is checked once by
+//! [`crate::admit`] before any solve.
 
 use crate::error::{Error, Result};
 use crate::exact::ExactField;
@@ -29,7 +29,6 @@ use crate::scene::{
     TractionSpec, MAX_SOLVER_COUNT,
 };
 use crate::solid::{check_geometry, Elasticity};
-use std::path::Path;
 
 /// One elastic body: its mesh (with named sets), material and first global dof.
 #[derive(Clone, Debug)]
@@ -127,15 +126,6 @@ pub struct Model {
     pub sweep: Option<SweepSpec>,
     /// Load steps, limits and tolerances of the solve.
     pub solver: SolverSpec,
-}
-
-/// Read, parse and validate a case file.
-pub fn load(path: &Path) -> Result<Model> {
-    let source = path.display().to_string();
-    let text =
-        std::fs::read_to_string(path).map_err(|e| Error::io(&source, "reading the case", e))?;
-    let case = parse(&text, &source)?;
-    Model::build(&case, &source)
 }
 
 /// Parse case JSON; errors carry line, column and a hint.
@@ -398,7 +388,6 @@ impl Model {
         model.apply_loads(case)?;
         model.resolve_contact(case)?;
         model.resolve_checks(case)?;
-        model.check_rigid_modes()?;
         Ok(model)
     }
 
@@ -878,49 +867,6 @@ impl Model {
             self.checks.push(check.clone());
         }
         Ok(())
-    }
-
-    /// Every rigid mode of every body must be held by the prescribed dofs and the contact rows
-    /// together, every candidate row counted as closed (see [`crate::rigid`]).
-    fn check_rigid_modes(&self) -> Result<()> {
-        let mut rows = Vec::new();
-        for pair in &self.contact {
-            rows.extend(
-                crate::contact::discretization::constraints(self, pair).map_err(|reason| {
-                    Error::invalid(
-                        &self.source,
-                        format!("contact '{}'", pair.name),
-                        format!("the discretization does not apply: {reason}"),
-                        "choose another discretization for this pair",
-                    )
-                })?,
-            );
-        }
-        let rows: Vec<&crate::contact::Constraint> = rows.iter().collect();
-        let Some(free) = crate::rigid::free_rigid_mode(self, &rows) else {
-            return Ok(());
-        };
-        let in_contact = self.contact.iter().any(|p| {
-            p.slave.0 == free.body
-                || matches!(&p.master, MasterSide::Body { body, .. } if *body == free.body)
-        });
-        let (problem, hint) = if in_contact {
-            (
-                format!("the body is not held against rigid motion even with every contact closed: it can {} ({})", free.motion(), free.why),
-                "add supports; frictionless contact holds a body only along the contact normals (e.g. fix u_x at one node of a punch)",
-            )
-        } else {
-            (
-                format!("the body is not held against rigid motion: it can {} ({})", free.motion(), free.why),
-                "add supports (e.g. \"y\": 0 on a side and \"x\": 0 at one corner) so that it can neither translate nor rotate",
-            )
-        };
-        Err(Error::invalid(
-            &self.source,
-            format!("body '{}'", self.bodies[free.body].name),
-            problem,
-            hint,
-        ))
     }
 }
 

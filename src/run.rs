@@ -1,9 +1,11 @@
 //! One run of one case: load and validate, solve, judge the checks, time every stage.
 
+use crate::admit::load;
+use crate::analysis::solve_static;
 use crate::checks::{evaluate, warnings, CheckResult};
 use crate::error::Result;
-use crate::model::{load, Model};
-use crate::solve::{solve_static, Solution};
+use crate::model::Model;
+use crate::solve::Solution;
 use std::path::Path;
 use std::time::Instant;
 

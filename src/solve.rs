@@ -48,7 +48,7 @@ pub struct Solution {
     pub relative_residual: f64,
     pub timings: Timings,
     /// What the contact solve found, when the model has contact pairs.
-    pub contact: Option<crate::contact::solver::ContactState>,
+    pub contact: Option<crate::contact::state::ContactState>,
 }
 
 /// Equation number of each global dof (`NO_EQUATION` for prescribed dofs).
@@ -294,12 +294,9 @@ pub fn assemble(model: &Model, extra_blocks: &[Vec<usize>]) -> LinearSystem {
     }
 }
 
-/// Solve the static problem (with contact when the model has contact pairs). `progress` is
-/// told the name of each stage as it starts.
-pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
-    if !model.contact.is_empty() {
-        return crate::contact::solver::solve(model, progress);
-    }
+/// Solve the static elastic problem without contact (see [`crate::analysis`] for the entry that
+/// adds contact when the scene asks for it). `progress` is told the name of each stage.
+pub fn solve_elastic(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
     let mut timings = Timings::default();
     let t = Instant::now();
     progress("assembling");

@@ -37,6 +37,7 @@ pub mod geometry;
 pub mod mortar;
 pub mod search;
 pub mod solver;
+pub mod state;
 
 /// One linearized contact constraint (a row of `B`).
 #[derive(Clone, Debug, PartialEq)]

@@ -31,7 +31,9 @@
 
 use super::discretization::{constraints, gap_second_derivative};
 use super::enforcement::{method, Method};
+pub use super::state::{ContactState, Departure, IterationRecord, StepRecord, Termination};
 use super::Constraint;
+use crate::dense::symmetric_eigen;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::rigid::{FreeMode, RigidModes};
@@ -40,51 +42,6 @@ use crate::solve::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATIO
 use crate::sparse::{Cholesky, PatternBuilder};
 use std::collections::{HashMap, HashSet};
 use std::time::Instant;
-
-/// Why the active-set loop stopped.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Termination {
-    Converged,
-    IterationLimit,
-    ActiveSetCycling,
-    /// The linear system could not be solved (the message says why).
-    Singular(String),
-}
-
-/// What the contact solve found.
-#[derive(Clone, Debug)]
-pub struct ContactState {
-    pub rows: Vec<Constraint>,
-    pub active: Vec<bool>,
-    /// Contact force of each row (zero when inactive).
-    pub forces: Vec<f64>,
-    pub gaps: Vec<f64>,
-    pub termination: Termination,
-    /// Linear solves performed (Newton iterations, inner and outer).
-    pub iterations: usize,
-    /// Number of dependent rows among the active constraints (rank deficiency of `B B^T`):
-    /// always computed for Lagrange multipliers and elimination (multiplier systems), for the
-    /// other methods only up to `RANK_CHECK_LIMIT` active rows (it costs `O(m^3)`).
-    pub rank_deficiency: Option<usize>,
-    /// The linear solver of the last iteration: `cholesky` (penalty-type, perturbed tangent,
-    /// augmented Lagrangian, elimination), `ldlt` (Lagrange, independent rows), `lu` (Lagrange,
-    /// when LDL^T refuses) or `schur-pseudo-inverse` (Lagrange, dependent rows).
-    pub linear_solver: &'static str,
-    /// Evaluations of the contact geometry (1 in the reference configuration).
-    pub geometry_updates: usize,
-    /// The displacement the rows were linearized at (`None`: the reference configuration).
-    pub configuration: Option<Vec<f64>>,
-    /// Slave nodes that left the master surface during the geometry updates.
-    pub departures: Vec<Departure>,
-    /// The load steps so far (the last one is this state's).
-    pub steps: Vec<StepRecord>,
-    /// Every iteration of every geometry update of every load step.
-    pub history: Vec<IterationRecord>,
-    /// Relative change of the displacement at each geometry update of the last step (current
-    /// geometry): how the geometry iteration converged.
-    pub geometry_changes: Vec<f64>,
-}
 
 /// Largest active set whose rank deficiency is measured for methods without multipliers.
 pub const RANK_CHECK_LIMIT: usize = 500;
@@ -113,21 +70,6 @@ impl EqRow {
             y[e] += scale * c;
         }
     }
-}
-
-/// One converged (or stopped) load step.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct StepRecord {
-    pub step: usize,
-    pub load_factor: f64,
-    pub termination: Termination,
-    /// Linear solves of the step's active-set loop (its last geometry update).
-    pub iterations: usize,
-    pub geometry_updates: usize,
-    /// Relative change of the displacement at each geometry update (current geometry; empty in
-    /// the reference configuration): quadratic decay where the rows provide their second
-    /// derivative (Newton), linear where the geometry is a fixed point.
-    pub geometry_changes: Vec<f64>,
 }
 
 /// Solve the contact problem of `model` (all pairs share one enforcement method) in the load
@@ -304,18 +246,6 @@ fn slid_off(previous: &HashSet<RowKey>, rows: &[Constraint]) -> Vec<RowKey> {
         .collect();
     lost.sort();
     lost
-}
-
-/// A slave node that was in contact at one geometry update and found no master facet at a
-/// later one (it slid past the end of the master surface): it carries no contact force.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Departure {
-    pub pair: usize,
-    pub body: usize,
-    pub node: usize,
-    /// Where it was when it left (current configuration of that update).
-    pub point: [f64; 2],
-    pub update: usize,
 }
 
 /// The contact rows of every pair, evaluated at `X + u` (reference configuration if `None`)
@@ -656,29 +586,6 @@ struct Kernel<'a> {
     initial_active: Option<Vec<bool>>,
     /// One record per iteration.
     history: Vec<IterationRecord>,
-}
-
-/// What one iteration of the active-set loop did (the solve's history, in `summary.json`).
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct IterationRecord {
-    /// Load step and geometry update (1-based) the iteration belongs to.
-    pub step: usize,
-    pub geometry_update: usize,
-    pub iteration: usize,
-    /// `max |K u - f - B^T lambda|` over the free equations, relative to the largest of
-    /// `|f|` and `|B^T lambda|`.
-    pub residual: f64,
-    /// Active rows during the iteration, and how many changed status after it (the count that
-    /// exposes chattering).
-    pub active: usize,
-    pub status_changes: usize,
-    /// Largest penetration `-g` of a contact row after the iteration.
-    pub max_gap_violation: f64,
-    /// Largest change of a row force from the previous iteration (the first iteration of a
-    /// geometry update or step counts from zero).
-    pub multiplier_change: f64,
-    pub linear_solver: &'static str,
-    pub seconds: f64,
 }
 
 type LoopResult = (Vec<f64>, Vec<f64>, Vec<bool>, Termination, usize);
@@ -1666,79 +1573,6 @@ fn pseudo_solve(s: &[f64], r: &[f64], m: usize) -> std::result::Result<Vec<f64>,
     Ok(x)
 }
 
-/// Eigenvalues and eigenvectors (columns of `v`, row-major) of a symmetric `m x m` matrix
-/// (row-major): faer's self-adjoint eigensolver, with cyclic Jacobi rotations as the fallback
-/// should it report a failure.
-pub fn symmetric_eigen(s: &[f64], m: usize) -> (Vec<f64>, Vec<f64>) {
-    let a = faer::Mat::<f64>::from_fn(m, m, |i, j| s[i * m + j]);
-    match a.self_adjoint_eigen(faer::Side::Lower) {
-        Ok(evd) => {
-            let (u, d) = (evd.U(), evd.S().column_vector());
-            let eig = (0..m).map(|k| d[k]).collect();
-            let mut v = vec![0.0; m * m];
-            for i in 0..m {
-                for k in 0..m {
-                    v[i * m + k] = u[(i, k)];
-                }
-            }
-            (eig, v)
-        }
-        Err(_) => jacobi_eigen(s, m),
-    }
-}
-
-/// Eigenvalues and eigenvectors (columns of `v`, row-major) of a symmetric matrix by cyclic
-/// Jacobi rotations.
-pub fn jacobi_eigen(s: &[f64], m: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut a = s.to_vec();
-    let mut v = vec![0.0; m * m];
-    for i in 0..m {
-        v[i * m + i] = 1.0;
-    }
-    for _sweep in 0..100 {
-        let off: f64 = (0..m)
-            .flat_map(|i| (0..m).filter(move |&j| j != i).map(move |j| (i, j)))
-            .map(|(i, j)| a[i * m + j].powi(2))
-            .sum();
-        let diag: f64 = (0..m).map(|i| a[i * m + i].powi(2)).sum();
-        if off <= 1e-30 * diag || off == 0.0 {
-            break;
-        }
-        for p in 0..m {
-            for q in (p + 1)..m {
-                let apq = a[p * m + q];
-                if apq.abs() < 1e-300 {
-                    continue;
-                }
-                let theta = (a[q * m + q] - a[p * m + p]) / (2.0 * apq);
-                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-                let t = if theta == 0.0 { 1.0 } else { t };
-                let c = 1.0 / (t * t + 1.0).sqrt();
-                let sn = t * c;
-                for k in 0..m {
-                    let akp = a[k * m + p];
-                    let akq = a[k * m + q];
-                    a[k * m + p] = c * akp - sn * akq;
-                    a[k * m + q] = sn * akp + c * akq;
-                }
-                for k in 0..m {
-                    let apk = a[p * m + k];
-                    let aqk = a[q * m + k];
-                    a[p * m + k] = c * apk - sn * aqk;
-                    a[q * m + k] = sn * apk + c * aqk;
-                }
-                for k in 0..m {
-                    let vkp = v[k * m + p];
-                    let vkq = v[k * m + q];
-                    v[k * m + p] = c * vkp - sn * vkq;
-                    v[k * m + q] = sn * vkp + c * vkq;
-                }
-            }
-        }
-    }
-    ((0..m).map(|i| a[i * m + i]).collect(), v)
-}
-
 /// Number of dependent rows among `rows`: null eigenvalues of the Gram matrix `B B^T`.
 fn rank_deficiency(rows: &[&EqRow], n: usize) -> usize {
     let m = rows.len();
@@ -1764,6 +1598,7 @@ fn rank_deficiency(rows: &[&EqRow], n: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dense::jacobi_eigen;
 
     #[test]
     fn jacobi_recovers_a_rank_deficient_spectrum() {

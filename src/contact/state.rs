@@ -1,0 +1,101 @@
+//! What a contact solve found and how it got there: the rows with their forces, gaps and
+//! active set, the termination, and the record of its load steps, geometry updates and
+//! iterations. Plain data, written by [`super::solver`] and read by the checks, the harness and
+//! the output (`summary.json`).
+
+use super::Constraint;
+
+/// Why the active-set loop stopped.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Termination {
+    Converged,
+    IterationLimit,
+    ActiveSetCycling,
+    /// The linear system could not be solved (the message says why).
+    Singular(String),
+}
+
+/// What the contact solve found.
+#[derive(Clone, Debug)]
+pub struct ContactState {
+    pub rows: Vec<Constraint>,
+    pub active: Vec<bool>,
+    /// Contact force of each row (zero when inactive).
+    pub forces: Vec<f64>,
+    pub gaps: Vec<f64>,
+    pub termination: Termination,
+    /// Linear solves performed (Newton iterations, inner and outer).
+    pub iterations: usize,
+    /// Number of dependent rows among the active constraints (rank deficiency of `B B^T`):
+    /// always computed for Lagrange multipliers and elimination (multiplier systems), for the
+    /// other methods only up to [`super::solver::RANK_CHECK_LIMIT`] active rows (it costs `O(m^3)`).
+    pub rank_deficiency: Option<usize>,
+    /// The linear solver of the last iteration: `cholesky` (penalty-type, perturbed tangent,
+    /// augmented Lagrangian, elimination), `ldlt` (Lagrange, independent rows), `lu` (Lagrange,
+    /// when LDL^T refuses) or `schur-pseudo-inverse` (Lagrange, dependent rows).
+    pub linear_solver: &'static str,
+    /// Evaluations of the contact geometry (1 in the reference configuration).
+    pub geometry_updates: usize,
+    /// The displacement the rows were linearized at (`None`: the reference configuration).
+    pub configuration: Option<Vec<f64>>,
+    /// Slave nodes that left the master surface during the geometry updates.
+    pub departures: Vec<Departure>,
+    /// The load steps so far (the last one is this state's).
+    pub steps: Vec<StepRecord>,
+    /// Every iteration of every geometry update of every load step.
+    pub history: Vec<IterationRecord>,
+    /// Relative change of the displacement at each geometry update of the last step (current
+    /// geometry): how the geometry iteration converged.
+    pub geometry_changes: Vec<f64>,
+}
+
+/// One converged (or stopped) load step.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct StepRecord {
+    pub step: usize,
+    pub load_factor: f64,
+    pub termination: Termination,
+    /// Linear solves of the step's active-set loop (its last geometry update).
+    pub iterations: usize,
+    pub geometry_updates: usize,
+    /// Relative change of the displacement at each geometry update (current geometry; empty in
+    /// the reference configuration): quadratic decay where the rows provide their second
+    /// derivative (Newton), linear where the geometry is a fixed point.
+    pub geometry_changes: Vec<f64>,
+}
+
+/// A slave node that was in contact at one geometry update and found no master facet at a
+/// later one (it slid past the end of the master surface): it carries no contact force.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Departure {
+    pub pair: usize,
+    pub body: usize,
+    pub node: usize,
+    /// Where it was when it left (current configuration of that update).
+    pub point: [f64; 2],
+    pub update: usize,
+}
+
+/// What one iteration of the active-set loop did (the solve's history, in `summary.json`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct IterationRecord {
+    /// Load step and geometry update (1-based) the iteration belongs to.
+    pub step: usize,
+    pub geometry_update: usize,
+    pub iteration: usize,
+    /// `max |K u - f - B^T lambda|` over the free equations, relative to the largest of
+    /// `|f|` and `|B^T lambda|`.
+    pub residual: f64,
+    /// Active rows during the iteration, and how many changed status after it (the count that
+    /// exposes chattering).
+    pub active: usize,
+    pub status_changes: usize,
+    /// Largest penetration `-g` of a contact row after the iteration.
+    pub max_gap_violation: f64,
+    /// Largest change of a row force from the previous iteration (the first iteration of a
+    /// geometry update or step counts from zero).
+    pub multiplier_change: f64,
+    pub linear_solver: &'static str,
+    pub seconds: f64,
+}
