@@ -11,18 +11,29 @@
 //! (see [`solid`]); prescribed dofs are eliminated, so the matrix solved is `K_ff`, symmetric
 //! positive definite when every body is held against rigid motion.
 //!
-//! ## Layout
-//! * [`scene`]: the case file (serde, unknown fields rejected) — plain data.
+//! ## Layout (a case flows down this list; no module imports one above it in the flow)
+//! * [`scene`]: the case file (serde, unknown fields and repeated names rejected) — plain data.
 //! * [`model`]: the case validated once into typed objects (meshes, materials, dof numbering,
-//!   prescribed values, consistent loads, resolved checks).
+//!   prescribed values, consistent loads, resolved checks, solver settings);
+//!   [`admit`]: the checks that need the contact rows (rigid modes), and reading a case file.
 //! * [`fe`], [`solid`], [`mesh`]: reference elements, elasticity kernels, meshes and sets.
-//! * [`sparse`]: sparsity pattern computed once, scatter-assembly, sparse Cholesky (faer).
-//! * [`solve`]: the static solve with a timing breakdown; [`post`]: stresses.
-//! * [`checks`]: case-declared checks; [`output`]: `summary.json` and VTK `.vtu` files.
+//! * [`contact`]: the two axes, meeting in [`contact::Constraint`]:
+//!   [`contact::discretization`] (with [`contact::mortar`], [`contact::geometry`],
+//!   [`contact::search`]) makes rows; [`contact::enforcement`] (one module per method) says how
+//!   they are enforced; [`contact::solver`] runs load steps, geometry updates and the active-set
+//!   loop; [`contact::state`] is what it found; [`contact::forces`] turns row forces into the
+//!   forces, pressures and penetrations every report uses.
+//! * [`sparse`], [`dense`]: sparse patterns and factorizations (faer), small dense eigen-solves;
+//!   [`rigid`]: which rigid motions supports and rows leave free.
+//! * [`solve`]: the elastic linear system and its solve; [`analysis`]: the entry that adds
+//!   contact when the scene has pairs; [`post`]: stresses.
+//! * [`checks`]: case-declared checks and warnings; [`output`]: `summary.json` and `.vtu`
+//!   files, written through [`paths`] (the one owner of every path written).
+//! * [`harness`], [`report`], [`layer`], [`svg`]: the patch-test tables and the tied-layer study.
 //!
-//! The contact axes (discretization x enforcement), friction, dynamics and finite deformation
-//! plug into the opt-in [`scene::Physics`] section and into the equation numbering of
-//! [`solve`]; a scene that does not ask for them never builds them.
+//! Physics is opt-in: a scene without contact pairs builds no contact row, and current contact
+//! geometry, load steps and geometric stiffness run only when the case's `physics` and `solver`
+//! sections ask for them.
 
 pub mod admit;
 pub mod analysis;

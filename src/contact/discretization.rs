@@ -40,7 +40,7 @@ const INSIDE: f64 = 1e-9;
 /// facet set (the punch of a patch test widening by Poisson's effect, in the current
 /// configuration) still projects onto it, with the facet's interpolation extrapolated, which is
 /// exact for straight masters. Farther out a node has left the surface.
-pub(crate) const END_EXTENSION: f64 = 0.25;
+pub const END_EXTENSION: f64 = 0.25;
 
 /// Collects rows: one row along `nu` for frictionless pairs, two bilateral rows (x and y) with
 /// zero initial gap for tied pairs.
