@@ -91,7 +91,8 @@ fn worst(a: f64, e: f64) -> f64 {
     }
 }
 
-/// Max over the nodes of `pair` (all pairs if `None`) that carry rows of
+/// Max over the nodes of `pair` (all pairs if `None`) that carry rows, in the forces `forces`
+/// of the solution (from [`pair_forces`]), of
 /// `|f_a / A_a - sigma_exact n_a| / scale` (ties: the whole traction; frictionless pairs: its
 /// normal component, the pressure), with `scale` the given one or, if `None`, `max |sigma_exact|`
 /// at the node (the problem's stress magnitude where that is 0). Infinite when the solve
@@ -99,16 +100,17 @@ fn worst(a: f64, e: f64) -> f64 {
 pub fn pressure_error(
     model: &Model,
     solution: &Solution,
+    forces: &[PairForces],
     exact: &crate::exact::ExactField,
     pair: Option<usize>,
     scale: Option<f64>,
 ) -> f64 {
-    let Some(state) = &solution.contact else {
+    if solution.contact.is_none() {
         return f64::INFINITY;
-    };
+    }
     let fallback = Magnitudes::of(model, solution).stress;
     let mut error = 0.0f64;
-    for pf in pair_forces(model, state) {
+    for pf in forces {
         if pair.is_some_and(|k| k != pf.pair) {
             continue;
         }
@@ -140,14 +142,14 @@ pub fn pressure_error(
 /// Largest over the pairs between deformable bodies of: the net force and moment the pair puts
 /// on its two bodies (relative to the sum of the nodal |contact forces|, moments divided by the
 /// model size; moments about the points where the forces act, in the configuration of the rows),
-/// and the relative equilibrium residual of the solve.
-pub fn force_balance(model: &Model, solution: &Solution) -> f64 {
-    let Some(state) = &solution.contact else {
+/// and the relative equilibrium residual of the solve (`forces` from [`pair_forces`]).
+pub fn force_balance(model: &Model, solution: &Solution, forces: &[PairForces]) -> f64 {
+    if solution.contact.is_none() {
         return f64::INFINITY;
-    };
+    }
     let size = model.size();
     let mut error = solution.relative_residual;
-    for pf in pair_forces(model, state) {
+    for pf in forces {
         if !matches!(model.contact[pf.pair].master, MasterSide::Body { .. })
             || pf.force_scale == 0.0
         {
@@ -285,7 +287,7 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
                 Check::ContactPressure { pair, tol } => {
                     let exact = model.exact.as_ref().expect("resolved when the model was built");
                     let k = model.contact.iter().position(|p| p.name == *pair).expect("resolved when the model was built");
-                    (format!("contact pressure of '{pair}' against the exact stress"), pressure_error(model, solution, exact, Some(k), None), *tol)
+                    (format!("contact pressure of '{pair}' against the exact stress"), pressure_error(model, solution, &forces, exact, Some(k), None), *tol)
                 }
                 Check::ContactForce { pair, component, value, tol } => {
                     let got = pair_of(&forces, model, pair).map(|f| f.on_slave[component.index()]).unwrap_or(f64::NAN);
@@ -305,7 +307,7 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
                     let of = pair.as_ref().map(|p| format!(" of '{p}'")).unwrap_or_default();
                     (format!("largest penetration{of} relative to the contact element size"), got, *share)
                 }
-                Check::ForceBalance { tol } => ("force balance of the contact forces and equilibrium".to_string(), force_balance(model, solution), *tol),
+                Check::ForceBalance { tol } => ("force balance of the contact forces and equilibrium".to_string(), force_balance(model, solution, &forces), *tol),
                 Check::Displacement { body, point, component, value, tol } => {
                     let b = model.body(body).expect("resolved when the model was built");
                     let (n, _) = b.mesh.nearest_node(*point).expect("a body has nodes");

@@ -112,12 +112,14 @@ fn measure(model: &Model, solution: &Solution, pressure: f64) -> Measured {
         }
     }
     let state = solution.contact.as_ref().expect("a contact solve");
+    let forces = pair_forces(model, state);
     let pressure_error = exact
-        .map(|e| crate::checks::pressure_error(model, solution, e, None, Some(pressure.abs())))
+        .map(|e| {
+            crate::checks::pressure_error(model, solution, &forces, e, None, Some(pressure.abs()))
+        })
         .unwrap_or(f64::NAN);
     // total interaction force on the pass-1 slave body, against the exact traction integrated
     // over the slave nodes that carry first-pass rows
-    let forces = pair_forces(model, state);
     let (mut f, mut f_exact, mut length) = ([0.0f64; 2], [0.0f64; 2], 0.0f64);
     let mut first_pass = std::collections::HashSet::new();
     for r in state.rows.iter().filter(|r| r.pass == 1) {
@@ -149,7 +151,7 @@ fn measure(model: &Model, solution: &Solution, pressure: f64) -> Measured {
         stress_error,
         pressure_error,
         load_error,
-        force_balance: crate::checks::force_balance(model, solution),
+        force_balance: crate::checks::force_balance(model, solution, &forces),
         max_penetration,
         rank_deficiency: state.rank_deficiency,
         iterations: state.iterations,

@@ -101,16 +101,17 @@ fn owner(model: &Model, d: usize) -> (usize, usize, usize) {
     (b, local / 2, local % 2)
 }
 
-/// `body` moved to `X + u` (or as it is without `u`).
-fn placed(body: &Body, u: Option<&[f64]>) -> Body {
+/// `body` moved to `X + u` (or as it is, borrowed, without `u`).
+fn placed<'a>(body: &'a Body, u: Option<&[f64]>) -> std::borrow::Cow<'a, Body> {
+    let Some(u) = u else {
+        return std::borrow::Cow::Borrowed(body);
+    };
     let mut b = body.clone();
-    if let Some(u) = u {
-        for (n, p) in b.mesh.nodes.iter_mut().enumerate() {
-            p[0] += u[body.dof(n, 0)];
-            p[1] += u[body.dof(n, 1)];
-        }
+    for (n, p) in b.mesh.nodes.iter_mut().enumerate() {
+        p[0] += u[body.dof(n, 0)];
+        p[1] += u[body.dof(n, 1)];
     }
-    b
+    std::borrow::Cow::Owned(b)
 }
 
 /// Longest facet (chord) at each node of `surface`.

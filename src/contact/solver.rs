@@ -450,6 +450,7 @@ fn solve_at(
         }
     }
     let mut kernel = Kernel {
+        prepared_for: None,
         initial_active,
         history: Vec::new(),
         model,
@@ -557,6 +558,8 @@ impl Saddle {
 }
 
 struct Kernel<'a> {
+    /// The active set `prepare` last ran for.
+    prepared_for: Option<Vec<bool>>,
     model: &'a Model,
     sys: &'a LinearSystem,
     rows: &'a [EqRow],
@@ -1090,6 +1093,11 @@ impl Kernel<'_> {
     /// satisfies `m_k^T S u = 0` (no arbitrary rigid motion) and only serves to choose the next
     /// active set. Otherwise `K` and `f` are restored.
     fn prepare(&mut self, active: &[bool]) {
+        // a function of the active set alone: the iterative methods repeat it many times
+        if self.prepared_for.as_deref() == Some(active) {
+            return;
+        }
+        self.prepared_for = Some(active.to_vec());
         let basis = self.modes.free_motions(
             self.constraints
                 .iter()
