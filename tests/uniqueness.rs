@@ -9,31 +9,19 @@
 //!   on the numbering of the nodes: renumbered meshes give the same field to 1e-12, or the same
 //!   refusal.
 
+mod common;
+use common::defect;
 use contact_patch::contact::solver::Termination;
 use contact_patch::model::{parse, Model};
 use contact_patch::run::{run_model, Outcome};
 use contact_patch::solve::assemble;
 use contact_patch::sparse::Cholesky;
 use serde_json::{json, Value};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn defect(name: &str) -> PathBuf {
-    let dir = root().join("tests/defects");
-    std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|p| {
-            p.file_name()
-                .unwrap()
-                .to_string_lossy()
-                .starts_with(&format!("{name}-"))
-        })
-        .unwrap_or_else(|| panic!("no reproducer {name}"))
 }
 
 fn read(path: &Path) -> Value {

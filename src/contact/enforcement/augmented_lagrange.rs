@@ -28,12 +28,6 @@ impl Enforcement for AugmentedLagrange {
             }
         }
     }
-    fn has_multiplier_system(&self) -> bool {
-        false
-    }
-    fn penalty_like(&self) -> bool {
-        false
-    }
     fn kappa(&self) -> Option<f64> {
         Some(self.kappa)
     }
@@ -42,9 +36,6 @@ impl Enforcement for AugmentedLagrange {
             kappa: self.kappa * factor,
             update: self.update,
         }
-    }
-    fn unknowns_per_row(&self) -> usize {
-        0
     }
     fn kernel(&self) -> Method {
         Method::AugmentedLagrange {

@@ -19,17 +19,8 @@ impl Enforcement for Elimination {
     fn has_multiplier_system(&self) -> bool {
         true
     }
-    fn penalty_like(&self) -> bool {
-        false
-    }
-    fn kappa(&self) -> Option<f64> {
-        None
-    }
     fn scaled(&self, _factor: f64) -> EnforcementSpec {
         EnforcementSpec::Elimination
-    }
-    fn unknowns_per_row(&self) -> usize {
-        0
     }
     fn kernel(&self) -> Method {
         Method::Elimination

@@ -18,12 +18,6 @@ impl Enforcement for Lagrange {
     fn has_multiplier_system(&self) -> bool {
         true
     }
-    fn penalty_like(&self) -> bool {
-        false
-    }
-    fn kappa(&self) -> Option<f64> {
-        None
-    }
     fn scaled(&self, _factor: f64) -> EnforcementSpec {
         EnforcementSpec::Lagrange
     }

@@ -36,16 +36,24 @@ pub trait Enforcement {
     fn title(&self) -> &'static str;
     /// Whether the method solves a multiplier system (Lagrange multipliers, constraint
     /// elimination), whose singularity is a stability failure.
-    fn has_multiplier_system(&self) -> bool;
+    fn has_multiplier_system(&self) -> bool {
+        false
+    }
     /// Whether the converged gap is only approximately zero and depends on the penalty (judged
     /// by the trend of the error as kappa grows).
-    fn penalty_like(&self) -> bool;
+    fn penalty_like(&self) -> bool {
+        false
+    }
     /// The penalty parameter, if the method has one.
-    fn kappa(&self) -> Option<f64>;
+    fn kappa(&self) -> Option<f64> {
+        None
+    }
     /// The same method with its penalty multiplied by `factor` (unchanged without one).
     fn scaled(&self, factor: f64) -> EnforcementSpec;
     /// Unknowns the method adds per active row to the linear system (multipliers).
-    fn unknowns_per_row(&self) -> usize;
+    fn unknowns_per_row(&self) -> usize {
+        0
+    }
     /// What the solver runs.
     fn kernel(&self) -> Method;
     /// Why the method cannot treat `rows`, if it cannot.

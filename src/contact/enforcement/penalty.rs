@@ -16,9 +16,6 @@ impl Enforcement for Penalty {
     fn title(&self) -> &'static str {
         "the penalty method"
     }
-    fn has_multiplier_system(&self) -> bool {
-        false
-    }
     fn penalty_like(&self) -> bool {
         true
     }
@@ -29,9 +26,6 @@ impl Enforcement for Penalty {
         EnforcementSpec::Penalty {
             kappa: self.kappa * factor,
         }
-    }
-    fn unknowns_per_row(&self) -> usize {
-        0
     }
     fn kernel(&self) -> Method {
         Method::Regularized { kappa: self.kappa }

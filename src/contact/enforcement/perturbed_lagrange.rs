@@ -1,7 +1,8 @@
 //! Perturbed Lagrangian: `g_i + lambda_i / (kappa A_i) = 0`, a multiplier per row regularized by
 //! the perturbation `C = diag(1 / (kappa A_i))`. With a diagonal `C` the multipliers can be
 //! eliminated and the numbers are the penalty method's; Taylor 2004 notes the two are "not always
-//! same" (a consistent, non-diagonal `C` for standard mortar multipliers differs).
+//! same" (a consistent, non-diagonal `C` for standard mortar multipliers differs). With the
+//! diagonal `C` the multipliers are eliminated: no unknowns of their own.
 
 use super::{Enforcement, Method};
 use crate::scene::EnforcementSpec;
@@ -17,9 +18,6 @@ impl Enforcement for PerturbedLagrange {
     fn title(&self) -> &'static str {
         "the perturbed Lagrangian"
     }
-    fn has_multiplier_system(&self) -> bool {
-        false
-    }
     fn penalty_like(&self) -> bool {
         true
     }
@@ -30,10 +28,6 @@ impl Enforcement for PerturbedLagrange {
         EnforcementSpec::PerturbedLagrange {
             kappa: self.kappa * factor,
         }
-    }
-    fn unknowns_per_row(&self) -> usize {
-        // eliminated with the diagonal perturbation
-        0
     }
     fn kernel(&self) -> Method {
         Method::Regularized { kappa: self.kappa }

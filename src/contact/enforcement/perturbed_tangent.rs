@@ -16,12 +16,6 @@ impl Enforcement for PerturbedTangent {
     fn title(&self) -> &'static str {
         "the perturbed tangent"
     }
-    fn has_multiplier_system(&self) -> bool {
-        false
-    }
-    fn penalty_like(&self) -> bool {
-        false
-    }
     fn kappa(&self) -> Option<f64> {
         Some(self.kappa)
     }
@@ -29,9 +23,6 @@ impl Enforcement for PerturbedTangent {
         EnforcementSpec::PerturbedTangent {
             kappa: self.kappa * factor,
         }
-    }
-    fn unknowns_per_row(&self) -> usize {
-        0
     }
     fn kernel(&self) -> Method {
         Method::PerturbedTangent { kappa: self.kappa }
