@@ -690,12 +690,18 @@ impl Model {
                 }
             }
             if let Some(first) = self.contact.first() {
-                if first.enforcement != spec.enforcement {
+                let family = |e| crate::contact::enforcement::method(e).kernel().family();
+                let (a, b) = (family(&first.enforcement), family(&spec.enforcement));
+                if a != b {
                     return Err(Error::invalid(
                         &self.source,
-                        &at,
-                        "all contact pairs of a case must use one enforcement method",
-                        "give every pair the same \"enforcement\"",
+                        format!("{at}.enforcement"),
+                        format!(
+                            "the pairs of a case are solved together, and this pair's method cannot be combined with those of pair '{}' ({})",
+                            first.name,
+                            a.describe()
+                        ),
+                        "methods of one family combine, a method per pair: penalty, perturbed Lagrangian and augmented Lagrangian; Lagrange multipliers, the perturbed tangent and constraint elimination each only with themselves",
                     ));
                 }
             }

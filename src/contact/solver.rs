@@ -30,7 +30,7 @@
 //! ([`crate::sparse`]), and a non-finite iterate is an error naming where it appeared.
 
 use super::discretization::{constraints, gap_second_derivative};
-use super::enforcement::{method, Method};
+use super::enforcement::{method, method as enforcement_method, Method};
 pub use super::state::{ContactState, Departure, IterationRecord, StepRecord, Termination};
 use super::Constraint;
 use crate::dense::symmetric_eigen;
@@ -72,7 +72,7 @@ impl EqRow {
     }
 }
 
-/// Solve the contact problem of `model` (all pairs share one enforcement method) in the load
+/// Solve the contact problem of `model` (each pair by its own method, the pairs of one family, see [`super::enforcement::Family`]) in the load
 /// steps of `model.solver`: step `k` of `n` applies the load factor `k / n` and starts from the
 /// active set of step `k - 1` (the only state frictionless contact has to carry). The solve stops
 /// at the first step that does not converge; its termination is the solve's.
@@ -348,16 +348,21 @@ fn solve_at(
     let t = Instant::now();
     progress("contact search");
     let mut rows = rows_at(model, u)?;
-    let enforcement = method(&model.contact[0].enforcement);
-    if let Some(why) = enforcement.obstacle(&rows, &model.prescribed) {
-        return Err(Error::invalid(
-            &model.source,
-            format!("contact '{}'", model.contact[0].name),
-            format!("{} does not apply: {why}", enforcement.title()),
-            "use another enforcement method for this pair",
-        ));
+    // each pair is enforced by its own method; the pairs of one solve share a family
+    // (validated in the model), whose first member drives the loop
+    for (k, pair) in model.contact.iter().enumerate() {
+        let enforcement = method(&pair.enforcement);
+        let of_pair: Vec<Constraint> = rows.iter().filter(|r| r.pair == k).cloned().collect();
+        if let Some(why) = enforcement.obstacle(&of_pair, &model.prescribed) {
+            return Err(Error::invalid(
+                &model.source,
+                format!("contact '{}'", pair.name),
+                format!("{} does not apply: {why}", enforcement.title()),
+                "use another enforcement method for this pair",
+            ));
+        }
     }
-    let method = enforcement.kernel();
+    let method = method(&model.contact[0].enforcement).kernel();
     progress("assembling");
     let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.dofs.clone()).collect();
     let mut sys = assemble(model, &blocks);
@@ -1363,7 +1368,25 @@ impl Kernel<'_> {
         let gap_tol = self.gap_tol();
         let size = self.model.size();
         let mut active = self.first_active_set(rows);
-        let kappa_w = |kappa: f64| -> Vec<f64> { rows.iter().map(|r| kappa * r.area).collect() };
+        // the method of each row (its pair's) and its penalty weight kappa A
+        let row_methods: Vec<Method> = rows
+            .iter()
+            .map(|r| enforcement_method(&self.model.contact[r.pair].enforcement).kernel())
+            .collect();
+        let row_w: Vec<f64> = rows
+            .iter()
+            .zip(&row_methods)
+            .map(|(r, m)| m.kappa().unwrap_or(0.0) * r.area)
+            .collect();
+        let iterative: Vec<bool> = row_methods
+            .iter()
+            .map(|m| {
+                matches!(
+                    m,
+                    Method::AugmentedLagrange { .. } | Method::PerturbedTangent { .. }
+                )
+            })
+            .collect();
         let owners: Vec<usize> = rows.iter().map(|r| self.sys.eq[r.owner]).collect();
         let mut lambda_k = vec![0.0; nrows];
         let mut x = vec![0.0; self.sys.n];
@@ -1379,9 +1402,9 @@ impl Kernel<'_> {
             let step: Step<(Vec<f64>, Vec<f64>)> = match method {
                 Method::Lagrange => self.lagrange(&active),
                 Method::Elimination => self.eliminate(&active, &owners),
-                Method::Regularized { kappa } | Method::AugmentedLagrange { kappa, .. } => {
-                    let w = kappa_w(kappa);
-                    self.regularized(&active, &w, &lambda_k).map(|x| {
+                Method::Regularized { .. } | Method::AugmentedLagrange { .. } => {
+                    let w = &row_w;
+                    self.regularized(&active, w, &lambda_k).map(|x| {
                         let f = (0..nrows)
                             .map(|i| {
                                 if active[i] {
@@ -1394,9 +1417,9 @@ impl Kernel<'_> {
                         (x, f)
                     })
                 }
-                Method::PerturbedTangent { kappa } => {
+                Method::PerturbedTangent { .. } => {
                     // Newton on the Lagrange residual with the perturbed tangent
-                    let w = kappa_w(kappa);
+                    let w = row_w.clone();
                     let mut ku = vec![0.0; self.sys.n];
                     self.sys.pattern.mul(&self.sys.k, &x, &mut ku);
                     let mut b = vec![0.0; self.sys.n];
@@ -1450,12 +1473,11 @@ impl Kernel<'_> {
             // the iterative methods stop when the multiplier update kappa A g of every active
             // row is negligible against the contact forces (1e-12 of the largest), or the gap is
             // at the round-off floor (1e-15 of the model size)
-            let gaps_closed = |kappa: f64| {
-                (0..nrows).filter(|&i| active[i]).all(|i| {
-                    let update = (kappa * rows[i].area * gaps[i]).abs();
-                    update <= 1e-12 * fmax || gaps[i].abs() <= 1e-15 * size
-                })
-            };
+            // (only the rows of iterative methods: a penalty row's gap stays open by design)
+            let gaps_closed = (0..nrows).filter(|&i| active[i] && iterative[i]).all(|i| {
+                let update = (row_w[i] * gaps[i]).abs();
+                update <= 1e-12 * fmax || gaps[i].abs() <= 1e-15 * size
+            });
             // ties (bilateral rows) stay active whatever the sign of their force
             let new_active: Vec<bool> = match method {
                 Method::Lagrange | Method::Elimination | Method::PerturbedTangent { .. } => (0
@@ -1469,12 +1491,8 @@ impl Kernel<'_> {
                             }
                     })
                     .collect(),
-                Method::Regularized { kappa } | Method::AugmentedLagrange { kappa, .. } => (0
-                    ..nrows)
-                    .map(|i| {
-                        rows[i].bilateral
-                            || lambda_k[i] - kappa * rows[i].area * gaps[i] > force_tol
-                    })
+                Method::Regularized { .. } | Method::AugmentedLagrange { .. } => (0..nrows)
+                    .map(|i| rows[i].bilateral || lambda_k[i] - row_w[i] * gaps[i] > force_tol)
                     .collect(),
             };
             let mut new_active = new_active;
@@ -1504,24 +1522,27 @@ impl Kernel<'_> {
                 seconds: iteration_start.elapsed().as_secs_f64(),
             });
             let converged = match method {
-                Method::Lagrange | Method::Elimination | Method::Regularized { .. } => stable,
-                Method::PerturbedTangent { kappa } => stable && gaps_closed(kappa),
-                Method::AugmentedLagrange { kappa, update } => {
-                    let done = stable && gaps_closed(kappa);
-                    // Uzawa: lambda_k <- max(0, lambda_k - kappa A g)
-                    let uzawa = |lk: &mut Vec<f64>| {
+                Method::Lagrange | Method::Elimination => stable,
+                Method::PerturbedTangent { .. } => stable && gaps_closed,
+                Method::Regularized { .. } | Method::AugmentedLagrange { .. } => {
+                    let done = stable && gaps_closed;
+                    // Uzawa on the augmented Lagrangian rows: lambda_k <- max(0, lambda_k -
+                    // kappa A g), after every iteration or (outer loop) once the set is stable
+                    if !done {
                         for i in 0..nrows {
-                            let update = lk[i] - kappa * rows[i].area * gaps[i];
-                            // ties carry forces of either sign; contact only compression
-                            lk[i] = if rows[i].bilateral {
-                                update
-                            } else {
-                                update.max(0.0)
+                            let Method::AugmentedLagrange { update, .. } = row_methods[i] else {
+                                continue;
                             };
+                            if update == MultiplierUpdate::PerIteration || stable {
+                                let next = lambda_k[i] - row_w[i] * gaps[i];
+                                // ties carry forces of either sign; contact only compression
+                                lambda_k[i] = if rows[i].bilateral {
+                                    next
+                                } else {
+                                    next.max(0.0)
+                                };
+                            }
                         }
-                    };
-                    if !done && (update == MultiplierUpdate::PerIteration || stable) {
-                        uzawa(&mut lambda_k);
                     }
                     done
                 }
@@ -1533,10 +1554,11 @@ impl Kernel<'_> {
                 }
                 return Ok((x, forces, active, Termination::Converged, it));
             }
+            // the loops without a multiplier iteration of their own can only cycle
             let cycles = matches!(
                 method,
                 Method::Lagrange | Method::Elimination | Method::Regularized { .. }
-            );
+            ) && !iterative.iter().any(|&it| it);
             if cycles && !stable && !seen.insert(new_active.clone()) {
                 return Ok((x, forces, active, Termination::ActiveSetCycling, it));
             }

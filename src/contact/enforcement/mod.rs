@@ -80,6 +80,55 @@ pub fn method(spec: &EnforcementSpec) -> Box<dyn Enforcement> {
     }
 }
 
+/// Which enforcement methods one contact solve can combine, a method per pair: the loop is
+/// driven by one family. Penalty, perturbed Lagrangian and augmented Lagrangian rows (any
+/// kappa, either Uzawa update) share the penalty-regularized loop; Lagrange multipliers,
+/// the perturbed tangent and constraint elimination each need their own.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Family {
+    LagrangeMultipliers,
+    PenaltyRegularized,
+    PerturbedTangent,
+    Elimination,
+}
+
+impl Method {
+    /// The penalty parameter the kernel uses, if any.
+    pub fn kappa(self) -> Option<f64> {
+        match self {
+            Method::Regularized { kappa }
+            | Method::PerturbedTangent { kappa }
+            | Method::AugmentedLagrange { kappa, .. } => Some(kappa),
+            Method::Lagrange | Method::Elimination => None,
+        }
+    }
+
+    /// The family of methods it can be combined with in one solve.
+    pub fn family(self) -> Family {
+        match self {
+            Method::Lagrange => Family::LagrangeMultipliers,
+            Method::Regularized { .. } | Method::AugmentedLagrange { .. } => {
+                Family::PenaltyRegularized
+            }
+            Method::PerturbedTangent { .. } => Family::PerturbedTangent,
+            Method::Elimination => Family::Elimination,
+        }
+    }
+}
+
+impl Family {
+    pub fn describe(self) -> &'static str {
+        match self {
+            Family::LagrangeMultipliers => "Lagrange multipliers",
+            Family::PenaltyRegularized => {
+                "penalty, perturbed Lagrangian and augmented Lagrangian (any mix)"
+            }
+            Family::PerturbedTangent => "the perturbed tangent",
+            Family::Elimination => "constraint elimination",
+        }
+    }
+}
+
 /// What the solver does for one enforcement method.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub enum Method {
