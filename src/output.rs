@@ -42,6 +42,99 @@ pub struct Summary {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact: Option<ContactSummary>,
     pub timings: Timings,
+    /// The effects the scene asked for and simulated, with the time each took.
+    pub effects: Vec<EffectSummary>,
+}
+
+/// One simulated effect: what it was, and its time (phases that belong to it alone).
+#[derive(Serialize)]
+pub struct EffectSummary {
+    pub effect: String,
+    pub detail: String,
+    /// Seconds and share of the total, where the effect has phases of its own.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seconds: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub share: Option<f64>,
+}
+
+/// The effects of `outcome`'s scene. Elasticity owns meshing and the element assembly; with
+/// contact, the contact solve owns the search, the factorizations and the solves of its loop
+/// (whose matrices hold the elastic stiffness too); without contact those belong to
+/// elasticity. Current geometry and load steps are parts of the contact solve (no time of
+/// their own).
+fn effects(outcome: &Outcome) -> Vec<EffectSummary> {
+    let (model, t) = (&outcome.model, &outcome.solution.timings);
+    let share = |s: f64| (t.total > 0.0).then(|| s / t.total);
+    let contact = outcome.solution.contact.as_ref();
+    let elastic = t.mesh
+        + t.assembly
+        + if contact.is_none() {
+            t.factorization + t.solve
+        } else {
+            0.0
+        };
+    let kinds: std::collections::BTreeSet<String> = model
+        .bodies
+        .iter()
+        .map(|b| format!("{:?}", b.mesh.kind))
+        .collect();
+    let mut out = vec![EffectSummary {
+        effect: "elasticity".into(),
+        detail: format!(
+            "small strain, plane {:?}, {} bodies ({})",
+            model.plane,
+            model.bodies.len(),
+            kinds.into_iter().collect::<Vec<_>>().join(", ")
+        )
+        .to_lowercase(),
+        seconds: Some(elastic),
+        share: share(elastic),
+    }];
+    if let Some(c) = contact {
+        let pairs: Vec<String> = model
+            .contact
+            .iter()
+            .map(|p| {
+                // in the case file's words
+                let words = |v: serde_json::Value| v.to_string().replace('"', "");
+                format!(
+                    "'{}': {}, {}, {}",
+                    p.name,
+                    words(serde_json::json!(p.interaction)),
+                    words(serde_json::json!(p.discretization)),
+                    method(&p.enforcement).name()
+                )
+            })
+            .collect();
+        let seconds = t.contact_search + t.factorization + t.solve;
+        out.push(EffectSummary {
+            effect: "contact".into(),
+            detail: pairs.join("; "),
+            seconds: Some(seconds),
+            share: share(seconds),
+        });
+        if c.configuration.is_some() {
+            out.push(EffectSummary {
+                effect: "current contact geometry".into(),
+                detail: format!(
+                    "{} geometry updates in the last load step",
+                    c.geometry_updates
+                ),
+                seconds: None,
+                share: None,
+            });
+        }
+        if c.steps.len() > 1 {
+            out.push(EffectSummary {
+                effect: "load steps".into(),
+                detail: format!("{} steps", c.steps.len()),
+                seconds: None,
+                share: None,
+            });
+        }
+    }
+    out
 }
 
 /// The contact solve in numbers (forces, pressures and penetrations from
@@ -242,6 +335,7 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
         checks: checks.clone(),
         warnings: outcome.warnings.clone(),
         timings: solution.timings.clone(),
+        effects: effects(outcome),
     }
 }
 

@@ -32,7 +32,20 @@ pub struct Timings {
     pub factorization: f64,
     /// Triangular solves and reactions.
     pub solve: f64,
+    /// Contact search and row evaluation (every geometry update and load step); 0 without
+    /// contact.
+    pub contact_search: f64,
     pub total: f64,
+}
+
+impl Timings {
+    /// Add the phases of another solve (a geometry update or load step) to these.
+    pub fn accumulate(&mut self, other: &Timings) {
+        self.assembly += other.assembly;
+        self.factorization += other.factorization;
+        self.solve += other.solve;
+        self.contact_search += other.contact_search;
+    }
 }
 
 /// The displacement solution and what the solve measured.

@@ -142,3 +142,50 @@ fn a_failed_run_keeps_the_previous_output_whole() {
         .collect();
     assert_eq!(names.len(), 2, "no partial folder may remain: {names:?}");
 }
+
+/// `summary.json` of `case` (relative to the repository) after `run`.
+fn summary_of(case: &str) -> serde_json::Value {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let case = format!("{}/{case}", env!("CARGO_MANIFEST_DIR"));
+    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .args(["run", &case, "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn the_summary_lists_only_the_effects_the_scene_asked_for() {
+    // elasticity alone: no contact section, one effect owning all the solver phases
+    let s = summary_of("cases/patch-single/q4-distorted.json");
+    assert!(s.get("contact").is_none());
+    let effects = s["effects"].as_array().unwrap();
+    assert_eq!(effects.len(), 1, "{effects:?}");
+    assert_eq!(effects[0]["effect"], "elasticity");
+    let t = &s["timings"];
+    let phases: f64 = ["mesh", "assembly", "factorization", "solve"]
+        .iter()
+        .map(|k| t[k].as_f64().unwrap())
+        .sum();
+    assert!((effects[0]["seconds"].as_f64().unwrap() - phases).abs() <= 1e-12);
+    // contact in the current configuration: elasticity, the contact pair in the case's words,
+    // the geometry updates; the shares of the timed effects add up to at most the total
+    let s = summary_of("cases/contact/block-on-rigid-cylinder-finite-sliding.json");
+    let effects = s["effects"].as_array().unwrap();
+    let names: Vec<&str> = effects
+        .iter()
+        .map(|e| e["effect"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["elasticity", "contact", "current contact geometry"]);
+    let detail = effects[1]["detail"].as_str().unwrap();
+    assert!(
+        detail.contains("frictionless")
+            && detail.contains("node_to_surface")
+            && detail.contains("lagrange"),
+        "{detail}"
+    );
+    let shares: f64 = effects.iter().filter_map(|e| e["share"].as_f64()).sum();
+    assert!(shares > 0.0 && shares <= 1.0 + 1e-12, "{shares}");
+}

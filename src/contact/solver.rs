@@ -83,6 +83,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
     let mut start: Option<Vec<f64>> = None;
     let mut departures: Vec<Departure> = Vec::new();
     let mut history: Vec<IterationRecord> = Vec::new();
+    let mut timings = crate::solve::Timings::default();
     let mut step = 1;
     loop {
         let t = step as f64 / n as f64;
@@ -94,6 +95,8 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
             &scaled
         };
         let mut solution = solve_step(at, previous.take(), start.take(), progress)?;
+        timings.accumulate(&solution.timings);
+        solution.timings = timings.clone();
         let state = solution.contact.as_mut().expect("a contact solve");
         records.push(StepRecord {
             step,
@@ -150,6 +153,7 @@ fn solve_step(
             let mut departures: Vec<Departure> = Vec::new();
             let mut history: Vec<IterationRecord> = Vec::new();
             let mut forces: Option<HashMap<RowKey, f64>> = None;
+            let mut timings = crate::solve::Timings::default();
             let mut changes: Vec<f64> = Vec::new();
             let max_updates = model.solver.max_geometry_updates;
             for update in 1..=max_updates {
@@ -181,6 +185,9 @@ fn solve_step(
                     }
                 }
                 state.departures = departures.clone();
+                timings.accumulate(&solution.timings);
+                solution.timings = timings.clone();
+                let state = solution.contact.as_mut().expect("a contact solve");
                 for r in &mut state.history {
                     r.geometry_update = update;
                 }
@@ -348,6 +355,8 @@ fn solve_at(
     let t = Instant::now();
     progress("contact search");
     let mut rows = rows_at(model, u)?;
+    timings.contact_search = t.elapsed().as_secs_f64();
+    let t = Instant::now();
     // each pair is enforced by its own method; the pairs of one solve share a family
     // (validated in the model), whose first member drives the loop
     for (k, pair) in model.contact.iter().enumerate() {
