@@ -22,6 +22,10 @@
 //! steps of iterative refinement. A pivot that the regularization replaced (it then holds
 //! exactly `+-epsilon`) or that is zero relative to its diagonal is an error, never a silently
 //! perturbed matrix.
+//!
+//! General matrices on a structurally symmetric pattern (unsymmetric tangents, saddle systems
+//! LDL^T refuses): [`GeneralPattern`] holds both triangles, [`Lu`] is faer's sparse LU with
+//! partial pivoting whose symbolic analysis is made once per pattern and reused.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError;
@@ -542,33 +546,186 @@ impl LdltFactor {
     }
 }
 
-/// Solve `A x = b` for the symmetric matrix whose upper triangle is `values` by sparse LU with
-/// partial pivoting (both triangles are expanded); `None` if LU fails or the result is not
-/// finite.
-pub fn lu_solve(pattern: &SymmetricPattern, values: &[f64], b: &[f64]) -> Option<Vec<f64>> {
-    use faer::sparse::{SparseColMat, Triplet};
-    let mut triplets = Vec::with_capacity(2 * pattern.nnz());
-    for j in 0..pattern.n {
-        for k in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
-            let i = pattern.row_idx[k];
-            triplets.push(Triplet::new(i, j, values[k]));
-            if i != j {
-                triplets.push(Triplet::new(j, i, values[k]));
+/// The full (both triangles) compressed-column pattern of a matrix whose structure is
+/// symmetric while its values need not be: unsymmetric tangents (Coulomb slip, slave normals
+/// without the `delta xi` term) and saddle-point systems that LDL^T refuses, solved by LU.
+/// Built once from a [`SymmetricPattern`]; `upper[k]` is the position in the symmetric storage
+/// of the entry `k` (or of its transpose), so a symmetric matrix's values expand without search.
+#[derive(Clone, Debug)]
+pub struct GeneralPattern {
+    pub n: usize,
+    pub col_ptr: Vec<usize>,
+    pub row_idx: Vec<usize>,
+    upper: Vec<usize>,
+}
+
+impl GeneralPattern {
+    /// Both triangles of `p`.
+    pub fn from_symmetric(p: &SymmetricPattern) -> GeneralPattern {
+        let n = p.n;
+        let mut count = vec![0usize; n];
+        for j in 0..n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let i = p.row_idx[k];
+                count[j] += 1;
+                if i != j {
+                    count[i] += 1;
+                }
             }
         }
+        let mut col_ptr = vec![0usize; n + 1];
+        for j in 0..n {
+            col_ptr[j + 1] = col_ptr[j] + count[j];
+        }
+        let mut next = col_ptr.clone();
+        let nnz = col_ptr[n];
+        let (mut row_idx, mut upper) = (vec![0usize; nnz], vec![0usize; nnz]);
+        // columns are filled in increasing row order: the lower part of column j (entries (i, j)
+        // with i > j, stored as (j, i) in column i) comes after its upper part, and both arrive
+        // sorted because the loop runs over columns in order
+        for j in 0..n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let i = p.row_idx[k];
+                row_idx[next[j]] = i;
+                upper[next[j]] = k;
+                next[j] += 1;
+                if i != j {
+                    row_idx[next[i]] = j;
+                    upper[next[i]] = k;
+                    next[i] += 1;
+                }
+            }
+        }
+        GeneralPattern {
+            n,
+            col_ptr,
+            row_idx,
+            upper,
+        }
     }
-    let a =
-        SparseColMat::<usize, f64>::try_new_from_triplets(pattern.n, pattern.n, &triplets).ok()?;
-    let lu = a.sp_lu().ok()?;
-    let mut rhs = Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
-    lu.solve_in_place(rhs.as_mut());
-    let x: Vec<f64> = (0..b.len()).map(|i| rhs[(i, 0)]).collect();
-    x.iter().all(|v| v.is_finite()).then_some(x)
+
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// Position of entry `(i, j)` in the value array, if it is in the pattern.
+    pub fn position(&self, i: usize, j: usize) -> Option<usize> {
+        let (a, b) = (self.col_ptr[j], self.col_ptr[j + 1]);
+        self.row_idx[a..b].binary_search(&i).ok().map(|k| a + k)
+    }
+
+    /// The values of the symmetric matrix whose upper triangle is `upper_values`.
+    pub fn symmetric_values(&self, upper_values: &[f64]) -> Vec<f64> {
+        self.upper.iter().map(|&k| upper_values[k]).collect()
+    }
+
+    fn symbolic(&self) -> SymbolicSparseColMatRef<'_, usize> {
+        SymbolicSparseColMatRef::new_checked(self.n, self.n, &self.col_ptr, None, &self.row_idx)
+    }
+}
+
+/// Sparse LU with partial pivoting (faer) whose symbolic analysis (column ordering and
+/// structure) is done once per pattern and reused for every numeric factorization.
+pub struct Lu {
+    symbolic: faer::sparse::linalg::solvers::SymbolicLu<usize>,
+}
+
+/// A numeric LU factorization.
+pub struct LuFactor {
+    lu: faer::sparse::linalg::solvers::Lu<usize, f64>,
+}
+
+impl Lu {
+    pub fn analyse(pattern: &GeneralPattern) -> Result<Lu, FactorError> {
+        faer::sparse::linalg::solvers::SymbolicLu::try_new(pattern.symbolic())
+            .map(|symbolic| Lu { symbolic })
+            .map_err(|e| FactorError::Other(format!("symbolic LU: {e:?}")))
+    }
+
+    /// Factor the matrix with `values` on `pattern` (the pattern of the analysis).
+    pub fn factor(
+        &self,
+        pattern: &GeneralPattern,
+        values: &[f64],
+    ) -> Result<LuFactor, FactorError> {
+        let mat = SparseColMatRef::new(pattern.symbolic(), values);
+        faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(self.symbolic.clone(), mat)
+            .map(|lu| LuFactor { lu })
+            .map_err(|e| FactorError::Other(format!("numeric LU: {e:?}")))
+    }
+}
+
+impl LuFactor {
+    /// Overwrite `b` with `A^-1 b`.
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        let mut rhs = Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
+        self.lu.solve_in_place(rhs.as_mut());
+        for (i, v) in b.iter_mut().enumerate() {
+            *v = rhs[(i, 0)];
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lu_solves_unsymmetric_values_and_reuses_its_analysis() {
+        // a symmetric structure (blocks of a chain) with unsymmetric values
+        let n = 40;
+        let mut pb = PatternBuilder::new(n);
+        for i in 0..n - 2 {
+            pb.add_block(&[i, i + 1, i + 2]);
+        }
+        let general = GeneralPattern::from_symmetric(&pb.build());
+        let lu = Lu::analyse(&general).unwrap();
+        for trial in 0..2 {
+            let mut a = vec![0.0; general.nnz()];
+            for j in 0..n {
+                for k in general.col_ptr[j]..general.col_ptr[j + 1] {
+                    let i = general.row_idx[k];
+                    a[k] = if i == j {
+                        4.0 + trial as f64
+                    } else {
+                        0.3 * (i as f64 + 2.0 * j as f64 + trial as f64).sin()
+                    };
+                }
+            }
+            let x: Vec<f64> = (0..n).map(|i| (0.7 * i as f64).cos()).collect();
+            let mut b = vec![0.0; n];
+            for j in 0..n {
+                for k in general.col_ptr[j]..general.col_ptr[j + 1] {
+                    b[general.row_idx[k]] += a[k] * x[j];
+                }
+            }
+            lu.factor(&general, &a).unwrap().solve_in_place(&mut b);
+            for i in 0..n {
+                assert!(
+                    (b[i] - x[i]).abs() < 1e-12,
+                    "trial {trial}, {i}: {} vs {}",
+                    b[i],
+                    x[i]
+                );
+            }
+        }
+        // symmetric values expand from the upper triangle
+        let mut pb = PatternBuilder::new(3);
+        pb.add_block(&[0, 1, 2]);
+        let p = pb.build();
+        let upper: Vec<f64> = (0..p.nnz()).map(|k| k as f64 + 1.0).collect();
+        let g = GeneralPattern::from_symmetric(&p);
+        let full = g.symmetric_values(&upper);
+        for i in 0..3 {
+            for j in 0..3 {
+                let (r, c) = (i.min(j), i.max(j));
+                assert_eq!(
+                    full[g.position(i, j).unwrap()],
+                    upper[p.position(r, c).unwrap()]
+                );
+            }
+        }
+    }
 
     #[test]
     fn assembled_laplacian_solves() {

@@ -538,6 +538,29 @@ struct Saddle {
     /// Position in `pattern` of each stored entry of the stiffness pattern.
     k_positions: Vec<usize>,
     ldlt: crate::sparse::Ldlt,
+    /// Both triangles of `pattern` and its LU analysis, made on the first LU fallback and reused
+    /// by every later one.
+    lu: std::cell::OnceCell<Option<(crate::sparse::GeneralPattern, crate::sparse::Lu)>>,
+}
+
+impl Saddle {
+    /// Solve with the saddle matrix whose upper triangle is `values` by LU (the fallback when
+    /// LDL^T refuses); `None` when LU fails or gives a non-finite result.
+    fn lu_solve(&self, values: &[f64], rhs: &[f64]) -> Option<Vec<f64>> {
+        let (general, lu) = self
+            .lu
+            .get_or_init(|| {
+                let general = crate::sparse::GeneralPattern::from_symmetric(&self.pattern);
+                crate::sparse::Lu::analyse(&general)
+                    .ok()
+                    .map(|lu| (general, lu))
+            })
+            .as_ref()?;
+        let factor = lu.factor(general, &general.symmetric_values(values)).ok()?;
+        let mut x = rhs.to_vec();
+        factor.solve_in_place(&mut x);
+        x.iter().all(|v| v.is_finite()).then_some(x)
+    }
 }
 
 impl Saddle {
@@ -567,6 +590,7 @@ impl Saddle {
             pattern,
             k_positions,
             ldlt,
+            lu: std::cell::OnceCell::new(),
         })
     }
 }
@@ -855,7 +879,7 @@ impl Kernel<'_> {
             Err(_) => {}
         }
         if solved.is_none() {
-            if let Some(x) = crate::sparse::lu_solve(&saddle.pattern, &values, &rhs) {
+            if let Some(x) = saddle.lu_solve(&values, &rhs) {
                 if small(residual(&x, &mut r)) {
                     solved = Some((x, "lu"));
                 }
