@@ -23,13 +23,13 @@
 //!   they are enforced; [`contact::solver`] runs load steps, geometry updates and the active-set
 //!   loop; [`contact::state`] is what it found; [`contact::forces`] turns row forces into the
 //!   forces, pressures and penetrations every report uses.
-//! * [`sparse`], [`dense`]: sparse patterns and factorizations (faer), small dense eigen-solves;
-//!   [`rigid`]: which rigid motions supports and rows leave free.
+//! * [`sparse`], `dense`: sparse patterns and factorizations (faer), small dense eigen-solves;
+//!   `rigid`: which rigid motions supports and rows leave free.
 //! * [`solve`]: the elastic linear system and its solve; [`analysis`]: the entry that adds
 //!   contact when the scene has pairs; [`post`]: stresses.
 //! * [`checks`]: case-declared checks and warnings; [`output`]: `summary.json` and `.vtu`
 //!   files, written through [`paths`] (the one owner of every path written).
-//! * [`harness`], [`report`], [`layer`], [`svg`]: the patch-test tables and the tied-layer study.
+//! * [`harness`], [`report`], [`layer`], `svg`: the patch-test tables and the tied-layer study.
 //!
 //! Physics is opt-in: a scene without contact pairs builds no contact row, and current contact
 //! geometry, load steps and geometric stiffness run only when the case's `physics` and `solver`
@@ -39,7 +39,7 @@ pub mod admit;
 pub mod analysis;
 pub mod checks;
 pub mod contact;
-pub mod dense;
+pub(crate) mod dense;
 pub mod error;
 pub mod exact;
 pub mod fe;
@@ -51,12 +51,12 @@ pub mod output;
 pub mod paths;
 pub mod post;
 pub mod report;
-pub mod rigid;
+pub(crate) mod rigid;
 pub mod run;
 pub mod scene;
 pub mod solid;
 pub mod solve;
 pub mod sparse;
-pub mod svg;
+pub(crate) mod svg;
 
 pub use error::{Error, Result};

@@ -18,7 +18,7 @@
 //! so the displacement is still returned when it exists.
 //!
 //! Rigid modes: before each solve the rigid modes of every body are tested against the
-//! prescribed dofs and the ACTIVE rows ([`crate::rigid`], three modes per body). The first
+//! prescribed dofs and the ACTIVE rows (`crate::rigid`, three modes per body). The first
 //! active set closes, besides the rows with zero gap, the rows at the smallest gap of a body that
 //! could otherwise move, until its modes are held (closest points first). A later set that
 //! leaves a motion `m` free is solved with springs `S = STABILIZATION K_ee` on the bodies it
@@ -1124,7 +1124,7 @@ impl Kernel<'_> {
     }
 
     /// Prepare the solve of the active set `active`: if the prescribed dofs and the active rows
-    /// leave a rigid motion free (see [`crate::rigid`]), the matrix would be singular on it. It
+    /// leave a rigid motion free (see `crate::rigid`), the matrix would be singular on it. It
     /// is then stabilized: springs `S = STABILIZATION K_ee` on the equations of the bodies it
     /// moves, and the load's component along the free motions removed from the right-hand side,
     /// `f' = f - sum_k S m_k (m_k . f)` with `m_k` orthonormal in `S`, so that the iterate
