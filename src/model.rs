@@ -50,6 +50,11 @@ impl Body {
         2 * self.mesh.nodes.len()
     }
 
+    /// Whether global dof `d` belongs to this body.
+    pub fn owns(&self, d: usize) -> bool {
+        d >= self.dof_offset && d < self.dof_offset + self.dof_count()
+    }
+
     /// Global dofs of cell `c`, in element dof order `[x0, y0, x1, y1, ...]`.
     pub fn cell_dofs(&self, c: usize, out: &mut Vec<usize>) {
         out.clear();
@@ -58,6 +63,14 @@ impl Body {
             out.push(self.dof(n, 1));
         }
     }
+}
+
+/// A global dof in the user's terms: body index, local node and component (0 = x, 1 = y).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct DofRef {
+    pub body: usize,
+    pub node: usize,
+    pub component: usize,
 }
 
 /// The master side of a resolved contact pair.
@@ -216,6 +229,25 @@ impl Model {
             *v *= t;
         }
         m
+    }
+
+    /// Body, node and component of global dof `d`: the one inverse of the numbering
+    /// `offset_b + 2 node + component` (bodies are numbered in order, so a binary search on
+    /// the offsets finds the body). `None` past the last dof.
+    pub fn dof_owner(&self, d: usize) -> Option<DofRef> {
+        let b = self
+            .bodies
+            .partition_point(|b| b.dof_offset <= d)
+            .checked_sub(1)?;
+        let body = &self.bodies[b];
+        body.owns(d).then(|| {
+            let local = d - body.dof_offset;
+            DofRef {
+                body: b,
+                node: local / 2,
+                component: local % 2,
+            }
+        })
     }
 
     pub fn body_index(&self, name: &str) -> Option<usize> {
@@ -1192,5 +1224,41 @@ fn add_body_force(body: &Body, b: [f64; 2], thickness: f64, force: &mut [f64]) {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod dof_numbering_tests {
+    use super::*;
+
+    #[test]
+    fn dof_owner_inverts_the_numbering() {
+        let text = r#"{"name": "two", "materials": {"m": {"E": 1.0, "nu": 0.3}},
+            "bodies": [
+              {"name": "a", "material": "m", "mesh": {"block": {"element": "Q4", "x": [0, 1, 2], "y": [0, 1]}}},
+              {"name": "b", "material": "m", "mesh": {"block": {"element": "Q9", "x": [0, 1], "y": [1, 2]}}}],
+            "supports": [{"body": "a", "set": "bottom", "x": 0.0, "y": 0.0},
+                         {"body": "b", "set": "top", "x": 0.0, "y": 0.0}]}"#;
+        let model = Model::build(&parse(text, "two").unwrap(), "two").unwrap();
+        let mut seen = 0;
+        for (bi, b) in model.bodies.iter().enumerate() {
+            for node in 0..b.mesh.nodes.len() {
+                for component in 0..2 {
+                    let d = b.dof(node, component);
+                    assert_eq!(
+                        model.dof_owner(d),
+                        Some(DofRef {
+                            body: bi,
+                            node,
+                            component
+                        })
+                    );
+                    assert!(b.owns(d));
+                    seen += 1;
+                }
+            }
+        }
+        assert_eq!(seen, model.dof_count);
+        assert_eq!(model.dof_owner(model.dof_count), None);
     }
 }

@@ -119,11 +119,7 @@ impl<'a> RigidModes<'a> {
 
     /// The body of global dof `d` and the values `(t_x, t_y, r)` of its three modes there.
     pub fn at(&self, d: usize) -> Option<(usize, [f64; 3])> {
-        let b = self
-            .model
-            .bodies
-            .iter()
-            .position(|b| d >= b.dof_offset && d < b.dof_offset + b.dof_count())?;
+        let b = self.model.dof_owner(d)?.body;
         let body = &self.model.bodies[b];
         let local = d - body.dof_offset;
         let p = body.mesh.nodes[local / 2];
@@ -224,11 +220,7 @@ impl<'a> RigidModes<'a> {
         let b = &self.model.bodies[body];
         let on_body: Vec<&&Constraint> = rows
             .iter()
-            .filter(|r| {
-                r.dofs
-                    .iter()
-                    .any(|&d| d >= b.dof_offset && d < b.dof_offset + b.dof_count())
-            })
+            .filter(|r| r.dofs.iter().any(|&d| b.owns(d)))
             .collect();
         let [px, py] = self.prescribed_count[body];
         let supports = match (px, py) {

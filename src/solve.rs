@@ -207,11 +207,8 @@ impl LinearSystem {
 
 /// The body and node of global dof `d` when that node belongs to no cell.
 fn orphan_node(model: &Model, d: usize) -> Option<(String, usize)> {
-    let body = model
-        .bodies
-        .iter()
-        .find(|b| d >= b.dof_offset && d < b.dof_offset + b.dof_count())?;
-    let node = (d - body.dof_offset) / 2;
+    let owner = model.dof_owner(d)?;
+    let (body, node) = (&model.bodies[owner.body], owner.node);
     let used = (0..body.mesh.cell_count()).any(|c| body.mesh.cell(c).contains(&node));
     (!used).then(|| (body.name.clone(), node))
 }
@@ -475,21 +472,21 @@ pub fn residual(model: &Model, u: &[f64]) -> Vec<f64> {
 
 /// "body 'x', node n at (x, y), u_x" for a global dof.
 pub fn describe_dof(model: &Model, dof: usize) -> String {
-    for body in &model.bodies {
-        if dof >= body.dof_offset && dof < body.dof_offset + body.dof_count() {
-            let local = dof - body.dof_offset;
-            let node = local / 2;
-            let p = body.mesh.nodes[node];
-            return format!(
-                "body '{}', node {node} at ({}, {}), u_{}",
+    match model.dof_owner(dof) {
+        Some(r) => {
+            let body = &model.bodies[r.body];
+            let p = body.mesh.nodes[r.node];
+            format!(
+                "body '{}', node {} at ({}, {}), u_{}",
                 body.name,
+                r.node,
                 p[0],
                 p[1],
-                ["x", "y"][local % 2]
-            );
+                ["x", "y"][r.component]
+            )
         }
+        None => format!("dof {dof}"),
     }
-    format!("dof {dof}")
 }
 
 #[cfg(test)]

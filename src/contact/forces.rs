@@ -92,13 +92,8 @@ impl PairForces {
 
 /// The body owning global dof `d`, and the local node and component.
 fn owner(model: &Model, d: usize) -> (usize, usize, usize) {
-    let b = model
-        .bodies
-        .iter()
-        .position(|b| d >= b.dof_offset && d < b.dof_offset + b.dof_count())
-        .expect("a body owns every dof");
-    let local = d - model.bodies[b].dof_offset;
-    (b, local / 2, local % 2)
+    let r = model.dof_owner(d).expect("a body owns every dof");
+    (r.body, r.node, r.component)
 }
 
 /// `body` moved to `X + u` (or as it is, borrowed, without `u`).
