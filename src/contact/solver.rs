@@ -72,10 +72,11 @@ impl EqRow {
     }
 }
 
-/// Solve the contact problem of `model` (each pair by its own method, the pairs of one family, see [`super::enforcement::Family`]) in the load
-/// steps of `model.solver`: step `k` of `n` applies the load factor `k / n` and starts from the
-/// active set of step `k - 1` (the only state frictionless contact has to carry). The solve stops
-/// at the first step that does not converge; its termination is the solve's.
+/// Solve the contact problem of `model` (each pair by its own method, the pairs of one family,
+/// see [`super::enforcement::Family`]) in the load steps of `model.solver`: step `k` of `n`
+/// applies the load factor `k / n` and starts from the active set of step `k - 1` (the only
+/// state frictionless contact has to carry). The solve stops at the first step that does not
+/// converge; its termination is the solve's.
 pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
     let n = model.solver.load_steps;
     let mut previous: Option<HashSet<RowKey>> = None;
