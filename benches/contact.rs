@@ -4,12 +4,12 @@
 //! patch mesh E. Read the figures as ratios within one run (e.g. augmented Lagrangian vs
 //! Lagrange), never as absolute times across machines.
 
-use contact_patch::admit::load;
-use contact_patch::analysis::solve_static;
-use contact_patch::model::Model;
-use contact_patch::scene::{
+use contact_patch::io::scene::{
     DiscretizationSpec, EnforcementSpec, MultiplierSpace, MultiplierUpdate, NormalChoice,
 };
+use contact_patch::model::admit::load;
+use contact_patch::model::Model;
+use contact_patch::solver::solve_static;
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::path::Path;

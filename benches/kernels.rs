@@ -10,8 +10,8 @@
 use contact_patch::fe::ElementKind;
 use contact_patch::model::{parse, Model};
 use contact_patch::solid::{element_stiffness, Elasticity, MAX_DOFS};
-use contact_patch::solve::{assemble, for_each_element_stiffness};
-use contact_patch::sparse::Cholesky;
+use contact_patch::solver::linear::{assemble, for_each_element_stiffness};
+use contact_patch::solver::sparse::Cholesky;
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 
@@ -28,7 +28,7 @@ fn distorted(kind: ElementKind) -> Vec<[f64; 2]> {
 }
 
 fn kernels(c: &mut Criterion) {
-    let mat = Elasticity::new(1000.0, 0.3, contact_patch::scene::Plane::Strain);
+    let mat = Elasticity::new(1000.0, 0.3, contact_patch::io::scene::Plane::Strain);
     let mut group = c.benchmark_group("element_stiffness");
     for kind in [
         ElementKind::Q4,

@@ -3,7 +3,7 @@ resolved on the mesh that our tool wrote (`<out>/<body>.vtu`), never on a regene
 
 The definitions mirror the Rust sources:
 
-* exact fields (src/exact.rs): uniform stress `sigma_0` with `u = [e_xx x + g/2 y, g/2 x + e_yy y]`,
+* exact fields (src/harness/exact.rs): uniform stress `sigma_0` with `u = [e_xx x + g/2 y, g/2 x + e_yy y]`,
   `e = D^-1 sigma_0`; Timoshenko & Goodier's cantilever (plane-stress formulas, plane strain
   through `E/(1 - nu^2)`, `nu/(1 - nu)`);
 * materials (src/solid.rs): plane strain `lambda = E nu/((1+nu)(1-2nu))`, plane stress
@@ -12,7 +12,7 @@ The definitions mirror the Rust sources:
   the bounding box, the corner sets the node at each corner, tolerance `1e-9 * size`;
   `box` sets are closed axis-aligned boxes, `point` the node at a point, `nodes` node ids
   (which are the .vtu point ids: the .vtu keeps our node order);
-* loads (src/model.rs): traction `t`, pressure `t = -p n` (outward `n`), exact traction
+* loads (src/model/mod.rs): traction `t`, pressure `t = -p n` (outward `n`), exact traction
   `t = sigma_exact(x) n`, body force `b`; all times the thickness.
 
 Each solver receives supports as (node coordinates, component, values) and loads as
@@ -309,7 +309,7 @@ EDGES = {
     "T6": [(0, 1, 3), (1, 2, 4), (2, 0, 5)],
 }
 
-# The nodal weights of our contact rows (src/contact/geometry.rs): A_a = t int N_a ds, which on a
+# The nodal weights of our contact rows (src/contact/discretization/geometry.rs): A_a = t int N_a ds, which on a
 # straight Line2 edge is half the length at each end (the trapezoidal rule at the nodes) and on
 # a Line3 edge 1/6, 2/3, 1/6 of the length (Simpson's rule at the nodes). A penalty term
 # int kappa (g)_- (v . n) ds evaluated with that rule gives exactly our rows' forces
@@ -324,7 +324,7 @@ NODAL_RULE = {
 
 class RigidContact:
     """A frictionless pair of the body's facet set against a rigid line or circle with
-    node-to-surface rows and a penalty (src/contact/discretization.rs, `rigid_rows`).
+    node-to-surface rows and a penalty (src/contact/discretization/mod.rs, `rigid_rows`).
 
     Small strain: the geometry is the reference one, so at a slave point X the gap is linear,
     g(u) = g0(X) + n(X) . u, with n the unit normal of the rigid surface at X:
@@ -360,7 +360,7 @@ class RigidContact:
             raise Unsupported(f"contact '{self.name}': discretization {disc}")
         enf = spec["enforcement"]
         # penalty and perturbed Lagrangian give identical numbers with node rows
-        # (src/contact/enforcement.rs); the references solve the penalty problem.
+        # (src/contact/enforcement/); the references solve the penalty problem.
         if enf.get("kind") not in ("penalty", "perturbed_lagrange"):
             raise Unsupported(f"contact '{self.name}': enforcement {enf.get('kind')!r} "
                               "(the cross-check solves penalty problems)")

@@ -27,7 +27,7 @@ objects whose quadrature is built element by element on the supermesh with
 
 * **mortar tie, the case's multiplier space**: the rows `int Phi_j (u_s - u_m) ds = 0` per
   slave node j and component, with `Phi_j` the slave traces (standard) or the biorthogonal
-  functions of src/contact/mortar.rs (dual: on each slave facet, Line2 `2 N_a - N_b`, Line3
+  functions of src/contact/discretization/mortar.rs (dual: on each slave facet, Line2 `2 N_a - N_b`, Line3
   `(3 N_a + N_b)/2 - N_m/4` at the ends and `3 N_m/2 - N_a - N_b` in the middle), assembled
   as a mass matrix against a discontinuous (ElementDG) copy of the slave element and combined
   facet by facet; each row scaled by `int Phi_j` and coefficients below 1e-12 dropped (ours:
@@ -68,7 +68,7 @@ DEGREE = {"Q4": 1, "Q9": 2, "T3": 1, "T6": 2}
 # Quadrature order on the supermesh segments: Phi_j N_k is of degree 2 (Line2) or 4 (Line3).
 MORTAR_ORDER = 4
 # Dual multipliers in terms of the facet's shape functions, rows/columns [start, end(, mid)]
-# (src/contact/mortar.rs: Line2 (1 -+ 3 s)/2; Line3 (5 s^2 -+ 2 s - 1)/4, (3 - 5 s^2)/2).
+# (src/contact/discretization/mortar.rs: Line2 (1 -+ 3 s)/2; Line3 (5 s^2 -+ 2 s - 1)/4, (3 - 5 s^2)/2).
 DUAL = {2: np.array([[2.0, -1.0], [-1.0, 2.0]]),
         3: np.array([[1.5, 0.5, -0.25], [0.5, 1.5, -0.25], [-1.0, -1.0, 1.5]])}
 NITSCHE_GAMMA = 10.0

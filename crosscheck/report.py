@@ -23,7 +23,7 @@ contact results or the tie solutions; see ref_dolfinx.py and ref_skfem.py). Quan
 * two bodies tied by a mortar pair: scikit-fem's mortar tie with the same multipliers; the
   field over both bodies (and per body), tolerance 1e-10. DOLFINx: not applicable (n/a).
 * studies (OUT_ROOT/studies.json, written by studies.py), sampled with common.Sampler:
-  - tied layer: du of src/layer.rs (our dual mortar tie against the one-body solution of our
+  - tied layer: du of src/harness/layer.rs (our dual mortar tie against the one-body solution of our
     tool, DOLFINx and scikit-fem at the same level); the three must agree to 1e-8 (absolute)
     with each other and with reports/tied-layer.json, and du must shrink at every level;
   - two blocks: distances of our mortar tie and of scikit-fem's Nitsche tie to the fine
@@ -402,7 +402,7 @@ def tie_rows(entry, tc, datas, errors, na):
 
 # --- studies ----------------------------------------------------------------------------------
 def layer_lines():
-    """The sample points of src/layer.rs: the interface y = 4 just inside the layer (201
+    """The sample points of src/harness/layer.rs: the interface y = 4 just inside the layer (201
     points), the vertical x = 1 through the layer (51 points)."""
     pts = [(10.0 * i / 200.0, 4.0 + 1e-6) for i in range(201)]
     pts += [(1.0, 4.0 + 1e-6 + (1.0 - 2e-6) * i / 50.0) for i in range(51)]
@@ -653,9 +653,9 @@ def write_md(path, report):
         lines += ["Not run (cases given on the command line, or no studies.json).", ""]
     if tl:
         lines += [
-            "### Tied layer (cases/tied-layer, src/layer.rs)",
+            "### Tied layer (cases/tied-layer, src/harness/layer.rs)",
             "",
-            "du = max |u_y - u_y,ref| / max |u_y,ref| over the sample lines of src/layer.rs "
+            "du = max |u_y - u_y,ref| / max |u_y,ref| over the sample lines of src/harness/layer.rs "
             "(the interface y = 4 + 1e-6 at 201 points, x = 1 through the layer at 51 points), "
             "u_y from our dual mortar tie (layer body), u_y,ref from the one-body mesh at the "
             "same level solved by each code. The three du must agree to 1e-8 (absolute) with "

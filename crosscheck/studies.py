@@ -3,7 +3,7 @@
 usage: studies.py OUT_DIR   (writes OUT_DIR/cases/<name>.json and OUT_DIR/studies.json, and
 prints the case paths, one per line)
 
-* **tied layer** (src/layer.rs, `contact-patch tied-layer`): cases/tied-layer/
+* **tied layer** (src/harness/layer.rs, `contact-patch tied-layer`): cases/tied-layer/
   one-body-layer-{q4,q9}.json and tied-layer-{q4,q9}.json with every uniform `divisions`
   multiplied by 1, 2, 4, 8 (the levels of reports/tied-layer.md). The one-body meshes are
   solved by DOLFINx and scikit-fem; the tie (dual mortar, Lagrange) by scikit-fem with the
@@ -13,7 +13,7 @@ prints the case paths, one per line)
   two-block-fine-q9.json.
 
 The level cases are generated here, at run time, from the current case files, so they never
-drift from them (the same refinement as `refine` in src/layer.rs).
+drift from them (the same refinement as `refine` in src/harness/layer.rs).
 """
 
 import copy

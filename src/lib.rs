@@ -11,52 +11,42 @@
 //! (see [`solid`]); prescribed dofs are eliminated, so the matrix solved is `K_ff`, symmetric
 //! positive definite when every body is held against rigid motion.
 //!
-//! ## Layout (a case flows down this list; no module imports one above it in the flow)
-//! * [`scene`]: the case file (serde, unknown fields and repeated names rejected) — plain data.
+//! ## Layout (a case flows down this list)
+//! * [`io::scene`]: the case file (serde, unknown fields and repeated names rejected) — plain data.
 //! * [`model`]: the case validated once into typed objects (meshes, materials, dof numbering,
 //!   prescribed values, consistent loads, resolved checks, solver settings);
-//!   [`admit`]: the checks that need the contact rows (rigid modes), and reading a case file.
-//! * [`fe`], [`solid`], [`mesh`]: reference elements, elasticity kernels, meshes and sets.
+//!   [`model::admit`]: the checks that need the contact rows (rigid modes), and reading a case
+//!   file; `model::rigid`: which rigid motions supports and rows leave free.
+//! * `mesh`, [`fe`], [`solid`]: meshes and sets, reference elements, elasticity kernels.
 //! * [`contact`]: the two axes, meeting in [`contact::Constraint`]:
-//!   [`contact::discretization`] (with [`contact::mortar`], [`contact::geometry`],
-//!   [`contact::search`]) makes rows; [`contact::enforcement`] (one module per method) says how
-//!   they are enforced; [`contact::solver`] runs load steps, geometry updates and the active-set
-//!   loop; [`contact::state`] is what it found; [`contact::forces`] turns row forces into the
+//!   [`contact::discretization`] (with its `geometry`, `mortar` and `search`) makes rows;
+//!   [`contact::enforcement`] (one module per method) says how they are enforced;
+//!   [`contact::state`] is what a solve found; [`contact::forces`] turns row forces into the
 //!   forces, pressures and penetrations every report uses.
-//! * [`sparse`], `dense`: sparse patterns and factorizations (faer), small dense eigen-solves;
-//!   `rigid`: which rigid motions supports and rows leave free.
-//! * [`solve`]: the elastic linear system and its solve; [`analysis`]: the entry that adds
-//!   contact when the scene has pairs; [`post`]: stresses.
-//! * [`checks`]: case-declared checks and warnings; [`output`]: `summary.json` and `.vtu`
-//!   files, written through [`paths`] (the one owner of every path written).
-//! * [`harness`], [`report`], [`layer`], `svg`: the patch-test tables and the tied-layer study.
+//! * [`solver`]: [`solver::solve_static`] runs one analysis with the effects its scene names;
+//!   [`solver::linear`] the elastic linear system; [`solver::active_set`] load steps, geometry
+//!   updates and the active-set loop; [`solver::sparse`] sparse patterns and factorizations
+//!   (faer), `solver::dense` small dense eigen-solves. [`post`]: stresses and errors.
+//! * [`harness`]: the patch-test tables ([`harness::report`]), case-declared checks
+//!   ([`harness::checks`]), exact solutions (`harness::exact`), the tied-layer study
+//!   ([`harness::layer`]).
+//! * [`io::output`]: `summary.json` and `.vtu` files, written through [`io::paths`] (the one
+//!   owner of every path written); [`run`]: one case from file to results, as the command runs it.
 //!
 //! Physics is opt-in: a scene without contact pairs builds no contact row, and current contact
 //! geometry, load steps and geometric stiffness run only when the case's `physics` and `solver`
 //! sections ask for them.
 
-pub mod admit;
-pub mod analysis;
-pub mod checks;
 pub mod contact;
-pub(crate) mod dense;
 pub mod error;
-pub mod exact;
 pub mod fe;
 pub mod harness;
-pub mod layer;
-pub mod mesh;
+pub mod io;
+pub(crate) mod mesh;
 pub mod model;
-pub mod output;
-pub mod paths;
 pub mod post;
-pub mod report;
-pub(crate) mod rigid;
 pub mod run;
-pub mod scene;
 pub mod solid;
-pub mod solve;
-pub mod sparse;
-pub(crate) mod svg;
+pub mod solver;
 
 pub use error::{Error, Result};

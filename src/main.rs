@@ -1,10 +1,10 @@
 //! The `contact-patch` command-line tool.
 
 use clap::{Parser, Subcommand};
-use contact_patch::output::write_run;
-use contact_patch::paths::{file_name, OutputFolder, ReportFolder};
+use contact_patch::io::output::write_run;
+use contact_patch::io::paths::{file_name, OutputFolder, ReportFolder};
+use contact_patch::io::scene::Catalogue;
 use contact_patch::run::{run_case, Outcome};
-use contact_patch::scene::Catalogue;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -354,8 +354,8 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
             .cloned()
             .collect();
         let report = match catalogue {
-            Catalogue::Tied => contact_patch::report::tied_report(&part),
-            Catalogue::Patch => contact_patch::report::patch_report(&part, seconds),
+            Catalogue::Tied => contact_patch::harness::report::tied_report(&part),
+            Catalogue::Patch => contact_patch::harness::report::patch_report(&part, seconds),
         };
         let json = serde_json::to_string_pretty(&part).expect("cells serialize") + "\n";
         let (md, js) = (
@@ -370,7 +370,7 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
             return ExitCode::from(2);
         }
         if catalogue == Catalogue::Patch {
-            println!("{}", contact_patch::report::seed_summary(&part));
+            println!("{}", contact_patch::harness::report::seed_summary(&part));
         }
         println!(
             "{}: {} cells ({} pass, {} fail, {} n/a); wrote {} and {}",
@@ -421,7 +421,7 @@ fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
     let plot_level = levels[levels.len() / 2];
     let mut studies = Vec::new();
     for element in ["q4", "q9"] {
-        match contact_patch::layer::study(cases, element, levels, plot_level) {
+        match contact_patch::harness::layer::study(cases, element, levels, plot_level) {
             Ok(s) => studies.push((element.to_string(), s)),
             Err(e) => {
                 eprintln!("error: {e}");
@@ -433,15 +433,17 @@ fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
         let runs_folder = folder.sub_folder("tied-layer")?;
         let mut files = Vec::new();
         for (element, study) in &studies {
-            for (stem, svg) in contact_patch::layer::plots(element, plot_level, &study.curves) {
+            for (stem, svg) in
+                contact_patch::harness::layer::plots(element, plot_level, &study.curves)
+            {
                 let name = format!("{stem}.svg");
                 folder.write_file(&name, &svg)?;
                 files.push(name);
             }
             for (name, model, solution) in &study.solved {
                 let outcome = contact_patch::run::Outcome {
-                    warnings: contact_patch::checks::warnings(model, solution),
-                    checks: contact_patch::checks::evaluate(model, solution),
+                    warnings: contact_patch::harness::checks::warnings(model, solution),
+                    checks: contact_patch::harness::checks::evaluate(model, solution),
                     model: model.clone(),
                     solution: solution.clone(),
                 };
@@ -451,7 +453,7 @@ fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
                 )?;
             }
         }
-        let report = contact_patch::layer::report(&studies, levels, plot_level, &files);
+        let report = contact_patch::harness::layer::report(&studies, levels, plot_level, &files);
         folder.write_file("tied-layer.md", &report)?;
         let runs: Vec<_> = studies.iter().flat_map(|(_, s)| s.runs.clone()).collect();
         let json = serde_json::to_string_pretty(&runs).expect("runs serialize") + "\n";

@@ -6,8 +6,8 @@
 //! * Relative L2 displacement error: `sqrt(int |u_h - u|^2 dA / int |u|^2 dA)`, with a Gauss rule
 //!   richer than the stiffness rule (see `fe::ElementKind::error_rule`).
 
-use crate::exact::ExactField;
 use crate::fe::point_values;
+use crate::harness::exact::ExactField;
 use crate::model::{Body, Model};
 use crate::solid::{strain_at, MAX_DOFS};
 
@@ -95,7 +95,7 @@ pub fn check_finite_stresses(model: &Model, u: &[f64]) -> crate::Result<()> {
                 .find(|v| !v.is_finite())
                 .unwrap_or(f64::NAN);
             let p = body.mesh.nodes[n];
-            return Err(crate::solve::non_finite_at(
+            return Err(crate::solver::linear::non_finite_at(
                 model,
                 "the nodal stress",
                 value,
@@ -143,7 +143,7 @@ pub fn relative_l2_displacement_error(model: &Model, u: &[f64], exact: &ExactFie
 /// and the first cell whose reference domain contains the result (within `1e-9`) is taken.
 pub struct CellLocator<'a> {
     body: &'a Body,
-    grid: crate::contact::search::BucketGrid,
+    grid: crate::contact::discretization::search::BucketGrid,
 }
 
 impl<'a> CellLocator<'a> {
@@ -163,7 +163,7 @@ impl<'a> CellLocator<'a> {
             .collect();
         CellLocator {
             body,
-            grid: crate::contact::search::BucketGrid::new(boxes),
+            grid: crate::contact::discretization::search::BucketGrid::new(boxes),
         }
     }
 

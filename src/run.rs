@@ -1,11 +1,11 @@
 //! One run of one case: load and validate, solve, judge the checks, time every stage.
 
-use crate::admit::load;
-use crate::analysis::solve_static;
-use crate::checks::{evaluate, warnings, CheckResult};
 use crate::error::Result;
+use crate::harness::checks::{evaluate, warnings, CheckResult};
+use crate::model::admit::load;
 use crate::model::Model;
-use crate::solve::Solution;
+use crate::solver::linear::Solution;
+use crate::solver::solve_static;
 use std::path::Path;
 use std::time::Instant;
 
@@ -15,7 +15,7 @@ pub struct Outcome {
     pub model: Model,
     pub solution: Solution,
     pub checks: Vec<CheckResult>,
-    /// What the run should say although no check failed (see [`crate::checks::warnings`]).
+    /// What the run should say although no check failed (see [`crate::harness::checks::warnings`]).
     pub warnings: Vec<String>,
 }
 

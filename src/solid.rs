@@ -10,7 +10,7 @@
 //! zero in plane stress.
 
 use crate::fe::{point_values, ElementKind, QuadPoint, MAX_NODES};
-use crate::scene::Plane;
+use crate::io::scene::Plane;
 
 /// Largest number of element dofs.
 pub const MAX_DOFS: usize = 2 * MAX_NODES;

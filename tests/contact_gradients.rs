@@ -10,8 +10,8 @@
 
 use contact_patch::contact::discretization::constraints;
 use contact_patch::contact::Constraint;
+use contact_patch::io::scene::{DiscretizationSpec, NormalChoice};
 use contact_patch::model::{parse, Model};
-use contact_patch::scene::{DiscretizationSpec, NormalChoice};
 
 fn two_blocks(element: &str, gap: f64, tilt: f64) -> Model {
     let lift = |x: f64| 5.0 + gap + tilt * (x - 4.0);
@@ -214,7 +214,7 @@ fn rigid_surface_rows_are_gap_gradients() {
 /// zero gap), on the non-nested meshes C (Line2) and E (Line3), both multiplier spaces.
 #[test]
 fn mortar_rows_are_weighted_gap_gradients_where_closed() {
-    use contact_patch::scene::MultiplierSpace;
+    use contact_patch::io::scene::MultiplierSpace;
     for mesh in ["C", "E"] {
         let text = std::fs::read_to_string(format!(
             "{}/cases/patch/patch-{mesh}-nu0.3.json",
@@ -240,7 +240,7 @@ fn mortar_rows_are_weighted_gap_gradients_where_closed() {
 /// else cancels).
 #[test]
 fn mortar_rows_conserve_linear_momentum() {
-    use contact_patch::scene::MultiplierSpace;
+    use contact_patch::io::scene::MultiplierSpace;
     for element in ["Q4", "Q9"] {
         let mut m = two_blocks(element, 0.03, 0.02);
         for multiplier in [MultiplierSpace::Standard, MultiplierSpace::Dual] {

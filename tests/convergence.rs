@@ -9,10 +9,10 @@
 //! Q9 3.09, T6 3.58. T6 on this structured diagonal mesh is pre-asymptotically faster than h^3;
 //! refining further (8x, 16x, 32x the base mesh) its rate falls to 3.39 and then 3.17.
 
-use contact_patch::analysis::solve_static;
+use contact_patch::io::scene::{Breaks, MeshSpec, UniformBreaks};
 use contact_patch::model::{parse, Model};
 use contact_patch::post::relative_l2_displacement_error;
-use contact_patch::scene::{Breaks, MeshSpec, UniformBreaks};
+use contact_patch::solver::solve_static;
 
 fn errors(element: &str, levels: &[usize]) -> Vec<(f64, f64)> {
     let path = format!(

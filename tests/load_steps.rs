@@ -56,7 +56,7 @@ fn one_and_ten_load_steps_agree() {
             assert!((s.load_factor - (k + 1) as f64 / 10.0).abs() < 1e-15);
             assert_eq!(
                 s.termination,
-                contact_patch::contact::solver::Termination::Converged
+                contact_patch::solver::active_set::Termination::Converged
             );
         }
         assert_eq!(one.passed(), ten.passed(), "{case}");

@@ -56,7 +56,7 @@ fn penalty_and_augmented_lagrange_pairs_solve_together() {
     let state = mixed.solution.contact.as_ref().unwrap();
     assert_eq!(
         state.termination,
-        contact_patch::contact::solver::Termination::Converged
+        contact_patch::solver::active_set::Termination::Converged
     );
     assert!(mixed.passed(), "{:?}", mixed.checks);
     // the penalty pair sinks by p / kappa, the augmented Lagrangian one closes its gap

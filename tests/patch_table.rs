@@ -2,8 +2,8 @@
 //! every passing cell balances its forces, and the whole grid (errors rounded so that round-off
 //! does not churn it, times left out) is a reviewed insta snapshot in `snapshots/`.
 
+use contact_patch::harness::report::seed_summary;
 use contact_patch::harness::{grid_markdown, run_sweep, Cell};
-use contact_patch::report::seed_summary;
 use std::path::Path;
 
 /// The cells of every case in `cases/<folder>` (expecting `count` cases).

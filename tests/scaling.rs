@@ -2,9 +2,9 @@
 //! variant pass at Young's moduli from 1e3 to 2e11 with the load scaled alike, and Lagrange
 //! multipliers keep going through the sparse LDL^T (not a fallback).
 
+use contact_patch::io::scene::{Check, DiscretizationSpec, EnforcementSpec, MultiplierSpace};
 use contact_patch::model::{parse, Model};
 use contact_patch::run::run_model;
-use contact_patch::scene::{Check, DiscretizationSpec, EnforcementSpec, MultiplierSpace};
 use std::time::Instant;
 
 #[test]
@@ -22,7 +22,7 @@ fn patch_b_passes_at_every_scale() {
             load.pressure = load.pressure.map(|p| p * scale);
         }
         let stress = [0.0, -10.0 * scale, 0.0];
-        case.exact = Some(contact_patch::scene::ExactSpec::UniformStress { stress });
+        case.exact = Some(contact_patch::io::scene::ExactSpec::UniformStress { stress });
         case.checks = vec![
             Check::UniformStress {
                 body: None,

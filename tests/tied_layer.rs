@@ -2,7 +2,7 @@
 //! solution under refinement (both distances shrink at every level, Q4 and Q9), and the
 //! `tied-layer` command writes its report, SVG plots and readable `.vtu` files.
 
-use contact_patch::layer::study;
+use contact_patch::harness::layer::study;
 use std::path::Path;
 use std::process::Command;
 

@@ -11,11 +11,11 @@
 
 mod common;
 use common::defect;
-use contact_patch::contact::solver::Termination;
 use contact_patch::model::{parse, Model};
 use contact_patch::run::{run_model, Outcome};
-use contact_patch::solve::assemble;
-use contact_patch::sparse::Cholesky;
+use contact_patch::solver::active_set::Termination;
+use contact_patch::solver::linear::assemble;
+use contact_patch::solver::sparse::Cholesky;
 use serde_json::{json, Value};
 use std::path::Path;
 use std::time::Instant;

@@ -29,8 +29,8 @@
 //! linearized: the reference configuration, or `X + u_k` with contact geometry in the current
 //! configuration.
 
-use super::geometry::Surface;
-use super::solver::ContactState;
+use super::discretization::geometry::Surface;
+use super::state::ContactState;
 use crate::model::{Body, MasterSide, Model};
 use std::collections::BTreeMap;
 

@@ -16,7 +16,7 @@
 //! **The discretization axis** ([`discretization`]): node-to-node, node-to-surface one-pass and
 //! two-pass (master or slave normals, the corner condition), rigid analytic masters.
 //!
-//! **The enforcement axis** ([`enforcement`], [`solver`]): with the contact force `lambda_i`
+//! **The enforcement axis** ([`enforcement`], [`crate::solver::active_set`]): with the contact force `lambda_i`
 //! (compression positive) equilibrium reads `K u = f + B^T lambda`, `B_ik = dg_i/du_k`, and
 //!
 //! * Lagrange multiplier: `g_i = 0` on the active set (an indefinite saddle-point system),
@@ -33,10 +33,6 @@
 pub mod discretization;
 pub mod enforcement;
 pub mod forces;
-pub mod geometry;
-pub mod mortar;
-pub mod search;
-pub mod solver;
 pub mod state;
 
 /// One linearized contact constraint (a row of `B`).

@@ -1,6 +1,6 @@
 //! What a contact solve found and how it got there: the rows with their forces, gaps and
 //! active set, the termination, and the record of its load steps, geometry updates and
-//! iterations. Plain data, written by [`super::solver`] and read by the checks, the harness and
+//! iterations. Plain data, written by [`crate::solver::active_set`] and read by the checks, the harness and
 //! the output (`summary.json`).
 
 use super::Constraint;
@@ -29,7 +29,7 @@ pub struct ContactState {
     pub iterations: usize,
     /// Number of dependent rows among the active constraints (rank deficiency of `B B^T`):
     /// always computed for Lagrange multipliers and elimination (multiplier systems), for the
-    /// other methods only up to [`super::solver::RANK_CHECK_LIMIT`] active rows (it costs `O(m^3)`).
+    /// other methods only up to [`crate::solver::active_set::RANK_CHECK_LIMIT`] active rows (it costs `O(m^3)`).
     pub rank_deficiency: Option<usize>,
     /// The linear solver of the last iteration: `cholesky` (penalty-type, perturbed tangent,
     /// augmented Lagrangian, elimination), `ldlt` (Lagrange, independent rows), `lu` (Lagrange,

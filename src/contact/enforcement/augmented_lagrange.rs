@@ -4,7 +4,7 @@
 //! Methods": the augmented form "can reduce to all other forms").
 
 use super::{Enforcement, Method};
-use crate::scene::{EnforcementSpec, MultiplierUpdate};
+use crate::io::scene::{EnforcementSpec, MultiplierUpdate};
 
 pub struct AugmentedLagrange {
     pub kappa: f64,

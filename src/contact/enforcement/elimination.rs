@@ -5,7 +5,7 @@
 
 use super::{Enforcement, Method};
 use crate::contact::Constraint;
-use crate::scene::EnforcementSpec;
+use crate::io::scene::EnforcementSpec;
 
 pub struct Elimination;
 

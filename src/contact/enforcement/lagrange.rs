@@ -4,7 +4,7 @@
 //! failure even when the displacements are right.
 
 use super::{Enforcement, Method};
-use crate::scene::EnforcementSpec;
+use crate::io::scene::EnforcementSpec;
 
 pub struct Lagrange;
 

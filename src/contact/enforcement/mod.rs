@@ -18,7 +18,7 @@
 //! differ in general, e.g. for mortar multipliers with a consistent `C`).
 
 use super::Constraint;
-use crate::scene::{EnforcementSpec, MultiplierUpdate};
+use crate::io::scene::{EnforcementSpec, MultiplierUpdate};
 
 mod augmented_lagrange;
 mod elimination;

@@ -3,7 +3,7 @@
 //! (Taylor 2004, "1985: Solution Methods").
 
 use super::{Enforcement, Method};
-use crate::scene::EnforcementSpec;
+use crate::io::scene::EnforcementSpec;
 
 pub struct Penalty {
     pub kappa: f64,

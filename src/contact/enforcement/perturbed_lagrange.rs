@@ -5,7 +5,7 @@
 //! diagonal `C` the multipliers are eliminated: no unknowns of their own.
 
 use super::{Enforcement, Method};
-use crate::scene::EnforcementSpec;
+use crate::io::scene::EnforcementSpec;
 
 pub struct PerturbedLagrange {
     pub kappa: f64,

@@ -3,7 +3,7 @@
 //! residual each iteration (Taylor 2004, "1985: Solution Methods").
 
 use super::{Enforcement, Method};
-use crate::scene::EnforcementSpec;
+use crate::io::scene::EnforcementSpec;
 
 pub struct PerturbedTangent {
     pub kappa: f64,

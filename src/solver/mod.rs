@@ -1,16 +1,21 @@
 //! One static analysis of a model, with only the effects its scene names: elasticity alone
-//! ([`crate::solve`]), or with the contact pairs it declares ([`crate::contact::solver`]: load
+//! ([`crate::solver::linear`]), or with the contact pairs it declares ([`crate::solver::active_set`]: load
 //! steps, active sets, geometry updates). A scene without contact builds no contact row.
+
+pub mod active_set;
+pub(crate) mod dense;
+pub mod linear;
+pub mod sparse;
 
 use crate::error::Result;
 use crate::model::Model;
-use crate::solve::Solution;
+use crate::solver::linear::Solution;
 
 /// Solve `model`; `progress` is told the name of each stage as it starts.
 pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
     if model.contact.is_empty() {
-        crate::solve::solve_elastic(model, progress)
+        crate::solver::linear::solve_elastic(model, progress)
     } else {
-        crate::contact::solver::solve(model, progress)
+        crate::solver::active_set::solve(model, progress)
     }
 }

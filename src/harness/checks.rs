@@ -19,10 +19,10 @@
 //! and the loads were scaled by 1e9, while the stress was exact to 1.5e-15).
 
 use crate::contact::forces::{pair_forces, PairForces};
+use crate::io::scene::{Check, Interaction};
 use crate::model::{MasterSide, Model};
 use crate::post::{for_each_quadrature_stress, relative_l2_displacement_error};
-use crate::scene::{Check, Interaction};
-use crate::solve::Solution;
+use crate::solver::linear::Solution;
 use serde::Serialize;
 
 /// The verdict of one check.
@@ -101,7 +101,7 @@ pub fn pressure_error(
     model: &Model,
     solution: &Solution,
     forces: &[PairForces],
-    exact: &crate::exact::ExactField,
+    exact: &crate::harness::exact::ExactField,
     pair: Option<usize>,
     scale: Option<f64>,
 ) -> f64 {
@@ -237,7 +237,7 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
         .contact
         .as_ref()
         .and_then(|c| match &c.termination {
-            crate::contact::solver::Termination::Converged => None,
+            crate::solver::active_set::Termination::Converged => None,
             t => Some(CheckResult {
                 check: format!("the contact solve converged (it ended: {t:?})"),
                 error: f64::INFINITY,

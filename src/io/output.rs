@@ -2,21 +2,21 @@
 //!
 //! The folder is an [`OutputFolder`]: written under a temporary name next to the target and
 //! renamed into place only when every file is complete, so a folder named like the target is
-//! always a whole run, and only a previous output is ever replaced (see [`crate::paths`]).
+//! always a whole run, and only a previous output is ever replaced (see [`crate::io::paths`]).
 //! The `.vtu` files are ASCII VTK XML (version 0.1) with point data `displacement` (3
 //! components, z = 0) and `stress` (`xx, yy, xy`, averaged at nodes), `stress_zz`, and cell
 //! data `stress` at cell centres; VTK cell types 9 (Q4), 28 (Q9), 5 (T3), 22 (T6), whose node
 //! orders match ours.
 
-use crate::checks::CheckResult;
 use crate::contact::enforcement::method;
 use crate::contact::forces::pair_forces;
 use crate::error::{Error, Result};
+use crate::harness::checks::CheckResult;
+use crate::io::paths::{file_name, OutputFolder};
 use crate::model::Body;
-use crate::paths::{file_name, OutputFolder};
 use crate::post::{cell_stresses, nodal_stresses};
 use crate::run::Outcome;
-use crate::solve::Timings;
+use crate::solver::linear::Timings;
 use serde::Serialize;
 use std::fs;
 use std::io::{BufWriter, Write};
@@ -163,10 +163,10 @@ pub struct ContactSummary {
     /// Per pair.
     pub pairs: Vec<PairSummary>,
     /// The load steps: load factor, termination, iterations and geometry updates of each.
-    pub steps: Vec<crate::contact::solver::StepRecord>,
+    pub steps: Vec<crate::solver::active_set::StepRecord>,
     /// Every iteration: residual, active rows, status changes, largest gap violation,
     /// multiplier change, linear solver, time.
-    pub history: Vec<crate::contact::solver::IterationRecord>,
+    pub history: Vec<crate::solver::active_set::IterationRecord>,
 }
 
 /// What one contact pair transmits.
@@ -293,7 +293,7 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
         let most = |get: fn(&PairSummary) -> f64| pairs.iter().map(get).fold(0.0, f64::max);
         ContactSummary {
             termination: match &c.termination {
-                crate::contact::solver::Termination::Singular(m) => format!("singular: {m}"),
+                crate::solver::active_set::Termination::Singular(m) => format!("singular: {m}"),
                 t => format!("{t:?}"),
             },
             iterations: c.iterations,

@@ -25,17 +25,22 @@
 //!   elimination) a singular one is `unstable` even when the displacements pass.
 //! * `n/a` cells say why the combination does not apply.
 
-use crate::admit::load;
-use crate::analysis::solve_static;
+pub mod checks;
+pub(crate) mod exact;
+pub mod layer;
+pub mod report;
+
 use crate::contact::discretization::constraints;
 use crate::contact::enforcement::method;
 use crate::contact::forces::pair_forces;
-use crate::contact::solver::Termination;
 use crate::error::Result;
+use crate::io::scene::{Catalogue, DiscretizationSpec, MultiplierSpace};
+use crate::model::admit::load;
 use crate::model::Model;
 use crate::post::for_each_quadrature_stress;
-use crate::scene::{Catalogue, DiscretizationSpec, MultiplierSpace};
-use crate::solve::Solution;
+use crate::solver::active_set::Termination;
+use crate::solver::linear::Solution;
+use crate::solver::solve_static;
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
@@ -115,7 +120,14 @@ fn measure(model: &Model, solution: &Solution, pressure: f64) -> Measured {
     let forces = pair_forces(model, state);
     let pressure_error = exact
         .map(|e| {
-            crate::checks::pressure_error(model, solution, &forces, e, None, Some(pressure.abs()))
+            crate::harness::checks::pressure_error(
+                model,
+                solution,
+                &forces,
+                e,
+                None,
+                Some(pressure.abs()),
+            )
         })
         .unwrap_or(f64::NAN);
     // total interaction force on the pass-1 slave body, against the exact traction integrated
@@ -151,7 +163,7 @@ fn measure(model: &Model, solution: &Solution, pressure: f64) -> Measured {
         stress_error,
         pressure_error,
         load_error,
-        force_balance: crate::checks::force_balance(model, solution, &forces),
+        force_balance: crate::harness::checks::force_balance(model, solution, &forces),
         max_penetration,
         rank_deficiency: state.rank_deficiency,
         iterations: state.iterations,

@@ -15,7 +15,7 @@
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::solid::{element_stiffness, MAX_DOFS};
-use crate::sparse::{Cholesky, FactorError, PatternBuilder, SymmetricPattern};
+use crate::solver::sparse::{Cholesky, FactorError, PatternBuilder, SymmetricPattern};
 use std::time::Instant;
 
 /// Marks a dof that has no equation (it is prescribed).
@@ -304,7 +304,7 @@ pub fn assemble(model: &Model, extra_blocks: &[Vec<usize>]) -> LinearSystem {
     }
 }
 
-/// Solve the static elastic problem without contact (see [`crate::analysis`] for the entry that
+/// Solve the static elastic problem without contact (see [`crate::solver`] for the entry that
 /// adds contact when the scene asks for it). `progress` is told the name of each stage.
 pub fn solve_elastic(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
     let mut timings = Timings::default();

@@ -1,5 +1,5 @@
 //! The active-set Newton loop for frictionless small-strain contact, written once against
-//! [`Constraint`] rows for every enforcement method (see [`super::enforcement`]).
+//! [`Constraint`] rows for every enforcement method (see [`crate::contact::enforcement`]).
 //!
 //! Unknowns: free displacements `u` and one contact force `lambda_i >= 0` per row (compression
 //! positive). Equilibrium `K u = f + B^T lambda`; complementarity `g >= 0`, `lambda >= 0`,
@@ -18,7 +18,7 @@
 //! so the displacement is still returned when it exists.
 //!
 //! Rigid modes: before each solve the rigid modes of every body are tested against the
-//! prescribed dofs and the ACTIVE rows (`crate::rigid`, three modes per body). The first
+//! prescribed dofs and the ACTIVE rows (`crate::model::rigid`, three modes per body). The first
 //! active set closes, besides the rows with zero gap, the rows at the smallest gap of a body that
 //! could otherwise move, until its modes are held (closest points first). A later set that
 //! leaves a motion `m` free is solved with springs `S = STABILIZATION K_ee` on the bodies it
@@ -27,19 +27,21 @@
 //! is moved along the push until its first open row closes. A set that leaves a motion free is
 //! never `Converged`: the loop ends with `Singular` naming the body, the mode and why. The
 //! factorizations report pivots that are zero relative to the matrix or needed regularization
-//! ([`crate::sparse`]), and a non-finite iterate is an error naming where it appeared.
+//! ([`crate::solver::sparse`]), and a non-finite iterate is an error naming where it appeared.
 
-use super::discretization::{constraints, gap_second_derivative};
-use super::enforcement::{method, method as enforcement_method, Method};
-pub use super::state::{ContactState, Departure, IterationRecord, StepRecord, Termination};
-use super::Constraint;
-use crate::dense::symmetric_eigen;
+use crate::contact::discretization::{constraints, gap_second_derivative};
+use crate::contact::enforcement::{method, method as enforcement_method, Method};
+pub use crate::contact::state::{
+    ContactState, Departure, IterationRecord, StepRecord, Termination,
+};
+use crate::contact::Constraint;
 use crate::error::{Error, Result};
+use crate::io::scene::{ContactGeometry, MultiplierUpdate};
+use crate::model::rigid::{FreeMode, RigidModes};
 use crate::model::Model;
-use crate::rigid::{FreeMode, RigidModes};
-use crate::scene::{ContactGeometry, MultiplierUpdate};
-use crate::solve::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
-use crate::sparse::{Cholesky, PatternBuilder};
+use crate::solver::dense::symmetric_eigen;
+use crate::solver::linear::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
+use crate::solver::sparse::{Cholesky, PatternBuilder};
 use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
@@ -73,7 +75,7 @@ impl EqRow {
 }
 
 /// Solve the contact problem of `model` (each pair by its own method, the pairs of one family,
-/// see [`super::enforcement::Family`]) in the load steps of `model.solver`: step `k` of `n`
+/// see [`crate::contact::enforcement::Family`]) in the load steps of `model.solver`: step `k` of `n`
 /// applies the load factor `k / n` and starts from the active set of step `k - 1` (the only
 /// state frictionless contact has to carry). The solve stops at the first step that does not
 /// converge; its termination is the solve's.
@@ -84,7 +86,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
     let mut start: Option<Vec<f64>> = None;
     let mut departures: Vec<Departure> = Vec::new();
     let mut history: Vec<IterationRecord> = Vec::new();
-    let mut timings = crate::solve::Timings::default();
+    let mut timings = crate::solver::linear::Timings::default();
     let mut step = 1;
     loop {
         let t = step as f64 / n as f64;
@@ -154,7 +156,7 @@ fn solve_step(
             let mut departures: Vec<Departure> = Vec::new();
             let mut history: Vec<IterationRecord> = Vec::new();
             let mut forces: Option<HashMap<RowKey, f64>> = None;
-            let mut timings = crate::solve::Timings::default();
+            let mut timings = crate::solver::linear::Timings::default();
             let mut changes: Vec<f64> = Vec::new();
             let max_updates = model.solver.max_geometry_updates;
             for update in 1..=max_updates {
@@ -381,7 +383,7 @@ fn solve_at(
         .iter()
         .find(|r| !r.g0.is_finite() || r.coeffs.iter().any(|c| !c.is_finite()))
     {
-        return Err(crate::solve::non_finite_at(
+        return Err(crate::solver::linear::non_finite_at(
             model,
             "the contact gap or its gradient",
             r.g0,
@@ -535,13 +537,18 @@ fn solve_at(
 
 /// The saddle-point pattern `[[K, B^T], [B, D]]` over all candidate rows, analysed once.
 struct Saddle {
-    pattern: crate::sparse::SymmetricPattern,
+    pattern: crate::solver::sparse::SymmetricPattern,
     /// Position in `pattern` of each stored entry of the stiffness pattern.
     k_positions: Vec<usize>,
-    ldlt: crate::sparse::Ldlt,
+    ldlt: crate::solver::sparse::Ldlt,
     /// Both triangles of `pattern` and its LU analysis, made on the first LU fallback and reused
     /// by every later one.
-    lu: std::cell::OnceCell<Option<(crate::sparse::GeneralPattern, crate::sparse::Lu)>>,
+    lu: std::cell::OnceCell<
+        Option<(
+            crate::solver::sparse::GeneralPattern,
+            crate::solver::sparse::Lu,
+        )>,
+    >,
 }
 
 impl Saddle {
@@ -551,8 +558,8 @@ impl Saddle {
         let (general, lu) = self
             .lu
             .get_or_init(|| {
-                let general = crate::sparse::GeneralPattern::from_symmetric(&self.pattern);
-                crate::sparse::Lu::analyse(&general)
+                let general = crate::solver::sparse::GeneralPattern::from_symmetric(&self.pattern);
+                crate::solver::sparse::Lu::analyse(&general)
                     .ok()
                     .map(|lu| (general, lu))
             })
@@ -586,7 +593,7 @@ impl Saddle {
                 k_positions.push(pattern.position(p.row_idx[k], j)?);
             }
         }
-        let ldlt = crate::sparse::Ldlt::analyse(&pattern, n).ok()?;
+        let ldlt = crate::solver::sparse::Ldlt::analyse(&pattern, n).ok()?;
         Some(Saddle {
             pattern,
             k_positions,
@@ -622,7 +629,11 @@ struct Kernel<'a> {
     saddle: Option<Saddle>,
     linear_solver: &'static str,
     /// The last Cholesky factorization with its active set and weights.
-    cache: Option<(Vec<bool>, Vec<f64>, std::rc::Rc<crate::sparse::Factor>)>,
+    cache: Option<(
+        Vec<bool>,
+        Vec<f64>,
+        std::rc::Rc<crate::solver::sparse::Factor>,
+    )>,
     factorizations: f64,
     /// The first active set, when a geometry update starts from the last one's.
     initial_active: Option<Vec<bool>>,
@@ -635,7 +646,7 @@ type LoopResult = (Vec<f64>, Vec<f64>, Vec<bool>, Termination, usize);
 /// Springs `STABILIZATION K_ee` hold a free rigid motion while the active set leaves it free:
 /// small enough to leave the elastic part of the iterate unchanged to about this relative
 /// amount, large enough that the pivots of the motion stay far above round-off
-/// ([`crate::sparse::TINY_PIVOT`]).
+/// ([`crate::solver::sparse::TINY_PIVOT`]).
 pub const STABILIZATION: f64 = 1e-8;
 
 /// A load component along a free motion larger than this share of the load pushes the body
@@ -712,7 +723,7 @@ impl Kernel<'_> {
         &mut self,
         active: &[bool],
         w: &[f64],
-    ) -> std::result::Result<std::rc::Rc<crate::sparse::Factor>, String> {
+    ) -> std::result::Result<std::rc::Rc<crate::solver::sparse::Factor>, String> {
         if let Some((a, ww, f)) = &self.cache {
             if a == active && ww == w {
                 return Ok(f.clone());
@@ -792,7 +803,7 @@ impl Kernel<'_> {
         }
         let mut signs = vec![1i8; n + m];
         signs[n..].iter_mut().for_each(|s| *s = -1);
-        let force_scale = crate::solve::max_abs(&rhs[..n]);
+        let force_scale = crate::solver::linear::max_abs(&rhs[..n]);
         // residual of x, block by block: (equilibrium / forces, gaps / size); NaN when x or the
         // scale is not finite, so that it never passes
         let residual = |x: &[f64], r: &mut Vec<f64>| -> (f64, f64) {
@@ -804,8 +815,8 @@ impl Kernel<'_> {
                 .iter()
                 .fold(force_scale, |a, v| a.max((rho * v).abs()))
                 .max(f64::MIN_POSITIVE);
-            let ru = crate::solve::max_abs(&r[..n]) / forces;
-            let rg = crate::solve::max_abs(&r[n..]) / rho / size;
+            let ru = crate::solver::linear::max_abs(&r[..n]) / forces;
+            let rg = crate::solver::linear::max_abs(&r[n..]) / rho / size;
             (ru, rg)
         };
         let small = |(ru, rg): (f64, f64)| ru <= 1e-11 && rg <= 1e-13;
@@ -826,7 +837,7 @@ impl Kernel<'_> {
                 for (v, what) in [(&x, "the solution"), (&r, "the residual K u - f")] {
                     if let Some(e) = v.iter().position(|v| !v.is_finite()) {
                         let error = if e < n {
-                            crate::solve::non_finite(
+                            crate::solver::linear::non_finite(
                                 self.model,
                                 what,
                                 v[e],
@@ -835,7 +846,7 @@ impl Kernel<'_> {
                             )
                         } else {
                             let c = &self.constraints[e - n];
-                            crate::solve::non_finite_at(
+                            crate::solver::linear::non_finite_at(
                                 self.model,
                                 &format!("{what} (contact force row)"),
                                 v[e],
@@ -857,7 +868,7 @@ impl Kernel<'_> {
                 let mut last_step = f64::INFINITY;
                 for _ in 0..MAX_REFINEMENT {
                     factor.solve_in_place(&mut r);
-                    let step = crate::solve::max_abs(&r);
+                    let step = crate::solver::linear::max_abs(&r);
                     // (a NaN step stops too)
                     if step.is_nan() || step >= 0.5 * last_step {
                         break;
@@ -865,7 +876,7 @@ impl Kernel<'_> {
                     x.iter_mut().zip(&r).for_each(|(a, d)| *a += d);
                     last_step = step;
                     res = residual(&x, &mut r);
-                    if step <= f64::EPSILON * crate::solve::max_abs(&x) {
+                    if step <= f64::EPSILON * crate::solver::linear::max_abs(&x) {
                         break;
                     }
                 }
@@ -873,7 +884,7 @@ impl Kernel<'_> {
                     solved = Some((x, "ldlt"));
                 }
             }
-            Err(e @ crate::sparse::FactorError::ZeroPivot { .. }) => {
+            Err(e @ crate::solver::sparse::FactorError::ZeroPivot { .. }) => {
                 self.factorizations += t.elapsed().as_secs_f64();
                 return Err(StepError::Singular(self.saddle_error(e)));
             }
@@ -900,10 +911,10 @@ impl Kernel<'_> {
 
     /// The message for a singular saddle-point matrix: an equation below `n` is a
     /// displacement, above it the multiplier of a contact row.
-    fn saddle_error(&self, e: crate::sparse::FactorError) -> String {
+    fn saddle_error(&self, e: crate::solver::sparse::FactorError) -> String {
         let n = self.sys.n;
         match e {
-            crate::sparse::FactorError::ZeroPivot { equation, .. } if equation >= n => {
+            crate::solver::sparse::FactorError::ZeroPivot { equation, .. } if equation >= n => {
                 let r = &self.constraints[equation - n];
                 Error::Solver {
                     path: self.model.source.clone(),
@@ -1125,7 +1136,7 @@ impl Kernel<'_> {
     }
 
     /// Prepare the solve of the active set `active`: if the prescribed dofs and the active rows
-    /// leave a rigid motion free (see `crate::rigid`), the matrix would be singular on it. It
+    /// leave a rigid motion free (see `crate::model::rigid`), the matrix would be singular on it. It
     /// is then stabilized: springs `S = STABILIZATION K_ee` on the equations of the bodies it
     /// moves, and the load's component along the free motions removed from the right-hand side,
     /// `f' = f - sum_k S m_k (m_k . f)` with `m_k` orthonormal in `S`, so that the iterate
@@ -1378,7 +1389,7 @@ impl Kernel<'_> {
             .check_finite(self.model, x, "the displacement", &stage)?;
         if let Some(i) = forces.iter().position(|v| !v.is_finite()) {
             let r = &self.constraints[i];
-            return Err(crate::solve::non_finite_at(
+            return Err(crate::solver::linear::non_finite_at(
                 self.model,
                 "the contact force",
                 forces[i],
@@ -1662,7 +1673,7 @@ fn rank_deficiency(rows: &[&EqRow], n: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dense::jacobi_eigen;
+    use crate::solver::dense::jacobi_eigen;
 
     #[test]
     fn jacobi_recovers_a_rank_deficient_spectrum() {

@@ -11,7 +11,7 @@
 //!   It is cubic, so Q4/T3 converge as h^2 and Q9/T6 as h^3 in the L2 norm of displacement.
 //!   Plane strain uses `E/(1 - nu^2)` and `nu/(1 - nu)` in the same formulas.
 
-use crate::scene::ExactSpec;
+use crate::io::scene::ExactSpec;
 use crate::solid::Elasticity;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -87,7 +87,7 @@ impl ExactField {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Plane;
+    use crate::io::scene::Plane;
 
     /// The exact fields are compatible: the strain of the displacement, through D, gives the stress.
     #[test]

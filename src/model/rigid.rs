@@ -162,7 +162,7 @@ impl<'a> RigidModes<'a> {
         for (dofs, coeffs) in rows {
             add_outer(&mut gram, &self.restraint(dofs, coeffs));
         }
-        let (eig, vecs) = crate::dense::symmetric_eigen(&gram, nm);
+        let (eig, vecs) = crate::solver::dense::symmetric_eigen(&gram, nm);
         let max = eig.iter().fold(0.0f64, |m, &e| m.max(e.abs()));
         (0..nm)
             .filter(|&k| eig[k].abs() <= NULL_EIGENVALUE * max)

@@ -11,14 +11,14 @@
 //! Both meshes converge to the same continuum solution, so a consistent tie shows distances
 //! that shrink under refinement.
 
-use crate::admit::admit;
-use crate::analysis::solve_static;
 use crate::error::{Error, Result};
+use crate::io::scene::{Breaks, Case, DiscretizationSpec, MeshSpec, MultiplierSpace, NormalChoice};
+use crate::io::svg::{line_plot, Series};
+use crate::model::admit::admit;
 use crate::model::{parse, Model};
 use crate::post::CellLocator;
-use crate::scene::{Breaks, Case, DiscretizationSpec, MeshSpec, MultiplierSpace, NormalChoice};
-use crate::solve::Solution;
-use crate::svg::{line_plot, Series};
+use crate::solver::linear::Solution;
+use crate::solver::solve_static;
 use serde::Serialize;
 use std::path::Path;
 

@@ -16,18 +16,21 @@
 //! Everything that can be wrong in the case's data is found here and reported as
 //! `Error::Invalid` (what, where, how to fix it); what needs the contact rows (a body that no
 //! support or contact can hold against a rigid motion) is checked once by
-//! [`crate::admit`] before any solve.
+//! [`crate::model::admit`] before any solve.
+
+pub mod admit;
+pub(crate) mod rigid;
 
 use crate::error::{Error, Result};
-use crate::exact::ExactField;
 use crate::fe::{point_values, ElementKind};
-use crate::mesh::{block, Facet, Mesh};
-use crate::paths::{name_problem, NAME_RULE};
-use crate::scene::{
+use crate::harness::exact::ExactField;
+use crate::io::paths::{name_problem, NAME_RULE};
+use crate::io::scene::{
     Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, Interaction,
     MeshSpec, NodeSetSpec, Physics, Plane, Prescribed, RigidSurface, SolverSpec, SweepSpec,
     TractionSpec, MAX_SOLVER_COUNT,
 };
+use crate::mesh::{block, Facet, Mesh};
 use crate::solid::{check_geometry, Elasticity};
 
 /// One elastic body: its mesh (with named sets), material and first global dof.
@@ -1064,7 +1067,7 @@ fn check_cells(mesh: &Mesh, source: &str, at: &str) -> Result<()> {
 
 fn add_user_sets(
     mesh: &mut Mesh,
-    spec: &crate::scene::BodySpec,
+    spec: &crate::io::scene::BodySpec,
     source: &str,
     at: &str,
 ) -> Result<()> {

@@ -10,7 +10,7 @@
 //! ```
 //!
 //! (`nu_j` the reversed nodal normal of the slave surface), so a mortar row is a
-//! [`super::Constraint`] with weights `D_jk / A_j` on slave nodes and `M_jl / A_j` on master
+//! [`crate::contact::Constraint`] with weights `D_jk / A_j` on slave nodes and `M_jl / A_j` on master
 //! nodes, and every enforcement method applies unchanged; its force `lambda_j` is the
 //! multiplier times `A_j`, a nodal force like the node-to-surface ones.
 //!
@@ -28,11 +28,11 @@
 //! * Because `sum_k D_jk = sum_l M_jl` when the slave facet is covered, the forces `D^T lambda`
 //!   and `-M^T lambda` balance (linear momentum); the check `force_balance` measures it.
 
-use super::discretization::Rows;
 use super::geometry::{closest_point, edge_shape, facet_point, Surface};
 use super::search::BucketGrid;
+use super::Rows;
 use crate::fe::{gauss_legendre, EdgeKind};
-use crate::scene::MultiplierSpace;
+use crate::io::scene::MultiplierSpace;
 use std::collections::BTreeMap;
 
 /// Multiplier function values at `s` on a slave facet.

@@ -1,7 +1,7 @@
 //! Admission of a built model: the checks that need more than the case's data, run once before
 //! any solve. [`Model::build`] resolves names, meshes and numbers; here the contact rows of
 //! every pair are built (with every candidate row counted as closed) to find a body that no
-//! support and no contact can hold against a rigid motion (`crate::rigid`), which would
+//! support and no contact can hold against a rigid motion (`crate::model::rigid`), which would
 //! otherwise surface as a singular matrix.
 
 use crate::contact::discretization::constraints;
@@ -25,7 +25,7 @@ pub fn admit(model: Model) -> Result<Model> {
 }
 
 /// Every rigid mode of every body must be held by the prescribed dofs and the contact rows
-/// together, every candidate row counted as closed (see `crate::rigid`).
+/// together, every candidate row counted as closed (see `crate::model::rigid`).
 pub fn check_rigid_modes(model: &Model) -> Result<()> {
     let mut rows = Vec::new();
     for pair in &model.contact {
@@ -39,7 +39,7 @@ pub fn check_rigid_modes(model: &Model) -> Result<()> {
         })?);
     }
     let rows: Vec<&crate::contact::Constraint> = rows.iter().collect();
-    let Some(free) = crate::rigid::free_rigid_mode(model, &rows) else {
+    let Some(free) = crate::model::rigid::free_rigid_mode(model, &rows) else {
         return Ok(());
     };
     let in_contact = model.contact.iter().any(|p| {

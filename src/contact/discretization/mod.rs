@@ -19,18 +19,22 @@
 //! * **Two-pass**: the rows of the pass with the roles swapped are appended (pass 2).
 //! * **Rigid masters**: a line `g = n . (x_s - p)` or a circle `g = |x_s - c| - R` with
 //!   `n = (x_s - c)/|x_s - c|`; only slave dofs appear.
-//! * **Mortar** (standard and dual, segment-based integration): see [`super::mortar`].
+//! * **Mortar** (standard and dual, segment-based integration): see `mortar`.
 //! * **Tied** pairs use the same weights with one bilateral row per global direction
 //!   (`e_x`, `e_y`) and zero initial gap: the interface keeps its initial geometry.
 //!
 //! Every row carries the slave node's tributary area, so penalty forces (`kappa A g`) do not
 //! depend on the mesh. Geometry is evaluated in the reference configuration (small strain).
 
-use super::geometry::{closest_point, edge_shape, facet_point, ray_point, unit_normal, Surface};
-use super::search::BucketGrid;
-use super::Constraint;
+pub(crate) mod geometry;
+pub(crate) mod mortar;
+pub(crate) mod search;
+
+use crate::contact::Constraint;
+use crate::io::scene::{DiscretizationSpec, Interaction, NormalChoice, RigidSurface};
 use crate::model::{ContactPair, MasterSide, Model};
-use crate::scene::{DiscretizationSpec, Interaction, NormalChoice, RigidSurface};
+use geometry::{closest_point, edge_shape, facet_point, ray_point, unit_normal, Surface};
+use search::BucketGrid;
 
 /// Tolerance on the facet parameter for "inside the facet".
 const INSIDE: f64 = 1e-9;
@@ -171,7 +175,7 @@ pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>,
         }
         (DiscretizationSpec::Mortar { multiplier }, MasterSide::Body { body, facets }) => {
             let master = Surface::new(*body, &model.bodies[*body], facets, model.thickness);
-            super::mortar::mortar_rows(&mut rows, &slave, &master, *multiplier)?;
+            mortar::mortar_rows(&mut rows, &slave, &master, *multiplier)?;
         }
     }
     if rows.out.is_empty() {
@@ -419,7 +423,7 @@ fn node_to_surface(
 /// `g = |x_s - c| - R` gives `d2g/dx_s2 = (I - n n^T) / |x_s - c|` at the slave position `x_s`
 /// (in the configuration the row is linearized in). Rigid lines and ties are affine (`None`);
 /// node-to-surface and mortar rows against deformable masters do not provide theirs yet (their
-/// geometry is then updated by a fixed point, see [`super::solver`]).
+/// geometry is then updated by a fixed point, see [`crate::solver::active_set`]).
 pub fn gap_second_derivative(model: &Model, row: &Constraint, x_s: [f64; 2]) -> Option<[f64; 4]> {
     let MasterSide::Rigid(RigidSurface::Circle { centre, .. }) = model.contact[row.pair].master
     else {

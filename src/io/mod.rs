@@ -1,0 +1,8 @@
+//! Everything that crosses the tool's boundary: the case file ([`scene`], plain serde data),
+//! the paths the tool writes ([`paths`], the one owner of every written path), the results it
+//! writes ([`output`]: `summary.json` and `.vtu` files) and its plots (`svg`).
+
+pub mod output;
+pub mod paths;
+pub mod scene;
+pub(crate) mod svg;
