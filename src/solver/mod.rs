@@ -5,6 +5,7 @@
 pub mod active_set;
 pub(crate) mod dense;
 pub mod linear;
+pub mod newton;
 pub mod sparse;
 
 use crate::error::Result;

@@ -619,6 +619,20 @@ impl GeneralPattern {
         self.upper.iter().map(|&k| upper_values[k]).collect()
     }
 
+    /// The upper triangle (the storage of the [`SymmetricPattern`] this pattern was built from,
+    /// `nnz_upper` entries) of the matrix with `values` on both triangles.
+    pub fn upper_values(&self, values: &[f64], nnz_upper: usize) -> Vec<f64> {
+        let mut out = vec![0.0; nnz_upper];
+        for j in 0..self.n {
+            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
+                if self.row_idx[k] <= j {
+                    out[self.upper[k]] = values[k];
+                }
+            }
+        }
+        out
+    }
+
     fn symbolic(&self) -> SymbolicSparseColMatRef<'_, usize> {
         SymbolicSparseColMatRef::new_checked(self.n, self.n, &self.col_ptr, None, &self.row_idx)
     }

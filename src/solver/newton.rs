@@ -1,0 +1,415 @@
+//! Newton's method on a [`System`]: the residual `R(x)` and the tangent `K_T(x) = dR/dx` at the
+//! current state, and one linear solve per iteration, `K_T(x_k) dx = -R(x_k)`,
+//! `x_{k+1} = x_k + dx`.
+//!
+//! Contact makes `R` piecewise smooth (a row is active or not; later, sticks or slips). The
+//! iteration is then the semi-smooth Newton method (Hintermüller, Ito & Kunisch, SIAM J. Optim.
+//! 13 (2003) 865-888; for contact, Hüeber & Wohlmuth, CMAME 194 (2005) 3147-3166): the system
+//! decides the status of every point from the current iterate inside [`System::evaluate`] and
+//! gives the tangent of the branch it chose. An iteration has converged when the residual at
+//! the iterate is below `tolerance` times the system's force scale and the status of no point
+//! changed in that evaluation; a linear problem with a fixed status converges in one solve.
+//! Augmented Lagrangian updates (Uzawa) are the system's business too:
+//! [`System::augment`] runs between iterations and tells whether it moved a multiplier.
+//!
+//! Linear algebra sits behind one interface, [`LinearSolver`]: sparse Cholesky for a symmetric
+//! tangent, sparse LU (its symbolic analysis reused) for an unsymmetric one or when Cholesky
+//! meets a pivot that is not positive (a symmetric tangent made indefinite by a geometric
+//! term); a factorization is reused when the tangent's values have not changed.
+
+use super::sparse::{
+    Cholesky, Factor, FactorError, GeneralPattern, Lu, LuFactor, SymmetricPattern,
+};
+use crate::contact::state::{IterationRecord, Termination};
+use crate::error::Result;
+use std::time::Instant;
+
+/// The tangent of one evaluation, on the system's pattern (both triangles).
+pub struct Tangent {
+    /// Values on [`LinearSolver::general`] (both triangles).
+    pub values: Vec<f64>,
+    /// Whether the values are symmetric (then Cholesky is tried first).
+    pub symmetric: bool,
+}
+
+/// What an evaluation reports besides the residual and the tangent.
+#[derive(Clone, Debug, Default)]
+pub struct Evaluation {
+    /// The force scale the residual is judged against (largest applied or contact force).
+    pub force_scale: f64,
+    /// Active points in this evaluation, and how many changed status against the last one.
+    pub active: usize,
+    pub status_changes: usize,
+    /// Largest penetration of a contact point at the iterate.
+    pub max_gap_violation: f64,
+    /// Largest change of a point's force against the last evaluation.
+    pub multiplier_change: f64,
+}
+
+/// A nonlinear problem in `n` unknowns with a fixed sparsity pattern.
+pub trait System {
+    /// The pattern of the tangent (upper triangle). It may grow between iterations (a contact
+    /// point that slides onto new master nodes): [`System::pattern_version`] then changes.
+    fn pattern(&self) -> &SymmetricPattern;
+    /// Changes whenever [`System::pattern`] does.
+    fn pattern_version(&self) -> usize {
+        0
+    }
+    /// Residual `R(x)` into `residual` and the tangent at `x` on `general` (both triangles of
+    /// [`System::pattern`]); the status of every point is decided here.
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        general: &GeneralPattern,
+        residual: &mut [f64],
+        tangent: &mut Tangent,
+    ) -> Result<Evaluation>;
+    /// Between iterations, after the iterate `x` (`converged`: the residual test passed):
+    /// update augmentations; `true` if anything moved (then the iteration has not converged).
+    fn augment(&mut self, _x: &[f64], _converged: bool) -> bool {
+        false
+    }
+}
+
+/// Limits and tolerance of one Newton solve.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    pub max_iterations: usize,
+    /// Residual tolerance relative to [`Evaluation::force_scale`].
+    pub tolerance: f64,
+}
+
+/// How a Newton solve ended.
+pub struct Outcome {
+    pub termination: Termination,
+    /// Linear solves performed.
+    pub iterations: usize,
+    pub history: Vec<IterationRecord>,
+    /// Seconds spent factoring, and the solver of the last solve.
+    pub factorization_seconds: f64,
+    pub linear_solver: &'static str,
+}
+
+/// Run Newton's method on `system` from `x` (overwritten with the last iterate).
+pub fn solve(system: &mut dyn System, x: &mut [f64], settings: Settings) -> Result<Outcome> {
+    let n = x.len();
+    let mut linear = LinearSolver::new(system.pattern());
+    let mut version = system.pattern_version();
+    let mut residual = vec![0.0; n];
+    let mut history = Vec::new();
+    let mut solves = 0;
+    let mut start = Instant::now();
+    let (mut augmented, mut augmentations) = (false, 0);
+    let termination = loop {
+        if system.pattern_version() != version {
+            linear = LinearSolver::new(system.pattern());
+            version = system.pattern_version();
+        }
+        let mut tangent = Tangent {
+            values: vec![0.0; linear.general.nnz()],
+            symmetric: true,
+        };
+        let eval = system.evaluate(x, &linear.general, &mut residual, &mut tangent)?;
+        let norm = residual.iter().fold(0.0f64, |m, v| {
+            if v.is_nan() || v.abs() > m {
+                v.abs()
+            } else {
+                m
+            }
+        });
+        let relative = norm / eval.force_scale.max(f64::MIN_POSITIVE);
+        let small = relative <= settings.tolerance;
+        if solves > 0 {
+            history.push(IterationRecord {
+                step: 0,
+                geometry_update: 0,
+                iteration: solves,
+                residual: relative,
+                active: eval.active,
+                status_changes: eval.status_changes,
+                max_gap_violation: eval.max_gap_violation,
+                multiplier_change: eval.multiplier_change,
+                linear_solver: linear.last_solver,
+                seconds: start.elapsed().as_secs_f64(),
+            });
+            start = Instant::now();
+        }
+        let converged = small && eval.status_changes == 0;
+        // an augmentation (Uzawa) moves multipliers: evaluate again before deciding; the
+        // evaluation right after one does not augment again
+        if solves > 0 && !augmented && system.augment(x, converged) {
+            augmented = true;
+            augmentations += 1;
+            if augmentations > settings.max_iterations {
+                break Termination::IterationLimit;
+            }
+            continue;
+        }
+        augmented = false;
+        if converged {
+            break Termination::Converged;
+        }
+        if !relative.is_finite() {
+            break Termination::Singular(format!(
+                "the residual of Newton iteration {solves} is not finite"
+            ));
+        }
+        if solves >= settings.max_iterations {
+            break Termination::IterationLimit;
+        }
+        residual.iter_mut().for_each(|v| *v = -*v);
+        if let Err(e) = linear.solve(&tangent, &mut residual) {
+            break Termination::Singular(format!(
+                "the tangent of Newton iteration {} could not be factored: {e:?}",
+                solves + 1
+            ));
+        }
+        x.iter_mut().zip(&residual).for_each(|(a, d)| *a += d);
+        solves += 1;
+    };
+    Ok(Outcome {
+        termination,
+        iterations: solves,
+        history,
+        factorization_seconds: linear.seconds,
+        linear_solver: linear.last_solver,
+    })
+}
+
+enum Factorization {
+    Cholesky(Factor),
+    Lu(LuFactor),
+}
+
+impl Factorization {
+    fn solve_in_place(&self, b: &mut [f64]) {
+        match self {
+            Factorization::Cholesky(f) => f.solve_in_place(b),
+            Factorization::Lu(f) => f.solve_in_place(b),
+        }
+    }
+}
+
+/// Cholesky and LU behind one interface, on one pattern analysed once per solver kind; the
+/// last factorization is reused while the tangent's values do not change.
+pub struct LinearSolver {
+    symmetric: SymmetricPattern,
+    pub general: GeneralPattern,
+    cholesky: Option<Cholesky>,
+    lu: Option<Lu>,
+    last: Option<(Vec<f64>, Factorization)>,
+    /// Numeric factorizations done, and solves that reused the last one.
+    pub factorizations: usize,
+    pub reused: usize,
+    pub seconds: f64,
+    pub last_solver: &'static str,
+}
+
+impl LinearSolver {
+    pub fn new(pattern: &SymmetricPattern) -> LinearSolver {
+        LinearSolver {
+            symmetric: pattern.clone(),
+            general: GeneralPattern::from_symmetric(pattern),
+            cholesky: None,
+            lu: None,
+            last: None,
+            factorizations: 0,
+            reused: 0,
+            seconds: 0.0,
+            last_solver: "none",
+        }
+    }
+
+    /// Overwrite `b` with `K_T^-1 b`.
+    pub fn solve(
+        &mut self,
+        tangent: &Tangent,
+        b: &mut [f64],
+    ) -> std::result::Result<(), FactorError> {
+        if let Some((values, f)) = &self.last {
+            if *values == tangent.values {
+                self.reused += 1;
+                f.solve_in_place(b);
+                return Ok(());
+            }
+        }
+        let t = Instant::now();
+        let factor = self.factor(tangent);
+        self.seconds += t.elapsed().as_secs_f64();
+        let factor = factor?;
+        factor.solve_in_place(b);
+        self.factorizations += 1;
+        self.last = Some((tangent.values.clone(), factor));
+        Ok(())
+    }
+
+    fn factor(&mut self, tangent: &Tangent) -> std::result::Result<Factorization, FactorError> {
+        if tangent.symmetric {
+            if self.cholesky.is_none() {
+                self.cholesky = Some(Cholesky::analyse(&self.symmetric)?);
+            }
+            let upper = self
+                .general
+                .upper_values(&tangent.values, self.symmetric.nnz());
+            let chol = self.cholesky.as_ref().expect("analysed");
+            match chol.factor(&self.symmetric, &upper) {
+                Ok(f) => {
+                    self.last_solver = "cholesky";
+                    return Ok(Factorization::Cholesky(f));
+                }
+                // indefinite (a geometric term): LU below; a zero pivot is singular either way
+                Err(FactorError::NotPositiveDefinite { .. }) => {}
+                Err(e) => return Err(e),
+            }
+        }
+        if self.lu.is_none() {
+            self.lu = Some(Lu::analyse(&self.general)?);
+        }
+        let f = self
+            .lu
+            .as_ref()
+            .expect("analysed")
+            .factor(&self.general, &tangent.values)?;
+        self.last_solver = "lu";
+        Ok(Factorization::Lu(f))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::sparse::PatternBuilder;
+
+    /// `R(x) = A x + c x^3 - f` on a tridiagonal `A`: Newton converges quadratically from zero.
+    struct Cubic {
+        pattern: SymmetricPattern,
+        c: f64,
+        f: Vec<f64>,
+        unsymmetric: f64,
+    }
+
+    impl System for Cubic {
+        fn pattern(&self) -> &SymmetricPattern {
+            &self.pattern
+        }
+        fn evaluate(
+            &mut self,
+            x: &[f64],
+            general: &GeneralPattern,
+            residual: &mut [f64],
+            tangent: &mut Tangent,
+        ) -> Result<Evaluation> {
+            let n = x.len();
+            tangent.symmetric = self.unsymmetric == 0.0;
+            for i in 0..n {
+                let mut r = 4.0 * x[i] + self.c * x[i].powi(3) - self.f[i];
+                let d = general.position(i, i).unwrap();
+                tangent.values[d] = 4.0 + 3.0 * self.c * x[i] * x[i];
+                if i > 0 {
+                    r -= x[i - 1];
+                    tangent.values[general.position(i, i - 1).unwrap()] = -1.0;
+                }
+                if i + 1 < n {
+                    r -= (1.0 + self.unsymmetric) * x[i + 1];
+                    tangent.values[general.position(i, i + 1).unwrap()] = -1.0 - self.unsymmetric;
+                }
+                residual[i] = r;
+            }
+            Ok(Evaluation {
+                force_scale: self.f.iter().fold(0.0, |m: f64, v| m.max(v.abs())),
+                ..Evaluation::default()
+            })
+        }
+    }
+
+    fn cubic(n: usize, c: f64, unsymmetric: f64) -> Cubic {
+        let mut b = PatternBuilder::new(n);
+        for i in 0..n - 1 {
+            b.add_block(&[i, i + 1]);
+        }
+        Cubic {
+            pattern: b.build(),
+            c,
+            f: (0..n).map(|i| 1.0 + i as f64).collect(),
+            unsymmetric,
+        }
+    }
+
+    #[test]
+    fn newton_converges_quadratically_on_a_cubic_system() {
+        for (unsymmetric, solver) in [(0.0, "cholesky"), (0.5, "lu")] {
+            let mut s = cubic(20, 0.5, unsymmetric);
+            let mut x = vec![0.0; 20];
+            let out = solve(
+                &mut s,
+                &mut x,
+                Settings {
+                    max_iterations: 30,
+                    tolerance: 1e-14,
+                },
+            )
+            .unwrap();
+            assert_eq!(out.termination, Termination::Converged);
+            assert_eq!(out.linear_solver, solver);
+            let r: Vec<f64> = out.history.iter().map(|h| h.residual).collect();
+            // quadratic: once below 1e-2, each residual is below a constant times the square
+            // of the last
+            let asymptotic: Vec<&[f64]> = r.windows(2).filter(|w| w[0] < 1e-2).collect();
+            assert!(!asymptotic.is_empty(), "{r:?}");
+            for w in asymptotic {
+                assert!(w[1] <= 10.0 * w[0] * w[0] + 1e-15, "{r:?}");
+            }
+            // the answer satisfies the equations
+            let mut res = vec![0.0; 20];
+            let general = GeneralPattern::from_symmetric(&s.pattern);
+            let mut t = Tangent {
+                values: vec![0.0; general.nnz()],
+                symmetric: true,
+            };
+            s.evaluate(&x, &general, &mut res, &mut t).unwrap();
+            assert!(res.iter().all(|v| v.abs() < 1e-12), "{res:?}");
+        }
+    }
+
+    #[test]
+    fn a_linear_system_takes_one_solve_and_an_unchanged_tangent_is_not_refactored() {
+        let mut s = cubic(10, 0.0, 0.0);
+        let mut x = vec![0.0; 10];
+        let settings = Settings {
+            max_iterations: 10,
+            tolerance: 1e-13,
+        };
+        let out = solve(&mut s, &mut x, settings).unwrap();
+        assert_eq!(out.termination, Termination::Converged);
+        assert_eq!(out.iterations, 1);
+        let mut linear = LinearSolver::new(&s.pattern);
+        let general = linear.general.clone();
+        let mut t = Tangent {
+            values: vec![0.0; general.nnz()],
+            symmetric: true,
+        };
+        let mut r = vec![0.0; 10];
+        s.evaluate(&x, &general, &mut r, &mut t).unwrap();
+        let mut b = vec![1.0; 10];
+        linear.solve(&t, &mut b).unwrap();
+        linear.solve(&t, &mut b).unwrap();
+        assert_eq!((linear.factorizations, linear.reused), (1, 1));
+    }
+
+    #[test]
+    fn the_iteration_limit_is_a_termination_not_an_error() {
+        let mut s = cubic(10, 50.0, 0.0);
+        let mut x = vec![0.0; 10];
+        let out = solve(
+            &mut s,
+            &mut x,
+            Settings {
+                max_iterations: 2,
+                tolerance: 1e-14,
+            },
+        )
+        .unwrap();
+        assert_eq!(out.termination, Termination::IterationLimit);
+        assert_eq!(out.iterations, 2);
+    }
+}
