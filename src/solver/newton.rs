@@ -178,7 +178,7 @@ pub fn solve(system: &mut dyn System, x: &mut [f64], settings: Settings) -> Resu
 
 enum Factorization {
     Cholesky(Factor),
-    Lu(LuFactor),
+    Lu(Box<LuFactor>),
 }
 
 impl Factorization {
@@ -271,7 +271,7 @@ impl LinearSolver {
             .expect("analysed")
             .factor(&self.general, &tangent.values)?;
         self.last_solver = "lu";
-        Ok(Factorization::Lu(f))
+        Ok(Factorization::Lu(Box::new(f)))
     }
 }
 
