@@ -73,6 +73,24 @@ pub struct SolverSpec {
     /// `false` for the plain fixed point (to compare).
     #[serde(default = "yes")]
     pub geometric_stiffness: bool,
+    /// How each load step is solved: `"active_set"` (default; every enforcement method) or
+    /// `"newton"` (the residual/tangent Newton core, penalty-type methods: penalty, perturbed
+    /// Lagrangian with diagonal perturbation, augmented Lagrangian).
+    #[serde(default)]
+    pub scheme: Scheme,
+}
+
+/// The nonlinear solution scheme of a load step.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Scheme {
+    /// Linear solves of the active-set loop inside geometry updates
+    /// ([`crate::solver::active_set`]).
+    #[default]
+    ActiveSet,
+    /// Semi-smooth Newton on the residual and tangent, rows searched again at every iterate in
+    /// the current geometry ([`crate::solver::newton`], [`crate::solver::contact_newton`]).
+    Newton,
 }
 
 fn yes() -> bool {
@@ -103,6 +121,7 @@ impl Default for SolverSpec {
             max_geometry_updates: fifty(),
             geometry_tolerance: geometry_tolerance(),
             geometric_stiffness: true,
+            scheme: Scheme::ActiveSet,
         }
     }
 }

@@ -724,6 +724,22 @@ impl Model {
                     ));
                 }
             }
+            if case.solver.scheme == crate::io::scene::Scheme::Newton {
+                let family = crate::contact::enforcement::method(&spec.enforcement)
+                    .kernel()
+                    .family();
+                if family != crate::contact::enforcement::Family::PenaltyRegularized {
+                    return Err(Error::invalid(
+                        &self.source,
+                        format!("{at}.enforcement"),
+                        format!(
+                            "the Newton scheme (solver.scheme \"newton\") solves penalty-type methods, not {}",
+                            family.describe()
+                        ),
+                        "use penalty, the perturbed Lagrangian or the augmented Lagrangian, or solver.scheme \"active_set\"",
+                    ));
+                }
+            }
             if let Some(first) = self.contact.first() {
                 let family = |e| crate::contact::enforcement::method(e).kernel().family();
                 let (a, b) = (family(&first.enforcement), family(&spec.enforcement));

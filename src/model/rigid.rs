@@ -170,6 +170,51 @@ impl<'a> RigidModes<'a> {
             .collect()
     }
 
+    /// Close rows until no rigid motion is free: while the rows `active` leave a motion free,
+    /// the open rows that restrain one of the free motions (`|N^T a_i| > 1e-8 |a_i|`) and whose
+    /// gap is within `1e-9 size` of the smallest such gap are closed (closest points first).
+    /// `gaps[i]` is the gap of `rows[i]` at the start.
+    pub fn close_free_bodies(
+        &self,
+        rows: &[Constraint],
+        gaps: &[f64],
+        size: f64,
+        active: &mut [bool],
+    ) {
+        loop {
+            let basis = self.free_motions(
+                rows.iter()
+                    .zip(active.iter())
+                    .filter(|(_, &a)| a)
+                    .map(|(r, _)| (&r.dofs[..], &r.coeffs[..])),
+            );
+            if basis.is_empty() {
+                return;
+            }
+            let holding: Vec<usize> = (0..rows.len())
+                .filter(|&i| !active[i])
+                .filter(|&i| {
+                    let a = self.restraint(&rows[i].dofs, &rows[i].coeffs);
+                    let norm = a.iter().map(|v| v * v).sum::<f64>().sqrt();
+                    let seen = basis
+                        .iter()
+                        .map(|q| q.iter().zip(&a).map(|(x, y)| x * y).sum::<f64>().powi(2))
+                        .sum::<f64>()
+                        .sqrt();
+                    seen > 1e-8 * norm
+                })
+                .collect();
+            let Some(smallest) = holding.iter().map(|&i| gaps[i]).min_by(f64::total_cmp) else {
+                return;
+            };
+            for &i in &holding {
+                if gaps[i] <= smallest + 1e-9 * size {
+                    active[i] = true;
+                }
+            }
+        }
+    }
+
     /// Name the free motions `basis` (non-empty): the body they move most, its pure mode that
     /// lies most in them, and what holds the body among the prescribed dofs and `rows`.
     pub fn describe(&self, basis: &[Vec<f64>], rows: &[&Constraint]) -> FreeMode {

@@ -128,7 +128,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
 }
 
 /// The identities of the active rows of `state`.
-fn active_keys(state: &ContactState) -> HashSet<RowKey> {
+pub(crate) fn active_keys(state: &ContactState) -> HashSet<RowKey> {
     state
         .rows
         .iter()
@@ -146,6 +146,9 @@ fn solve_step(
     start: Option<Vec<f64>>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Solution> {
+    if model.solver.scheme == crate::io::scene::Scheme::Newton {
+        return crate::solver::contact_newton::solve_step(model, previous, start, progress);
+    }
     match model.physics.contact_geometry {
         ContactGeometry::Reference => solve_at(model, None, previous.as_ref(), None, progress),
         ContactGeometry::Current => {
@@ -238,9 +241,9 @@ fn solve_step(
 
 /// A row's identity across geometry updates: pair, pass, slave body and node, and for ties the
 /// direction (0 = x, 1 = y).
-type RowKey = (usize, u8, usize, usize, u8);
+pub(crate) type RowKey = (usize, u8, usize, usize, u8);
 
-fn row_key(r: &Constraint) -> RowKey {
+pub(crate) fn row_key(r: &Constraint) -> RowKey {
     let direction = u8::from(r.bilateral && r.normal[1].abs() > r.normal[0].abs());
     (r.pair, r.pass, r.slave_body, r.slave_node, direction)
 }
@@ -259,8 +262,12 @@ fn slid_off(previous: &HashSet<RowKey>, rows: &[Constraint]) -> Vec<RowKey> {
 }
 
 /// The contact rows of every pair, evaluated at `X + u` (reference configuration if `None`)
-/// and linearized there.
-fn rows_at(model: &Model, u: Option<&[f64]>) -> Result<Vec<Constraint>> {
+/// and linearized there. A row's `area`, the weight of a penalty (`kappa A`), stays its area in
+/// the reference configuration when the point has a row there: the penalty acts per unit
+/// reference area (a nominal pressure), so the penalty force `kappa A_0 g(u)` has the exact
+/// derivative `kappa A_0 dg/du` (the current area would add the variation of the tributary
+/// lengths, which no tangent carries, and Newton would converge only linearly).
+pub(crate) fn rows_at(model: &Model, u: Option<&[f64]>) -> Result<Vec<Constraint>> {
     let moved;
     let geometry = match u {
         None => model,
@@ -300,6 +307,17 @@ fn rows_at(model: &Model, u: Option<&[f64]>) -> Result<Vec<Constraint>> {
             }
             c
         }));
+    }
+    if u.is_some() {
+        let reference: HashMap<RowKey, f64> = rows_at(model, None)?
+            .iter()
+            .map(|r| (row_key(r), r.area))
+            .collect();
+        for r in &mut rows {
+            if let Some(&area) = reference.get(&row_key(r)) {
+                r.area = area;
+            }
+        }
     }
     Ok(rows)
 }
@@ -1297,7 +1315,6 @@ impl Kernel<'_> {
     /// points, the same ones whatever the numbering of its nodes.
     fn first_active_set(&self, rows: &[Constraint]) -> Vec<bool> {
         let gap_tol = self.gap_tol();
-        let size = self.model.size();
         let mut active: Vec<bool> = rows
             .iter()
             .zip(self.rows)
@@ -1307,43 +1324,10 @@ impl Kernel<'_> {
                 None => c.bilateral || r.g0 <= gap_tol,
             })
             .collect();
-        loop {
-            let basis = self.modes.free_motions(
-                rows.iter()
-                    .zip(&active)
-                    .filter(|(_, &a)| a)
-                    .map(|(r, _)| (&r.dofs[..], &r.coeffs[..])),
-            );
-            if basis.is_empty() {
-                return active;
-            }
-            // open rows that restrain a free motion: |N^T a_i| > 1e-8 |a_i|
-            let holding: Vec<usize> = (0..rows.len())
-                .filter(|&i| !active[i])
-                .filter(|&i| {
-                    let a = self.modes.restraint(&rows[i].dofs, &rows[i].coeffs);
-                    let norm = a.iter().map(|v| v * v).sum::<f64>().sqrt();
-                    let seen = basis
-                        .iter()
-                        .map(|q| q.iter().zip(&a).map(|(x, y)| x * y).sum::<f64>().powi(2))
-                        .sum::<f64>()
-                        .sqrt();
-                    seen > 1e-8 * norm
-                })
-                .collect();
-            let Some(smallest) = holding
-                .iter()
-                .map(|&i| self.rows[i].g0)
-                .min_by(f64::total_cmp)
-            else {
-                return active;
-            };
-            for &i in &holding {
-                if self.rows[i].g0 <= smallest + 1e-9 * size {
-                    active[i] = true;
-                }
-            }
-        }
+        let gaps: Vec<f64> = self.rows.iter().map(|r| r.g0).collect();
+        self.modes
+            .close_free_bodies(rows, &gaps, self.model.size(), &mut active);
+        active
     }
 
     /// The refusal when the active-set loop settles on a set that leaves a rigid motion free:

@@ -48,8 +48,9 @@ pub struct Evaluation {
 
 /// A nonlinear problem in `n` unknowns with a fixed sparsity pattern.
 pub trait System {
-    /// The pattern of the tangent (upper triangle). It may grow between iterations (a contact
-    /// point that slides onto new master nodes): [`System::pattern_version`] then changes.
+    /// The pattern of the tangent (upper triangle). An evaluation may grow it (a contact point
+    /// that slides onto new master nodes): [`System::pattern_version`] then changes, and the
+    /// driver analyses the new pattern and evaluates again (that evaluation's output is unused).
     fn pattern(&self) -> &SymmetricPattern;
     /// Changes whenever [`System::pattern`] does.
     fn pattern_version(&self) -> usize {
@@ -110,6 +111,10 @@ pub fn solve(system: &mut dyn System, x: &mut [f64], settings: Settings) -> Resu
             symmetric: true,
         };
         let eval = system.evaluate(x, &linear.general, &mut residual, &mut tangent)?;
+        if system.pattern_version() != version {
+            // the evaluation grew the pattern: analyse it and evaluate again
+            continue;
+        }
         let norm = residual.iter().fold(0.0f64, |m, v| {
             if v.is_nan() || v.abs() > m {
                 v.abs()
@@ -119,7 +124,7 @@ pub fn solve(system: &mut dyn System, x: &mut [f64], settings: Settings) -> Resu
         });
         let relative = norm / eval.force_scale.max(f64::MIN_POSITIVE);
         let small = relative <= settings.tolerance;
-        if solves > 0 {
+        if solves > 0 && !augmented {
             history.push(IterationRecord {
                 step: 0,
                 geometry_update: 0,
@@ -134,9 +139,9 @@ pub fn solve(system: &mut dyn System, x: &mut [f64], settings: Settings) -> Resu
             });
             start = Instant::now();
         }
-        let converged = small && eval.status_changes == 0;
-        // an augmentation (Uzawa) moves multipliers: evaluate again before deciding; the
-        // evaluation right after one does not augment again
+        // an augmentation (Uzawa) moves multipliers: the next evaluation does not augment again
+        // and is always followed by a Newton step
+        let converged = small && eval.status_changes == 0 && !augmented;
         if solves > 0 && !augmented && system.augment(x, converged) {
             augmented = true;
             augmentations += 1;

@@ -1,0 +1,212 @@
+//! The Newton core (`solver.scheme: "newton"`, `src/solver/newton.rs` and
+//! `src/solver/contact_newton.rs`) against the active-set scheme, two independent paths to the
+//! same discrete problem: every penalty-type cell of the patch and tied catalogues must agree,
+//! and Newton must converge quadratically where its tangent is exact.
+
+use contact_patch::model::{parse, Model};
+use contact_patch::run::{run_model, Outcome};
+use contact_patch::solver::active_set::Termination;
+use serde_json::{json, Value};
+use std::path::Path;
+
+fn read(case: &str) -> Value {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(case);
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn run(v: &Value, name: &str) -> contact_patch::Result<Outcome> {
+    let case = parse(&v.to_string(), name)?;
+    let model = Model::build(&case, name)?;
+    run_model(model, 0.0, std::time::Instant::now(), &mut |_| {})
+}
+
+fn with_scheme(v: &Value, scheme: &str) -> Value {
+    let mut v = v.clone();
+    if v.get("solver").is_none() {
+        v["solver"] = json!({});
+    }
+    v["solver"]["scheme"] = json!(scheme);
+    v
+}
+
+/// Largest difference of the displacements relative to the largest displacement.
+fn difference(a: &Outcome, b: &Outcome) -> f64 {
+    let scale = a.solution.u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    a.solution
+        .u
+        .iter()
+        .zip(&b.solution.u)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        / scale
+}
+
+fn termination(o: &Outcome) -> Termination {
+    o.solution.contact.as_ref().unwrap().termination.clone()
+}
+
+/// The cells of a catalogue case's sweep with a penalty-type method, as case values.
+fn penalty_cells(case: &str) -> Vec<(String, Value)> {
+    let v = read(case);
+    let sweep = v["sweep"].clone();
+    let pair = v["contact"][0].clone();
+    let mut cells = Vec::new();
+    for d in sweep["discretizations"].as_array().unwrap() {
+        for e in sweep["enforcements"].as_array().unwrap() {
+            let kind = e["kind"].as_str().unwrap();
+            if !matches!(
+                kind,
+                "penalty" | "perturbed_lagrange" | "augmented_lagrange"
+            ) {
+                continue;
+            }
+            let mut c = v.clone();
+            c.as_object_mut().unwrap().remove("sweep");
+            let mut p = pair.clone();
+            if let Some(slave) = d.get("slave") {
+                if p["slave"]["body"] != *slave {
+                    let s = p["slave"].clone();
+                    p["slave"] = p["master"].clone();
+                    p["master"] = s;
+                }
+            }
+            p["discretization"] = d["discretization"].clone();
+            p["enforcement"] = e.clone();
+            c["contact"] = json!([p]);
+            cells.push((format!("{case} {} {}", d, e), c));
+        }
+    }
+    cells
+}
+
+#[test]
+fn newton_agrees_with_the_active_set_scheme_on_every_penalty_cell_of_the_catalogue() {
+    let mut compared = 0;
+    let mut worst = 0.0f64;
+    let mut cases = Vec::new();
+    for mesh in ["A", "B", "C", "D", "E"] {
+        for nu in ["0.0", "0.3", "0.4"] {
+            cases.push(format!("cases/patch/patch-{mesh}-nu{nu}.json"));
+        }
+        for load in ["normal", "parallel", "shear"] {
+            cases.push(format!("cases/tied/tied-{mesh}-{load}.json"));
+        }
+    }
+    {
+        for case in cases {
+            if !Path::new(env!("CARGO_MANIFEST_DIR")).join(&case).exists() {
+                continue;
+            }
+            for (name, cell) in penalty_cells(&case) {
+                let old = run(&with_scheme(&cell, "active_set"), &name);
+                let new = run(&with_scheme(&cell, "newton"), &name);
+                let (old, new) = match (old, new) {
+                    (Ok(a), Ok(b)) => (a, b),
+                    (Err(a), Err(b)) => {
+                        assert_eq!(a.to_string(), b.to_string(), "{name}");
+                        continue;
+                    }
+                    (a, b) => panic!(
+                        "{name}: one scheme failed: {:?} / {:?}",
+                        a.err().map(|e| e.to_string()),
+                        b.err().map(|e| e.to_string())
+                    ),
+                };
+                assert_eq!(termination(&old), termination(&new), "{name}");
+                let d = difference(&old, &new);
+                worst = worst.max(d);
+                assert!(d <= 1e-9, "{name}: the schemes differ by {d:e}");
+                assert_eq!(
+                    old.passed(),
+                    new.passed(),
+                    "{name}: {:#?} / {:#?} ({:?})",
+                    old.checks,
+                    new.checks,
+                    new.solution.contact.as_ref().unwrap().history
+                );
+                compared += 1;
+            }
+        }
+    }
+    eprintln!("{compared} cells compared, largest relative difference {worst:e}");
+    assert!(compared >= 300, "only {compared} cells compared");
+}
+
+/// The rigid cylinder in the current geometry with a penalty: each Newton iteration searches
+/// the rows again at the iterate, and with the second derivative of the gap the tangent is
+/// exact, so the residual falls quadratically; the answer is the active-set scheme's
+/// (geometry updates around active-set loops). The augmented Lagrangian (outer loop) reaches
+/// the same answer as the active-set scheme too.
+#[test]
+fn newton_converges_quadratically_on_the_rigid_cylinder_in_current_geometry() {
+    for enforcement in [
+        json!({"kind": "penalty", "kappa": 1.0e4}),
+        json!({"kind": "augmented_lagrange", "kappa": 1.0e3, "update": "outer_loop"}),
+    ] {
+        let mut v = read("cases/contact/block-on-rigid-cylinder-finite-sliding.json");
+        v["contact"][0]["enforcement"] = enforcement.clone();
+        // the checks are the Lagrange case's (the penalty's force balance holds, its pressure
+        // differs): keep the equilibrium checks only
+        v["checks"] = json!([{"check": "force_balance", "tol": 1e-10}]);
+        let old = run(&with_scheme(&v, "active_set"), "cylinder").unwrap();
+        let new = run(&with_scheme(&v, "newton"), "cylinder").unwrap();
+        assert_eq!(termination(&new), Termination::Converged, "{enforcement}");
+        assert!(new.passed(), "{enforcement}: {:#?}", new.checks);
+        let d = difference(&old, &new);
+        assert!(d <= 1e-10, "{enforcement}: schemes differ by {d:e}");
+        if enforcement["kind"] != "penalty" {
+            // the Uzawa updates between Newton solves converge linearly by design
+            continue;
+        }
+        let history = &new.solution.contact.as_ref().unwrap().history;
+        let r: Vec<f64> = history.iter().map(|h| h.residual).collect();
+        eprintln!("{enforcement}: residuals {r:?}");
+        // quadratic where the status is settled: below 1e-3, each residual is below
+        // 10 times the square of the last, until round-off (1e-13)
+        let settled: Vec<(f64, f64)> = history
+            .windows(2)
+            .filter(|w| w[0].status_changes == 0 && w[0].residual < 1e-3 && w[0].residual > 1e-13)
+            .map(|w| (w[0].residual, w[1].residual))
+            .collect();
+        assert!(!settled.is_empty(), "{enforcement}: {r:?}");
+        for (a, b) in settled {
+            assert!(b <= 10.0 * a * a + 1e-13, "{enforcement}: {r:?}");
+        }
+    }
+}
+
+/// Frictionless contact has no history: 1 and 10 load steps agree under Newton too.
+#[test]
+fn newton_one_and_ten_load_steps_agree() {
+    for case in [
+        "cases/contact/signorini-block-on-rigid-line.json",
+        "cases/patch/patch-C-nu0.3.json",
+    ] {
+        let mut v = read(case);
+        v.as_object_mut().unwrap().remove("sweep");
+        v["contact"][0]["enforcement"] = json!({"kind": "penalty", "kappa": 1.0e4});
+        v["checks"] = json!([]);
+        let mut ten = with_scheme(&v, "newton");
+        ten["solver"]["load_steps"] = json!(10);
+        let one = run(&with_scheme(&v, "newton"), case).unwrap();
+        let ten = run(&ten, case).unwrap();
+        let d = difference(&one, &ten);
+        assert!(d <= 1e-12, "{case}: 1 and 10 steps differ by {d:e}");
+        assert_eq!(ten.solution.contact.as_ref().unwrap().steps.len(), 10);
+    }
+}
+
+#[test]
+fn newton_refuses_methods_with_multiplier_systems_with_the_reason() {
+    for kind in ["lagrange", "elimination", "perturbed_tangent"] {
+        let mut v = read("cases/contact/signorini-block-on-rigid-line.json");
+        v["contact"][0]["enforcement"] = if kind == "perturbed_tangent" {
+            json!({"kind": kind, "kappa": 1.0e4})
+        } else {
+            json!({"kind": kind})
+        };
+        let err = run(&with_scheme(&v, "newton"), "signorini").err().unwrap();
+        let msg = err.to_string();
+        assert!(msg.contains("the Newton scheme"), "{kind}: {msg}");
+        assert!(msg.contains("solver.scheme"), "{kind}: {msg}");
+    }
+}
