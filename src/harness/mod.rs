@@ -12,8 +12,8 @@
 //!   traction integrated over the interface.
 //! * Exact methods (Lagrange, elimination, perturbed tangent, augmented Lagrangian) pass when
 //!   the stress error, the load error and, if the rows are independent, the pressure error are
-//!   within the sweep's tolerance, the force balance within 1e-12, and the active-set loop
-//!   converged.
+//!   within the sweep's tolerance, the force balance within the case's `force_balance`
+//!   tolerance (1e-12 if it declares none), and the active-set loop converged.
 //! * Penalty-type methods (penalty, perturbed Lagrangian) satisfy the gap only approximately;
 //!   they run at `kappa` and at `penalty_factor * kappa` (both runs must converge and carry the
 //!   load) and are judged on the stress error: a
@@ -302,7 +302,17 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             } else if !converged {
                 notes.push(format!("the active-set loop ended by {:?}", m.termination));
             }
-            let balanced = m.force_balance <= 1e-12;
+            // the case's own force-balance tolerance (its `force_balance` check), 1e-12 if it
+            // declares none
+            let balance_tol = model
+                .checks
+                .iter()
+                .find_map(|c| match c {
+                    crate::io::scene::Check::ForceBalance { tol } => Some(*tol),
+                    _ => None,
+                })
+                .unwrap_or(1e-12);
+            let balanced = m.force_balance <= balance_tol;
             if !balanced {
                 notes.push(format!("force balance {:.1e}", m.force_balance));
             }
