@@ -1,8 +1,10 @@
 //! A method per pair: two blocks, each on its own rigid line, one pair enforced by penalty and
 //! one by the augmented Lagrangian, solved together. The bodies do not interact, so each must
 //! come out as its pair's method gives it alone: the penalty block sinks by `p / kappa` with
-//! an exact uniform stress, the augmented Lagrangian block closes its gap. Methods that need
-//! a loop of their own (Lagrange multipliers with penalty) are refused with a reason.
+//! an exact uniform stress, the augmented Lagrangian block closes its gap. In the active-set
+//! scheme, methods that need a loop of their own (Lagrange multipliers with penalty) are
+//! refused with a reason; the Newton scheme (`solver.scheme: "newton"`) solves Lagrange
+//! multiplier pairs and penalty pairs together.
 
 use contact_patch::model::{parse, Model};
 use contact_patch::run::{run_model, Outcome};
@@ -122,4 +124,49 @@ fn methods_that_need_their_own_loop_are_refused_with_the_reason() {
         "{}",
         penetration(&o, 1)
     );
+}
+
+#[test]
+fn the_newton_scheme_solves_a_lagrange_pair_with_a_penalty_pair() {
+    let kappa = 1e4;
+    let lagrange = json!({"kind": "lagrange"});
+    let penalty = json!({"kind": "penalty", "kappa": kappa});
+    let newton = |v: Value| {
+        let mut v = v;
+        v["solver"] = json!({"scheme": "newton"});
+        v
+    };
+    let mixed = solve(&newton(two_blocks(lagrange.clone(), penalty.clone()))).unwrap();
+    let state = mixed.solution.contact.as_ref().unwrap();
+    assert_eq!(
+        state.termination,
+        contact_patch::solver::active_set::Termination::Converged
+    );
+    assert!(mixed.passed(), "{:?}", mixed.checks);
+    assert!(
+        penetration(&mixed, 0) <= 1e-12,
+        "Lagrange penetration {}",
+        penetration(&mixed, 0)
+    );
+    let sunk = penetration(&mixed, 1);
+    assert!(
+        (sunk - 5.0 / kappa).abs() <= 1e-10 * sunk,
+        "penalty penetration {sunk}"
+    );
+    // each block as its method gives it alone, in the active-set scheme
+    for (both, body) in [(lagrange, 0), (penalty, 1)] {
+        let alone = solve(&two_blocks(both.clone(), both)).unwrap();
+        let b = &mixed.model.bodies[body];
+        let range = b.dof_offset..b.dof_offset + b.dof_count();
+        let scale = alone.solution.u[range.clone()]
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = mixed.solution.u[range.clone()]
+            .iter()
+            .zip(&alone.solution.u[range])
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(diff <= 1e-12 * scale, "body {body}: {}", diff / scale);
+    }
+    // the linear solver of a saddle-point system with multipliers
+    assert_eq!(state.linear_solver, "ldlt");
 }

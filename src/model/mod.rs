@@ -21,6 +21,7 @@
 pub mod admit;
 pub(crate) mod rigid;
 
+use crate::contact::enforcement::Family;
 use crate::error::{Error, Result};
 use crate::fe::{point_values, ElementKind};
 use crate::harness::exact::ExactField;
@@ -724,25 +725,26 @@ impl Model {
                     ));
                 }
             }
-            if case.solver.scheme == crate::io::scene::Scheme::Newton {
-                let family = crate::contact::enforcement::method(&spec.enforcement)
-                    .kernel()
-                    .family();
-                if family != crate::contact::enforcement::Family::PenaltyRegularized {
-                    return Err(Error::invalid(
-                        &self.source,
-                        format!("{at}.enforcement"),
-                        format!(
-                            "the Newton scheme (solver.scheme \"newton\") solves penalty-type methods, not {}",
-                            family.describe()
-                        ),
-                        "use penalty, the perturbed Lagrangian or the augmented Lagrangian, or solver.scheme \"active_set\"",
-                    ));
-                }
+            let newton = case.solver.scheme == crate::io::scene::Scheme::Newton;
+            let family_of = |e| crate::contact::enforcement::method(e).kernel().family();
+            if newton
+                && !matches!(
+                    family_of(&spec.enforcement),
+                    Family::PenaltyRegularized | Family::LagrangeMultipliers
+                )
+            {
+                return Err(Error::invalid(
+                    &self.source,
+                    format!("{at}.enforcement"),
+                    format!(
+                        "the Newton scheme (solver.scheme \"newton\") solves penalty-type methods and Lagrange multipliers, not {}",
+                        family_of(&spec.enforcement).describe()
+                    ),
+                    "use penalty, the perturbed Lagrangian, the augmented Lagrangian or Lagrange multipliers, or solver.scheme \"active_set\"",
+                ));
             }
-            if let Some(first) = self.contact.first() {
-                let family = |e| crate::contact::enforcement::method(e).kernel().family();
-                let (a, b) = (family(&first.enforcement), family(&spec.enforcement));
+            if let (Some(first), false) = (self.contact.first(), newton) {
+                let (a, b) = (family_of(&first.enforcement), family_of(&spec.enforcement));
                 if a != b {
                     return Err(Error::invalid(
                         &self.source,
@@ -752,7 +754,7 @@ impl Model {
                             first.name,
                             a.describe()
                         ),
-                        "methods of one family combine, a method per pair: penalty, perturbed Lagrangian and augmented Lagrangian; Lagrange multipliers, the perturbed tangent and constraint elimination each only with themselves",
+                        "methods of one family combine, a method per pair: penalty, perturbed Lagrangian and augmented Lagrangian; Lagrange multipliers, the perturbed tangent and constraint elimination each only with themselves (with solver.scheme \"newton\", Lagrange multipliers and penalty-type methods combine too)",
                     ));
                 }
             }

@@ -1,5 +1,7 @@
-//! Frictionless contact with penalty-type enforcement as a [`System`] for the Newton core
-//! ([`super::newton`]): `solver.scheme: "newton"`.
+//! Frictionless contact as a [`System`] for the Newton core ([`super::newton`]):
+//! `solver.scheme: "newton"`, for penalty-type rows (penalty, perturbed Lagrangian with its
+//! diagonal perturbation, augmented Lagrangian) and Lagrange-multiplier rows, mixed freely
+//! pair by pair.
 //!
 //! Unknowns: the free displacements `x` (prescribed values folded in, [`LinearSystem`]). Each
 //! contact row `i` (a [`Constraint`]: gap `g_i(u)`, gradient `b_i`, tributary area `A_i`) with
@@ -22,6 +24,23 @@
 //! every update is negligible (`|w_i g_i| <= 1e-12` of the largest force, or the gap is at the
 //! round-off floor `1e-15` of the model size), the stopping rule of the active-set scheme.
 //!
+//! **Lagrange multipliers** are unknowns of their own, scaled to the stiffness scale `rho`
+//! (the largest diagonal entry of `K`): `lambda_j = rho mu_j`, one per row with free
+//! equations, numbered after the displacements. The semi-smooth Newton method (primal-dual
+//! active set, Hintermüller, Ito & Kunisch 2003; Hüeber & Wohlmuth 2005) decides the status
+//! from `lambda_j - rho g_j > 0` (ties always active) and solves
+//!
+//! `R_u = K x - f - sum_pen lambda_i b_i - rho sum_j mu_j b_j + rho sum_{j active} g_j b_j`,
+//! `R_mu_j = -rho g_j(x)` (active), `R_mu_j = -rho mu_j` (inactive),
+//!
+//! whose tangent is the symmetric saddle-point matrix
+//! `[[K_pen + rho B_A^T B_A, -rho B^T], [-rho B_A, -rho I_I]]`, factored by `L D L^T` with
+//! negative pivots on the multipliers. The term `rho g_j b_j` vanishes at the solution; it makes
+//! the displacement block definite for bodies held only by contact (the augmentation of the
+//! active-set scheme). Dependent active rows (a two-pass discretization) make the matrix
+//! singular: the step ends `Singular` with the reason, where the active-set scheme picks the
+//! minimum-norm multipliers.
+//!
 //! A body held by nothing but contact rows that are open at the start has a singular tangent:
 //! in the first evaluation the rows that would hold it are closed, nearest first
 //! ([`RigidModes::close_free_bodies`]), as in the active-set scheme; their forces may then be
@@ -29,9 +48,9 @@
 //! from the gaps.
 
 use super::active_set::{row_key, rows_at, RowKey};
-use super::linear::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
+use super::linear::{assemble, finish, max_abs, LinearSystem, Solution, Timings, NO_EQUATION};
 use super::newton::{self, Evaluation, System, Tangent};
-use super::sparse::{GeneralPattern, SymmetricPattern};
+use super::sparse::{GeneralPattern, PatternBuilder, SymmetricPattern};
 use crate::contact::discretization::gap_second_derivative;
 use crate::contact::enforcement::{method, Method};
 use crate::contact::state::{ContactState, Termination};
@@ -46,13 +65,35 @@ use std::time::Instant;
 /// Residual tolerance of the Newton solve, relative to the largest applied or contact force.
 pub const RESIDUAL_TOLERANCE: f64 = 1e-10;
 
-/// The penalty-type contact problem of one load step.
-pub(crate) struct PenaltyContact<'a> {
+/// How a row is enforced in the Newton scheme.
+#[derive(Copy, Clone, Debug)]
+enum RowLaw {
+    /// `lambda = max(0, lambda_bar - w g)`, with Uzawa updates of `lambda_bar` if any.
+    Penalty {
+        w: f64,
+        update: Option<MultiplierUpdate>,
+    },
+    /// A Lagrange multiplier unknown.
+    Multiplier,
+}
+
+/// The frictionless contact problem of one load step.
+pub(crate) struct ContactSystem<'a> {
     model: &'a Model,
     sys: LinearSystem,
+    /// The pattern of the unknowns: `K`'s, the rows' blocks, and the multipliers' couplings.
+    pattern: SymmetricPattern,
+    /// Position in `pattern` of each entry of `sys.pattern`.
+    k_positions: Vec<usize>,
     version: usize,
     /// Rows of the last evaluation (current geometry) or of the reference configuration.
     rows: Vec<Constraint>,
+    /// The multiplier unknown of each row (Lagrange rows with free equations).
+    multiplier: Vec<Option<usize>>,
+    /// The multiplier unknowns of the last pattern, by point (to carry them to a new one).
+    carried: HashMap<RowKey, usize>,
+    /// Stiffness scale `rho`.
+    rho: f64,
     /// Per point: the Uzawa multiplier, the status and the force of the last evaluation.
     augmentation: HashMap<RowKey, f64>,
     active: HashMap<RowKey, bool>,
@@ -63,7 +104,7 @@ pub(crate) struct PenaltyContact<'a> {
     pub(crate) search_seconds: f64,
 }
 
-impl<'a> PenaltyContact<'a> {
+impl<'a> ContactSystem<'a> {
     /// The problem at the start of a load step: `previous` are the active points of the last
     /// step, `u` its displacement.
     pub(crate) fn new(
@@ -78,6 +119,10 @@ impl<'a> PenaltyContact<'a> {
         let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.dofs.clone()).collect();
         let sys = assemble(model, &blocks);
         sys.check_assembled(model)?;
+        let rho = (0..sys.n)
+            .filter_map(|e| sys.pattern.position(e, e).map(|k| sys.k[k].abs()))
+            .fold(0.0f64, f64::max)
+            .max(f64::MIN_POSITIVE);
         let zero = vec![0.0; model.dof_count];
         let u = u.unwrap_or(&zero);
         let size = model.size();
@@ -98,44 +143,127 @@ impl<'a> PenaltyContact<'a> {
             .filter(|(_, &c)| c)
             .map(|(r, _)| row_key(r))
             .collect();
-        Ok(PenaltyContact {
+        let mut system = ContactSystem {
             model,
+            pattern: sys.pattern.clone(),
+            k_positions: Vec::new(),
             sys,
             version: 0,
             rows,
+            multiplier: Vec::new(),
+            carried: HashMap::new(),
+            rho,
             augmentation: HashMap::new(),
             active: HashMap::new(),
             forces: HashMap::new(),
             closed_at_start,
             evaluations: 0,
             search_seconds,
-        })
+        };
+        system.number_unknowns();
+        Ok(system)
     }
 
-    /// `(kappa A, Uzawa rule)` of row `r`.
-    fn weight(&self, r: &Constraint) -> (f64, Option<MultiplierUpdate>) {
+    /// How row `r` is enforced.
+    fn law(&self, r: &Constraint) -> RowLaw {
         match method(&self.model.contact[r.pair].enforcement).kernel() {
-            Method::Regularized { kappa } => (kappa * r.area, None),
-            Method::AugmentedLagrange { kappa, update } => (kappa * r.area, Some(update)),
+            Method::Regularized { kappa } => RowLaw::Penalty {
+                w: kappa * r.area,
+                update: None,
+            },
+            Method::AugmentedLagrange { kappa, update } => RowLaw::Penalty {
+                w: kappa * r.area,
+                update: Some(update),
+            },
+            Method::Lagrange => RowLaw::Multiplier,
             other => unreachable!("the model refuses {other:?} with the Newton scheme"),
         }
     }
 
-    /// The force of row `r` at the displacement `u`, and whether it is active.
-    fn force(&self, r: &Constraint, u: &[f64]) -> (f64, bool) {
+    /// The free equations of row `r` with their coefficients.
+    fn free_terms(&self, r: &Constraint) -> Vec<(usize, f64)> {
+        r.dofs
+            .iter()
+            .zip(&r.coeffs)
+            .filter_map(|(&d, &c)| {
+                let e = self.sys.eq[d];
+                (e != NO_EQUATION).then_some((e, c))
+            })
+            .collect()
+    }
+
+    /// Number the multiplier unknowns of the rows and build the pattern of all unknowns.
+    fn number_unknowns(&mut self) {
+        let n = self.sys.n;
+        let mut m = 0;
+        self.multiplier = self
+            .rows
+            .iter()
+            .map(|r| {
+                let has_free = !self.free_terms(r).is_empty();
+                (matches!(self.law(r), RowLaw::Multiplier) && has_free).then(|| {
+                    m += 1;
+                    n + m - 1
+                })
+            })
+            .collect();
+        if m == 0 {
+            self.pattern = self.sys.pattern.clone();
+            self.k_positions = (0..self.sys.pattern.nnz()).collect();
+            return;
+        }
+        let p = &self.sys.pattern;
+        let mut builder = PatternBuilder::new(n + m);
+        for j in 0..n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                builder.add_block(&[p.row_idx[k], j]);
+            }
+        }
+        for (r, mult) in self.rows.iter().zip(&self.multiplier) {
+            if let Some(j) = mult {
+                let mut block: Vec<usize> = self.free_terms(r).iter().map(|&(e, _)| e).collect();
+                block.push(*j);
+                builder.add_block(&block);
+            }
+        }
+        self.pattern = builder.build();
+        let mut positions = Vec::with_capacity(p.nnz());
+        for j in 0..n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                positions.push(self.pattern.position(p.row_idx[k], j).expect("copied"));
+            }
+        }
+        self.k_positions = positions;
+    }
+
+    /// The force of row `r` at the unknowns `(u, mu)`, and whether it is active.
+    fn force(&self, i: usize, u: &[f64], x: &[f64]) -> (f64, bool) {
+        let r = &self.rows[i];
         let key = row_key(r);
-        let (w, _) = self.weight(r);
-        let trial = self.augmentation.get(&key).copied().unwrap_or(0.0) - w * r.gap(u);
         let closed = self.evaluations == 0 && self.closed_at_start.contains(&key);
-        if r.bilateral || closed || trial > 0.0 {
-            (trial, true)
-        } else {
-            (0.0, false)
+        let g = r.gap(u);
+        match self.law(r) {
+            RowLaw::Penalty { w, .. } => {
+                let trial = self.augmentation.get(&key).copied().unwrap_or(0.0) - w * g;
+                if r.bilateral || closed || trial > 0.0 {
+                    (trial, true)
+                } else {
+                    (0.0, false)
+                }
+            }
+            RowLaw::Multiplier => {
+                let Some(j) = self.multiplier[i] else {
+                    return (0.0, false);
+                };
+                let lambda = self.rho * x[j];
+                let on = r.bilateral || closed || lambda - self.rho * g > 0.0;
+                (lambda, on)
+            }
         }
     }
 
     /// Grow the pattern when a row couples equations it does not hold (a slave node that slid
-    /// onto new master nodes): assemble again with every row's block.
+    /// onto new master nodes) or the rows changed under multipliers: assemble again.
     fn cover(&mut self) {
         let eq = &self.sys.eq;
         let covered = self.rows.iter().all(|r| {
@@ -150,34 +278,76 @@ impl<'a> PenaltyContact<'a> {
                     .all(|&b| self.sys.pattern.position(a.min(b), a.max(b)).is_some())
             })
         });
+        let multipliers: Vec<RowKey> = self
+            .rows
+            .iter()
+            .filter(|r| matches!(self.law(r), RowLaw::Multiplier) && !self.free_terms(r).is_empty())
+            .map(row_key)
+            .collect();
+        let same_multipliers = multipliers.len() == self.carried.len()
+            && multipliers.iter().all(|k| self.carried.contains_key(k));
         if !covered {
             let blocks: Vec<Vec<usize>> = self.rows.iter().map(|r| r.dofs.clone()).collect();
             self.sys = assemble(self.model, &blocks);
+        }
+        if !covered || !same_multipliers {
+            self.number_unknowns();
             self.version += 1;
+        } else {
+            // the same points, perhaps in another order: their unknowns stay
+            self.multiplier = self
+                .rows
+                .iter()
+                .map(|r| self.carried.get(&row_key(r)).copied())
+                .collect();
         }
     }
 
-    /// The contact state at the displacement `u` (after the solve).
-    fn state(&self, u: &[f64]) -> (Vec<bool>, Vec<f64>, Vec<f64>) {
+    /// The contact state at the unknowns `x` (after the solve).
+    fn state(&self, x: &[f64]) -> (Vec<bool>, Vec<f64>, Vec<f64>) {
+        let u = self.sys.expand(&x[..self.sys.n]);
         let mut active = Vec::with_capacity(self.rows.len());
         let mut forces = Vec::with_capacity(self.rows.len());
-        for r in &self.rows {
-            let (f, a) = self.force(r, u);
+        for i in 0..self.rows.len() {
+            let (f, a) = self.force(i, &u, x);
             active.push(a);
-            forces.push(f);
+            forces.push(if a { f } else { 0.0 });
         }
-        let gaps = self.rows.iter().map(|r| r.gap(u)).collect();
+        let gaps = self.rows.iter().map(|r| r.gap(&u)).collect();
         (active, forces, gaps)
+    }
+
+    /// Remember which point each multiplier unknown belongs to.
+    fn remember_multipliers(&mut self) {
+        self.carried = self
+            .rows
+            .iter()
+            .zip(&self.multiplier)
+            .filter_map(|(r, m)| m.map(|j| (row_key(r), j)))
+            .collect();
     }
 }
 
-impl System for PenaltyContact<'_> {
+impl System for ContactSystem<'_> {
     fn pattern(&self) -> &SymmetricPattern {
-        &self.sys.pattern
+        &self.pattern
     }
 
     fn pattern_version(&self) -> usize {
         self.version
+    }
+
+    fn carry(&mut self, x: &[f64]) -> Vec<f64> {
+        let n = self.sys.n;
+        let mut out = x[..n].to_vec();
+        out.resize(self.pattern.n, 0.0);
+        for (r, m) in self.rows.iter().zip(&self.multiplier) {
+            if let (Some(j), Some(&old)) = (m, self.carried.get(&row_key(r))) {
+                out[*j] = x[old];
+            }
+        }
+        self.remember_multipliers();
+        out
     }
 
     fn evaluate(
@@ -187,7 +357,11 @@ impl System for PenaltyContact<'_> {
         residual: &mut [f64],
         tangent: &mut Tangent,
     ) -> Result<Evaluation> {
-        let u = self.sys.expand(x);
+        let n = self.sys.n;
+        if self.evaluations == 0 {
+            self.remember_multipliers();
+        }
+        let u = self.sys.expand(&x[..n]);
         let current = self.model.physics.contact_geometry == ContactGeometry::Current;
         if current && self.evaluations > 0 {
             let t = Instant::now();
@@ -199,62 +373,83 @@ impl System for PenaltyContact<'_> {
                 return Ok(Evaluation::default());
             }
         }
-        self.sys.pattern.mul(&self.sys.k, x, residual);
-        residual
+        let rho = self.rho;
+        let mut upper = vec![0.0; self.pattern.nnz()];
+        for (k, &p) in self.k_positions.iter().enumerate() {
+            upper[p] = self.sys.k[k];
+        }
+        residual.iter_mut().for_each(|v| *v = 0.0);
+        self.sys
+            .pattern
+            .mul(&self.sys.k, &x[..n], &mut residual[..n]);
+        residual[..n]
             .iter_mut()
             .zip(&self.sys.rhs)
             .for_each(|(r, f)| *r -= f);
-        tangent.values = general.symmetric_values(&self.sys.k);
-        tangent.symmetric = true;
-        let eq = &self.sys.eq;
         let mut eval = Evaluation {
-            force_scale: super::linear::max_abs(&self.sys.rhs),
+            force_scale: max_abs(&self.sys.rhs),
             ..Evaluation::default()
         };
         let geometric = current && self.model.solver.geometric_stiffness;
         let mut active = HashMap::with_capacity(self.rows.len());
         let mut forces = HashMap::with_capacity(self.rows.len());
-        let mut eqs = Vec::new();
-        for r in &self.rows {
+        let mut terms: Vec<(usize, f64)> = Vec::new();
+        for i in 0..self.rows.len() {
+            let r = &self.rows[i];
             let key = row_key(r);
-            let (lambda, on) = self.force(r, &u);
-            let (w, _) = self.weight(r);
+            let (lambda, on) = self.force(i, &u, x);
+            let g = r.gap(&u);
             if self.active.get(&key).copied().unwrap_or(false) != on && self.evaluations > 0 {
                 eval.status_changes += 1;
             }
+            let shown = if on { lambda } else { 0.0 };
             eval.multiplier_change = eval
                 .multiplier_change
-                .max((lambda - self.forces.get(&key).copied().unwrap_or(0.0)).abs());
+                .max((shown - self.forces.get(&key).copied().unwrap_or(0.0)).abs());
             if !r.bilateral {
-                eval.max_gap_violation = eval.max_gap_violation.max(-r.gap(&u));
+                eval.max_gap_violation = eval.max_gap_violation.max(-g);
             }
             active.insert(key, on);
-            forces.insert(key, lambda);
-            if !on {
-                continue;
-            }
-            eval.active += 1;
-            eqs.clear();
-            eqs.extend(r.dofs.iter().map(|&d| eq[d]));
-            for (&e, &c) in eqs.iter().zip(&r.coeffs) {
-                if e != NO_EQUATION {
-                    residual[e] -= lambda * c;
-                    eval.force_scale = eval.force_scale.max((lambda * c).abs());
-                }
-            }
-            for (a, (&ea, &ca)) in eqs.iter().zip(&r.coeffs).enumerate() {
-                if ea == NO_EQUATION {
-                    continue;
-                }
-                for (&eb, &cb) in eqs.iter().zip(&r.coeffs).skip(a) {
-                    if eb == NO_EQUATION {
+            forces.insert(key, shown);
+            terms.clear();
+            terms.extend(self.free_terms(r));
+            // the weight of b b^T in the displacement block, and the force on the equations
+            let (w, force) = match (self.law(r), self.multiplier[i]) {
+                (RowLaw::Penalty { w, .. }, _) => {
+                    if !on {
                         continue;
                     }
-                    let v = w * ca * cb;
-                    tangent.values[general.position(ea, eb).expect("covered")] += v;
-                    if ea != eb {
-                        tangent.values[general.position(eb, ea).expect("covered")] += v;
+                    (w, lambda)
+                }
+                (RowLaw::Multiplier, None) => continue,
+                (RowLaw::Multiplier, Some(j)) => {
+                    if !on {
+                        // R_mu = -rho mu drives the multiplier to zero; it exerts no force
+                        residual[j] = -rho * x[j];
+                        upper[self.pattern.position(j, j).expect("diagonal")] = -rho;
+                        continue;
                     }
+                    residual[j] = -rho * g;
+                    for &(e, c) in &terms {
+                        upper[self.pattern.position(e, j).expect("coupling")] = -rho * c;
+                    }
+                    // lambda b - rho g b: the augmented force of an active multiplier row
+                    (rho, lambda - rho * g)
+                }
+            };
+            if on {
+                eval.active += 1;
+            }
+            for &(e, c) in &terms {
+                residual[e] -= force * c;
+                eval.force_scale = eval.force_scale.max((shown * c).abs());
+            }
+            for (a, &(ea, ca)) in terms.iter().enumerate() {
+                for &(eb, cb) in &terms[a..] {
+                    upper[self
+                        .pattern
+                        .position(ea.min(eb), ea.max(eb))
+                        .expect("covered")] += w * ca * cb;
                 }
             }
             if geometric && lambda != 0.0 {
@@ -265,18 +460,25 @@ impl System for PenaltyContact<'_> {
                     b.mesh.nodes[r.slave_node][1] + u[dofs[1]],
                 ];
                 if let Some(h) = gap_second_derivative(self.model, r, x_s) {
+                    let eq = &self.sys.eq;
                     for a in 0..2 {
-                        for c in 0..2 {
+                        for c in a..2 {
                             let (ea, ec) = (eq[dofs[a]], eq[dofs[c]]);
                             if ea != NO_EQUATION && ec != NO_EQUATION {
-                                tangent.values[general.position(ea, ec).expect("node block")] -=
-                                    lambda * h[2 * a + c];
+                                upper[self
+                                    .pattern
+                                    .position(ea.min(ec), ea.max(ec))
+                                    .expect("node block")] -= lambda * h[2 * a + c];
                             }
                         }
                     }
                 }
             }
         }
+        tangent.values = general.symmetric_values(&upper);
+        tangent.symmetric = true;
+        tangent.multipliers = self.pattern.n - n;
+        tangent.scale = rho;
         self.active = active;
         self.forces = forces;
         self.evaluations += 1;
@@ -284,14 +486,18 @@ impl System for PenaltyContact<'_> {
     }
 
     fn augment(&mut self, x: &[f64], converged: bool) -> bool {
-        let u = self.sys.expand(x);
+        let u = self.sys.expand(&x[..self.sys.n]);
         let size = self.model.size();
         let fmax = self.forces.values().fold(0.0f64, |m, f| m.max(f.abs()));
-        let mut moved = false;
         let mut updates = Vec::new();
         for r in &self.rows {
-            let (w, rule) = self.weight(r);
-            let Some(rule) = rule else { continue };
+            let RowLaw::Penalty {
+                w,
+                update: Some(rule),
+            } = self.law(r)
+            else {
+                continue;
+            };
             let key = row_key(r);
             if !self.active.get(&key).copied().unwrap_or(false) {
                 continue;
@@ -305,8 +511,8 @@ impl System for PenaltyContact<'_> {
             }
             let next = self.augmentation.get(&key).copied().unwrap_or(0.0) - w * g;
             updates.push((key, if r.bilateral { next } else { next.max(0.0) }));
-            moved = true;
         }
+        let moved = !updates.is_empty();
         self.augmentation.extend(updates);
         moved
     }
@@ -323,19 +529,16 @@ pub(crate) fn solve_step(
     let mut timings = Timings::default();
     let t = Instant::now();
     progress("assembling");
-    let mut system = PenaltyContact::new(model, start.as_deref(), previous.as_ref())?;
+    let mut system = ContactSystem::new(model, start.as_deref(), previous.as_ref())?;
     timings.assembly = (t.elapsed().as_secs_f64() - system.search_seconds).max(0.0);
-    let mut x: Vec<f64> = match &start {
-        Some(u) => system
-            .sys
-            .eq
-            .iter()
-            .enumerate()
-            .filter(|(_, &e)| e != NO_EQUATION)
-            .map(|(d, _)| u[d])
-            .collect(),
-        None => vec![0.0; system.sys.n],
-    };
+    let mut x: Vec<f64> = vec![0.0; system.pattern.n];
+    if let Some(u) = &start {
+        for (d, &e) in system.sys.eq.iter().enumerate() {
+            if e != NO_EQUATION {
+                x[e] = u[d];
+            }
+        }
+    }
     let t = Instant::now();
     progress("newton iterations");
     let outcome = newton::solve(
@@ -351,8 +554,8 @@ pub(crate) fn solve_step(
     timings.solve =
         (t.elapsed().as_secs_f64() - outcome.factorization_seconds - timings.contact_search)
             .max(0.0);
-    let u = system.sys.expand(&x);
-    let (active, forces, gaps) = system.state(&u);
+    let u = system.sys.expand(&x[..system.sys.n]);
+    let (active, forces, gaps) = system.state(&x);
     let mut contact_force = vec![0.0; model.dof_count];
     for (r, &f) in system.rows.iter().zip(&forces) {
         for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
@@ -361,16 +564,15 @@ pub(crate) fn solve_step(
     }
     let current = model.physics.contact_geometry == ContactGeometry::Current;
     let mut solution = finish(model, &system.sys, u.clone(), &contact_force, timings)?;
-    let termination = outcome.termination;
     let iterations = outcome.iterations;
     solution.contact = Some(ContactState {
         rows: std::mem::take(&mut system.rows),
         active,
         forces,
         gaps,
-        termination: match termination {
+        termination: match outcome.termination {
             Termination::Singular(why) => Termination::Singular(format!(
-                "{why}; a body may be held by contact rows that opened (check its supports)"
+                "{why}; the active rows may depend on each other (a node constrained twice, as in a two-pass discretization with Lagrange multipliers), or a body may be held only by rows that opened"
             )),
             t => t,
         },

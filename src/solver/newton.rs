@@ -18,7 +18,7 @@
 //! term); a factorization is reused when the tangent's values have not changed.
 
 use super::sparse::{
-    Cholesky, Factor, FactorError, GeneralPattern, Lu, LuFactor, SymmetricPattern,
+    Cholesky, Factor, FactorError, GeneralPattern, Ldlt, LdltFactor, Lu, LuFactor, SymmetricPattern,
 };
 use crate::contact::state::{IterationRecord, Termination};
 use crate::error::Result;
@@ -30,6 +30,12 @@ pub struct Tangent {
     pub values: Vec<f64>,
     /// Whether the values are symmetric (then Cholesky is tried first).
     pub symmetric: bool,
+    /// The trailing unknowns that are (scaled) Lagrange multipliers: a symmetric tangent with
+    /// multipliers is a saddle-point matrix, factored by `L D L^T` with negative pivots there.
+    pub multipliers: usize,
+    /// The stiffness scale of the saddle-point matrix (its pivots below `1e-13` of it count as
+    /// zero).
+    pub scale: f64,
 }
 
 /// What an evaluation reports besides the residual and the tangent.
@@ -55,6 +61,11 @@ pub trait System {
     /// Changes whenever [`System::pattern`] does.
     fn pattern_version(&self) -> usize {
         0
+    }
+    /// The unknowns `x` of the previous pattern carried to the current one (a system whose
+    /// unknowns change with its pattern, e.g. the multipliers of rows that appeared).
+    fn carry(&mut self, x: &[f64]) -> Vec<f64> {
+        x.to_vec()
     }
     /// Residual `R(x)` into `residual` and the tangent at `x` on `general` (both triangles of
     /// [`System::pattern`]); the status of every point is decided here.
@@ -92,7 +103,7 @@ pub struct Outcome {
 }
 
 /// Run Newton's method on `system` from `x` (overwritten with the last iterate).
-pub fn solve(system: &mut dyn System, x: &mut [f64], settings: Settings) -> Result<Outcome> {
+pub fn solve(system: &mut dyn System, x: &mut Vec<f64>, settings: Settings) -> Result<Outcome> {
     let n = x.len();
     let mut linear = LinearSolver::new(system.pattern());
     let mut version = system.pattern_version();
@@ -105,10 +116,14 @@ pub fn solve(system: &mut dyn System, x: &mut [f64], settings: Settings) -> Resu
         if system.pattern_version() != version {
             linear = LinearSolver::new(system.pattern());
             version = system.pattern_version();
+            *x = system.carry(x);
+            residual = vec![0.0; x.len()];
         }
         let mut tangent = Tangent {
             values: vec![0.0; linear.general.nnz()],
             symmetric: true,
+            multipliers: 0,
+            scale: 1.0,
         };
         let eval = system.evaluate(x, &linear.general, &mut residual, &mut tangent)?;
         if system.pattern_version() != version {
@@ -183,6 +198,7 @@ pub fn solve(system: &mut dyn System, x: &mut [f64], settings: Settings) -> Resu
 
 enum Factorization {
     Cholesky(Factor),
+    Ldlt(LdltFactor),
     Lu(Box<LuFactor>),
 }
 
@@ -190,17 +206,21 @@ impl Factorization {
     fn solve_in_place(&self, b: &mut [f64]) {
         match self {
             Factorization::Cholesky(f) => f.solve_in_place(b),
+            Factorization::Ldlt(f) => f.solve_in_place(b),
             Factorization::Lu(f) => f.solve_in_place(b),
         }
     }
 }
 
-/// Cholesky and LU behind one interface, on one pattern analysed once per solver kind; the
-/// last factorization is reused while the tangent's values do not change.
+/// Cholesky, `L D L^T` with pivot signs and LU behind one interface, on one pattern analysed
+/// once per solver kind; the last factorization is reused while the tangent's values do not
+/// change.
 pub struct LinearSolver {
     symmetric: SymmetricPattern,
     pub general: GeneralPattern,
     cholesky: Option<Cholesky>,
+    /// With the number of leading (displacement) unknowns it was analysed for.
+    ldlt: Option<(usize, Ldlt)>,
     lu: Option<Lu>,
     last: Option<(Vec<f64>, Factorization)>,
     /// Numeric factorizations done, and solves that reused the last one.
@@ -216,6 +236,7 @@ impl LinearSolver {
             symmetric: pattern.clone(),
             general: GeneralPattern::from_symmetric(pattern),
             cholesky: None,
+            ldlt: None,
             lu: None,
             last: None,
             factorizations: 0,
@@ -249,7 +270,29 @@ impl LinearSolver {
     }
 
     fn factor(&mut self, tangent: &Tangent) -> std::result::Result<Factorization, FactorError> {
-        if tangent.symmetric {
+        if tangent.symmetric && tangent.multipliers > 0 {
+            let n = self.general.n;
+            let leading = n - tangent.multipliers;
+            if self.ldlt.as_ref().is_none_or(|(l, _)| *l != leading) {
+                self.ldlt = Some((leading, Ldlt::analyse(&self.symmetric, leading)?));
+            }
+            let upper = self
+                .general
+                .upper_values(&tangent.values, self.symmetric.nnz());
+            let signs: Vec<i8> = (0..n).map(|i| if i < leading { 1 } else { -1 }).collect();
+            let (_, ldlt) = self.ldlt.as_ref().expect("analysed");
+            let scale = tangent.scale;
+            match ldlt.factor(&self.symmetric, &upper, &signs, 1e-13 * scale, scale) {
+                Ok(f) => {
+                    self.last_solver = "ldlt";
+                    return Ok(Factorization::Ldlt(f));
+                }
+                // singular: dependent rows (two passes), a body the active rows leave free
+                Err(e @ FactorError::ZeroPivot { .. }) => return Err(e),
+                // LU below
+                Err(_) => {}
+            }
+        } else if tangent.symmetric {
             if self.cholesky.is_none() {
                 self.cholesky = Some(Cholesky::analyse(&self.symmetric)?);
             }
@@ -370,6 +413,8 @@ mod tests {
             let mut t = Tangent {
                 values: vec![0.0; general.nnz()],
                 symmetric: true,
+                multipliers: 0,
+                scale: 1.0,
             };
             s.evaluate(&x, &general, &mut res, &mut t).unwrap();
             assert!(res.iter().all(|v| v.abs() < 1e-12), "{res:?}");
@@ -392,6 +437,8 @@ mod tests {
         let mut t = Tangent {
             values: vec![0.0; general.nnz()],
             symmetric: true,
+            multipliers: 0,
+            scale: 1.0,
         };
         let mut r = vec![0.0; 10];
         s.evaluate(&x, &general, &mut r, &mut t).unwrap();
