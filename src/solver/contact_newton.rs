@@ -28,7 +28,11 @@
 //! (the largest diagonal entry of `K`): `lambda_j = rho mu_j`, one per row with free
 //! equations, numbered after the displacements. The semi-smooth Newton method (primal-dual
 //! active set, Hintermüller, Ito & Kunisch 2003; Hüeber & Wohlmuth 2005) decides the status
-//! from `lambda_j - rho g_j > 0` (ties always active) and solves
+//! of each point from its last one, as the active-set scheme does: an active point stays
+//! active while its force is compressive (above `-1e-10` of the largest force), an inactive
+//! one becomes active when it penetrates (ties always active). (The complementarity function
+//! `lambda_j - c g_j > 0` with one constant `c` would let the gap a step leaves in the current
+//! geometry, of the order of the geometry's change, release every point at once.) It solves
 //!
 //! `R_u = K x - f - sum_pen lambda_i b_i - rho sum_j mu_j b_j + rho sum_{j active} g_j b_j`,
 //! `R_mu_j = -rho g_j(x)` (active), `R_mu_j = -rho mu_j` (inactive),
@@ -53,7 +57,7 @@ use super::newton::{self, Evaluation, System, Tangent};
 use super::sparse::{GeneralPattern, PatternBuilder, SymmetricPattern};
 use crate::contact::discretization::gap_second_derivative;
 use crate::contact::enforcement::{method, Method};
-use crate::contact::state::{ContactState, Termination};
+use crate::contact::state::{ContactState, Departure, Termination};
 use crate::contact::Constraint;
 use crate::error::Result;
 use crate::io::scene::{ContactGeometry, MultiplierUpdate};
@@ -101,6 +105,12 @@ pub(crate) struct ContactSystem<'a> {
     /// Rows closed in the first evaluation to hold bodies that would otherwise float.
     closed_at_start: HashSet<RowKey>,
     evaluations: usize,
+    /// A multiplier row stays active while its force is above `-force_tolerance` (`1e-10` of
+    /// the largest force of the last evaluation).
+    force_tolerance: f64,
+    /// Active points whose slave node left the master surface (no row any more), first time
+    /// each node left.
+    departures: Vec<Departure>,
     pub(crate) search_seconds: f64,
 }
 
@@ -158,6 +168,8 @@ impl<'a> ContactSystem<'a> {
             forces: HashMap::new(),
             closed_at_start,
             evaluations: 0,
+            force_tolerance: 0.0,
+            departures: Vec::new(),
             search_seconds,
         };
         system.number_unknowns();
@@ -256,7 +268,13 @@ impl<'a> ContactSystem<'a> {
                     return (0.0, false);
                 };
                 let lambda = self.rho * x[j];
-                let on = r.bilateral || closed || lambda - self.rho * g > 0.0;
+                let on = r.bilateral
+                    || closed
+                    || if self.active.get(&key).copied().unwrap_or(false) {
+                        lambda >= -self.force_tolerance
+                    } else {
+                        g < -1e-14 * self.model.size()
+                    };
                 (lambda, on)
             }
         }
@@ -317,6 +335,37 @@ impl<'a> ContactSystem<'a> {
         (active, forces, gaps)
     }
 
+    /// The active points of the last evaluation that have no row at `u`: their slave nodes
+    /// slid off the master surface (a warning in the summary).
+    fn record_departures(&mut self, u: &[f64]) {
+        let now: HashSet<RowKey> = self.rows.iter().map(row_key).collect();
+        let mut lost: Vec<RowKey> = self
+            .active
+            .iter()
+            .filter(|(k, &on)| on && !now.contains(k))
+            .map(|(k, _)| *k)
+            .collect();
+        lost.sort();
+        for (pair, _, body, node, _) in lost {
+            if self
+                .departures
+                .iter()
+                .any(|d| d.body == body && d.node == node)
+            {
+                continue;
+            }
+            let b = &self.model.bodies[body];
+            let x = b.mesh.nodes[node];
+            self.departures.push(Departure {
+                pair,
+                body,
+                node,
+                point: [x[0] + u[b.dof(node, 0)], x[1] + u[b.dof(node, 1)]],
+                update: self.evaluations,
+            });
+        }
+    }
+
     /// Remember which point each multiplier unknown belongs to.
     fn remember_multipliers(&mut self) {
         self.carried = self
@@ -335,6 +384,25 @@ impl System for ContactSystem<'_> {
 
     fn pattern_version(&self) -> usize {
         self.version
+    }
+
+    fn describe_unknown(&self, k: usize) -> String {
+        if k < self.sys.n {
+            return match self.sys.dof_of(k) {
+                Some(d) => super::linear::describe_dof(self.model, d),
+                None => format!("equation {k}"),
+            };
+        }
+        match self.multiplier.iter().position(|&m| m == Some(k)) {
+            Some(i) => {
+                let r = &self.rows[i];
+                format!(
+                    "the multiplier of the slave node at ({}, {}) of contact '{}' (pass {})",
+                    r.point[0], r.point[1], self.model.contact[r.pair].name, r.pass
+                )
+            }
+            None => format!("multiplier {k}"),
+        }
     }
 
     fn carry(&mut self, x: &[f64]) -> Vec<f64> {
@@ -367,6 +435,7 @@ impl System for ContactSystem<'_> {
             let t = Instant::now();
             self.rows = rows_at(self.model, Some(&u))?;
             self.search_seconds += t.elapsed().as_secs_f64();
+            self.record_departures(&u);
             let version = self.version;
             self.cover();
             if self.version != version {
@@ -479,6 +548,7 @@ impl System for ContactSystem<'_> {
         tangent.symmetric = true;
         tangent.multipliers = self.pattern.n - n;
         tangent.scale = rho;
+        self.force_tolerance = 1e-10 * forces.values().fold(0.0f64, |m, f| m.max(f.abs()));
         self.active = active;
         self.forces = forces;
         self.evaluations += 1;
@@ -581,7 +651,7 @@ pub(crate) fn solve_step(
         linear_solver: outcome.linear_solver,
         geometry_updates: if current { iterations } else { 1 },
         configuration: current.then_some(u),
-        departures: Vec::new(),
+        departures: std::mem::take(&mut system.departures),
         steps: Vec::new(),
         history: outcome.history,
         geometry_changes: Vec::new(),

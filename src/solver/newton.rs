@@ -76,6 +76,10 @@ pub trait System {
         residual: &mut [f64],
         tangent: &mut Tangent,
     ) -> Result<Evaluation>;
+    /// What unknown `k` is, for messages.
+    fn describe_unknown(&self, k: usize) -> String {
+        format!("unknown {k}")
+    }
     /// Between iterations, after the iterate `x` (`converged`: the residual test passed):
     /// update augmentations; `true` if anything moved (then the iteration has not converged).
     fn augment(&mut self, _x: &[f64], _converged: bool) -> bool {
@@ -179,8 +183,19 @@ pub fn solve(system: &mut dyn System, x: &mut Vec<f64>, settings: Settings) -> R
         }
         residual.iter_mut().for_each(|v| *v = -*v);
         if let Err(e) = linear.solve(&tangent, &mut residual) {
+            let why = match e {
+                FactorError::ZeroPivot { equation, .. } => format!(
+                    "a zero pivot at {} (the matrix is singular)",
+                    system.describe_unknown(equation)
+                ),
+                FactorError::NotPositiveDefinite { equation } => format!(
+                    "a pivot that is not positive at {}",
+                    system.describe_unknown(equation)
+                ),
+                FactorError::Other(why) => why,
+            };
             break Termination::Singular(format!(
-                "the tangent of Newton iteration {} could not be factored: {e:?}",
+                "the tangent of Newton iteration {} could not be factored: {why}",
                 solves + 1
             ));
         }
