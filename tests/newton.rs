@@ -85,6 +85,7 @@ fn newton_cells(case: &str) -> Vec<(String, Value)> {
 fn newton_agrees_with_the_active_set_scheme_on_every_penalty_and_lagrange_cell_of_the_catalogue() {
     let mut compared = 0;
     let mut singular = 0;
+    let mut refused = 0;
     let mut worst = 0.0f64;
     let mut cases = Vec::new();
     for mesh in ["A", "B", "C", "D", "E"] {
@@ -103,6 +104,18 @@ fn newton_agrees_with_the_active_set_scheme_on_every_penalty_and_lagrange_cell_o
             for (name, cell) in newton_cells(&case) {
                 let old = run(&with_scheme(&cell, "active_set"), &name);
                 let new = run(&with_scheme(&cell, "newton"), &name);
+                let pair = &cell["contact"][0];
+                if pair["enforcement"]["kind"] == "perturbed_lagrange"
+                    && pair["discretization"]["kind"] == "mortar"
+                    && pair["discretization"]["multiplier"] == "standard"
+                {
+                    // the consistent mortar coupling: the active-set scheme only, for now
+                    let msg = new.err().unwrap().to_string();
+                    assert!(msg.contains("does not yet solve"), "{name}: {msg}");
+                    assert!(old.is_ok(), "{name}");
+                    refused += 1;
+                    continue;
+                }
                 let (old, new) = match (old, new) {
                     (Ok(a), Ok(b)) => (a, b),
                     (Err(a), Err(b)) => {
@@ -145,7 +158,7 @@ fn newton_agrees_with_the_active_set_scheme_on_every_penalty_and_lagrange_cell_o
             }
         }
     }
-    eprintln!("{compared} cells compared, largest relative difference {worst:e}; {singular} Lagrange cells with dependent rows end singular");
+    eprintln!("{compared} cells compared, largest relative difference {worst:e}; {singular} Lagrange cells with dependent rows end singular; {refused} perturbed Lagrangian standard-mortar cells refused");
     assert!(compared >= 300, "only {compared} cells compared");
 }
 

@@ -66,6 +66,13 @@ pub struct Constraint {
     pub pair: usize,
     /// A tie: always active, its force may have either sign.
     pub bilateral: bool,
+    /// The row's line of the multiplier mass `M_jk = int Phi_j Phi_k dGamma` (length x
+    /// thickness) over the slave nodes `k` of the same pair, pass and direction (`j` is this
+    /// row's slave node, listed too), when the discretization's multipliers are not lumped;
+    /// empty when the mass is the lumped `diag(area)` (node-based rows, dual mortar). Its
+    /// entries sum to `area`. Only the perturbed Lagrangian uses it (see
+    /// [`enforcement`]): `C = A^-1 M A^-1 / kappa`.
+    pub mass: Vec<(usize, f64)>,
 }
 
 impl Constraint {

@@ -14,6 +14,9 @@
 //!   the stress error, the load error and, if the rows are independent, the pressure error are
 //!   within the sweep's tolerance, the force balance within the case's `force_balance`
 //!   tolerance (1e-12 if it declares none), and the active-set loop converged.
+//! * The perturbed Lagrangian on standard mortar rows (a consistent, non-diagonal multiplier
+//!   mass) is also compared with the penalty method at the same kappa (`vs_penalty`, in the
+//!   note); elsewhere the two are the same method.
 //! * Penalty-type methods (penalty, perturbed Lagrangian) satisfy the gap only approximately;
 //!   they run at `kappa` and at `penalty_factor * kappa` (both runs must converge and carry the
 //!   load) and are judged on the stress error: a
@@ -34,7 +37,7 @@ use crate::contact::discretization::constraints;
 use crate::contact::enforcement::method;
 use crate::contact::forces::pair_forces;
 use crate::error::Result;
-use crate::io::scene::{Catalogue, DiscretizationSpec, MultiplierSpace};
+use crate::io::scene::{Catalogue, DiscretizationSpec, EnforcementSpec, MultiplierSpace};
 use crate::model::admit::load;
 use crate::model::Model;
 use crate::post::for_each_quadrature_stress;
@@ -81,6 +84,10 @@ pub struct Cell {
     pub termination: Option<String>,
     /// `cholesky`, `ldlt` or `schur-pseudo-inverse` (see `contact::solver::ContactState`).
     pub linear_solver: Option<String>,
+    /// Methods that use the rows' multiplier mass (the perturbed Lagrangian) on rows that carry
+    /// a consistent one (standard mortar): the largest stress difference from the penalty
+    /// method at the same kappa, over `p` (zero for a lumped mass, where the two coincide).
+    pub vs_penalty: Option<f64>,
     pub time_ms: f64,
     pub note: String,
 }
@@ -172,6 +179,25 @@ fn measure(model: &Model, solution: &Solution, pressure: f64) -> Measured {
     }
 }
 
+/// The largest difference between the stresses of `a` and `b` over the quadrature points of
+/// every body, over `|p|`.
+fn stress_difference(model: &Model, a: &Solution, b: &Solution, pressure: f64) -> f64 {
+    let mut d = 0.0f64;
+    for body in &model.bodies {
+        let mut sa = Vec::new();
+        for_each_quadrature_stress(body, &a.u, |_, _, s| sa.push(s));
+        let mut k = 0;
+        for_each_quadrature_stress(body, &b.u, |_, _, s| {
+            for i in 0..3 {
+                let e = (s[i] - sa[k][i]).abs() / pressure.abs();
+                d = if e.is_nan() || e > d { e } else { d };
+            }
+            k += 1;
+        });
+    }
+    d
+}
+
 /// Run the sweep of one case file.
 pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell>> {
     let base = load(path)?;
@@ -246,6 +272,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 newton_iterations: None,
                 termination: None,
                 linear_solver: None,
+                vs_penalty: None,
                 time_ms: 0.0,
                 note: String::new(),
             };
@@ -269,7 +296,24 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             let solved = solve_static(&model, &mut |_| {});
             cell.time_ms = start.elapsed().as_secs_f64() * 1e3;
             let m = match solved {
-                Ok(s) => measure(&model, &s, sweep.pressure),
+                Ok(s) => {
+                    // the perturbed Lagrangian with a consistent multiplier mass against the
+                    // penalty method at the same kappa
+                    if let (true, Some(kappa)) = (
+                        method(e).uses_multiplier_mass() && rows.iter().any(|r| !r.mass.is_empty()),
+                        method(e).kappa(),
+                    ) {
+                        let mut penalty = model.clone();
+                        penalty.contact[0].enforcement = EnforcementSpec::Penalty { kappa };
+                        let start = Instant::now();
+                        cell.vs_penalty = Some(match solve_static(&penalty, &mut |_| {}) {
+                            Ok(p) => stress_difference(&model, &s, &p, sweep.pressure),
+                            Err(_) => f64::NAN,
+                        });
+                        cell.time_ms += start.elapsed().as_secs_f64() * 1e3;
+                    }
+                    measure(&model, &s, sweep.pressure)
+                }
                 Err(err) => {
                     cell.verdict = "fail".into();
                     cell.note = format!(
@@ -297,6 +341,18 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             });
             let converged = m.termination == Termination::Converged;
             let mut notes = Vec::new();
+            if let Some(d) = cell.vs_penalty {
+                let same = d <= sweep.tol;
+                notes.push(format!(
+                    "multipliers with the consistent mortar mass (non-diagonal C): stress differs from penalty's by {}{}",
+                    rounded(Some(d)),
+                    if same && m.pressure_error <= sweep.tol {
+                        " (the interface traction is uniform, where the two coincide)"
+                    } else {
+                        ""
+                    }
+                ));
+            }
             if let Termination::Singular(msg) = &m.termination {
                 notes.push(msg.clone());
             } else if !converged {

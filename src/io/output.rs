@@ -305,7 +305,7 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
                 .iter()
                 .zip(&c.active)
                 .filter(|(_, &a)| a)
-                .map(|(r, _)| method(&model.contact[r.pair].enforcement).unknowns_per_row())
+                .map(|(r, _)| method(&model.contact[r.pair].enforcement).unknowns_per_row(r))
                 .sum(),
             rank_deficiency: c.rank_deficiency,
             total_force: pairs.iter().fold([0.0; 2], |t, p| {

@@ -28,8 +28,8 @@ use crate::harness::exact::ExactField;
 use crate::io::paths::{name_problem, NAME_RULE};
 use crate::io::scene::{
     Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, Interaction,
-    MeshSpec, NodeSetSpec, Physics, Plane, Prescribed, RigidSurface, SolverSpec, SweepSpec,
-    TractionSpec, MAX_SOLVER_COUNT,
+    MeshSpec, MultiplierSpace, NodeSetSpec, Physics, Plane, Prescribed, RigidSurface, SolverSpec,
+    SweepSpec, TractionSpec, MAX_SOLVER_COUNT,
 };
 use crate::mesh::{block, Facet, Mesh};
 use crate::solid::{check_geometry, Elasticity};
@@ -741,6 +741,22 @@ impl Model {
                         family_of(&spec.enforcement).describe()
                     ),
                     "use penalty, the perturbed Lagrangian, the augmented Lagrangian or Lagrange multipliers, or solver.scheme \"active_set\"",
+                ));
+            }
+            if newton
+                && matches!(spec.enforcement, EnforcementSpec::PerturbedLagrange { .. })
+                && matches!(
+                    spec.discretization,
+                    DiscretizationSpec::Mortar {
+                        multiplier: MultiplierSpace::Standard
+                    }
+                )
+            {
+                return Err(Error::invalid(
+                    &self.source,
+                    format!("{at}.enforcement"),
+                    "the Newton scheme does not yet solve the perturbed Lagrangian's consistent (non-diagonal) coupling of standard mortar multipliers".to_string(),
+                    "use solver.scheme \"active_set\" for this pair, or dual mortar multipliers (where the perturbed Lagrangian is the penalty method)",
                 ));
             }
             if let (Some(first), false) = (self.contact.first(), newton) {

@@ -6,7 +6,9 @@
 //! `g lambda = 0`. Each iteration solves the linear problem of the current active set, then
 //! updates the set: an active row whose force turns tensile is released, an inactive row that
 //! penetrates is activated (for penalty-type methods: a row is active when its trial force
-//! `lambda_k - kappa A g` is compressive). The loop ends with a [`Termination`] reason.
+//! `lambda_k - kappa A g` is compressive; for perturbed Lagrangian rows with a consistent
+//! multiplier mass, which keep their multipliers, an active row stays while `lambda >= 0` and
+//! an inactive one closes when `g + C lambda < 0`). The loop ends with a [`Termination`] reason.
 //!
 //! Linear algebra: `M = K + sum_i w_i b_i b_i^T` over the active rows, factored by sparse
 //! Cholesky; the pattern includes every candidate row, so its symbolic analysis is done once.
@@ -15,7 +17,10 @@
 //! definite even for bodies held only by contact). `S` is decomposed by Jacobi rotations; its
 //! null eigenvalues are the rank deficiency of the multiplier system (duplicated constraints
 //! of a two-pass discretization), and the pseudo-inverse picks the minimum-norm multipliers,
-//! so the displacement is still returned when it exists.
+//! so the displacement is still returned when it exists. Perturbed Lagrangian rows with a
+//! consistent multiplier mass (standard mortar) are solved in the same saddle-point system with
+//! their perturbation `C` on its multiplier block, the other rows of the penalty family entering
+//! it with their weights (see [`Kernel::saddle_ldlt`]).
 //!
 //! Rigid modes: before each solve the rigid modes of every body are tested against the
 //! prescribed dofs and the ACTIVE rows (`crate::model::rigid`, three modes per body). The first
@@ -465,6 +470,8 @@ fn solve_at(
         keep[k - 1]
     });
     eq_rows.retain(|e| !e.eqs.is_empty());
+    let perturbation = perturbation(model, &rows);
+    let coupled = perturbation.iter().any(|c| !c.is_empty());
     timings.assembly = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -499,11 +506,12 @@ fn solve_at(
         free: None,
         iteration: 0,
         chol,
-        saddle: if method == Method::Lagrange {
-            Saddle::new(&sys, &eq_rows)
+        saddle: if method == Method::Lagrange || coupled {
+            Saddle::new(&sys, &eq_rows, &perturbation)
         } else {
             None
         },
+        perturbation,
         linear_solver: "cholesky",
         cache: None,
         factorizations: 0.0,
@@ -553,7 +561,45 @@ fn solve_at(
     Ok(solution)
 }
 
-/// The saddle-point pattern `[[K, B^T], [B, D]]` over all candidate rows, analysed once.
+/// The perturbation `C = A^-1 M A^-1 / kappa` of the perturbed Lagrangian over the rows that
+/// keep their multipliers (see [`crate::contact::enforcement`]): for each row `i`, the entries
+/// `(j, C_ij)`, symmetric, the diagonal included; empty for every other row. Rows are coupled
+/// when their pair's method uses the multiplier mass and the row carries a consistent one
+/// ([`Constraint::mass`], standard mortar); the mass line of row `i` names slave nodes, matched
+/// to the rows of the same pair, pass and direction. `M_ij` is in area units and the rows' forces
+/// are nodal forces `lambda_i = A_i p_i`, so `int Phi_i (g_h + p_h / kappa) = 0` divided by
+/// `A_i` is `g_i + sum_j M_ij lambda_j / (kappa A_i A_j) = 0`.
+fn perturbation(model: &Model, rows: &[Constraint]) -> Vec<Vec<(usize, f64)>> {
+    let index: HashMap<RowKey, usize> = rows
+        .iter()
+        .enumerate()
+        .map(|(i, r)| (row_key(r), i))
+        .collect();
+    let mut c: Vec<std::collections::BTreeMap<usize, f64>> = vec![Default::default(); rows.len()];
+    for (i, r) in rows.iter().enumerate() {
+        let enforcement = enforcement_method(&model.contact[r.pair].enforcement);
+        if r.mass.is_empty() || !enforcement.uses_multiplier_mass() {
+            continue;
+        }
+        let kappa = enforcement
+            .kappa()
+            .expect("a method using the multiplier mass has a kappa");
+        let (pair, pass, body, _, direction) = row_key(r);
+        for &(node, m) in &r.mass {
+            if let Some(&j) = index.get(&(pair, pass, body, node, direction)) {
+                // half from each of the two rows' lines: M is symmetric
+                let v = 0.5 * m / (kappa * r.area * rows[j].area);
+                *c[i].entry(j).or_default() += v;
+                *c[j].entry(i).or_default() += v;
+            }
+        }
+    }
+    c.into_iter().map(|c| c.into_iter().collect()).collect()
+}
+
+/// The saddle-point pattern `[[K, B^T], [B, D]]` over all candidate rows, analysed once; with a
+/// perturbation `C`, `D` holds `C` and `C C` and the coupling block `B^T C` as well (see
+/// [`Kernel::saddle_ldlt`]).
 struct Saddle {
     pattern: crate::solver::sparse::SymmetricPattern,
     /// Position in `pattern` of each stored entry of the stiffness pattern.
@@ -590,7 +636,11 @@ impl Saddle {
 }
 
 impl Saddle {
-    fn new(sys: &LinearSystem, rows: &[EqRow]) -> Option<Saddle> {
+    fn new(
+        sys: &LinearSystem,
+        rows: &[EqRow],
+        perturbation: &[Vec<(usize, f64)>],
+    ) -> Option<Saddle> {
         let (n, m) = (sys.n, rows.len());
         let mut b = PatternBuilder::new(n + m);
         let p = &sys.pattern;
@@ -602,6 +652,16 @@ impl Saddle {
         for (i, row) in rows.iter().enumerate() {
             for &e in &row.eqs {
                 b.add_block(&[e, n + i]);
+            }
+            // C, C C and B^T C
+            for &(k, _) in &perturbation[i] {
+                b.add_block(&[n + i, n + k]);
+                for &(j, _) in &perturbation[k] {
+                    b.add_block(&[n + i, n + j]);
+                }
+                for &e in &rows[k].eqs {
+                    b.add_block(&[e, n + i]);
+                }
             }
         }
         let pattern = b.build();
@@ -643,8 +703,11 @@ struct Kernel<'a> {
     /// The iteration of the active-set loop (for messages).
     iteration: usize,
     chol: Cholesky,
-    /// Built only for Lagrange multipliers.
+    /// Built only for Lagrange multipliers and for perturbed Lagrangian rows with a consistent
+    /// multiplier mass.
     saddle: Option<Saddle>,
+    /// The perturbed Lagrangian's consistent perturbation `C` (see [`perturbation`]).
+    perturbation: Vec<Vec<(usize, f64)>>,
     linear_solver: &'static str,
     /// The last Cholesky factorization with its active set and weights.
     cache: Option<(
@@ -778,17 +841,42 @@ impl Kernel<'_> {
         values
     }
 
-    /// Lagrange multipliers from the saddle-point system, scaled so that both blocks share the
-    /// stiffness scale `rho` (`lambda = rho mu`):
-    /// `[[K + rho B^T B, -rho B^T], [-rho B, 0]] [u; mu] = [f - rho B^T g0; rho g0]`
-    /// (inactive rows: `-rho mu_i = 0`), factored by LDL^T with multipliers ordered last, then
-    /// refined. The residual is judged block by block: equilibrium against the force scale,
-    /// gap rows against the model size; a non-finite iterate or scale never passes. A pivot
-    /// that needed regularization or is zero relative to the matrix means the system is
-    /// singular: that is an error naming the equation. If LDL^T fails otherwise, sparse LU of
-    /// the same matrix is tried; `None` when neither gives a small residual (the caller falls
-    /// back to the Schur complement, which also handles dependent rows).
-    fn lagrange_ldlt(&mut self, active: &[bool], rho: f64) -> Step<Option<(Vec<f64>, Vec<f64>)>> {
+    /// Multipliers from the saddle-point system of the rows `multiplier`, whose equations are
+    /// `K u - B^T lambda = f` and `B u + g0 + C lambda = 0` (`C` the perturbation, zero for
+    /// Lagrange multipliers, see [`perturbation`]). It is solved as the stationary point of
+    /// `1/2 u K u - f u - lambda (B u + g0) - 1/2 lambda C lambda + alpha/2 |B u + g0 + C lambda|^2`,
+    /// whose augmentation vanishes at the solution and makes the displacement block definite
+    /// for bodies held only by contact, scaled so that both blocks share the stiffness scale
+    /// `rho` (`lambda = rho mu`):
+    ///
+    /// ```text
+    /// [[K + alpha B^T B,          -rho B^T (I - alpha C)],  [u ]   [f - alpha B^T g0      ]
+    ///  [-rho (I - alpha C) B,  -rho^2 C (I - alpha C)]]  [mu] = [rho (I - alpha C) g0]
+    /// ```
+    ///
+    /// (its second row is `-rho (I - alpha C)` times the constraint, so with `alpha C < I` the
+    /// solution is the unaugmented one; with `alpha C <= I / 2` the multiplier block's Schur
+    /// complement is negative definite). Lagrange multipliers: `C = 0`, `alpha = rho`:
+    /// `[[K + rho B^T B, -rho B^T], [-rho B, 0]] [u; mu] = [f - rho B^T g0; rho g0]`. The other
+    /// rows: `-rho mu_i = 0`; the active ones among them add `w_i b_i b_i^T` to `K` (penalty
+    /// rows, whose terms the caller put in `rhs_u`; `w_i = alpha` for the multiplier rows).
+    /// Factored by LDL^T with multipliers ordered last, then refined. The residual is judged
+    /// block by block: equilibrium against the force scale, gap rows against the model size; a
+    /// non-finite iterate or scale never passes. A pivot that needed regularization or is zero
+    /// relative to the matrix means the system is singular: that is an error naming the
+    /// equation. If LDL^T fails otherwise, sparse LU of the same matrix is tried; `None` when
+    /// neither gives a small residual (Lagrange multipliers then fall back to the Schur
+    /// complement, which also handles dependent rows).
+    #[allow(clippy::too_many_arguments)]
+    fn saddle_ldlt(
+        &mut self,
+        active: &[bool],
+        multiplier: &[bool],
+        w: &[f64],
+        rhs_u: Vec<f64>,
+        rho: f64,
+        alpha: f64,
+    ) -> Step<Option<(Vec<f64>, Vec<f64>)>> {
         let t = Instant::now();
         let n = self.sys.n;
         let m = self.rows.len();
@@ -796,28 +884,59 @@ impl Kernel<'_> {
         let Some(saddle) = self.saddle.as_ref() else {
             return Ok(None);
         };
-        let w = vec![rho; m];
-        let k = self.augmented(active, &w);
+        let k = self.augmented(active, w);
         let mut values = vec![0.0; saddle.pattern.nnz()];
         for (p, &v) in saddle.k_positions.iter().zip(&k) {
             values[*p] += v;
         }
-        let mut rhs = self.rhs.clone();
+        let mut rhs = rhs_u;
         rhs.resize(n + m, 0.0);
-        for (i, row) in self.rows.iter().enumerate() {
-            let diag = saddle
-                .pattern
-                .position(n + i, n + i)
-                .expect("diagonal stored");
-            if active[i] {
-                for (&e, &c) in row.eqs.iter().zip(&row.coeffs) {
-                    values[saddle.pattern.position(e, n + i).expect("coupling stored")] = -rho * c;
+        // C restricted to the multiplier rows
+        let c: Vec<Vec<(usize, f64)>> = (0..m)
+            .map(|i| {
+                if multiplier[i] {
+                    self.perturbation[i]
+                        .iter()
+                        .copied()
+                        .filter(|&(j, _)| multiplier[j])
+                        .collect()
+                } else {
+                    Vec::new()
                 }
-                row.add_to(-rho * row.g0, &mut rhs);
-                rhs[n + i] = rho * row.g0;
-            } else {
-                values[diag] = -rho;
+            })
+            .collect();
+        let at = |a: usize, b: usize| saddle.pattern.position(a, b).expect("entry stored");
+        for (i, row) in self.rows.iter().enumerate() {
+            if !multiplier[i] {
+                values[at(n + i, n + i)] = -rho;
+                continue;
             }
+            // -rho (I - alpha C) B
+            for (&e, &co) in row.eqs.iter().zip(&row.coeffs) {
+                values[at(e, n + i)] += -rho * co;
+            }
+            for &(k, c_ik) in &c[i] {
+                let rk = &self.rows[k];
+                for (&e, &co) in rk.eqs.iter().zip(&rk.coeffs) {
+                    values[at(e, n + i)] += rho * alpha * c_ik * co;
+                }
+            }
+            // -rho^2 (C - alpha C C), upper triangle
+            for &(j, c_ij) in &c[i] {
+                if j >= i {
+                    values[at(n + i, n + j)] -= rho * rho * c_ij;
+                }
+            }
+            for &(k, c_ik) in &c[i] {
+                for &(j, c_kj) in &c[k] {
+                    if j >= i {
+                        values[at(n + i, n + j)] += rho * rho * alpha * c_ik * c_kj;
+                    }
+                }
+            }
+            row.add_to(-alpha * row.g0, &mut rhs);
+            let c_g0: f64 = c[i].iter().map(|&(k, c_ik)| c_ik * self.rows[k].g0).sum();
+            rhs[n + i] = rho * (row.g0 - alpha * c_g0);
         }
         let mut signs = vec![1i8; n + m];
         signs[n..].iter_mut().for_each(|s| *s = -1);
@@ -921,7 +1040,7 @@ impl Kernel<'_> {
         };
         self.linear_solver = solver;
         let forces = (0..m)
-            .map(|i| if active[i] { rho * x[n + i] } else { 0.0 })
+            .map(|i| if multiplier[i] { rho * x[n + i] } else { 0.0 })
             .collect();
         x.truncate(n);
         Ok(Some((x, forces)))
@@ -961,18 +1080,81 @@ impl Kernel<'_> {
         Ok(x)
     }
 
+    /// The stiffness scale `rho` (the largest diagonal entry of `K`, 1 without one), which
+    /// keeps the augmented matrices well conditioned.
+    fn stiffness_scale(&self) -> f64 {
+        let mut rho = 0.0f64;
+        for j in 0..self.sys.n {
+            if let Some(p) = self.sys.pattern.position(j, j) {
+                rho = rho.max(self.sys.k[p]);
+            }
+        }
+        if rho > 0.0 {
+            rho
+        } else {
+            1.0
+        }
+    }
+
+    /// The perturbed Lagrangian with a consistent multiplier mass, in the loop of the
+    /// penalty-regularized family: the active rows with a perturbation (see [`perturbation`])
+    /// keep their multipliers in the saddle-point system of [`Kernel::saddle_ldlt`]; every other
+    /// active row enters with its penalty weight `w_i` and its Uzawa force `lambda_k,i`, as in
+    /// [`Kernel::regularized`]. The augmentation is the stiffness scale, limited to
+    /// `alpha ||C||_inf <= 1/2`.
+    fn perturbed(
+        &mut self,
+        active: &[bool],
+        w: &[f64],
+        lambda_k: &[f64],
+    ) -> Step<(Vec<f64>, Vec<f64>)> {
+        let m = self.rows.len();
+        let rho = self.stiffness_scale();
+        let multiplier: Vec<bool> = (0..m)
+            .map(|i| active[i] && !self.perturbation[i].is_empty())
+            .collect();
+        let norm = (0..m)
+            .filter(|&i| multiplier[i])
+            .map(|i| {
+                self.perturbation[i]
+                    .iter()
+                    .filter(|&&(j, _)| multiplier[j])
+                    .map(|(_, v)| v.abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0f64, f64::max);
+        let alpha = if norm > 0.0 { rho.min(0.5 / norm) } else { rho };
+        let weights: Vec<f64> = (0..m)
+            .map(|i| if multiplier[i] { alpha } else { w[i] })
+            .collect();
+        let mut rhs = self.rhs.clone();
+        for (i, row) in self.rows.iter().enumerate() {
+            if active[i] && !multiplier[i] {
+                row.add_to(lambda_k[i] - w[i] * row.g0, &mut rhs);
+            }
+        }
+        let Some((x, mut forces)) =
+            self.saddle_ldlt(active, &multiplier, &weights, rhs, rho, alpha)?
+        else {
+            return Err(StepError::Singular(format!(
+                "the saddle-point system of the perturbed Lagrangian (contact iteration {}) could not be solved to a small residual by LDL^T or LU",
+                self.iteration
+            )));
+        };
+        for (i, row) in self.rows.iter().enumerate() {
+            if active[i] && !multiplier[i] {
+                forces[i] = lambda_k[i] - w[i] * (row.g0 + row.dot(&x));
+            }
+        }
+        Ok((x, forces))
+    }
+
     /// Lagrange multipliers: LDL^T of the saddle-point system when the active rows are
     /// independent, else the Schur complement of the augmented system with a pseudo-inverse.
     fn lagrange(&mut self, active: &[bool]) -> Step<(Vec<f64>, Vec<f64>)> {
         let n = self.sys.n;
         // rho: the stiffness scale, so that M stays well conditioned
-        let mut rho = 0.0f64;
-        for j in 0..n {
-            if let Some(p) = self.sys.pattern.position(j, j) {
-                rho = rho.max(self.sys.k[p]);
-            }
-        }
-        let rho = if rho > 0.0 { rho } else { 1.0 };
+        let rho = self.stiffness_scale();
         let active_rows: Vec<&EqRow> = self
             .rows
             .iter()
@@ -981,7 +1163,9 @@ impl Kernel<'_> {
             .map(|(r, _)| r)
             .collect();
         if rank_deficiency(&active_rows, n) == 0 {
-            if let Some(solution) = self.lagrange_ldlt(active, rho)? {
+            let w = vec![rho; self.rows.len()];
+            let rhs = self.rhs.clone();
+            if let Some(solution) = self.saddle_ldlt(active, active, &w, rhs, rho, rho)? {
                 return Ok(solution);
             }
         }
@@ -1417,6 +1601,8 @@ impl Kernel<'_> {
             })
             .collect();
         let owners: Vec<usize> = rows.iter().map(|r| self.sys.eq[r.owner]).collect();
+        // perturbed Lagrangian rows with a consistent multiplier mass: a saddle-point solve
+        let coupled = self.perturbation.iter().any(|c| !c.is_empty());
         let mut lambda_k = vec![0.0; nrows];
         let mut x = vec![0.0; self.sys.n];
         let mut forces = vec![0.0; nrows];
@@ -1431,7 +1617,16 @@ impl Kernel<'_> {
             let step: Step<(Vec<f64>, Vec<f64>)> = match method {
                 Method::Lagrange => self.lagrange(&active),
                 Method::Elimination => self.eliminate(&active, &owners),
-                Method::Regularized { .. } | Method::AugmentedLagrange { .. } => {
+                Method::Regularized { .. }
+                | Method::PerturbedLagrange { .. }
+                | Method::AugmentedLagrange { .. }
+                    if coupled =>
+                {
+                    self.perturbed(&active, &row_w, &lambda_k)
+                }
+                Method::Regularized { .. }
+                | Method::PerturbedLagrange { .. }
+                | Method::AugmentedLagrange { .. } => {
                     let w = &row_w;
                     self.regularized(&active, w, &lambda_k).map(|x| {
                         let f = (0..nrows)
@@ -1520,8 +1715,27 @@ impl Kernel<'_> {
                             }
                     })
                     .collect(),
-                Method::Regularized { .. } | Method::AugmentedLagrange { .. } => (0..nrows)
-                    .map(|i| rows[i].bilateral || lambda_k[i] - row_w[i] * gaps[i] > force_tol)
+                // rows with multipliers (the consistent perturbed Lagrangian): complementarity of
+                // lambda >= 0 and g + C lambda >= 0; the others by their trial force
+                Method::Regularized { .. }
+                | Method::PerturbedLagrange { .. }
+                | Method::AugmentedLagrange { .. } => (0..nrows)
+                    .map(|i| {
+                        rows[i].bilateral
+                            || if !self.perturbation[i].is_empty() {
+                                if active[i] {
+                                    forces[i] >= -force_tol
+                                } else {
+                                    let c_lambda: f64 = self.perturbation[i]
+                                        .iter()
+                                        .map(|&(j, c)| c * forces[j])
+                                        .sum();
+                                    gaps[i] + c_lambda < -gap_tol
+                                }
+                            } else {
+                                lambda_k[i] - row_w[i] * gaps[i] > force_tol
+                            }
+                    })
                     .collect(),
             };
             let mut new_active = new_active;
@@ -1553,7 +1767,9 @@ impl Kernel<'_> {
             let converged = match method {
                 Method::Lagrange | Method::Elimination => stable,
                 Method::PerturbedTangent { .. } => stable && gaps_closed,
-                Method::Regularized { .. } | Method::AugmentedLagrange { .. } => {
+                Method::Regularized { .. }
+                | Method::PerturbedLagrange { .. }
+                | Method::AugmentedLagrange { .. } => {
                     let done = stable && gaps_closed;
                     // Uzawa on the augmented Lagrangian rows: lambda_k <- max(0, lambda_k -
                     // kappa A g), after every iteration or (outer loop) once the set is stable
@@ -1586,7 +1802,10 @@ impl Kernel<'_> {
             // the loops without a multiplier iteration of their own can only cycle
             let cycles = matches!(
                 method,
-                Method::Lagrange | Method::Elimination | Method::Regularized { .. }
+                Method::Lagrange
+                    | Method::Elimination
+                    | Method::Regularized { .. }
+                    | Method::PerturbedLagrange { .. }
             ) && !iterative.iter().any(|&it| it);
             if cycles && !stable && !seen.insert(new_active.clone()) {
                 return Ok((x, forces, active, Termination::ActiveSetCycling, it));

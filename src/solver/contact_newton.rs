@@ -179,10 +179,14 @@ impl<'a> ContactSystem<'a> {
     /// How row `r` is enforced.
     fn law(&self, r: &Constraint) -> RowLaw {
         match method(&self.model.contact[r.pair].enforcement).kernel() {
-            Method::Regularized { kappa } => RowLaw::Penalty {
-                w: kappa * r.area,
-                update: None,
-            },
+            // the model refuses the perturbed Lagrangian's consistent mortar coupling here,
+            // so its rows carry the lumped mass: the penalty's law
+            Method::Regularized { kappa } | Method::PerturbedLagrange { kappa } => {
+                RowLaw::Penalty {
+                    w: kappa * r.area,
+                    update: None,
+                }
+            }
             Method::AugmentedLagrange { kappa, update } => RowLaw::Penalty {
                 w: kappa * r.area,
                 update: Some(update),

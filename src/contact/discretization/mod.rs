@@ -262,6 +262,7 @@ pub(crate) fn weighted_row(
         owner,
         pair: 0,
         bilateral,
+        mass: Vec::new(),
     }
 }
 

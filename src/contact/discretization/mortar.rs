@@ -27,6 +27,15 @@
 //!   not pass the patch test (benchmarks.md s. 2 reports errors of 1e-3 to 1e-5).
 //! * Because `sum_k D_jk = sum_l M_jl` when the slave facet is covered, the forces `D^T lambda`
 //!   and `-M^T lambda` balance (linear momentum); the check `force_balance` measures it.
+//! * **Multiplier mass** (for the perturbed Lagrangian, `int mu_h lambda_h / kappa`): the L2
+//!   pairing of the multiplier field with the slave trace, `int Phi_j N_k dGamma`, is `D_jk`
+//!   itself. With standard multipliers `Phi = N`, so it is the consistent (non-diagonal) mass
+//!   `int Phi_j Phi_k dGamma`, and each row carries its line `[(k, D_jk)]`
+//!   ([`crate::contact::Constraint::mass`], summing to `A_j`). With dual multipliers it is
+//!   `delta_jk A_j` by biorthogonality, the lumped mass every row already has in its area, so
+//!   dual rows carry none. (The Galerkin pairing `int psi_j psi_k` of two dual functions is not
+//!   diagonal, e.g. `h [[1, -1/2], [-1/2, 1]]` on one Line2 facet; we pair the dual multiplier
+//!   with the trace space, the choice that keeps dual mortar local.)
 
 use super::geometry::{closest_point, edge_shape, facet_point, Surface};
 use super::search::BucketGrid;
@@ -156,6 +165,7 @@ pub(crate) fn mortar_rows(
             let x = mb.mesh.nodes[l];
             g0 -= w * (nu[0] * x[0] + nu[1] * x[1]);
         }
+        let before = rows.out.len();
         rows.push(
             slave,
             j,
@@ -166,6 +176,16 @@ pub(crate) fn mortar_rows(
             area,
             1,
         );
+        if space == MultiplierSpace::Standard {
+            // the multiplier mass M_jk = int N_j N_k = D_jk (Phi = N), in area units
+            let mass: Vec<(usize, f64)> = std::iter::once(j)
+                .chain(dj.keys().copied().filter(|&k| k != j))
+                .map(|k| (k, dj.get(&k).copied().unwrap_or(0.0)))
+                .collect();
+            for r in &mut rows.out[before..] {
+                r.mass = mass.clone();
+            }
+        }
     }
     if rows.out.is_empty() {
         return Err("no slave facet overlaps a master facet".into());

@@ -21,7 +21,7 @@ impl Enforcement for Lagrange {
     fn scaled(&self, _factor: f64) -> EnforcementSpec {
         EnforcementSpec::Lagrange
     }
-    fn unknowns_per_row(&self) -> usize {
+    fn unknowns_per_row(&self, _row: &crate::contact::Constraint) -> usize {
         1
     }
     fn kernel(&self) -> Method {

@@ -7,15 +7,19 @@
 //! | method | weights `w_i` | multipliers | residual |
 //! |---|---|---|---|
 //! | Lagrange | `rho` (augmentation only) | Schur complement `B M^-1 B^T`, pseudo-inverse | `g = 0` |
-//! | perturbed Lagrangian | `kappa A_i` | `lambda = -kappa A g` | `g + lambda/(kappa A) = 0` |
+//! | perturbed Lagrangian | `kappa A_i` (lumped mass) | `lambda = -kappa A g` | `g + C lambda = 0` |
 //! | penalty | `kappa A_i` | eliminated | same solution as perturbed Lagrangian |
 //! | perturbed tangent | `kappa A_i` | Newton update | `g = 0` with the perturbed tangent |
 //! | augmented Lagrangian | `kappa A_i` | Uzawa `lambda_k <- lambda_k - kappa A g` | `g = 0` in the limit |
 //! | elimination | none | from the residual at the owned dof | `g = 0` exactly |
 //!
-//! With node-based rows the perturbation matrix `C = diag(1/(kappa A_i))` is diagonal, so the
-//! perturbed Lagrangian and the penalty method give identical numbers (Taylor 2004 notes they
-//! differ in general, e.g. for mortar multipliers with a consistent `C`).
+//! The perturbed Lagrangian's perturbation is `C = A^-1 M A^-1 / kappa` with the rows'
+//! multiplier mass `M` ([`Constraint::mass`]). With node-based rows and dual mortar `M` is the
+//! lumped `diag(A)`, `C = diag(1/(kappa A_i))`, and the perturbed Lagrangian and the penalty
+//! method give identical numbers; with standard mortar multipliers `M` is the consistent,
+//! non-diagonal mass, the multipliers are unknowns of a saddle-point system (the weights of
+//! the rows are then not `kappa A_i`), and the two differ wherever the contact pressure is not
+//! uniform (Taylor 2004: "not always same"); see `perturbed_lagrange`.
 
 use super::Constraint;
 use crate::io::scene::{EnforcementSpec, MultiplierUpdate};
@@ -35,7 +39,9 @@ pub trait Enforcement {
     /// The method's name in prose (messages, reports).
     fn title(&self) -> &'static str;
     /// Whether the method solves a multiplier system (Lagrange multipliers, constraint
-    /// elimination), whose singularity is a stability failure.
+    /// elimination), whose singularity is a stability failure. (The perturbed Lagrangian's
+    /// multipliers on standard mortar rows solve a system regularized by `C`, which dependent
+    /// rows cannot make singular: it answers no.)
     fn has_multiplier_system(&self) -> bool {
         false
     }
@@ -50,9 +56,15 @@ pub trait Enforcement {
     }
     /// The same method with its penalty multiplied by `factor` (unchanged without one).
     fn scaled(&self, factor: f64) -> EnforcementSpec;
-    /// Unknowns the method adds per active row to the linear system (multipliers).
-    fn unknowns_per_row(&self) -> usize {
+    /// Unknowns the method adds to the linear system for the active row `row` (multipliers).
+    fn unknowns_per_row(&self, _row: &Constraint) -> usize {
         0
+    }
+    /// Whether the method regularizes with the multiplier mass the rows carry
+    /// ([`Constraint::mass`]; the perturbed Lagrangian), so that it differs from the penalty
+    /// method where the discretization's mass is not lumped.
+    fn uses_multiplier_mass(&self) -> bool {
+        false
     }
     /// What the solver runs.
     fn kernel(&self) -> Method;
@@ -82,7 +94,9 @@ pub fn method(spec: &EnforcementSpec) -> Box<dyn Enforcement> {
 
 /// Which enforcement methods one contact solve can combine, a method per pair: the loop is
 /// driven by one family. Penalty, perturbed Lagrangian and augmented Lagrangian rows (any
-/// kappa, either Uzawa update) share the penalty-regularized loop; Lagrange multipliers,
+/// kappa, either Uzawa update) share the penalty-regularized loop (whose linear solve becomes
+/// a saddle-point system when perturbed Lagrangian rows carry a consistent multiplier mass,
+/// the other rows entering it with their penalty weights); Lagrange multipliers,
 /// the perturbed tangent and constraint elimination each need their own.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum Family {
@@ -97,6 +111,7 @@ impl Method {
     pub fn kappa(self) -> Option<f64> {
         match self {
             Method::Regularized { kappa }
+            | Method::PerturbedLagrange { kappa }
             | Method::PerturbedTangent { kappa }
             | Method::AugmentedLagrange { kappa, .. } => Some(kappa),
             Method::Lagrange | Method::Elimination => None,
@@ -107,9 +122,9 @@ impl Method {
     pub fn family(self) -> Family {
         match self {
             Method::Lagrange => Family::LagrangeMultipliers,
-            Method::Regularized { .. } | Method::AugmentedLagrange { .. } => {
-                Family::PenaltyRegularized
-            }
+            Method::Regularized { .. }
+            | Method::PerturbedLagrange { .. }
+            | Method::AugmentedLagrange { .. } => Family::PenaltyRegularized,
             Method::PerturbedTangent { .. } => Family::PerturbedTangent,
             Method::Elimination => Family::Elimination,
         }
@@ -133,8 +148,14 @@ impl Family {
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub enum Method {
     Lagrange,
-    /// Penalty-regularized methods: perturbed Lagrangian and penalty.
+    /// Penalty: `lambda_i = -kappa A_i g_i` eliminated up front.
     Regularized {
+        kappa: f64,
+    },
+    /// Perturbed Lagrangian: `g + C lambda = 0` with `C = A^-1 M A^-1 / kappa` from the rows'
+    /// multiplier mass; rows with a lumped mass are eliminated as penalty rows, rows with a
+    /// consistent one keep their multipliers (a saddle-point system).
+    PerturbedLagrange {
         kappa: f64,
     },
     PerturbedTangent {
