@@ -331,7 +331,7 @@ fn add_geometric_stiffness(
         let Some(h) = gap_second_derivative(model, r, x_s) else {
             continue;
         };
-        let eqs = [sys.eq[dofs[0]], sys.eq[dofs[1]]];
+        let eqs = [sys.eq(dofs[0]), sys.eq(dofs[1])];
         if eqs.contains(&NO_EQUATION) {
             continue;
         }
@@ -406,8 +406,8 @@ fn solve_at(
                 g0: r.g0,
             };
             for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
-                match sys.eq[d] {
-                    NO_EQUATION => out.g0 += c * sys.u_prescribed[d],
+                match sys.eq(d) {
+                    NO_EQUATION => out.g0 += c * sys.constraints.constants()[d],
                     e => {
                         out.eqs.push(e);
                         out.coeffs.push(c);
@@ -460,12 +460,7 @@ fn solve_at(
             })
             .collect()
     });
-    let mut eq_dof = vec![0; sys.n];
-    for (d, &e) in sys.eq.iter().enumerate() {
-        if e != NO_EQUATION {
-            eq_dof[e] = d;
-        }
-    }
+    let eq_dof = sys.constraints.free_dofs().to_vec();
     let mut kernel = Kernel {
         prepared_for: None,
         initial_active,
@@ -1432,7 +1427,7 @@ impl Kernel<'_> {
                 )
             })
             .collect();
-        let owners: Vec<usize> = rows.iter().map(|r| self.sys.eq[r.owner]).collect();
+        let owners: Vec<usize> = rows.iter().map(|r| self.sys.eq(r.owner)).collect();
         let mut lambda_k = vec![0.0; nrows];
         let mut x = vec![0.0; self.sys.n];
         let mut forces = vec![0.0; nrows];
