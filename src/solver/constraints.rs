@@ -46,7 +46,10 @@
 //! occurrence, so a set without chains or repeats keeps its lines as given). A **cycle**
 //! (`u_1 = u_2`, `u_2 = 2 u_1`; or a line that names its own dof as master) has no such
 //! resolution and is refused with [`ConstraintError::Cycle`]; a dof constrained twice with
-//! [`ConstraintError::Repeated`]. The multipliers [`AffineConstraints::forces`] returns are
+//! [`ConstraintError::Repeated`]. A constrained master whose coefficient is exactly zero
+//! contributes nothing and is dropped instead of followed (a contact row keeps the zero
+//! component of a slave node's normal; two such rows at a corner would otherwise close a
+//! cycle that does not exist); unconstrained masters are kept as given, zeros included. The multipliers [`AffineConstraints::forces`] returns are
 //! those of the resolved lines (the resolution is a row operation `G' = L G`, `mu = L^T mu'`).
 //!
 //! **Dirichlet-only sets** ([`AffineConstraints::dirichlet`], no line has a master) cost no
@@ -248,8 +251,9 @@ fn resolve_chains(
             let (l, next) = *top;
             if next < ptr[l + 1] {
                 top.1 += 1;
-                let m = line_of[masters[next].0];
-                if m == NO_LINE {
+                let (j, c) = masters[next];
+                let m = line_of[j];
+                if m == NO_LINE || c == 0.0 {
                     continue;
                 }
                 match state[m] {
@@ -273,6 +277,7 @@ fn resolve_chains(
             for &(j, c) in &masters[ptr[l]..ptr[l + 1]] {
                 match line_of[j] {
                     NO_LINE => merge_into(&mut out, 0, &[(j, c)], 1.0),
+                    _ if c == 0.0 => {}
                     m => {
                         merge_into(&mut out, 0, &resolved[m].0, c);
                         b += c * resolved[m].1;
@@ -1019,6 +1024,14 @@ mod tests {
             b.constrain(1, &[(0, f64::NAN)], 0.0),
             Err(ConstraintError::NotFinite { dof: 1 })
         );
+        // a zero coefficient is no dependency: u_1 = 0 u_2 + 2 u_3 and u_2 = 0 u_1 + 1 resolve
+        let mut z = ConstraintBuilder::new(4);
+        z.constrain(1, &[(2, 0.0), (3, 2.0)], 0.0).unwrap();
+        z.constrain(2, &[(1, 0.0)], 1.0).unwrap();
+        let zeros = z.close().unwrap();
+        assert_eq!(zeros.line(0).masters, &[3][..]);
+        assert_eq!(zeros.line(1).masters, &[] as &[usize]);
+        assert_eq!(zeros.expand(&[5.0, 7.0]), vec![5.0, 14.0, 1.0, 7.0]);
         // the refused lines left nothing behind
         let c = b.close().unwrap();
         assert_eq!(c.len(), 1);
