@@ -60,7 +60,7 @@ fn block_model(n: usize) -> Model {
 fn assembly(c: &mut Criterion) {
     let model = block_model(50);
     let sys = assemble(&model, &[]);
-    let (eq, pattern) = (&sys.eq, &sys.pattern);
+    let (eq, pattern) = (sys.constraints.equations(), &sys.pattern);
     let mut values = vec![0.0; pattern.nnz()];
     let mut group = c.benchmark_group("q4_block_50x50");
     group.sample_size(20);

@@ -9,7 +9,10 @@
 //! `a` of body `b` is `offset_b + 2 a + i`. Voigt stress `[sigma_xx, sigma_yy, sigma_xy]`.
 //! The discrete equilibrium is `K u = f` with `K = sum_e K_e`, `K_e = int B^T D B t dA`
 //! (see [`solid`]); prescribed dofs are eliminated, so the matrix solved is `K_ff`, symmetric
-//! positive definite when every body is held against rigid motion.
+//! positive definite when every body is held against rigid motion. The global dof numbering
+//! and which body owns a dof belong to [`model`] (`Body::dof`, `Model::dof_owner`); the
+//! equation numbering (which dofs are unknowns) to the affine constraints
+//! [`solver::constraints`], which serve the prescribed dofs and constraint elimination alike.
 //!
 //! ## Layout (a case flows down this list)
 //! * [`io::scene`]: the case file (serde, unknown fields and repeated names rejected) — plain data.
@@ -24,7 +27,8 @@
 //!   [`contact::state`] is what a solve found; [`contact::forces`] turns row forces into the
 //!   forces, pressures and penetrations every report uses.
 //! * [`solver`]: [`solver::solve_static`] runs one analysis with the effects its scene names;
-//!   [`solver::linear`] the elastic linear system; [`solver::active_set`] load steps, geometry
+//!   [`solver::linear`] the elastic linear system; [`solver::constraints`] affine constraints
+//!   `u = T y + t` (Dirichlet data, eliminated contact rows); [`solver::active_set`] load steps, geometry
 //!   updates and the active-set loop; [`solver::sparse`] sparse patterns and factorizations
 //!   (faer), `solver::dense` small dense eigen-solves. [`post`]: stresses and errors.
 //! * [`harness`]: the patch-test tables ([`harness::report`]), case-declared checks

@@ -44,6 +44,7 @@ use crate::error::{Error, Result};
 use crate::io::scene::{ContactGeometry, MultiplierUpdate};
 use crate::model::rigid::{FreeMode, RigidModes};
 use crate::model::Model;
+use crate::solver::constraints::{ConstraintBuilder, ConstraintError};
 use crate::solver::dense::symmetric_eigen;
 use crate::solver::linear::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
 use crate::solver::sparse::{Cholesky, PatternBuilder};
@@ -354,7 +355,7 @@ fn add_geometric_stiffness(
         let Some(h) = gap_second_derivative(model, r, x_s) else {
             continue;
         };
-        let eqs = [sys.eq[dofs[0]], sys.eq[dofs[1]]];
+        let eqs = [sys.eq(dofs[0]), sys.eq(dofs[1])];
         if eqs.contains(&NO_EQUATION) {
             continue;
         }
@@ -429,8 +430,8 @@ fn solve_at(
                 g0: r.g0,
             };
             for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
-                match sys.eq[d] {
-                    NO_EQUATION => out.g0 += c * sys.u_prescribed[d],
+                match sys.eq(d) {
+                    NO_EQUATION => out.g0 += c * sys.constraints.constants()[d],
                     e => {
                         out.eqs.push(e);
                         out.coeffs.push(c);
@@ -485,12 +486,7 @@ fn solve_at(
             })
             .collect()
     });
-    let mut eq_dof = vec![0; sys.n];
-    for (d, &e) in sys.eq.iter().enumerate() {
-        if e != NO_EQUATION {
-            eq_dof[e] = d;
-        }
-    }
+    let eq_dof = sys.constraints.free_dofs().to_vec();
     let mut kernel = Kernel {
         prepared_for: None,
         initial_active,
@@ -1217,122 +1213,95 @@ impl Kernel<'_> {
         Ok((x, forces))
     }
 
-    /// Constraint elimination: each active row solved for its owned equation.
+    /// Constraint elimination: each active row `g0 + sum_k c_k x_k = 0` solved for its owned
+    /// equation `o`, `x_o = sum_{k != o} (-c_k / c_o) x_k - g0 / c_o`. The rows are affine
+    /// constraints ([`crate::solver::constraints`]) on the equations of the Dirichlet-reduced
+    /// system, layered on it: the prescribed values are already folded into `g0` (the chain
+    /// through a prescribed master, resolved once when the rows were built), and the reduced
+    /// system `T^T K T y = T^T (f - K t)` is formed from the assembled `K_ff` of this solve
+    /// (stabilizing springs included), then `x = T y + t`. The force of a row is the multiplier
+    /// of its line, the residual at its owned equation, over `c_o`:
+    /// `lambda = (K x - f)_o / c_o`. Rows of different pairs that are solved for the same
+    /// equation, or whose lines form a cycle, end the loop as singular; a chain (a row naming
+    /// another row's owned equation) is resolved.
     fn eliminate(&mut self, active: &[bool], owners: &[usize]) -> Step<(Vec<f64>, Vec<f64>)> {
         let n = self.sys.n;
-        // map: equation -> (reduced terms, constant)
-        let mut is_owner = vec![usize::MAX; n];
-        for i in 0..self.rows.len() {
-            if active[i] {
-                is_owner[owners[i]] = i;
-            }
-        }
-        let mut reduced = vec![usize::MAX; n];
-        let mut nr = 0;
-        for e in 0..n {
-            if is_owner[e] == usize::MAX {
-                reduced[e] = nr;
-                nr += 1;
-            }
-        }
-        let mut terms: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
-        let mut constant = vec![0.0; n];
-        for e in 0..n {
-            match is_owner[e] {
-                usize::MAX => terms[e].push((reduced[e], 1.0)),
-                i => {
-                    let row = &self.rows[i];
-                    let k = row
-                        .eqs
-                        .iter()
-                        .position(|&q| q == e)
-                        .expect("the owner is in its row");
-                    let co = row.coeffs[k];
-                    constant[e] = -row.g0 / co;
-                    for (&q, &c) in row.eqs.iter().zip(&row.coeffs) {
-                        if q != e {
-                            terms[e].push((reduced[q], -c / co));
-                        }
-                    }
+        let refuse = |e: ConstraintError| -> StepError {
+            let at = |q: usize| crate::solver::linear::describe_dof(self.model, self.eq_dof[q]);
+            let what = match e {
+                ConstraintError::Repeated { dof } => {
+                    format!("two active rows are solved for the same dof ({})", at(dof))
                 }
+                ConstraintError::Cycle { dofs } => format!(
+                    "the active rows solved for {} depend on each other in a cycle",
+                    dofs.iter().map(|&q| at(q)).collect::<Vec<_>>().join("; ")
+                ),
+                ConstraintError::NotFinite { dof } => format!(
+                    "the row solved for {} has a coefficient that is not finite relative to the owned one",
+                    at(dof)
+                ),
+                other => other.to_string(),
+            };
+            StepError::Singular(
+                Error::Solver {
+                    path: self.model.source.clone(),
+                    problem: format!("constraint elimination cannot solve the active contact rows: {what}"),
+                    hint: "let each row own a slave dof no other row touches (one elimination pair per slave surface), or use Lagrange multipliers".into(),
+                }
+                .to_string(),
+            )
+        };
+        // one line per active row: x_o = sum_k (-c_k / c_o) x_k - g0 / c_o
+        let mut builder = ConstraintBuilder::new(n);
+        let mut lines: Vec<(usize, f64)> = Vec::new(); // (row, c_o)
+        let mut masters: Vec<(usize, f64)> = Vec::new();
+        for (i, row) in self.rows.iter().enumerate() {
+            if !active[i] {
+                continue;
             }
+            let o = owners[i];
+            let k = row
+                .eqs
+                .iter()
+                .position(|&q| q == o)
+                .expect("the owner is in its row");
+            let co = row.coeffs[k];
+            masters.clear();
+            masters.extend(
+                row.eqs
+                    .iter()
+                    .zip(&row.coeffs)
+                    .filter(|(&q, _)| q != o)
+                    .map(|(&q, &c)| (q, -c / co)),
+            );
+            builder
+                .constrain(o, &masters, -row.g0 / co)
+                .map_err(&refuse)?;
+            lines.push((i, co));
         }
+        let constraints = builder.close().map_err(&refuse)?;
         let t = Instant::now();
-        let p = &self.sys.pattern;
-        let mut builder = PatternBuilder::new(nr);
-        for j in 0..n {
-            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
-                let i = p.row_idx[k];
-                let mut block: Vec<usize> = terms[i].iter().chain(&terms[j]).map(|t| t.0).collect();
-                block.sort_unstable();
-                block.dedup();
-                builder.add_block(&block);
-            }
-        }
-        let rp = builder.build();
-        let mut values = vec![0.0; rp.nnz()];
-        for j in 0..n {
-            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
-                let i = p.row_idx[k];
-                let kij = self.k[k];
-                let pairs: &[(usize, usize)] = if i == j { &[(i, j)] } else { &[(i, j), (j, i)] };
-                for &(r, c) in pairs {
-                    for &(pr, a) in &terms[r] {
-                        for &(pc, b) in &terms[c] {
-                            if pr <= pc {
-                                values[rp.position(pr, pc).expect("in the reduced pattern")] +=
-                                    a * b * kij;
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        // rhs: T^T (rhs - K t)
-        let mut kt = vec![0.0; n];
-        p.mul(&self.k, &constant, &mut kt);
-        let mut rb = vec![0.0; nr];
-        for e in 0..n {
-            let v = self.rhs[e] - kt[e];
-            for &(q, a) in &terms[e] {
-                rb[q] += a * v;
-            }
-        }
-        let chol = Cholesky::analyse(&rp).map_err(|e| format!("{e:?}"))?;
-        // a failing pivot is named by its equation of the reduced system: map it back
-        let mut eq_of_reduced = vec![0; nr];
-        for e in 0..n {
-            if reduced[e] != usize::MAX {
-                eq_of_reduced[reduced[e]] = e;
-            }
-        }
-        let f = chol.factor(&rp, &values).map_err(|e| {
+        let reduction = constraints.reduction(&self.sys.pattern);
+        let values = reduction.matrix(&self.k);
+        let mut y = reduction.rhs(&self.k, &self.rhs);
+        let chol = Cholesky::analyse(&reduction.pattern).map_err(|e| format!("{e:?}"))?;
+        // a failing pivot is named by its unknown of the reduced system: map it back
+        let free = constraints.free_dofs();
+        let f = chol.factor(&reduction.pattern, &values).map_err(|e| {
             self.sys
-                .factor_error(self.model, e.map_equation(|q| eq_of_reduced[q]))
+                .factor_error(self.model, e.map_equation(|q| free[q]))
                 .to_string()
         })?;
         self.factorizations += t.elapsed().as_secs_f64();
-        f.solve_in_place(&mut rb);
-        let mut x = constant.clone();
-        for e in 0..n {
-            for &(q, a) in &terms[e] {
-                x[e] += a * rb[q];
-            }
-        }
+        f.solve_in_place(&mut y);
+        let x = constraints.expand(&y);
         // forces from the residual at the owned equations: (K x - rhs)_o = c_o lambda
-        let mut kx = vec![0.0; n];
-        p.mul(&self.k, &x, &mut kx);
+        let mut r = vec![0.0; n];
+        self.sys.pattern.mul(&self.k, &x, &mut r);
+        r.iter_mut().zip(&self.rhs).for_each(|(a, b)| *a -= b);
         let mut forces = vec![0.0; self.rows.len()];
-        for (i, row) in self.rows.iter().enumerate() {
-            if active[i] {
-                let o = owners[i];
-                let k = row
-                    .eqs
-                    .iter()
-                    .position(|&q| q == o)
-                    .expect("the owner is in its row");
-                forces[i] = (kx[o] - self.rhs[o]) / row.coeffs[k];
-            }
+        for (&(i, co), mu) in lines.iter().zip(constraints.forces(&r)) {
+            forces[i] = mu / co;
         }
         Ok((x, forces))
     }
@@ -1600,7 +1569,7 @@ impl Kernel<'_> {
                 )
             })
             .collect();
-        let owners: Vec<usize> = rows.iter().map(|r| self.sys.eq[r.owner]).collect();
+        let owners: Vec<usize> = rows.iter().map(|r| self.sys.eq(r.owner)).collect();
         // perturbed Lagrangian rows with a consistent multiplier mass: a saddle-point solve
         let coupled = self.perturbation.iter().any(|c| !c.is_empty());
         let mut lambda_k = vec![0.0; nrows];

@@ -202,7 +202,7 @@ impl<'a> ContactSystem<'a> {
             .iter()
             .zip(&r.coeffs)
             .filter_map(|(&d, &c)| {
-                let e = self.sys.eq[d];
+                let e = self.sys.eq(d);
                 (e != NO_EQUATION).then_some((e, c))
             })
             .collect()
@@ -287,12 +287,12 @@ impl<'a> ContactSystem<'a> {
     /// Grow the pattern when a row couples equations it does not hold (a slave node that slid
     /// onto new master nodes) or the rows changed under multipliers: assemble again.
     fn cover(&mut self) {
-        let eq = &self.sys.eq;
+        let sys = &self.sys;
         let covered = self.rows.iter().all(|r| {
             let eqs: Vec<usize> = r
                 .dofs
                 .iter()
-                .map(|&d| eq[d])
+                .map(|&d| sys.eq(d))
                 .filter(|&e| e != NO_EQUATION)
                 .collect();
             eqs.iter().all(|&a| {
@@ -533,10 +533,9 @@ impl System for ContactSystem<'_> {
                     b.mesh.nodes[r.slave_node][1] + u[dofs[1]],
                 ];
                 if let Some(h) = gap_second_derivative(self.model, r, x_s) {
-                    let eq = &self.sys.eq;
                     for a in 0..2 {
                         for c in a..2 {
-                            let (ea, ec) = (eq[dofs[a]], eq[dofs[c]]);
+                            let (ea, ec) = (self.sys.eq(dofs[a]), self.sys.eq(dofs[c]));
                             if ea != NO_EQUATION && ec != NO_EQUATION {
                                 upper[self
                                     .pattern
@@ -607,10 +606,8 @@ pub(crate) fn solve_step(
     timings.assembly = (t.elapsed().as_secs_f64() - system.search_seconds).max(0.0);
     let mut x: Vec<f64> = vec![0.0; system.pattern.n];
     if let Some(u) = &start {
-        for (d, &e) in system.sys.eq.iter().enumerate() {
-            if e != NO_EQUATION {
-                x[e] = u[d];
-            }
+        for (e, &d) in system.sys.constraints.free_dofs().iter().enumerate() {
+            x[e] = u[d];
         }
     }
     let t = Instant::now();

@@ -1,9 +1,12 @@
 //! The static solve of small-strain elasticity: `K u = f` with prescribed dofs eliminated.
 //!
-//! Equations are numbered over the free dofs only. With `u = [u_f; u_p]` and `u_p` prescribed,
-//! `K_ff u_f = f_f - K_fp u_p` is assembled element by element (the `K_fp u_p` term from each
-//! element's own block), factored by sparse Cholesky and solved (with two steps of iterative
-//! refinement). Reactions are the residual of
+//! The prescribed dofs are the Dirichlet lines of an [`AffineConstraints`] set built from the
+//! model's prescribed values; it owns the equation numbering (free dofs only) and the
+//! prescribed values. With `u = [u_f; u_p]` and `u_p` prescribed,
+//! `K_ff u_f = f_f - K_fp u_p` is assembled element by element through the set's
+//! [`crate::solver::constraints::LocalAssembler`] (a scatter of each element's free block and
+//! its `K_fp u_p` term: no `T^T K T` product for Dirichlet data), factored by sparse Cholesky
+//! and solved (with two steps of iterative refinement). Reactions are the residual of
 //! the full system, `r = K u - f`, evaluated element by element; at free dofs it is the
 //! equilibrium error (reported as `residual`), at prescribed dofs it is the support reaction.
 //!
@@ -15,11 +18,10 @@
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::solid::{element_stiffness, MAX_DOFS};
+use crate::solver::constraints::AffineConstraints;
+pub use crate::solver::constraints::NO_EQUATION;
 use crate::solver::sparse::{Cholesky, FactorError, PatternBuilder, SymmetricPattern};
 use std::time::Instant;
-
-/// Marks a dof that has no equation (it is prescribed).
-pub const NO_EQUATION: usize = usize::MAX;
 
 /// Wall-clock seconds of each stage of a run.
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -64,24 +66,6 @@ pub struct Solution {
     pub contact: Option<crate::contact::state::ContactState>,
 }
 
-/// Equation number of each global dof (`NO_EQUATION` for prescribed dofs).
-pub fn number_equations(model: &Model) -> (Vec<usize>, usize) {
-    let mut count = 0;
-    let eq = model
-        .prescribed
-        .iter()
-        .map(|p| {
-            if p.is_some() {
-                NO_EQUATION
-            } else {
-                count += 1;
-                count - 1
-            }
-        })
-        .collect();
-    (eq, count)
-}
-
 /// Calls `visit(dofs, ke)` for every cell of every body.
 pub fn for_each_element_stiffness(model: &Model, mut visit: impl FnMut(&[usize], &[f64])) {
     let mut dofs = Vec::with_capacity(MAX_DOFS);
@@ -108,33 +92,32 @@ pub fn for_each_element_stiffness(model: &Model, mut visit: impl FnMut(&[usize],
 
 /// The assembled stiffness over the free equations: `K_ff` and `f_f - K_fp u_p`.
 pub struct LinearSystem {
-    /// Equation of each global dof (`NO_EQUATION` when prescribed).
-    pub eq: Vec<usize>,
+    /// The Dirichlet data as affine constraints: the equation of each global dof
+    /// ([`AffineConstraints::equations`], `NO_EQUATION` when prescribed), the dof of each
+    /// equation and the prescribed values ([`AffineConstraints::constants`]).
+    pub constraints: AffineConstraints,
     pub n: usize,
     pub pattern: SymmetricPattern,
     /// Values of `K_ff` on `pattern`.
     pub k: Vec<f64>,
     /// `f_f - K_fp u_p`.
     pub rhs: Vec<f64>,
-    /// Global vector holding the prescribed values (zero at free dofs).
-    pub u_prescribed: Vec<f64>,
 }
 
 impl LinearSystem {
-    /// Global displacement from the free-equation solution `x`.
+    /// Global displacement from the free-equation solution `x` (prescribed values included).
     pub fn expand(&self, x: &[f64]) -> Vec<f64> {
-        let mut u = self.u_prescribed.clone();
-        for (d, &e) in self.eq.iter().enumerate() {
-            if e != NO_EQUATION {
-                u[d] = x[e];
-            }
-        }
-        u
+        self.constraints.expand(x)
+    }
+
+    /// The equation of global dof `d` (`NO_EQUATION` when prescribed).
+    pub fn eq(&self, d: usize) -> usize {
+        self.constraints.equations()[d]
     }
 
     /// The global dof of equation `e`.
     pub fn dof_of(&self, e: usize) -> Option<usize> {
-        self.eq.iter().position(|&x| x == e)
+        self.constraints.free_dofs().get(e).copied()
     }
 
     /// The error for a stiffness that cannot be factored: `equation` is where the first bad
@@ -252,55 +235,32 @@ pub fn non_finite_at(model: &Model, what: &str, value: f64, at: &str, stage: &st
 /// Assemble `K_ff` and the right-hand side. `extra_blocks` (global dofs) are added to the
 /// sparsity pattern, e.g. the dofs coupled by contact constraints.
 pub fn assemble(model: &Model, extra_blocks: &[Vec<usize>]) -> LinearSystem {
-    let (eq, n) = number_equations(model);
-    let u_prescribed: Vec<f64> = model.prescribed.iter().map(|p| p.unwrap_or(0.0)).collect();
+    let constraints = AffineConstraints::dirichlet(&model.prescribed);
+    let n = constraints.free_count();
+    let mut local = constraints.local();
     let mut builder = PatternBuilder::new(n);
     let mut dofs = Vec::with_capacity(MAX_DOFS);
-    let mut eqs = Vec::with_capacity(MAX_DOFS);
     for body in &model.bodies {
         for c in 0..body.mesh.cell_count() {
             body.cell_dofs(c, &mut dofs);
-            eqs.clear();
-            eqs.extend(dofs.iter().map(|&d| eq[d]));
-            builder.add_block(&eqs);
+            local.add_pattern(&dofs, &mut builder);
         }
     }
     for block in extra_blocks {
-        let eqs: Vec<usize> = block.iter().map(|&d| eq[d]).collect();
-        builder.add_block(&eqs);
+        local.add_pattern(block, &mut builder);
     }
     let pattern = builder.build();
     let mut k = vec![0.0; pattern.nnz()];
-    let mut rhs = vec![0.0; n];
-    for (d, &e) in eq.iter().enumerate() {
-        if e != NO_EQUATION {
-            rhs[e] = model.external_force[d];
-        }
-    }
+    let mut rhs = constraints.reduce_vector(&model.external_force);
     for_each_element_stiffness(model, |dofs, ke| {
-        eqs.clear();
-        eqs.extend(dofs.iter().map(|&d| eq[d]));
-        pattern.scatter(&eqs, ke, &mut k);
-        // move K_fp u_p to the right-hand side
-        let m = dofs.len();
-        for (b, &db) in dofs.iter().enumerate() {
-            if eqs[b] != NO_EQUATION || u_prescribed[db] == 0.0 {
-                continue;
-            }
-            for a in 0..m {
-                if eqs[a] != NO_EQUATION {
-                    rhs[eqs[a]] -= ke[a * m + b] * u_prescribed[db];
-                }
-            }
-        }
+        local.distribute(dofs, ke, &pattern, &mut k, &mut rhs);
     });
     LinearSystem {
-        eq,
+        constraints,
         n,
         pattern,
         k,
         rhs,
-        u_prescribed,
     }
 }
 
@@ -426,23 +386,16 @@ pub fn finish(
             "in the reactions of the solution",
         ));
     }
-    let eq = &sys.eq;
+    // the support reactions are the forces of the Dirichlet constraints
+    let supports = sys.constraints.forces(&reactions);
     let scale = max_abs(
-        model.external_force.iter().chain(contact_force).chain(
-            reactions
-                .iter()
-                .enumerate()
-                .filter(|(d, _)| eq[*d] == NO_EQUATION)
-                .map(|(_, r)| r),
-        ),
-    );
-    let worst = max_abs(
-        reactions
+        model
+            .external_force
             .iter()
-            .enumerate()
-            .filter(|(d, _)| eq[*d] != NO_EQUATION)
-            .map(|(_, r)| r),
+            .chain(contact_force)
+            .chain(&supports),
     );
+    let worst = max_abs(sys.constraints.free_dofs().iter().map(|&d| &reactions[d]));
     Ok(Solution {
         u,
         reactions,
