@@ -41,7 +41,9 @@ fn element_stiffness_reference(
     let nn = kind.node_count();
     let nd = 2 * nn;
     ke[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
-    let d = &material.d;
+    // `D` as the array it was then (it is an nalgebra `Matrix3` now)
+    let d: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| material.d[(i, j)]));
+    let d = &d;
     for q in rule {
         let pv = point_values(kind, coords, q.xi);
         let w = q.weight * pv.det_j * thickness;
