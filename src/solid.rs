@@ -525,6 +525,223 @@ mod tests {
         }
     }
 
+    const KINDS: [ElementKind; 4] = [
+        ElementKind::Q4,
+        ElementKind::Q9,
+        ElementKind::T3,
+        ElementKind::T6,
+    ];
+    const THICKNESS: f64 = 0.7;
+
+    fn materials() -> [Elasticity; 2] {
+        [
+            Elasticity::new(1000.0, 0.3, Plane::Strain),
+            Elasticity::new(1000.0, 0.3, Plane::Stress),
+        ]
+    }
+
+    /// Element displacements of no particular form (`2 n` values of order 1e-2).
+    fn some_displacements(kind: ElementKind) -> Vec<f64> {
+        (0..2 * kind.node_count())
+            .map(|i| 0.01 * (1.7 * i as f64 + 0.3).sin())
+            .collect()
+    }
+
+    fn internal_force(kind: ElementKind, mat: &Elasticity, u: &[f64]) -> ElementVector {
+        let coords = distorted(kind);
+        let rule = kind.stiffness_rule();
+        element_internal_force(
+            Kinematics::SmallStrain,
+            kind,
+            &coords,
+            u,
+            mat,
+            THICKNESS,
+            &rule,
+        )
+    }
+
+    fn largest(v: impl IntoIterator<Item = f64>) -> f64 {
+        v.into_iter().fold(0.0, |m, x| m.max(x.abs()))
+    }
+
+    #[test]
+    fn tangent_is_the_central_difference_of_the_internal_force() {
+        for mat in materials() {
+            for kind in KINDS {
+                let coords = distorted(kind);
+                let rule = kind.stiffness_rule();
+                let nd = 2 * kind.node_count();
+                let u = some_displacements(kind);
+                let (f, k) = element_residual_and_tangent(
+                    Kinematics::SmallStrain,
+                    kind,
+                    &coords,
+                    &u,
+                    &mat,
+                    THICKNESS,
+                    &rule,
+                );
+                // the two entry points agree, and nothing is written beyond the element's dofs
+                assert_eq!(f, internal_force(kind, &mat, &u));
+                assert!(f.rows(nd, MAX_DOFS - nd).iter().all(|&v| v == 0.0));
+                assert!(k.columns(nd, MAX_DOFS - nd).iter().all(|&v| v == 0.0));
+                assert!(k.rows(nd, MAX_DOFS - nd).iter().all(|&v| v == 0.0));
+                // element_stiffness (row-major) is the same tangent
+                let mut ke = [0.0; MAX_DOFS * MAX_DOFS];
+                element_stiffness(kind, &coords, &mat, THICKNESS, &rule, &mut ke);
+                for i in 0..nd {
+                    for j in 0..nd {
+                        assert_eq!(ke[i * nd + j], k[(i, j)], "{kind:?} K[{i}][{j}]");
+                    }
+                }
+                let h = 1e-6;
+                let mut fd = ElementMatrix::zeros();
+                for j in 0..nd {
+                    let (mut up, mut um) = (u.clone(), u.clone());
+                    up[j] += h;
+                    um[j] -= h;
+                    let column = (internal_force(kind, &mat, &up)
+                        - internal_force(kind, &mat, &um))
+                        / (2.0 * h);
+                    fd.set_column(j, &column);
+                    let scale = largest(k.column(j).iter().copied());
+                    let err = largest((0..nd).map(|i| column[i] - k[(i, j)]));
+                    assert!(
+                        err < 1e-7 * scale,
+                        "{kind:?} {:?}: column {j} of K_T differs from the central difference by {err:e} (scale {scale:e})",
+                        mat.plane
+                    );
+                }
+                // K_T is symmetric, and so is the difference quotient of f_int alone (f_int is
+                // the gradient of an energy)
+                let scale = largest(k.iter().copied());
+                for i in 0..nd {
+                    for j in 0..nd {
+                        assert!((k[(i, j)] - k[(j, i)]).abs() <= 1e-14 * scale);
+                        assert!((fd[(i, j)] - fd[(j, i)]).abs() < 1e-7 * scale);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rigid_motions_have_no_internal_force() {
+        for mat in materials() {
+            for kind in KINDS {
+                let coords = distorted(kind);
+                let scale = {
+                    let u = some_displacements(kind);
+                    largest(internal_force(kind, &mat, &u).iter().copied()) / 0.01
+                };
+                // translation x, translation y, infinitesimal rotation u = a + w e_z x p
+                for (a, w) in [([1.0, 0.0], 0.0), ([0.0, 1.0], 0.0), ([0.0, 0.0], 1.0)] {
+                    let u: Vec<f64> = coords
+                        .iter()
+                        .flat_map(|&p| [a[0] - w * p[1], a[1] + w * p[0]])
+                        .collect();
+                    let f = internal_force(kind, &mat, &u);
+                    let worst = largest(f.iter().copied());
+                    assert!(
+                        worst < 1e-12 * scale,
+                        "{kind:?} {:?}: rigid motion {a:?}, {w} has internal force {worst:e}",
+                        mat.plane
+                    );
+                }
+            }
+        }
+    }
+
+    /// `int_{boundary} N_a sigma n t ds` for a constant stress, edge by edge (the element's own
+    /// isoparametric edges, outward normal = tangent turned clockwise).
+    fn boundary_force(kind: ElementKind, coords: &[[f64; 2]], sigma: [f64; 3]) -> Vec<f64> {
+        let [sxx, syy, sxy] = sigma;
+        let edge = kind.edge_kind();
+        let m = edge.node_count();
+        let mut f = vec![0.0; 2 * kind.node_count()];
+        for nodes in kind.edges() {
+            for (s, w) in crate::fe::gauss_legendre(4) {
+                let (mut n, mut dn) = ([0.0; 3], [0.0; 3]);
+                edge.shape(s, &mut n[..m], &mut dn[..m]);
+                let mut tangent = [0.0; 2];
+                for (i, &a) in nodes.iter().enumerate() {
+                    tangent[0] += dn[i] * coords[a][0];
+                    tangent[1] += dn[i] * coords[a][1];
+                }
+                let normal = [tangent[1], -tangent[0]]; // n ds / dxi
+                let traction = [
+                    sxx * normal[0] + sxy * normal[1],
+                    sxy * normal[0] + syy * normal[1],
+                ];
+                for (i, &a) in nodes.iter().enumerate() {
+                    f[2 * a] += w * n[i] * traction[0] * THICKNESS;
+                    f[2 * a + 1] += w * n[i] * traction[1] * THICKNESS;
+                }
+            }
+        }
+        f
+    }
+
+    #[test]
+    fn a_linear_field_has_the_constant_stress_d_eps() {
+        // u(x) = c + A x, A neither symmetric nor small: eps = [A_xx, A_yy, A_xy + A_yx]
+        let c = [0.3, -0.2];
+        let a = [[0.02, -0.05], [0.03, -0.01]];
+        let eps = [a[0][0], a[1][1], a[0][1] + a[1][0]];
+        for mat in materials() {
+            let sigma = mat.stress(eps);
+            // sigma = D eps written out, not through `stress`
+            let (e, nu) = mat.plane_stress_equivalent();
+            let g = e / (2.0 * (1.0 + nu));
+            let expected = [
+                e / (1.0 - nu * nu) * (eps[0] + nu * eps[1]),
+                e / (1.0 - nu * nu) * (eps[1] + nu * eps[0]),
+                g * eps[2],
+            ];
+            for i in 0..3 {
+                assert!((sigma[i] - expected[i]).abs() < 1e-12 * largest(expected));
+            }
+            for kind in KINDS {
+                let coords = distorted(kind);
+                let u: Vec<f64> = coords
+                    .iter()
+                    .flat_map(|p| {
+                        [
+                            c[0] + a[0][0] * p[0] + a[0][1] * p[1],
+                            c[1] + a[1][0] * p[0] + a[1][1] * p[1],
+                        ]
+                    })
+                    .collect();
+                // the kernel's strain at every quadrature point is eps
+                let rule = kind.stiffness_rule();
+                with_sizes!(kind, |N, ND| {
+                    let um = SMatrix::<f64, 2, N>::from_column_slice(&u[..ND]);
+                    let x = nodes::<N>(&coords);
+                    for p in rule.iter().filter_map(|q| point(kind, &x, q, THICKNESS)) {
+                        let got = small_strain_at(&p, &um);
+                        for i in 0..3 {
+                            assert!((got[i] - eps[i]).abs() < 1e-13, "{kind:?}: {got:?}");
+                        }
+                    }
+                });
+                // and f_int is the boundary integral of the constant traction sigma n
+                let f = internal_force(kind, &mat, &u);
+                let expected = boundary_force(kind, &coords, sigma);
+                let scale = largest(expected.iter().copied());
+                assert!(scale > 0.0);
+                for (i, want) in expected.iter().enumerate() {
+                    assert!(
+                        (f[i] - want).abs() < 1e-12 * scale,
+                        "{kind:?} {:?}: f_int[{i}] = {} but the traction gives {want}",
+                        mat.plane,
+                        f[i]
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn strain_of_stress_inverts_d() {
         for plane in [Plane::Strain, Plane::Stress] {
