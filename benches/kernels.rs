@@ -1,13 +1,13 @@
 //! Criterion benchmarks of the element kernels and of the global assembly.
 //!
 //! Representative configurations, not sweeps: one stiffness per element kind on a distorted
-//! cell, and full assembly (pattern + values), kernels + scatter, and factorization of a 50 x 50
+//! cell (beside `<kind>_reference`, the array-loop kernel that preceded the nalgebra one), and full assembly (pattern + values), kernels + scatter, and factorization of a 50 x 50
 //! Q4 plane-strain block (5,202 dofs), by `sparse::Cholesky` and by faer's high-level `Llt`
 //! side by side. Compare the figures as ratios within one run (e.g. Q9 vs Q4 kernel,
 //! factorization vs assembly, `numeric_cholesky` vs `numeric_cholesky_faer_llt`), never as
 //! absolute times across machines.
 
-use contact_patch::fe::ElementKind;
+use contact_patch::fe::{point_values, ElementKind, QuadPoint};
 use contact_patch::model::{parse, Model};
 use contact_patch::solid::{element_stiffness, Elasticity, MAX_DOFS};
 use contact_patch::solver::linear::{assemble, for_each_element_stiffness};
@@ -27,6 +27,51 @@ fn distorted(kind: ElementKind) -> Vec<[f64; 2]> {
         .collect()
 }
 
+/// The element stiffness as it was before the kernels moved to nalgebra (hand-written loops on
+/// arrays, every `(a, b)` block computed), kept to measure the nalgebra kernel against it in the
+/// same run.
+fn element_stiffness_reference(
+    kind: ElementKind,
+    coords: &[[f64; 2]],
+    material: &Elasticity,
+    thickness: f64,
+    rule: &[QuadPoint],
+    ke: &mut [f64],
+) {
+    let nn = kind.node_count();
+    let nd = 2 * nn;
+    ke[..nd * nd].iter_mut().for_each(|v| *v = 0.0);
+    // `D` as the array it was then (it is an nalgebra `Matrix3` now)
+    let d: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| material.d[(i, j)]));
+    let d = &d;
+    for q in rule {
+        let pv = point_values(kind, coords, q.xi);
+        let w = q.weight * pv.det_j * thickness;
+        for b in 0..nn {
+            let [bx, by] = pv.dndx[b];
+            // D B_b (3 x 2)
+            let db = [
+                [d[0][0] * bx + d[0][2] * by, d[0][1] * by + d[0][2] * bx],
+                [d[1][0] * bx + d[1][2] * by, d[1][1] * by + d[1][2] * bx],
+                [d[2][0] * bx + d[2][2] * by, d[2][1] * by + d[2][2] * bx],
+            ];
+            for a in 0..nn {
+                let [ax, ay] = pv.dndx[a];
+                // B_a^T (D B_b)
+                let k00 = ax * db[0][0] + ay * db[2][0];
+                let k01 = ax * db[0][1] + ay * db[2][1];
+                let k10 = ay * db[1][0] + ax * db[2][0];
+                let k11 = ay * db[1][1] + ax * db[2][1];
+                let (r, c) = (2 * a, 2 * b);
+                ke[r * nd + c] += w * k00;
+                ke[r * nd + c + 1] += w * k01;
+                ke[(r + 1) * nd + c] += w * k10;
+                ke[(r + 1) * nd + c + 1] += w * k11;
+            }
+        }
+    }
+}
+
 fn kernels(c: &mut Criterion) {
     let mat = Elasticity::new(1000.0, 0.3, contact_patch::io::scene::Plane::Strain);
     let mut group = c.benchmark_group("element_stiffness");
@@ -41,6 +86,11 @@ fn kernels(c: &mut Criterion) {
         let mut ke = [0.0; MAX_DOFS * MAX_DOFS];
         group.bench_function(format!("{kind:?}"), |b| {
             b.iter(|| element_stiffness(kind, black_box(&coords), &mat, 1.0, &rule, &mut ke))
+        });
+        group.bench_function(format!("{kind:?}_reference"), |b| {
+            b.iter(|| {
+                element_stiffness_reference(kind, black_box(&coords), &mat, 1.0, &rule, &mut ke)
+            })
         });
     }
     group.finish();

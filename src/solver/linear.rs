@@ -7,7 +7,8 @@
 //! [`crate::solver::constraints::LocalAssembler`] (a scatter of each element's free block and
 //! its `K_fp u_p` term: no `T^T K T` product for Dirichlet data), factored by sparse Cholesky
 //! and solved (with two steps of iterative refinement). Reactions are the residual of
-//! the full system, `r = K u - f`, evaluated element by element; at free dofs it is the
+//! the full system, `r = f_int(u) - f` (`= K u - f`), with the internal force evaluated element
+//! by element (`internal_force`, from the solids' residual kernel); at free dofs it is the
 //! equilibrium error (reported as `residual`), at prescribed dofs it is the support reaction.
 //!
 //! Every number a run reports must be finite: the assembled loads, stiffness and right-hand
@@ -17,7 +18,7 @@
 
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::solid::{element_stiffness, MAX_DOFS};
+use crate::solid::{element_internal_force, element_stiffness, Kinematics, MAX_DOFS};
 use crate::solver::constraints::AffineConstraints;
 pub use crate::solver::constraints::NO_EQUATION;
 use crate::solver::sparse::{Cholesky, FactorError, PatternBuilder, SymmetricPattern};
@@ -407,19 +408,43 @@ pub fn finish(
     })
 }
 
-/// `K u - f`, element by element.
-pub fn residual(model: &Model, u: &[f64]) -> Vec<f64> {
-    let mut r: Vec<f64> = model.external_force.iter().map(|f| -f).collect();
-    for_each_element_stiffness(model, |dofs, ke| {
-        let m = dofs.len();
-        for a in 0..m {
-            let mut s = 0.0;
-            for b in 0..m {
-                s += ke[a * m + b] * u[dofs[b]];
+/// The internal force `f_int(u)` of every body at the global displacement `u`, element by
+/// element (small strain: `K u`).
+pub fn internal_force(model: &Model, u: &[f64]) -> Vec<f64> {
+    let mut f = vec![0.0; u.len()];
+    let mut dofs = Vec::with_capacity(MAX_DOFS);
+    let mut ue = [0.0; MAX_DOFS];
+    for body in &model.bodies {
+        let kind = body.mesh.kind;
+        let rule = kind.stiffness_rule();
+        for c in 0..body.mesh.cell_count() {
+            body.cell_dofs(c, &mut dofs);
+            for (v, &d) in ue.iter_mut().zip(&dofs) {
+                *v = u[d];
             }
-            r[dofs[a]] += s;
+            let fe = element_internal_force(
+                Kinematics::SmallStrain,
+                kind,
+                &body.mesh.cell_coords(c),
+                &ue[..dofs.len()],
+                &body.material,
+                model.thickness,
+                &rule,
+            );
+            for (a, &d) in dofs.iter().enumerate() {
+                f[d] += fe[a];
+            }
         }
-    });
+    }
+    f
+}
+
+/// `f_int(u) - f`, element by element.
+pub fn residual(model: &Model, u: &[f64]) -> Vec<f64> {
+    let mut r = internal_force(model, u);
+    for (r, f) in r.iter_mut().zip(&model.external_force) {
+        *r -= f;
+    }
     r
 }
 
