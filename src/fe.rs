@@ -279,6 +279,23 @@ fn lagrange_1d_quadratic(node: f64, s: f64) -> (f64, f64) {
 
 /// Gauss-Legendre points and weights on `[-1, 1]`, by Newton iteration on `P_n`.
 pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    // the rules up to 16 points are computed once (the mortar segments and element loops ask
+    // for them thousands of times)
+    static RULES: std::sync::OnceLock<Vec<Vec<(f64, f64)>>> = std::sync::OnceLock::new();
+    const CACHED: usize = 16;
+    if (1..=CACHED).contains(&n) {
+        let rules = RULES.get_or_init(|| {
+            (0..=CACHED)
+                .map(|k| compute_gauss_legendre(k.max(1)))
+                .collect()
+        });
+        return rules[n].clone();
+    }
+    compute_gauss_legendre(n)
+}
+
+/// The `n`-point Gauss-Legendre rule by Newton iteration on the Legendre polynomial.
+fn compute_gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     assert!(n >= 1, "a Gauss rule needs at least one point");
     let mut rule = Vec::with_capacity(n);
     for i in 0..n {
