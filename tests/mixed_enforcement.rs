@@ -49,6 +49,24 @@ fn penetration(o: &Outcome, pair: usize) -> f64 {
         .depth
 }
 
+/// Each block of `mixed` moves as it does when both pairs use its pair's method (`methods[b]`
+/// for block `b`), to 1e-12.
+fn assert_each_block_as_alone(mixed: &Outcome, methods: [Value; 2]) {
+    for (body, both) in methods.into_iter().enumerate() {
+        let alone = solve(&two_blocks(both.clone(), both)).unwrap();
+        let b = &mixed.model.bodies[body];
+        let range = b.dof_offset..b.dof_offset + b.dof_count();
+        let scale = alone.solution.u[range.clone()]
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = mixed.solution.u[range.clone()]
+            .iter()
+            .zip(&alone.solution.u[range])
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(diff <= 1e-12 * scale, "body {body}: {}", diff / scale);
+    }
+}
+
 #[test]
 fn penalty_and_augmented_lagrange_pairs_solve_together() {
     let kappa = 1e4;
@@ -73,19 +91,7 @@ fn penalty_and_augmented_lagrange_pairs_solve_together() {
         penetration(&mixed, 1)
     );
     // each block as its method gives it alone
-    for (both, body) in [(penalty.clone(), 0), (augmented.clone(), 1)] {
-        let alone = solve(&two_blocks(both.clone(), both)).unwrap();
-        let b = &mixed.model.bodies[body];
-        let range = b.dof_offset..b.dof_offset + b.dof_count();
-        let scale = alone.solution.u[range.clone()]
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-        let diff = mixed.solution.u[range.clone()]
-            .iter()
-            .zip(&alone.solution.u[range])
-            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        assert!(diff <= 1e-12 * scale, "body {body}: {}", diff / scale);
-    }
+    assert_each_block_as_alone(&mixed, [penalty.clone(), augmented.clone()]);
     // the pairs' methods are the ones reported
     let names: Vec<&str> = mixed
         .model
@@ -154,19 +160,7 @@ fn the_newton_scheme_solves_a_lagrange_pair_with_a_penalty_pair() {
         "penalty penetration {sunk}"
     );
     // each block as its method gives it alone, in the active-set scheme
-    for (both, body) in [(lagrange, 0), (penalty, 1)] {
-        let alone = solve(&two_blocks(both.clone(), both)).unwrap();
-        let b = &mixed.model.bodies[body];
-        let range = b.dof_offset..b.dof_offset + b.dof_count();
-        let scale = alone.solution.u[range.clone()]
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-        let diff = mixed.solution.u[range.clone()]
-            .iter()
-            .zip(&alone.solution.u[range])
-            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        assert!(diff <= 1e-12 * scale, "body {body}: {}", diff / scale);
-    }
+    assert_each_block_as_alone(&mixed, [lagrange, penalty]);
     // the linear solver of a saddle-point system with multipliers
     assert_eq!(state.linear_solver, "ldlt");
 }
