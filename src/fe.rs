@@ -21,7 +21,7 @@
 use serde::{Deserialize, Serialize};
 
 /// A reference element type.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, schemars::JsonSchema)]
 pub enum ElementKind {
     Q4,
     Q9,
@@ -30,7 +30,7 @@ pub enum ElementKind {
 }
 
 /// A reference edge type.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, schemars::JsonSchema)]
 pub enum EdgeKind {
     Line2,
     Line3,

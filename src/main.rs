@@ -64,6 +64,10 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// Print the JSON Schema of the case format (committed as cases/case.schema.json; a case
+    /// file may name it in "$schema" so that editors validate and complete it).
+    #[command(after_help = "Example:\n  contact-patch schema > cases/case.schema.json")]
+    Schema,
     /// Run the checks declared in cases; exit 0 only when every check of every case passes.
     #[command(
         after_help = "Example:\n  contact-patch check cases/patch-single cases/convergence/cantilever-q4.json\n\nFolders are searched recursively for *.json case files."
@@ -82,6 +86,10 @@ fn main() -> ExitCode {
         Command::Check { paths } => check(&paths),
         Command::Table { paths, out } => table(&paths, &out),
         Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
+        Command::Schema => {
+            print!("{}", contact_patch::io::scene::case_schema());
+            ExitCode::SUCCESS
+        }
     }
 }
 

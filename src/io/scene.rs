@@ -10,12 +10,16 @@
 //! pressure loads that push against the outward normal.
 
 use crate::fe::ElementKind;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Case {
+    /// The JSON Schema the file follows, for editors (`cases/case.schema.json`); not read.
+    #[serde(rename = "$schema", default, skip_serializing_if = "Option::is_none")]
+    pub schema: Option<String>,
     /// Short identifier; the default output folder is `out/<name>`.
     pub name: String,
     #[serde(default)]
@@ -53,7 +57,7 @@ pub struct Case {
 
 /// How the solve proceeds: the load applied in equal steps, each converged before the next
 /// starts from its state, with limits per case instead of global constants.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SolverSpec {
     /// Number of equal load steps (load factor `k / n` at step `k`); default 1.
@@ -81,7 +85,7 @@ pub struct SolverSpec {
 }
 
 /// The nonlinear solution scheme of a load step.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Scheme {
     /// Linear solves of the active-set loop inside geometry updates
@@ -127,7 +131,7 @@ impl Default for SolverSpec {
 }
 
 /// Bounds on the size of a case, checked before meshing (a case may raise them).
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Limits {
     /// The most nodes all bodies together may have (default 2,000,000, 4 million dofs: four
@@ -152,6 +156,15 @@ impl Default for Limits {
 
 /// A JSON object as a map whose keys must differ: a repeated key is an error naming it, where
 /// serde's map would keep the last one silently.
+/// The JSON Schema of the case format (draft 2020-12), pretty-printed: what
+/// `contact-patch schema` prints and `cases/case.schema.json` holds.
+pub fn case_schema() -> String {
+    let schema = schemars::schema_for!(Case);
+    let mut text = serde_json::to_string_pretty(&schema).expect("a schema serializes");
+    text.push('\n');
+    text
+}
+
 fn unique_keys<'de, D, V>(d: D) -> Result<BTreeMap<String, V>, D::Error>
 where
     D: serde::Deserializer<'de>,
@@ -184,7 +197,7 @@ where
 }
 
 /// A facet set of a body.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SurfaceSpec {
     pub body: String,
@@ -192,7 +205,7 @@ pub struct SurfaceSpec {
 }
 
 /// A rigid, fixed analytic master surface.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum RigidSurface {
     /// The line through `point`; `normal` points to the side where the slave body lives.
@@ -202,7 +215,7 @@ pub enum RigidSurface {
 }
 
 /// The master side of a pair: a facet set of a body, or a rigid surface.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MasterSpec {
     #[serde(default)]
@@ -215,7 +228,7 @@ pub struct MasterSpec {
 
 /// One contact pair: slave facets against master facets (or a rigid surface), with a
 /// discretization and an enforcement method.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
     pub name: String,
@@ -233,7 +246,7 @@ pub struct ContactSpec {
 }
 
 /// What a pair enforces.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Interaction {
     /// Unilateral, frictionless contact: `g >= 0`, `lambda >= 0`, `g lambda = 0`.
@@ -244,7 +257,7 @@ pub enum Interaction {
 }
 
 /// The multiplier space of a mortar discretization.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum MultiplierSpace {
     /// The slave shape functions.
@@ -255,7 +268,7 @@ pub enum MultiplierSpace {
 }
 
 /// Which normal defines the gap of a node-to-surface constraint.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum NormalChoice {
     /// The outward normal of the master facet at the closest point.
@@ -270,7 +283,7 @@ fn one_pass() -> u8 {
 }
 
 /// The discretization axis.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum DiscretizationSpec {
     /// Each slave node against the master node at the same place.
@@ -291,7 +304,7 @@ pub enum DiscretizationSpec {
 }
 
 /// When the augmented Lagrangian updates its multipliers.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum MultiplierUpdate {
     /// After every Newton (active-set) iteration.
@@ -302,7 +315,7 @@ pub enum MultiplierUpdate {
 }
 
 /// The enforcement axis. `kappa` is a penalty per unit contact area (pressure per gap).
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum EnforcementSpec {
     Lagrange,
@@ -325,7 +338,7 @@ pub enum EnforcementSpec {
 
 /// One discretization variant of a sweep: a discretization, and which body is the slave of
 /// a one-pass run (default: the pair's own slave).
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SweepDiscretization {
     pub discretization: DiscretizationSpec,
@@ -335,7 +348,7 @@ pub struct SweepDiscretization {
 
 /// The product of discretizations and enforcements that `contact-patch table` runs on the
 /// case's first contact pair.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SweepSpec {
     /// Which table the cells go to: `patch` (default, `reports/patch-table.*`) or `tied`
@@ -356,7 +369,9 @@ pub struct SweepSpec {
 }
 
 /// The tables a sweep's cells go to; the name is the stem of the table's files.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum Catalogue {
     /// The contact patch test (`patch-table.*`).
@@ -379,7 +394,7 @@ fn thousand() -> f64 {
     1000.0
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Analysis {
     #[serde(default)]
@@ -401,7 +416,7 @@ fn one() -> f64 {
     1.0
 }
 
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Plane {
     #[default]
@@ -410,7 +425,7 @@ pub enum Plane {
 }
 
 /// Isotropic linear elasticity.
-#[derive(Copy, Clone, Debug, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
     #[serde(rename = "E")]
@@ -418,7 +433,7 @@ pub struct MaterialSpec {
     pub nu: f64,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
     pub name: String,
@@ -430,7 +445,7 @@ pub struct BodySpec {
     pub facet_sets: BTreeMap<String, FacetSetSpec>,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum MeshSpec {
     /// Structured block from element breaks along x and y.
@@ -439,7 +454,7 @@ pub enum MeshSpec {
     Explicit(ExplicitMeshSpec),
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BlockSpec {
     pub element: ElementKind,
@@ -451,7 +466,7 @@ pub struct BlockSpec {
 }
 
 /// Element boundaries along one axis: an explicit list, or uniform divisions.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, JsonSchema)]
 #[serde(untagged)]
 pub enum Breaks {
     List(Vec<f64>),
@@ -484,7 +499,7 @@ impl<'de> Deserialize<'de> for Breaks {
     }
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct UniformBreaks {
     pub from: f64,
@@ -525,14 +540,14 @@ impl Breaks {
     }
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Move {
     pub from: [f64; 2],
     pub to: [f64; 2],
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ExplicitMeshSpec {
     pub element: ElementKind,
@@ -540,7 +555,7 @@ pub struct ExplicitMeshSpec {
     pub cells: Vec<Vec<usize>>,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum NodeSetSpec {
     /// Nodes in a closed axis-aligned box.
@@ -551,7 +566,7 @@ pub enum NodeSetSpec {
     Nodes(Vec<usize>),
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum FacetSetSpec {
     /// Boundary facets whose nodes all lie in a closed axis-aligned box.
@@ -560,7 +575,7 @@ pub enum FacetSetSpec {
     Facets(Vec<[usize; 2]>),
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BoxSpec {
     pub min: [f64; 2],
@@ -568,14 +583,14 @@ pub struct BoxSpec {
 }
 
 /// The keyword `"exact"`: take the value from the case's exact solution.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum FromExact {
     Exact,
 }
 
 /// A prescribed displacement component: a number, or `"exact"`.
-#[derive(Copy, Clone, Debug, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(untagged)]
 pub enum Prescribed {
     Value(f64),
@@ -583,7 +598,7 @@ pub enum Prescribed {
 }
 
 /// Prescribed displacement components on a node set (`x`, `y` or both).
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Support {
     pub body: String,
@@ -595,7 +610,7 @@ pub struct Support {
 }
 
 /// A traction vector, or `"exact"` (sigma_exact . n).
-#[derive(Copy, Clone, Debug, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(untagged)]
 pub enum TractionSpec {
     Vector([f64; 2]),
@@ -603,7 +618,7 @@ pub enum TractionSpec {
 }
 
 /// One load: `pressure` or `traction` on a facet set, or a `body_force` on a whole body.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Load {
     pub body: String,
@@ -621,7 +636,7 @@ pub struct Load {
 }
 
 /// Analytic reference solutions.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ExactSpec {
     /// Constant stress `[xx, yy, xy]`, displacement `u = eps x` (no rigid motion).
@@ -633,7 +648,7 @@ pub enum ExactSpec {
 
 /// What the scene simulates beyond static, small-strain, frictionless elasticity. Every
 /// extra effect is opt-in.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Physics {
     #[serde(default)]
@@ -644,7 +659,7 @@ pub struct Physics {
 }
 
 /// The configuration in which the contact geometry is evaluated.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum ContactGeometry {
     /// Once, in the reference configuration (small sliding; the consistent choice for small
@@ -657,14 +672,14 @@ pub enum ContactGeometry {
     Current,
 }
 
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Kinematics {
     #[default]
     SmallStrain,
 }
 
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Component {
     X,
@@ -681,7 +696,7 @@ impl Component {
 }
 
 /// A check judged after the solve; tolerances belong to the case.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(tag = "check", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Check {
     /// Max over quadrature points (all bodies, or `body`) of |sigma - stress| / max|stress|
