@@ -617,7 +617,8 @@ pub enum TractionSpec {
     Exact(FromExact),
 }
 
-/// One load: `pressure` or `traction` on a facet set, or a `body_force` on a whole body.
+/// One load: `pressure` or `traction` on a facet set, a concentrated `force` at every node of a
+/// node set, or a `body_force` on a whole body.
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Load {
@@ -633,6 +634,10 @@ pub struct Load {
     /// Force per volume.
     #[serde(default)]
     pub body_force: Option<[f64; 2]>,
+    /// A concentrated force `[f_x, f_y]` (total, for the case's thickness) at every node of the
+    /// node set `set`.
+    #[serde(default)]
+    pub force: Option<[f64; 2]>,
 }
 
 /// Analytic reference solutions.

@@ -571,16 +571,40 @@ impl Model {
                 load.pressure.is_some(),
                 load.traction.is_some(),
                 load.body_force.is_some(),
+                load.force.is_some(),
             ];
             if given.iter().filter(|&&g| g).count() != 1 {
                 return Err(Error::invalid(
                     &self.source,
                     &at,
-                    "a load needs exactly one of \"pressure\", \"traction\" or \"body_force\"",
+                    "a load needs exactly one of \"pressure\", \"traction\", \"force\" or \"body_force\"",
                     "split it into one load per kind",
                 ));
             }
             let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+            if let Some(force) = load.force {
+                let Some(set) = &load.set else {
+                    return Err(Error::invalid(
+                        &self.source,
+                        &at,
+                        "a concentrated force needs a node \"set\"",
+                        "add \"set\": the name of a node set of the body (e.g. a \"point\" set)",
+                    ));
+                };
+                if !finite(&force) {
+                    return Err(Error::invalid(
+                        &self.source,
+                        &at,
+                        "the force is not finite",
+                        "give finite numbers",
+                    ));
+                }
+                for &n in self.find_node_set(&body, set, &at)? {
+                    self.external_force[body.dof(n, 0)] += force[0];
+                    self.external_force[body.dof(n, 1)] += force[1];
+                }
+                continue;
+            }
             if let Some(b) = load.body_force {
                 if load.set.is_some() {
                     return Err(Error::invalid(
