@@ -116,8 +116,12 @@ pub fn solve(system: &mut dyn System, x: &mut Vec<f64>, settings: Settings) -> R
     let mut solves = 0;
     let mut start = Instant::now();
     let (mut augmented, mut augmentations) = (false, 0);
+    // factoring time and solver name of the linear solvers of earlier patterns
+    let mut earlier_seconds = 0.0;
+    let mut last_solver = "none";
     let termination = loop {
         if system.pattern_version() != version {
+            earlier_seconds += linear.seconds;
             linear = LinearSolver::new(system.pattern());
             version = system.pattern_version();
             *x = system.carry(x);
@@ -153,7 +157,7 @@ pub fn solve(system: &mut dyn System, x: &mut Vec<f64>, settings: Settings) -> R
                 status_changes: eval.status_changes,
                 max_gap_violation: eval.max_gap_violation,
                 multiplier_change: eval.multiplier_change,
-                linear_solver: linear.last_solver,
+                linear_solver: last_solver,
                 seconds: start.elapsed().as_secs_f64(),
             });
             start = Instant::now();
@@ -200,14 +204,15 @@ pub fn solve(system: &mut dyn System, x: &mut Vec<f64>, settings: Settings) -> R
             ));
         }
         x.iter_mut().zip(&residual).for_each(|(a, d)| *a += d);
+        last_solver = linear.last_solver;
         solves += 1;
     };
     Ok(Outcome {
         termination,
         iterations: solves,
         history,
-        factorization_seconds: linear.seconds,
-        linear_solver: linear.last_solver,
+        factorization_seconds: earlier_seconds + linear.seconds,
+        linear_solver: last_solver,
     })
 }
 
