@@ -57,84 +57,61 @@ type Key = (
     String,
 );
 
-fn key_of(
-    catalogue: Catalogue,
-    case: &str,
-    mesh: &str,
-    nu: f64,
-    discretization: &str,
-    passes: Option<u8>,
-    slave: Option<&str>,
-    enforcement: &str,
-) -> Key {
-    (
-        catalogue,
-        case.into(),
-        mesh.into(),
-        nu.to_bits(),
-        discretization.into(),
-        passes,
-        slave.map(String::from),
-        enforcement.into(),
-    )
-}
-
 impl BaselineCell {
     fn key(&self) -> Key {
-        key_of(
+        (
             self.catalogue,
-            &self.case,
-            &self.mesh,
-            self.nu,
-            &self.discretization,
+            self.case.clone(),
+            self.mesh.clone(),
+            self.nu.to_bits(),
+            self.discretization.clone(),
             self.passes,
-            self.slave.as_deref(),
-            &self.enforcement,
+            self.slave.clone(),
+            self.enforcement.clone(),
         )
     }
 
-    /// The cell in words, as in the JUnit test names.
+    /// The cell in words: catalogue, mesh, nu, discretization, passes, slave, enforcement.
     pub fn name(&self) -> String {
-        name(
-            self.catalogue,
-            &self.mesh,
+        format!(
+            "{} {} nu={} {}{}{} {}",
+            self.catalogue.name(),
+            self.mesh,
             self.nu,
-            &self.discretization,
-            self.passes,
-            self.slave.as_deref(),
-            &self.enforcement,
+            self.discretization,
+            self.passes
+                .map(|p| format!(" {p}-pass"))
+                .unwrap_or_default(),
+            self.slave
+                .as_deref()
+                .map(|s| format!(" slave={s}"))
+                .unwrap_or_default(),
+            self.enforcement
         )
+    }
+
+    /// What the table file holds of a new cell.
+    fn of(c: &Cell) -> BaselineCell {
+        BaselineCell {
+            catalogue: c.catalogue,
+            case: c.case.clone(),
+            mesh: c.mesh.clone(),
+            nu: c.nu,
+            discretization: c.discretization.clone(),
+            passes: c.passes,
+            slave: c.slave.clone(),
+            enforcement: c.enforcement.clone(),
+            verdict: c.verdict.clone(),
+            stress_error: c.stress_error,
+            pressure_error: c.pressure_error,
+            load_error: c.load_error,
+            force_balance: c.force_balance,
+        }
     }
 }
 
 fn cell_key(c: &Cell) -> Key {
-    key_of(
-        c.catalogue,
-        &c.case,
-        &c.mesh,
-        c.nu,
-        &c.discretization,
-        c.passes,
-        c.slave.as_deref(),
-        &c.enforcement,
-    )
-}
-
-fn name(
-    catalogue: Catalogue,
-    mesh: &str,
-    nu: f64,
-    discretization: &str,
-    passes: Option<u8>,
-    slave: Option<&str>,
-    enforcement: &str,
-) -> String {
-    format!(
-        "{} {mesh} nu={nu} {discretization}{}{} {enforcement}",
-        catalogue.name(),
-        passes.map(|p| format!(" {p}-pass")).unwrap_or_default(),
-        slave.map(|s| format!(" slave={s}")).unwrap_or_default(),
-    )
+    BaselineCell::of(c).key()
 }
 
 const VERDICTS: [&str; 3] = ["pass", "fail", "n/a"];
@@ -353,15 +330,7 @@ pub fn compare(old: &[BaselineCell], new: &[Cell], factor: f64) -> Comparison {
         } else if !old_keys.contains(&cell_key(n)) {
             result.changes.push(Change {
                 kind: Kind::Other,
-                cell: name(
-                    n.catalogue,
-                    &n.mesh,
-                    n.nu,
-                    &n.discretization,
-                    n.passes,
-                    n.slave.as_deref(),
-                    &n.enforcement,
-                ),
+                cell: BaselineCell::of(n).name(),
                 what: "new cell (not in the baseline)".into(),
                 old: "-".into(),
                 new: n.verdict.clone(),
@@ -455,7 +424,7 @@ mod tests {
         let now = cell("pass", Some(0.0));
         let cmp = compare(
             &[old(&other), old(&dropped), old(&now)],
-            &[now.clone()],
+            std::slice::from_ref(&now),
             10.0,
         );
         assert_eq!((cmp.compared, cmp.not_compared), (2, 1));
