@@ -1,8 +1,9 @@
 //! The `contact-patch` command-line tool.
 
 use clap::{Parser, Subcommand};
+use contact_patch::harness::{baseline, junit};
 use contact_patch::io::output::write_run;
-use contact_patch::io::paths::{file_name, OutputFolder, ReportFolder};
+use contact_patch::io::paths::{file_name, NamedFile, OutputFolder, ReportFolder};
 use contact_patch::io::scene::Catalogue;
 use contact_patch::run::{run_case, Outcome};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -38,14 +39,23 @@ enum Command {
     },
     /// Run the contact patch-test catalogue and write reports/patch-table.md and .json.
     #[command(
-        after_help = "Example:\n  contact-patch table\n  contact-patch table cases/patch/patch-C-nu0.3.json --out /tmp/reports"
+        after_help = "Example:\n  contact-patch table\n  contact-patch table cases/patch/patch-C-nu0.3.json --out /tmp/reports\n  contact-patch table --out new --junit table.xml --baseline old/patch-table.json --baseline old/tied-table.json\n\nWith --baseline the exit code is 1 only on a regression against the baseline (a verdict lost,\na cell gone, an error grown by more than --baseline-factor above 1e-10), not on failing cells."
     )]
     Table {
-        /// Case files or folders with a sweep (default: cases/patch).
+        /// Case files or folders with a sweep (default: cases/patch and cases/tied).
         paths: Vec<PathBuf>,
         /// Folder for patch-table.md and patch-table.json.
         #[arg(long, default_value = "reports")]
         out: PathBuf,
+        /// Also write JUnit XML to this file (one test case per cell; its folder must exist).
+        #[arg(long, value_name = "FILE")]
+        junit: Option<PathBuf>,
+        /// A previous patch-table.json or tied-table.json to compare with (repeatable).
+        #[arg(long, value_name = "OLD.json")]
+        baseline: Vec<PathBuf>,
+        /// How much an error may grow against the baseline before it is a regression.
+        #[arg(long, value_name = "FACTOR", default_value_t = baseline::DEFAULT_FACTOR)]
+        baseline_factor: f64,
     },
     /// The seed's tied layer: node-to-surface and mortar ties against one body, under refinement;
     /// writes reports/tied-layer.md, SVG plots and .vtu files.
@@ -76,6 +86,9 @@ enum Command {
         /// Case files or folders of case files.
         #[arg(required = true)]
         paths: Vec<PathBuf>,
+        /// Also write JUnit XML to this file (one test case per check; its folder must exist).
+        #[arg(long, value_name = "FILE")]
+        junit: Option<PathBuf>,
     },
 }
 
@@ -83,8 +96,14 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Run { case, out } => run(&case, out),
-        Command::Check { paths } => check(&paths),
-        Command::Table { paths, out } => table(&paths, &out),
+        Command::Check { paths, junit } => check(&paths, junit.as_deref()),
+        Command::Table {
+            paths,
+            out,
+            junit,
+            baseline,
+            baseline_factor,
+        } => table(&paths, &out, junit.as_deref(), &baseline, baseline_factor),
         Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
         Command::Schema => {
             print!("{}", contact_patch::io::scene::case_schema());
@@ -217,7 +236,36 @@ fn collect_cases(paths: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
     Ok(out)
 }
 
-fn check(paths: &[PathBuf]) -> ExitCode {
+/// The `--junit` file, checked before any work (a refusal is bad input).
+fn junit_file(path: Option<&Path>) -> Result<Option<NamedFile>, ExitCode> {
+    path.map(|p| NamedFile::new(p, "the --junit file"))
+        .transpose()
+        .map_err(|e| {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        })
+}
+
+/// Write the JUnit document; a failure is reported and turns the exit code into 2.
+fn write_junit(file: Option<&NamedFile>, name: &str, suites: &[junit::TestSuite]) -> bool {
+    let Some(file) = file else { return true };
+    match file.write(&junit::render(name, suites)) {
+        Ok(()) => {
+            println!("wrote {}", file.path().display());
+            true
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            false
+        }
+    }
+}
+
+fn check(paths: &[PathBuf], junit_path: Option<&Path>) -> ExitCode {
+    let junit_out = match junit_file(junit_path) {
+        Ok(f) => f,
+        Err(code) => return code,
+    };
     let cases = match collect_cases(paths) {
         Ok(c) => c,
         Err(e) => {
@@ -228,11 +276,23 @@ fn check(paths: &[PathBuf]) -> ExitCode {
     let bar = progress_bar(cases.len());
     let mut failures: Vec<(String, String)> = Vec::new();
     let mut errors = 0;
+    let mut suites = Vec::new();
     for case in &cases {
         if let Some(b) = &bar {
             b.set_message(case.display().to_string());
         }
-        match guarded(case, || run_case(case, &mut |_| {})) {
+        let start = std::time::Instant::now();
+        let result = guarded(case, || run_case(case, &mut |_| {}));
+        let shown = case.display().to_string();
+        suites.push(junit::TestSuite {
+            name: shown.clone(),
+            seconds: start.elapsed().as_secs_f64(),
+            cases: match &result {
+                Ok(outcome) => junit::check_cases(&outcome.model.name, &outcome.checks),
+                Err(e) => vec![junit::error_case(&shown, "run", e)],
+            },
+        });
+        match result {
             Ok(outcome) => {
                 let fail: Vec<_> = outcome.checks.iter().filter(|c| !c.passed).collect();
                 let line = format!(
@@ -270,9 +330,14 @@ fn check(paths: &[PathBuf]) -> ExitCode {
     if let Some(b) = bar {
         b.finish_and_clear();
     }
+    let written = write_junit(junit_out.as_ref(), "contact-patch check", &suites);
     if failures.is_empty() {
         println!("all {} cases pass", cases.len());
-        return ExitCode::SUCCESS;
+        return if written {
+            ExitCode::SUCCESS
+        } else {
+            ExitCode::from(2)
+        };
     }
     println!("\n| case | failure |\n|---|---|");
     for (case, what) in &failures {
@@ -287,7 +352,7 @@ fn check(paths: &[PathBuf]) -> ExitCode {
             .len(),
         cases.len()
     );
-    ExitCode::from(if errors > 0 { 2 } else { 1 })
+    ExitCode::from(if errors > 0 || !written { 2 } else { 1 })
 }
 
 /// Run `job` on one case, turning a panic (a bug, never expected) into an error so that a
@@ -302,7 +367,13 @@ fn guarded<T>(case: &Path, job: impl FnOnce() -> contact_patch::Result<T>) -> Re
     }
 }
 
-fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
+fn table(
+    paths: &[PathBuf],
+    out: &Path,
+    junit_path: Option<&Path>,
+    baseline_paths: &[PathBuf],
+    baseline_factor: f64,
+) -> ExitCode {
     let paths = if paths.is_empty() {
         vec![PathBuf::from("cases/patch"), PathBuf::from("cases/tied")]
     } else {
@@ -310,6 +381,21 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
     };
     let folder = match ReportFolder::new(out) {
         Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let junit_out = match junit_file(junit_path) {
+        Ok(f) => f,
+        Err(code) => return code,
+    };
+    if !(baseline_factor.is_finite() && baseline_factor > 1.0) {
+        eprintln!("error: --baseline-factor {baseline_factor}: must be a number above 1\n  hint: it is how many times an error may grow before it is a regression, e.g. --baseline-factor 10");
+        return ExitCode::from(2);
+    }
+    let old_cells = match baseline::load(baseline_paths) {
+        Ok(c) => c,
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(2);
@@ -341,7 +427,7 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
                     Some(b) => b.println(format!("error: {e}")),
                     None => eprintln!("error: {e}"),
                 }
-                errors.push(case.display().to_string());
+                errors.push((case.display().to_string(), e));
             }
         }
         if let Some(b) = &bar {
@@ -355,7 +441,8 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
     let mut catalogues: Vec<Catalogue> = cells.iter().map(|c| c.catalogue).collect();
     catalogues.sort();
     catalogues.dedup();
-    for catalogue in catalogues {
+    let mut suites = Vec::new();
+    for &catalogue in &catalogues {
         let part: Vec<_> = cells
             .iter()
             .filter(|c| c.catalogue == catalogue)
@@ -380,6 +467,11 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
         if catalogue == Catalogue::Patch {
             println!("{}", contact_patch::harness::report::seed_summary(&part));
         }
+        suites.push(junit::TestSuite {
+            name: catalogue.name().to_string(),
+            seconds: part.iter().map(|c| c.time_ms / 1e3).sum(),
+            cases: part.iter().map(junit::cell_case).collect(),
+        });
         println!(
             "{}: {} cells ({} pass, {} fail, {} n/a); wrote {} and {}",
             catalogue.name(),
@@ -392,17 +484,73 @@ fn table(paths: &[PathBuf], out: &Path) -> ExitCode {
         );
     }
     println!("{} cells in {seconds:.2}s", cells.len());
-    if errors.is_empty() {
-        ExitCode::SUCCESS
-    } else {
+    if !errors.is_empty() {
+        suites.push(junit::TestSuite {
+            name: "cases that could not run".into(),
+            seconds: 0.0,
+            cases: errors
+                .iter()
+                .map(|(case, e)| junit::error_case(case, "sweep", e))
+                .collect(),
+        });
+    }
+    let mut code = ExitCode::SUCCESS;
+    if !write_junit(junit_out.as_ref(), "contact-patch table", &suites) {
+        code = ExitCode::from(2);
+    }
+    if !baseline_paths.is_empty() {
+        let cmp = baseline::compare(&old_cells, &cells, baseline_factor);
+        let shown: Vec<String> = baseline_paths
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        println!(
+            "\nbaseline {}: {} cells compared, {} regressions, {} improvements, {} other changes",
+            shown.join(", "),
+            cmp.compared,
+            cmp.regressions(),
+            cmp.improvements(),
+            cmp.changes.len() - cmp.regressions() - cmp.improvements()
+        );
+        if cmp.not_compared > 0 {
+            println!(
+                "({} baseline cells belong to cases this run did not cover; not compared)",
+                cmp.not_compared
+            );
+        }
+        if cmp.new_not_compared > 0 {
+            println!(
+                "({} new cells belong to cases the baseline does not hold; not compared)",
+                cmp.new_not_compared
+            );
+        }
+        if !cmp.changes.is_empty() {
+            println!("\n{}", cmp.markdown(40));
+        }
+        if cmp.regressions() > 0 {
+            eprintln!(
+                "error: {} regressions against the baseline (see the table above)",
+                cmp.regressions()
+            );
+            if code == ExitCode::SUCCESS {
+                code = ExitCode::from(1);
+            }
+        }
+    }
+    if !errors.is_empty() {
         eprintln!(
             "error: {} of {} cases could not be run (their cells are missing from the tables): {}",
             errors.len(),
             cases.len(),
-            errors.join(", ")
+            errors
+                .iter()
+                .map(|(c, _)| c.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
         );
-        ExitCode::from(2)
+        code = ExitCode::from(2);
     }
+    code
 }
 
 /// The most refinement levels `tied-layer` accepts, and the largest level.

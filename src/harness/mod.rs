@@ -28,8 +28,10 @@
 //!   elimination) a singular one is `unstable` even when the displacements pass.
 //! * `n/a` cells say why the combination does not apply.
 
+pub mod baseline;
 pub mod checks;
 pub(crate) mod exact;
+pub mod junit;
 pub mod layer;
 pub mod report;
 
@@ -90,6 +92,10 @@ pub struct Cell {
     pub vs_penalty: Option<f64>,
     pub time_ms: f64,
     pub note: String,
+    /// The sweep's tolerance (relative to `pressure`); not in the table files (their cells are
+    /// compared by `table --baseline`), shown in JUnit messages.
+    #[serde(skip)]
+    pub tol: f64,
 }
 
 /// What one solve measured.
@@ -275,6 +281,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 vs_penalty: None,
                 time_ms: 0.0,
                 note: String::new(),
+                tol: sweep.tol,
             };
             let mut model = base.clone();
             pair.enforcement = e.clone();

@@ -16,6 +16,11 @@
 //!    is removed. [`ReportFolder`] is a folder the tool writes named files into (`table`,
 //!    `tied-layer`): the same refusals, each file written under a temporary name and renamed
 //!    over the file of the same name; nothing else in the folder is touched.
+//! 3. **A file the user names is written exactly there, and nothing else.** [`NamedFile`] is a
+//!    single file given on the command line (`--junit FILE`): its folder must exist (nothing is
+//!    created), the path must not be a folder, a symbolic link or anything but a regular file,
+//!    and the text goes to a new temporary file beside it (created exclusively, so no other
+//!    file is opened) that is renamed over it; on failure only that temporary file is removed.
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -452,6 +457,130 @@ impl ReportFolder {
     }
 }
 
+/// One file the user names explicitly (e.g. `--junit FILE`), written as a whole.
+#[derive(Debug)]
+pub struct NamedFile {
+    given: PathBuf,
+    what: &'static str,
+    target: PathBuf,
+}
+
+impl NamedFile {
+    /// Check that `path` may be written (see the module notes); nothing is created. `what`
+    /// names the file in refusals (e.g. "the --junit file").
+    pub fn new(path: &Path, what: &'static str) -> Result<NamedFile> {
+        let refuse =
+            |problem: &str, hint: &str| Err(Error::invalid(path.display(), what, problem, hint));
+        let hint = "give the path of a file (new or to be replaced) in an existing folder, e.g. out/junit.xml";
+        if path.as_os_str().is_empty() {
+            return refuse("is empty", hint);
+        }
+        let Some(name) = path.file_name() else {
+            return refuse("does not end in a file name", hint);
+        };
+        let raw = path.as_os_str().to_string_lossy();
+        if raw.ends_with('/') || raw.ends_with("/.") || raw == "." {
+            return refuse("ends with a separator or '.' (a folder)", hint);
+        }
+        let parent = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let parent = match parent.canonicalize() {
+            Ok(p) if p.is_dir() => p,
+            Ok(_) => return refuse("has a parent that is not a folder", hint),
+            Err(_) => {
+                return refuse(
+                    "is in a folder that does not exist",
+                    "create the folder first (the tool does not create it), or give a file in an existing folder",
+                )
+            }
+        };
+        let target = parent.join(name);
+        let file = NamedFile {
+            given: path.to_path_buf(),
+            what,
+            target,
+        };
+        file.refuse_existing()?;
+        Ok(file)
+    }
+
+    /// The path as the user gave it.
+    pub fn path(&self) -> &Path {
+        &self.given
+    }
+
+    /// Refuse a target that exists and is not a regular file (a folder, a symbolic link...).
+    fn refuse_existing(&self) -> Result<()> {
+        match fs::symlink_metadata(&self.target) {
+            Err(_) => Ok(()),
+            Ok(m) if m.is_symlink() => Err(Error::invalid(
+                self.given.display(),
+                self.what,
+                "is a symbolic link",
+                "give the file itself, not a link to it",
+            )),
+            Ok(m) if m.is_dir() => Err(Error::invalid(
+                self.given.display(),
+                self.what,
+                "is a folder",
+                "give a file name inside the folder, e.g. DIR/junit.xml",
+            )),
+            Ok(m) if !m.is_file() => Err(Error::invalid(
+                self.given.display(),
+                self.what,
+                "exists and is not a regular file",
+                "give the path of a regular file or of a new one",
+            )),
+            Ok(_) => Ok(()),
+        }
+    }
+
+    /// Write `text`: to a new temporary file beside the target, then renamed over it.
+    pub fn write(&self, text: &str) -> Result<()> {
+        use std::io::Write;
+        // Checked again: the path may have changed since `new`.
+        self.refuse_existing()?;
+        let parent = self.target.parent().unwrap_or(Path::new("/"));
+        let name = self
+            .target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let io = |e| Error::io(self.given.display(), "writing", e);
+        let (tmp, mut handle) = (0..1000)
+            .find_map(|n| {
+                let tmp = parent.join(format!(".{name}.partial-{}-{n}", std::process::id()));
+                match fs::OpenOptions::new()
+                    .write(true)
+                    .create_new(true)
+                    .open(&tmp)
+                {
+                    Ok(h) => Some(Ok((tmp, h))),
+                    Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => None,
+                    Err(e) => Some(Err(e)),
+                }
+            })
+            .unwrap_or_else(|| {
+                Err(std::io::Error::other(
+                    "1000 leftover temporary files named .NAME.partial-*",
+                ))
+            })
+            .map_err(io)?;
+        let result = handle
+            .write_all(text.as_bytes())
+            .and_then(|_| handle.sync_all())
+            .map_err(io)
+            .and_then(|_| self.refuse_existing())
+            .and_then(|_| fs::rename(&tmp, &self.target).map_err(io));
+        if result.is_err() {
+            let _ = fs::remove_file(&tmp);
+        }
+        result
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -560,5 +689,67 @@ mod tests {
         });
         assert!(r.is_err());
         assert_eq!(fs::read_dir(scratch.path()).unwrap().count(), 0);
+    }
+    #[test]
+    fn a_named_file_is_written_exactly_there() {
+        let scratch = tempfile::tempdir().unwrap();
+        fs::write(scratch.path().join("other.txt"), "keep").unwrap();
+        let path = scratch.path().join("junit.xml");
+        let f = NamedFile::new(&path, "the --junit file").unwrap();
+        f.write("one").unwrap();
+        assert_eq!(fs::read_to_string(&path).unwrap(), "one");
+        // replaced as a whole
+        NamedFile::new(&path, "the --junit file")
+            .unwrap()
+            .write("two")
+            .unwrap();
+        assert_eq!(fs::read_to_string(&path).unwrap(), "two");
+        let mut names: Vec<_> = fs::read_dir(scratch.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["junit.xml", "other.txt"], "temporary files left");
+        assert_eq!(
+            fs::read_to_string(scratch.path().join("other.txt")).unwrap(),
+            "keep"
+        );
+    }
+
+    #[test]
+    fn a_named_file_refuses_folders_links_and_missing_parents() {
+        let scratch = tempfile::tempdir().unwrap();
+        let what = "the --junit file";
+        // a folder
+        let e = NamedFile::new(scratch.path(), what)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("is a folder") && e.contains(what), "{e}");
+        let mut slash = scratch.path().join("x").into_os_string();
+        slash.push("/");
+        assert!(NamedFile::new(Path::new(&slash), what).is_err());
+        assert!(NamedFile::new(Path::new(""), what).is_err());
+        assert!(NamedFile::new(Path::new(".."), what).is_err());
+        assert!(NamedFile::new(&scratch.path().join("new").join("."), what).is_err());
+        // a missing parent: refused, and nothing is created
+        let deep = scratch.path().join("no").join("such").join("junit.xml");
+        let e = NamedFile::new(&deep, what).unwrap_err().to_string();
+        assert!(e.contains("does not exist"), "{e}");
+        assert!(!scratch.path().join("no").exists());
+        // a symbolic link (to a file the user keeps): refused, the file untouched
+        let kept = scratch.path().join("kept.txt");
+        fs::write(&kept, "mine").unwrap();
+        let link = scratch.path().join("link.xml");
+        std::os::unix::fs::symlink(&kept, &link).unwrap();
+        let e = NamedFile::new(&link, what).unwrap_err().to_string();
+        assert!(e.contains("symbolic link"), "{e}");
+        // a path that became a folder after the check is refused at writing
+        let later = scratch.path().join("later.xml");
+        let f = NamedFile::new(&later, what).unwrap();
+        fs::create_dir(&later).unwrap();
+        assert!(f.write("x").is_err());
+        assert!(later.is_dir());
+        assert_eq!(fs::read_to_string(&kept).unwrap(), "mine");
+        assert_eq!(fs::read_dir(scratch.path()).unwrap().count(), 3);
     }
 }
