@@ -78,6 +78,10 @@ pub struct SolverSpec {
     /// Lagrangian with diagonal perturbation, augmented Lagrangian).
     #[serde(default)]
     pub scheme: Scheme,
+    /// The tangent of slipping frictional points (Coulomb pairs, Newton scheme):
+    /// `"consistent"` (default, unsymmetric) or `"symmetrized"`.
+    #[serde(default)]
+    pub friction_tangent: FrictionTangent,
 }
 
 /// The nonlinear solution scheme of a load step.
@@ -122,6 +126,7 @@ impl Default for SolverSpec {
             geometry_tolerance: geometry_tolerance(),
             geometric_stiffness: true,
             scheme: Scheme::ActiveSet,
+            friction_tangent: FrictionTangent::Consistent,
         }
     }
 }
@@ -223,7 +228,8 @@ pub struct ContactSpec {
     pub master: MasterSpec,
     pub discretization: DiscretizationSpec,
     pub enforcement: EnforcementSpec,
-    /// `frictionless` contact (default) or a `tied` (glued) interface.
+    /// `frictionless` contact (default), a `tied` (glued) interface, or
+    /// `{"coulomb": {"mu": .., "kappa_t": ..}}` friction.
     #[serde(default)]
     pub interaction: Interaction,
     /// How far from the master surface a slave node is still a contact candidate (default:
@@ -233,14 +239,45 @@ pub struct ContactSpec {
 }
 
 /// What a pair enforces.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum Interaction {
     /// Unilateral, frictionless contact: `g >= 0`, `lambda >= 0`, `g lambda = 0`.
     #[default]
     Frictionless,
     /// Both displacement components continuous across the interface (bilateral).
     Tied,
+    /// Unilateral contact with Coulomb friction, `|lambda_t| <= mu lambda_n`, regularized by a
+    /// tangential penalty `kappa_t` (force per unit area per unit elastic slip; default: the
+    /// pair's normal `kappa`). `solver.scheme: "newton"` with a penalty-type method only (see
+    /// [`crate::contact::friction`]).
+    Coulomb {
+        mu: f64,
+        #[serde(default)]
+        kappa_t: Option<f64>,
+    },
+}
+
+impl Interaction {
+    /// The friction coefficient of a Coulomb pair.
+    pub fn friction(&self) -> Option<f64> {
+        match *self {
+            Interaction::Coulomb { mu, .. } => Some(mu),
+            _ => None,
+        }
+    }
+}
+
+/// The tangent of the frictional rows in a slip state.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FrictionTangent {
+    /// The exact derivative of the return map: unsymmetric in slip (solved by LU).
+    #[default]
+    Consistent,
+    /// The symmetric part of the consistent tangent (Cholesky where it is definite; Newton then
+    /// converges linearly in slip).
+    Symmetrized,
 }
 
 /// The multiplier space of a mortar discretization.

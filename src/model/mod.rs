@@ -726,6 +726,9 @@ impl Model {
                 }
             }
             let newton = case.solver.scheme == crate::io::scene::Scheme::Newton;
+            if let Interaction::Coulomb { mu, kappa_t } = spec.interaction {
+                validate_coulomb(case, spec, mu, kappa_t, &self.source, &at)?;
+            }
             let family_of = |e| crate::contact::enforcement::method(e).kernel().family();
             if newton
                 && !matches!(
@@ -943,6 +946,85 @@ impl Model {
         }
         Ok(())
     }
+}
+
+/// A Coulomb pair: its parameters, and what this slice of friction solves (the Newton scheme,
+/// penalty-type normal laws, node-based rows with master normals, the reference geometry).
+fn validate_coulomb(
+    case: &Case,
+    spec: &crate::io::scene::ContactSpec,
+    mu: f64,
+    kappa_t: Option<f64>,
+    source: &str,
+    at: &str,
+) -> Result<()> {
+    let here = format!("{at}.interaction.coulomb");
+    if !(mu.is_finite() && mu >= 0.0) {
+        return Err(Error::invalid(
+            source,
+            format!("{here}.mu"),
+            format!("the friction coefficient mu must be a finite number >= 0, got {mu}"),
+            "give e.g. \"mu\": 0.3 (mu = 0 is frictionless with tangential rows)",
+        ));
+    }
+    if let Some(k) = kappa_t {
+        if !(k.is_finite() && k > 0.0) {
+            return Err(Error::invalid(
+                source,
+                format!("{here}.kappa_t"),
+                format!("the tangential penalty kappa_t must be positive and finite, got {k}"),
+                "leave it out to use the pair's normal kappa, or give a positive value",
+            ));
+        }
+    }
+    if case.solver.scheme != crate::io::scene::Scheme::Newton {
+        return Err(Error::invalid(
+            source,
+            &here,
+            "Coulomb friction is solved by the Newton scheme only".to_string(),
+            "set \"solver\": {\"scheme\": \"newton\"}",
+        ));
+    }
+    if !matches!(
+        spec.enforcement,
+        EnforcementSpec::Penalty { .. }
+            | EnforcementSpec::PerturbedLagrange { .. }
+            | EnforcementSpec::AugmentedLagrange { .. }
+    ) {
+        return Err(Error::invalid(
+            source,
+            format!("{at}.enforcement"),
+            format!(
+                "Coulomb friction is regularized by a tangential penalty and needs a penalty-type normal law, not {}",
+                crate::contact::enforcement::method(&spec.enforcement).name()
+            ),
+            "use the penalty, the perturbed Lagrangian or the augmented Lagrangian for this pair",
+        ));
+    }
+    let node_based = match spec.discretization {
+        DiscretizationSpec::NodeToNode => true,
+        DiscretizationSpec::NodeToSurface { passes, normal } => {
+            passes == 1 && normal == crate::io::scene::NormalChoice::Master
+        }
+        DiscretizationSpec::Mortar { .. } => false,
+    };
+    if !node_based {
+        return Err(Error::invalid(
+            source,
+            format!("{at}.discretization"),
+            "Coulomb friction has tangential rows for node-to-node and one-pass node-to-surface with master normals (and rigid masters) only, so far".to_string(),
+            "use {\"kind\": \"node_to_node\"} or {\"kind\": \"node_to_surface\", \"passes\": 1, \"normal\": \"master\"}",
+        ));
+    }
+    if case.physics.contact_geometry != crate::io::scene::ContactGeometry::Reference {
+        return Err(Error::invalid(
+            source,
+            &here,
+            "Coulomb friction is solved in the reference contact geometry only, so far".to_string(),
+            "set \"physics\": {\"contact_geometry\": \"reference\"}",
+        ));
+    }
+    Ok(())
 }
 
 fn validate_enforcement(e: &EnforcementSpec, source: &str, at: &str) -> Result<()> {
