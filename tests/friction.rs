@@ -272,13 +272,6 @@ fn a_block_on_an_incline_slides_at_the_coulomb_limit() {
     );
     for ratio in [0.5, 0.98, 0.995] {
         let o = run(&incline(ratio * limit, tan_a, 4));
-        let h = &o.solution.contact.as_ref().unwrap().history;
-        println!(
-            "{ratio}: {:?}",
-            h.iter()
-                .map(|r| (r.step, r.residual, r.status_changes))
-                .collect::<Vec<_>>()
-        );
         assert_eq!(
             termination(&o),
             Termination::Converged,
@@ -435,4 +428,142 @@ fn the_frictional_tangent_is_the_derivative_of_the_residual_in_stick_and_in_slip
             assert!(e < 1e-6, "{name} {status:?}: {e:e}");
         }
     }
+}
+
+/// Residual history of the first step of `v` with the given friction tangent.
+fn history(v: &Value, tangent: &str) -> (Termination, Vec<(f64, usize, &'static str)>) {
+    let mut v = v.clone();
+    v["solver"]["friction_tangent"] = json!(tangent);
+    let o = run(&v);
+    let c = o.solution.contact.as_ref().unwrap();
+    (
+        c.termination.clone(),
+        c.history
+            .iter()
+            .map(|h| (h.residual, h.status_changes, h.linear_solver))
+            .collect(),
+    )
+}
+
+#[test]
+fn newton_with_the_consistent_tangent_beats_the_symmetrized_one_in_slip() {
+    for (name, v) in [
+        (
+            "patch A, node-to-node",
+            patch(
+                "A",
+                "0.0",
+                node_to_node(),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+        ),
+        (
+            "patch C, node-to-surface",
+            patch(
+                "C",
+                "0.0",
+                node_to_surface(),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+        ),
+    ] {
+        let (t_c, consistent) = history(&v, "consistent");
+        let (t_s, symmetrized) = history(&v, "symmetrized");
+        println!("{name}\n  consistent  {consistent:?}\n  symmetrized {symmetrized:?}");
+        assert_eq!(t_c, Termination::Converged, "{name}");
+        assert_eq!(t_s, Termination::Converged, "{name}");
+        // the consistent tangent is unsymmetric in slip: LU
+        assert_eq!(consistent.last().unwrap().2, "lu");
+        // with the branch fixed the residual is affine in u and the consistent tangent exact:
+        // the first iteration without a status change lands on the solution
+        let settled = consistent.iter().position(|h| h.1 == 0).unwrap();
+        assert_eq!(settled, consistent.len() - 1, "{name}");
+        assert!(consistent.last().unwrap().0 <= 1e-10);
+        // the symmetrized tangent converges linearly: more iterations, the residual falling
+        // by a bounded factor per iteration once the branch is fixed
+        assert!(symmetrized.len() > consistent.len() + 2, "{name}");
+        let tail: Vec<f64> = symmetrized
+            .iter()
+            .filter(|h| h.1 == 0)
+            .map(|h| h.0)
+            .collect();
+        let rates: Vec<f64> = tail.windows(2).map(|w| w[1] / w[0]).collect();
+        assert!(rates.iter().all(|&r| r < 1.0), "{name}: {rates:?}");
+    }
+    // on the rigid circle (points opening and closing on the way) the consistent tangent
+    // settles its branches in four iterations and then lands on the solution; the symmetrized
+    // one was seen to cycle between two branch sets there (iteration limit), not asserted
+    let (t, consistent) = history(&dragged(circle(), 0.05), "consistent");
+    assert_eq!(t, Termination::Converged);
+    assert_eq!(
+        consistent.iter().position(|h| h.1 == 0),
+        Some(consistent.len() - 1)
+    );
+}
+
+fn refusal(v: &Value) -> String {
+    match build(v) {
+        Ok(_) => panic!("accepted"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn friction_is_refused_where_this_slice_does_not_solve_it_with_the_fix() {
+    let base = patch("A", "0.3", node_to_node(), 0.0, Top::Traction, 1);
+    assert!(build(&base).is_ok());
+    let with = |f: &dyn Fn(&mut Value)| {
+        let mut v = base.clone();
+        f(&mut v);
+        refusal(&v)
+    };
+    let m = with(&|v| v["contact"][0]["interaction"]["coulomb"]["mu"] = json!(-0.1));
+    assert!(m.contains("mu must be a finite number >= 0"), "{m}");
+    let m = with(&|v| v["contact"][0]["interaction"]["coulomb"]["kappa_t"] = json!(0.0));
+    assert!(m.contains("kappa_t must be positive"), "{m}");
+    let m = with(&|v| v["solver"]["scheme"] = json!("active_set"));
+    assert!(
+        m.contains("Newton scheme only") && m.contains("\"newton\""),
+        "{m}"
+    );
+    let m = with(&|v| v["contact"][0]["enforcement"] = json!({"kind": "lagrange"}));
+    assert!(m.contains("penalty-type normal law"), "{m}");
+    let m = with(&|v| v["contact"][0]["discretization"] = json!({"kind": "mortar"}));
+    assert!(
+        m.contains("node-to-node and one-pass node-to-surface"),
+        "{m}"
+    );
+    let m = with(&|v| {
+        v["contact"][0]["discretization"] = json!({"kind": "node_to_surface", "passes": 2})
+    });
+    assert!(m.contains("one-pass"), "{m}");
+    let m = with(&|v| v["physics"] = json!({"contact_geometry": "current"}));
+    assert!(m.contains("reference contact geometry"), "{m}");
+    // unknown fields of the interaction are refused by the parser
+    let mut v = base.clone();
+    v["contact"][0]["interaction"]["coulomb"]["m"] = json!(0.3);
+    assert!(parse(&v.to_string(), "friction").is_err());
+}
+
+#[test]
+fn a_frictionless_scene_builds_no_tangential_row() {
+    let mut v = patch("A", "0.3", node_to_node(), 0.0, Top::Traction, 1);
+    v["contact"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("interaction");
+    // the punch needs its x support back without friction
+    v["supports"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"body": "punch", "set": "top_left", "x": 0.0}));
+    let o = run(&v);
+    let c = o.solution.contact.as_ref().unwrap();
+    assert!(c.rows.iter().all(|r| r.tangent.is_none()));
+    assert!(c.friction.iter().all(|f| f.is_none()));
+    assert!(c.steps.iter().all(|s| s.friction.is_none()));
 }

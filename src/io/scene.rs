@@ -275,8 +275,8 @@ pub enum FrictionTangent {
     /// The exact derivative of the return map: unsymmetric in slip (solved by LU).
     #[default]
     Consistent,
-    /// The symmetric part of the consistent tangent (Cholesky where it is definite; Newton then
-    /// converges linearly in slip).
+    /// The consistent tangent without the slip coupling `s mu w b_t b_n^T` (symmetric, Cholesky;
+    /// Newton then converges linearly in slip).
     Symmetrized,
 }
 

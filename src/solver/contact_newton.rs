@@ -50,8 +50,10 @@
 //! [`crate::contact::friction`] gives the tangential force `lambda_t` from the plastic slip
 //! committed at the end of the last load step (`committed`, carried from step to step by
 //! [`crate::solver::active_set::solve`]). The residual gains `- lambda_t b_t`, the tangent
-//! `w_t b_t b_t^T` in stick and `s mu w b_t b_n^T` in slip (unsymmetric: solved by LU), or its
-//! symmetric part with `solver.friction_tangent: "symmetrized"`. A change of a point's
+//! `w_t b_t b_t^T` in stick and `s mu w b_t b_n^T` in slip (unsymmetric: solved by LU); with
+//! `solver.friction_tangent: "symmetrized"` the slip coupling is dropped (a symmetric tangent
+//! that is not the derivative: Newton converges linearly in slip; the coupling's symmetric part
+//! instead makes the matrix indefinite, and the iteration diverged on the patch test). A change of a point's
 //! frictional status (open, stick, slip) counts as a status change of the iteration.
 //!
 //! A body held by nothing but contact rows that are open at the start has a singular tangent:
@@ -661,14 +663,12 @@ impl System for ContactSystem<'_> {
             }
         }
         tangent.values = general.symmetric_values(&upper);
+        // the symmetrized tangent drops the slip coupling (its symmetric part would make the
+        // matrix indefinite and Newton diverge)
         tangent.symmetric = coupling.is_empty() || symmetrized;
-        for (a, b, v) in coupling {
-            let at = |i: usize, j: usize| general.position(i, j).expect("covered");
-            if symmetrized {
-                tangent.values[at(a, b)] += 0.5 * v;
-                tangent.values[at(b, a)] += 0.5 * v;
-            } else {
-                tangent.values[at(a, b)] += v;
+        if !symmetrized {
+            for (a, b, v) in coupling {
+                tangent.values[general.position(a, b).expect("covered")] += v;
             }
         }
         tangent.multipliers = self.pattern.n - n;
