@@ -58,34 +58,52 @@ enum Top {
     Displacement(f64),
 }
 
-/// A patch case with the uniform field `[0, -p, sxy]`: every free boundary of both bodies
-/// carries its traction (the foundation's bottom along x too), so the field is the exact
-/// solution of the bonded (stick) problem, and of the slip problem with `sxy = mu p`.
+/// A patch case with the uniform field `[0, -p, sxy]`, loaded along a path: in the first
+/// step (of `steps >= 2`) the pressure `p` alone (on the punch top and the foundation's exposed
+/// top), then the shear part of the field's traction `(sxy n_y, sxy n_x)` on every free
+/// boundary of both bodies (the foundation's bottom along x too) in the later steps. The field
+/// is then the exact solution of the bonded (stick) problem, and of the slip problem with
+/// `sxy = mu p`. With one step, both at once.
 fn patch(mesh: &str, nu: &str, discretization: Value, sxy: f64, top: Top, steps: usize) -> Value {
     let mut v = read(&format!("cases/patch/patch-{mesh}-nu{nu}.json"));
     let o = v.as_object_mut().unwrap();
     o.remove("sweep");
     o.remove("checks");
     v["exact"] = json!({"kind": "uniform_stress", "stress": [0.0, -P, sxy]});
-    let exact = |body: &str, set: &str| json!({"body": body, "set": set, "traction": "exact"});
+    // normal first, then tangential
+    let normal: Vec<f64> = vec![1.0; steps];
+    let tangential: Vec<f64> = (1..=steps)
+        .map(|k| {
+            if steps == 1 {
+                1.0
+            } else {
+                (k - 1) as f64 / (steps - 1) as f64
+            }
+        })
+        .collect();
+    let pressure =
+        |body: &str, set: &str| json!({"body": body, "set": set, "pressure": P, "path": normal});
+    let shear = |body: &str, set: &str, t: [f64; 2]| json!({"body": body, "set": set, "traction": [t[0] * sxy, t[1] * sxy], "path": tangential});
     let mut supports = vec![
         json!({"body": "foundation", "set": "bottom", "y": 0.0}),
         json!({"body": "foundation", "set": "bottom_left", "x": 0.0}),
     ];
     let mut loads = vec![
-        exact("punch", "left"),
-        exact("punch", "right"),
-        exact("foundation", "exposed_left"),
-        exact("foundation", "exposed_right"),
-        exact("foundation", "left"),
-        exact("foundation", "right"),
-        exact("foundation", "bottom"),
+        pressure("punch", "top"),
+        pressure("foundation", "exposed_left"),
+        pressure("foundation", "exposed_right"),
+        shear("punch", "left", [0.0, -1.0]),
+        shear("punch", "right", [0.0, 1.0]),
+        shear("foundation", "exposed_left", [1.0, 0.0]),
+        shear("foundation", "exposed_right", [1.0, 0.0]),
+        shear("foundation", "left", [0.0, -1.0]),
+        shear("foundation", "right", [0.0, 1.0]),
+        shear("foundation", "bottom", [-1.0, 0.0]),
     ];
     match top {
-        Top::Traction => loads.push(exact("punch", "top")),
+        Top::Traction => loads.push(shear("punch", "top", [1.0, 0.0])),
         Top::Displacement(d) => {
-            loads.push(json!({"body": "punch", "set": "top", "pressure": P}));
-            supports.push(json!({"body": "punch", "set": "top", "x": d}));
+            supports.push(json!({"body": "punch", "set": "top", "x": d, "path": tangential}))
         }
     }
     v["supports"] = json!(supports);
@@ -160,6 +178,11 @@ fn frictional_patch_test_sticks_below_the_cone_with_the_uniform_stress() {
         for p in &pts {
             assert!(p.1.abs() <= MU * p.2 * (1.0 + 1e-12));
         }
+        // the first step pressed the punch without tangential force: every point stuck
+        let steps = &o.solution.contact.as_ref().unwrap().steps;
+        let first = steps[0].friction.as_ref().unwrap();
+        assert_eq!(first.stick, pts.len());
+        assert!(first.tangential_force[0].abs() <= 1e-10 * P, "{first:?}");
         let e = stress_error(&o, [0.0, -P, q]) / P;
         println!("stick, mesh {mesh}, {disc}: stress error {e:.1e} p");
         if exact_patch {
@@ -227,6 +250,10 @@ fn frictional_patch_test_slips_with_traction_mu_p_under_a_prescribed_tangential_
             let f = step.friction.as_ref().unwrap();
             assert!(f.dissipation >= 0.0 && f.max_cone_ratio <= 1.0 + 1e-12);
         }
+        // pressed without sliding in the first step, sliding with dissipation in the last
+        assert_eq!(s[0].friction.as_ref().unwrap().slip, 0);
+        let last = s.last().unwrap().friction.as_ref().unwrap();
+        assert!(last.dissipation > 0.0);
     }
 }
 
@@ -543,6 +570,11 @@ fn friction_is_refused_where_this_slice_does_not_solve_it_with_the_fix() {
     assert!(m.contains("one-pass"), "{m}");
     let m = with(&|v| v["physics"] = json!({"contact_geometry": "current"}));
     assert!(m.contains("reference contact geometry"), "{m}");
+    let m = with(&|v| v["loads"][0]["path"] = json!([0.0, 1.0]));
+    assert!(
+        m.contains("one factor per load step: 2 given, solver.load_steps is 1"),
+        "{m}"
+    );
     // unknown fields of the interaction are refused by the parser
     let mut v = base.clone();
     v["contact"][0]["interaction"]["coulomb"]["m"] = json!(0.3);

@@ -629,6 +629,11 @@ pub struct Support {
     pub x: Option<Prescribed>,
     #[serde(default)]
     pub y: Option<Prescribed>,
+    /// The factor of the prescribed values at each load step (one per step of
+    /// `solver.load_steps`; default: proportional, `k / n` at step `k`): a load path, e.g.
+    /// `[0, 1]` for "not in the first step, fully in the second".
+    #[serde(default)]
+    pub path: Option<Vec<f64>>,
 }
 
 /// A traction vector, or `"exact"` (sigma_exact . n).
@@ -655,6 +660,11 @@ pub struct Load {
     /// Force per volume.
     #[serde(default)]
     pub body_force: Option<[f64; 2]>,
+    /// The factor of the load at each load step (one per step of `solver.load_steps`; default:
+    /// proportional, `k / n` at step `k`): a load path, e.g. a normal load `[1, 1]` and a
+    /// tangential one `[0, 1]` (friction is path dependent).
+    #[serde(default)]
+    pub path: Option<Vec<f64>>,
 }
 
 /// Analytic reference solutions.

@@ -102,7 +102,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
         let at = if n == 1 {
             model
         } else {
-            scaled = model.with_load_factor(t);
+            scaled = model.at_step(step, n);
             &scaled
         };
         let mut solution = solve_step(
