@@ -335,6 +335,47 @@ fn a_block_on_an_incline_slides_at_the_coulomb_limit() {
     assert_ne!(termination(&o), Termination::Converged);
 }
 
+#[test]
+fn on_a_load_path_the_block_starts_to_slide_at_the_coulomb_limit() {
+    // the weight first, then the push ramped across the limit: the solve converges in every
+    // step below it and stops at the first step past it
+    let tan_a: f64 = 0.1;
+    let limit = (tan_a + MU) / (1.0 - MU * tan_a);
+    let ramp = [0.0, 0.25, 0.5, 0.75, 0.9, 0.97, 0.99, 0.998, 1.005, 1.02];
+    let (g, area) = (10.0, 2.0);
+    let (s, c) = (
+        tan_a / (1.0 + tan_a * tan_a).sqrt(),
+        1.0 / (1.0 + tan_a * tan_a).sqrt(),
+    );
+    let f = limit * g;
+    let mut v = incline(0.0, tan_a, ramp.len());
+    v["loads"] = json!([
+        {"body": "block", "body_force": [-g * s / area, -g * c / area], "path": vec![1.0; ramp.len()]},
+        {"body": "block", "body_force": [f * c / area, -f * s / area], "path": ramp},
+    ]);
+    let o = run(&v);
+    let steps = &o.solution.contact.as_ref().unwrap().steps;
+    let past = ramp.iter().position(|&r| r > 1.0).unwrap();
+    assert_eq!(steps.len(), past + 1, "{steps:?}");
+    for (k, step) in steps.iter().enumerate() {
+        if k < past {
+            assert_eq!(step.termination, Termination::Converged, "step {}", k + 1);
+            let fr = step.friction.as_ref().unwrap();
+            assert!(fr.max_cone_ratio <= 1.0 + 1e-12, "{fr:?}");
+            assert!(fr.dissipation >= 0.0, "{fr:?}");
+            // the tangential forces carry the tangential load of the step
+            let load = ramp[k] * f * c - g * s;
+            assert!((fr.tangential_force[0] + load).abs() <= 1e-9 * g, "{fr:?}");
+        } else {
+            assert_ne!(step.termination, Termination::Converged);
+        }
+    }
+    // under its weight alone (tan a < mu) the block holds; an edge node may slip locally
+    // (Poisson's expansion against friction), as the counts show
+    let first = steps[0].friction.as_ref().unwrap();
+    assert!(first.stick > first.slip, "{first:?}");
+}
+
 /// A block `[0, 2] x [0, 1]` pressed by `p` onto a rigid master and dragged by a prescribed
 /// displacement `d` of its top along x (`nu = 0`: no Poisson expansion for friction to resist,
 /// so a small `d` sticks at every point).
@@ -598,4 +639,34 @@ fn a_frictionless_scene_builds_no_tangential_row() {
     assert!(c.rows.iter().all(|r| r.tangent.is_none()));
     assert!(c.friction.iter().all(|f| f.is_none()));
     assert!(c.steps.iter().all(|s| s.friction.is_none()));
+}
+
+#[test]
+fn the_summary_reports_the_tangential_force_and_the_stick_and_slip_counts() {
+    let o = run(&patch(
+        "A",
+        "0.0",
+        node_to_node(),
+        MU * P,
+        Top::Displacement(0.05),
+        2,
+    ));
+    let nodal: Vec<Vec<[f64; 3]>> = o
+        .model
+        .bodies
+        .iter()
+        .map(|b| contact_patch::post::nodal_stresses(b, &o.solution.u))
+        .collect();
+    let summary = serde_json::to_value(contact_patch::io::output::summary(&o, &nodal)).unwrap();
+    let pair = &summary["contact"]["pairs"][0];
+    let f = &pair["friction"];
+    assert_eq!(f["slip"], json!(3), "{f}");
+    assert_eq!(f["stick"], json!(0), "{f}");
+    let t = f["tangential_force"][0].as_f64().unwrap();
+    assert!((t + 2.0 * MU * P).abs() <= 1e-10 * P, "{f}");
+    assert!(f["dissipation"].as_f64().unwrap() > 0.0);
+    // per step too
+    let steps = summary["contact"]["steps"].as_array().unwrap();
+    assert_eq!(steps[0]["friction"]["slip"], json!(0));
+    assert_eq!(steps[1]["friction"]["slip"], json!(3));
 }

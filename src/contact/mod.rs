@@ -1,4 +1,5 @@
-//! Frictionless small-strain contact: two orthogonal axes that meet in one small type.
+//! Small-strain contact: two orthogonal axes that meet in one small type (frictionless, tied,
+//! and Coulomb friction through [`friction`]).
 //!
 //! **The meeting point.** Every discretization turns a contact pair into a list of
 //! [`Constraint`]s: a gap that is affine in the displacements,
@@ -26,6 +27,9 @@
 //! * augmented Lagrangian: `lambda_i = lambda_k,i - kappa A_i g_i` with the Uzawa update
 //!   `lambda_k <- lambda` per Newton iteration or in an outer loop,
 //! * constraint elimination: each active row solved for its own slave dof.
+//!
+//! Coulomb pairs give every row its tangential slip measure too ([`TangentRow`]); the return
+//! map of [`friction`] (penalty regularization, Newton scheme) turns it into a tangential force.
 //!
 //! All six are written once against [`Constraint`] (Taylor 2004, "1985: Solution Methods":
 //! the augmented perturbed form "can reduce to all other forms").
