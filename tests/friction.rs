@@ -1,4 +1,5 @@
-//! Coulomb friction with penalty regularization in the Newton scheme
+//! Coulomb friction with penalty regularization in the Newton scheme (penalty and perturbed
+//! Lagrangian normal laws)
 //! (`src/contact/friction.rs`, `src/solver/contact_newton.rs`), every check against a closed
 //! form:
 //!
@@ -669,4 +670,28 @@ fn the_summary_reports_the_tangential_force_and_the_stick_and_slip_counts() {
     let steps = summary["contact"]["steps"].as_array().unwrap();
     assert_eq!(steps[0]["friction"]["slip"], json!(0));
     assert_eq!(steps[1]["friction"]["slip"], json!(3));
+}
+
+#[test]
+fn the_perturbed_lagrangian_carries_friction_as_the_penalty_does() {
+    let mut v = patch(
+        "A",
+        "0.0",
+        node_to_node(),
+        MU * P,
+        Top::Displacement(0.05),
+        2,
+    );
+    v["contact"][0]["enforcement"] = json!({"kind": "perturbed_lagrange", "kappa": KAPPA});
+    let o = run(&v);
+    assert_eq!(termination(&o), Termination::Converged);
+    for p in points(&o) {
+        assert_eq!(p.0, Status::Slip);
+        assert!((p.1.abs() / p.3 - MU * P).abs() <= 1e-9 * MU * P);
+    }
+    assert!(stress_error(&o, [0.0, -P, MU * P]) < 1e-8 * P);
+    // the augmented Lagrangian is refused with friction, for now (see Model::build)
+    v["contact"][0]["enforcement"] = json!({"kind": "augmented_lagrange", "kappa": KAPPA});
+    let m = refusal(&v);
+    assert!(m.contains("augmented Lagrangian is not solved yet"), "{m}");
 }

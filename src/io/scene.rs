@@ -249,7 +249,8 @@ pub enum Interaction {
     Tied,
     /// Unilateral contact with Coulomb friction, `|lambda_t| <= mu lambda_n`, regularized by a
     /// tangential penalty `kappa_t` (force per unit area per unit elastic slip; default: the
-    /// pair's normal `kappa`). `solver.scheme: "newton"` with a penalty-type method only (see
+    /// pair's normal `kappa`). `solver.scheme: "newton"` with the penalty or the perturbed
+    /// Lagrangian only (see
     /// [`crate::contact::friction`]).
     Coulomb {
         mu: f64,

@@ -45,7 +45,8 @@
 //! singular: the step ends `Singular` with the reason, where the active-set scheme picks the
 //! minimum-norm multipliers.
 //!
-//! **Coulomb friction** (pairs with `interaction: {"coulomb": ..}`, penalty-type normal laws):
+//! **Coulomb friction** (pairs with `interaction: {"coulomb": ..}`, the penalty or the
+//! perturbed Lagrangian as normal law):
 //! every row carries its tangential slip `g_t` with gradient `b_t`, and the return map of
 //! [`crate::contact::friction`] gives the tangential force `lambda_t` from the plastic slip
 //! committed at the end of the last load step (`committed`, carried from step to step by
