@@ -665,7 +665,17 @@ fn the_summary_reports_the_tangential_force_and_the_stick_and_slip_counts() {
     assert_eq!(f["stick"], json!(0), "{f}");
     let t = f["tangential_force"][0].as_f64().unwrap();
     assert!((t + 2.0 * MU * P).abs() <= 1e-10 * P, "{f}");
-    assert!(f["dissipation"].as_f64().unwrap() > 0.0);
+    // the punch top moved d = 0.05; the uniform shear gamma = mu p / G carries it through the
+    // punch and the foundation (heights 2 and 5, u_x = gamma y), the penalty spring takes
+    // mu p / kappa_t: the rest slid, against the traction mu p over the width 2
+    let (d, gamma) = (0.05, MU * P / 500.0);
+    let slid = d - gamma * 7.0 - MU * P / KAPPA;
+    let dissipation = f["dissipation"].as_f64().unwrap();
+    assert!(
+        (dissipation - 2.0 * MU * P * slid).abs() <= 1e-10,
+        "{dissipation} against {}",
+        2.0 * MU * P * slid
+    );
     // per step too
     let steps = summary["contact"]["steps"].as_array().unwrap();
     assert_eq!(steps[0]["friction"]["slip"], json!(0));

@@ -254,7 +254,7 @@ pub enum Interaction {
     /// [`crate::contact::friction`]).
     Coulomb {
         mu: f64,
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         kappa_t: Option<f64>,
     },
 }
