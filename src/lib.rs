@@ -24,6 +24,7 @@
 //! * [`contact`]: the two axes, meeting in [`contact::Constraint`]:
 //!   [`contact::discretization`] (with its `geometry`, `mortar` and `search`) makes rows;
 //!   [`contact::enforcement`] (one module per method) says how they are enforced;
+//!   [`contact::friction`] is Coulomb's return map (stick, slip, open);
 //!   [`contact::state`] is what a solve found; [`contact::forces`] turns row forces into the
 //!   forces, pressures and penetrations every report uses.
 //! * [`solver`]: [`solver::solve_static`] runs one analysis with the effects its scene names;

@@ -204,7 +204,8 @@ fn print_outcome(o: &Outcome) {
     }
 }
 
-/// Case files named by `paths` (folders searched recursively), sorted.
+/// Case files named by `paths` (folders searched recursively), sorted. In folders, a
+/// `*.schema.json` file (the case format's schema) is not a case.
 fn collect_cases(paths: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
     fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), String> {
         let entries = std::fs::read_dir(dir)
@@ -214,7 +215,9 @@ fn collect_cases(paths: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
         for p in paths {
             if p.is_dir() {
                 walk(&p, out)?;
-            } else if p.extension().is_some_and(|x| x == "json") {
+            } else if p.extension().is_some_and(|x| x == "json")
+                && !p.to_string_lossy().ends_with(".schema.json")
+            {
                 out.push(p);
             }
         }

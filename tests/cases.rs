@@ -18,7 +18,9 @@ fn case_files(dir: &Path, out: &mut Vec<PathBuf>) {
                 continue;
             }
             case_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "json") {
+        } else if p.extension().is_some_and(|x| x == "json")
+            && !p.to_string_lossy().ends_with(".schema.json")
+        {
             out.push(p);
         }
     }

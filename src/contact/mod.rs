@@ -1,4 +1,5 @@
-//! Frictionless small-strain contact: two orthogonal axes that meet in one small type.
+//! Small-strain contact: two orthogonal axes that meet in one small type (frictionless, tied,
+//! and Coulomb friction through [`friction`]).
 //!
 //! **The meeting point.** Every discretization turns a contact pair into a list of
 //! [`Constraint`]s: a gap that is affine in the displacements,
@@ -27,12 +28,16 @@
 //!   `lambda_k <- lambda` per Newton iteration or in an outer loop,
 //! * constraint elimination: each active row solved for its own slave dof.
 //!
+//! Coulomb pairs give every row its tangential slip measure too ([`TangentRow`]); the return
+//! map of [`friction`] (penalty regularization, Newton scheme) turns it into a tangential force.
+//!
 //! All six are written once against [`Constraint`] (Taylor 2004, "1985: Solution Methods":
 //! the augmented perturbed form "can reduce to all other forms").
 
 pub mod discretization;
 pub mod enforcement;
 pub mod forces;
+pub mod friction;
 pub mod state;
 
 /// One linearized contact constraint (a row of `B`).
@@ -73,6 +78,32 @@ pub struct Constraint {
     /// entries sum to `area`. Only the perturbed Lagrangian uses it (see
     /// [`enforcement`]): `C = A^-1 M A^-1 / kappa`.
     pub mass: Vec<(usize, f64)>,
+    /// The tangential slip measure of a frictional (Coulomb) pair, `None` elsewhere: physics
+    /// is opt-in, a frictionless scene builds no tangential row.
+    pub tangent: Option<TangentRow>,
+}
+
+/// The tangential slip of a contact point, `g_t(u) = sum_k c_ik u_{d_ik}` (zero at `u = 0`):
+/// the relative displacement of the slave node against its master point along the unit tangent
+/// `t` (`t = (-n_y, n_x)` for the row's normal `n`), with the normal row's projection weights,
+/// `g_t = t . (u_s - sum_m N_m u_m)` (rigid masters: `t . u_s`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TangentRow {
+    pub dofs: Vec<usize>,
+    pub coeffs: Vec<f64>,
+    /// The unit tangent `t`: the row's tangential force on the slave node is `lambda_t t`.
+    pub direction: [f64; 2],
+}
+
+impl TangentRow {
+    /// The slip measure at `u`.
+    pub fn slip(&self, u: &[f64]) -> f64 {
+        self.dofs
+            .iter()
+            .zip(&self.coeffs)
+            .map(|(&d, c)| c * u[d])
+            .sum()
+    }
 }
 
 impl Constraint {
@@ -85,5 +116,20 @@ impl Constraint {
                 .zip(&self.coeffs)
                 .map(|(&d, c)| c * u[d])
                 .sum::<f64>()
+    }
+
+    /// The gradients the row restrains: the normal one, then the tangential one (if any).
+    pub fn gradients(&self) -> impl Iterator<Item = (&[usize], &[f64])> {
+        std::iter::once((&self.dofs[..], &self.coeffs[..]))
+            .chain(self.tangent.as_ref().map(|t| (&t.dofs[..], &t.coeffs[..])))
+    }
+
+    /// Every dof of the row's normal and tangential gradients (each once).
+    pub fn all_dofs(&self) -> Vec<usize> {
+        let mut d = self.dofs.clone();
+        if let Some(t) = &self.tangent {
+            d.extend(t.dofs.iter().filter(|x| !self.dofs.contains(x)));
+        }
+        d
     }
 }

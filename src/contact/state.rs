@@ -48,6 +48,22 @@ pub struct ContactState {
     /// Relative change of the displacement at each geometry update of the last step (current
     /// geometry): how the geometry iteration converged.
     pub geometry_changes: Vec<f64>,
+    /// Per row: its frictional state (Coulomb pairs; `None` for frictionless and tied rows).
+    pub friction: Vec<Option<super::friction::FrictionPoint>>,
+}
+
+impl ContactState {
+    /// The plastic slip of every frictional point at the end of this state's step: the history
+    /// the next load step starts from.
+    pub(crate) fn friction_history(
+        &self,
+    ) -> std::collections::HashMap<crate::solver::active_set::RowKey, f64> {
+        self.rows
+            .iter()
+            .zip(&self.friction)
+            .filter_map(|(r, f)| f.map(|f| (crate::solver::active_set::row_key(r), f.plastic_slip)))
+            .collect()
+    }
 }
 
 /// One converged (or stopped) load step.
@@ -63,6 +79,10 @@ pub struct StepRecord {
     /// the reference configuration): quadratic decay where the rows provide their second
     /// derivative (Newton), linear where the geometry is a fixed point.
     pub geometry_changes: Vec<f64>,
+    /// Coulomb pairs: the step's frictional totals over all pairs (stick/slip/open counts,
+    /// dissipation, largest `|lambda_t| / (mu lambda_n)`); `None` without friction.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<super::friction::FrictionSummary>,
 }
 
 /// A slave node that was in contact at one geometry update and found no master facet at a

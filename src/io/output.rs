@@ -182,6 +182,9 @@ pub struct PairSummary {
     /// Body, node and position of the slave node with the largest share.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_penetration_at: Option<PointRef>,
+    /// Coulomb pairs: total tangential force, stick/slip/open counts, dissipation.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<crate::contact::friction::FrictionSummary>,
 }
 
 /// A node named for a user: body name, node number, position.
@@ -288,6 +291,7 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
                     node,
                     point,
                 }),
+                friction: crate::contact::friction::pair_summary(c, f.pair),
             })
             .collect();
         let most = |get: fn(&PairSummary) -> f64| pairs.iter().map(get).fold(0.0, f64::max);

@@ -82,6 +82,10 @@ pub struct SolverSpec {
     /// Lagrangian with diagonal perturbation, augmented Lagrangian).
     #[serde(default)]
     pub scheme: Scheme,
+    /// The tangent of slipping frictional points (Coulomb pairs, Newton scheme):
+    /// `"consistent"` (default, unsymmetric) or `"symmetrized"`.
+    #[serde(default)]
+    pub friction_tangent: FrictionTangent,
 }
 
 /// The nonlinear solution scheme of a load step.
@@ -126,6 +130,7 @@ impl Default for SolverSpec {
             geometry_tolerance: geometry_tolerance(),
             geometric_stiffness: true,
             scheme: Scheme::ActiveSet,
+            friction_tangent: FrictionTangent::Consistent,
         }
     }
 }
@@ -236,7 +241,8 @@ pub struct ContactSpec {
     pub master: MasterSpec,
     pub discretization: DiscretizationSpec,
     pub enforcement: EnforcementSpec,
-    /// `frictionless` contact (default) or a `tied` (glued) interface.
+    /// `frictionless` contact (default), a `tied` (glued) interface, or
+    /// `{"coulomb": {"mu": .., "kappa_t": ..}}` friction.
     #[serde(default)]
     pub interaction: Interaction,
     /// How far from the master surface a slave node is still a contact candidate (default:
@@ -246,14 +252,46 @@ pub struct ContactSpec {
 }
 
 /// What a pair enforces.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum Interaction {
     /// Unilateral, frictionless contact: `g >= 0`, `lambda >= 0`, `g lambda = 0`.
     #[default]
     Frictionless,
     /// Both displacement components continuous across the interface (bilateral).
     Tied,
+    /// Unilateral contact with Coulomb friction, `|lambda_t| <= mu lambda_n`, regularized by a
+    /// tangential penalty `kappa_t` (force per unit area per unit elastic slip; default: the
+    /// pair's normal `kappa`). `solver.scheme: "newton"` with the penalty or the perturbed
+    /// Lagrangian only (see
+    /// [`crate::contact::friction`]).
+    Coulomb {
+        mu: f64,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        kappa_t: Option<f64>,
+    },
+}
+
+impl Interaction {
+    /// The friction coefficient of a Coulomb pair.
+    pub fn friction(&self) -> Option<f64> {
+        match *self {
+            Interaction::Coulomb { mu, .. } => Some(mu),
+            _ => None,
+        }
+    }
+}
+
+/// The tangent of the frictional rows in a slip state.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum FrictionTangent {
+    /// The exact derivative of the return map: unsymmetric in slip (solved by LU).
+    #[default]
+    Consistent,
+    /// The consistent tangent without the slip coupling `s mu w b_t b_n^T` (symmetric, Cholesky;
+    /// Newton then converges linearly in slip).
+    Symmetrized,
 }
 
 /// The multiplier space of a mortar discretization.
@@ -607,6 +645,11 @@ pub struct Support {
     pub x: Option<Prescribed>,
     #[serde(default)]
     pub y: Option<Prescribed>,
+    /// The factor of the prescribed values at each load step (one per step of
+    /// `solver.load_steps`; default: proportional, `k / n` at step `k`): a load path, e.g.
+    /// `[0, 1]` for "not in the first step, fully in the second".
+    #[serde(default)]
+    pub path: Option<Vec<f64>>,
 }
 
 /// A traction vector, or `"exact"` (sigma_exact . n).
@@ -638,6 +681,11 @@ pub struct Load {
     /// node set `set`.
     #[serde(default)]
     pub force: Option<[f64; 2]>,
+    /// The factor of the load at each load step (one per step of `solver.load_steps`; default:
+    /// proportional, `k / n` at step `k`): a load path, e.g. a normal load `[1, 1]` and a
+    /// tangential one `[0, 1]` (friction is path dependent).
+    #[serde(default)]
+    pub path: Option<Vec<f64>>,
 }
 
 /// Analytic reference solutions.

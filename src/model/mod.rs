@@ -84,6 +84,15 @@ pub enum MasterSide {
     Rigid(RigidSurface),
 }
 
+/// A load or support on a load path: its consistent forces (zero for a support) and its
+/// prescribed dofs (none for a load), at the factors `factors[k - 1]` in step `k`.
+#[derive(Clone, Debug)]
+pub struct PathPart {
+    pub force: Vec<f64>,
+    pub dofs: Vec<usize>,
+    pub factors: Vec<f64>,
+}
+
 /// A contact pair with its names resolved.
 #[derive(Clone, Debug)]
 pub struct ContactPair {
@@ -131,6 +140,10 @@ pub struct Model {
     pub prescribed: Vec<Option<f64>>,
     /// Consistent external nodal forces.
     pub external_force: Vec<f64>,
+    /// Loads and supports with a load path of their own (`path` in the case file): their
+    /// forces and prescribed dofs, with the factor at each load step. Empty: every load is
+    /// proportional to the load factor.
+    pub load_path: Vec<PathPart>,
     pub exact: Option<ExactField>,
     pub physics: Physics,
     /// Checks with every name already resolved.
@@ -231,6 +244,44 @@ impl Model {
         }
         for v in m.prescribed.iter_mut().flatten() {
             *v *= t;
+        }
+        m
+    }
+
+    /// The model at load step `k` of `n`: the proportional loads and supports at the factor
+    /// `k / n`, those on a load path at their own factor for step `k`.
+    pub fn at_step(&self, k: usize, n: usize) -> Model {
+        let t = k as f64 / n as f64;
+        if self.load_path.is_empty() {
+            return self.with_load_factor(t);
+        }
+        let mut m = self.clone();
+        let mut path_dof = vec![None; self.dof_count];
+        for part in &self.load_path {
+            for &d in &part.dofs {
+                path_dof[d] = Some(part.factors[k - 1]);
+            }
+        }
+        // proportional forces: the total minus the parts (round-off where both act on a dof)
+        let mut proportional = self.external_force.clone();
+        for part in &self.load_path {
+            for (p, f) in proportional.iter_mut().zip(&part.force) {
+                *p -= f;
+            }
+        }
+        for (i, f) in m.external_force.iter_mut().enumerate() {
+            *f = proportional[i] * t;
+        }
+        for part in &self.load_path {
+            let factor = part.factors[k - 1];
+            for (f, p) in m.external_force.iter_mut().zip(&part.force) {
+                *f += factor * p;
+            }
+        }
+        for (d, v) in m.prescribed.iter_mut().enumerate() {
+            if let Some(v) = v {
+                *v *= path_dof[d].unwrap_or(t);
+            }
         }
         m
     }
@@ -411,6 +462,7 @@ impl Model {
             dof_count: offset,
             prescribed: vec![None; offset],
             external_force: vec![0.0; offset],
+            load_path: Vec::new(),
             bodies,
             exact,
             physics: case.physics.clone(),
@@ -517,8 +569,13 @@ impl Model {
                     "add \"x\" and/or \"y\" (a number, or \"exact\")",
                 ));
             }
+            let factors = self.load_path_factors(case, s.path.as_deref(), &at)?;
+            let mut path_dofs = Vec::new();
             for (comp, value) in [(0, s.x), (1, s.y)] {
                 let Some(value) = value else { continue };
+                if factors.is_some() {
+                    path_dofs.extend(nodes.iter().map(|&n| body.dof(n, comp)));
+                }
                 if let Prescribed::Value(v) = value {
                     if !v.is_finite() {
                         return Err(Error::invalid(
@@ -559,8 +616,46 @@ impl Model {
                     }
                 }
             }
+            if let Some(factors) = factors {
+                self.load_path.push(PathPart {
+                    force: Vec::new(),
+                    dofs: path_dofs,
+                    factors,
+                });
+            }
         }
         Ok(())
+    }
+
+    /// The factors of a load path (`None`: proportional), one per load step.
+    fn load_path_factors(
+        &self,
+        case: &Case,
+        path: Option<&[f64]>,
+        at: &str,
+    ) -> Result<Option<Vec<f64>>> {
+        let Some(path) = path else { return Ok(None) };
+        let n = case.solver.load_steps;
+        if path.len() != n {
+            return Err(Error::invalid(
+                &self.source,
+                format!("{at}.path"),
+                format!(
+                    "a load path has one factor per load step: {} given, solver.load_steps is {n}",
+                    path.len()
+                ),
+                "give solver.load_steps factors, e.g. [0, 1] with \"load_steps\": 2",
+            ));
+        }
+        if let Some(v) = path.iter().find(|v| !v.is_finite()) {
+            return Err(Error::invalid(
+                &self.source,
+                format!("{at}.path"),
+                format!("the load path's factors must be finite, got {v}"),
+                "give finite numbers",
+            ));
+        }
+        Ok(Some(path.to_vec()))
     }
 
     fn apply_loads(&mut self, case: &Case) -> Result<()> {
@@ -581,6 +676,32 @@ impl Model {
                     "split it into one load per kind",
                 ));
             }
+            let factors = self.load_path_factors(case, load.path.as_deref(), &at)?;
+            let Some(factors) = factors else {
+                self.apply_load(load, &body, &at)?;
+                continue;
+            };
+            // a load on a path is assembled on its own, then added to the total
+            let total = std::mem::replace(&mut self.external_force, vec![0.0; self.dof_count]);
+            let result = self.apply_load(load, &body, &at);
+            let force = std::mem::replace(&mut self.external_force, total);
+            result?;
+            for (f, p) in self.external_force.iter_mut().zip(&force) {
+                *f += p;
+            }
+            self.load_path.push(PathPart {
+                force,
+                dofs: Vec::new(),
+                factors,
+            });
+        }
+        Ok(())
+    }
+
+    /// Assemble one load into `external_force`.
+    fn apply_load(&mut self, load: &crate::io::scene::Load, body: &Body, at: &str) -> Result<()> {
+        let at = at.to_string();
+        {
             let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
             if let Some(force) = load.force {
                 let Some(set) = &load.set else {
@@ -599,11 +720,11 @@ impl Model {
                         "give finite numbers",
                     ));
                 }
-                for &n in self.find_node_set(&body, set, &at)? {
+                for &n in self.find_node_set(body, set, &at)? {
                     self.external_force[body.dof(n, 0)] += force[0];
                     self.external_force[body.dof(n, 1)] += force[1];
                 }
-                continue;
+                return Ok(());
             }
             if let Some(b) = load.body_force {
                 if load.set.is_some() {
@@ -622,8 +743,8 @@ impl Model {
                         "give finite numbers",
                     ));
                 }
-                add_body_force(&body, b, self.thickness, &mut self.external_force);
-                continue;
+                add_body_force(body, b, self.thickness, &mut self.external_force);
+                return Ok(());
             }
             let Some(set) = &load.set else {
                 return Err(Error::invalid(
@@ -633,7 +754,7 @@ impl Model {
                     "add \"set\": the name of a facet set of the body",
                 ));
             };
-            let facets = self.find_facet_set(&body, set, &at)?.to_vec();
+            let facets = self.find_facet_set(body, set, &at)?.to_vec();
             let traction = match (load.pressure, load.traction) {
                 (Some(p), _) => {
                     if !p.is_finite() {
@@ -661,13 +782,7 @@ impl Model {
                 _ => unreachable!("exactly one load kind checked above"),
             };
             for f in facets {
-                add_facet_load(
-                    &body,
-                    f,
-                    &traction,
-                    self.thickness,
-                    &mut self.external_force,
-                );
+                add_facet_load(body, f, &traction, self.thickness, &mut self.external_force);
             }
         }
         Ok(())
@@ -750,6 +865,9 @@ impl Model {
                 }
             }
             let newton = case.solver.scheme == crate::io::scene::Scheme::Newton;
+            if let Interaction::Coulomb { mu, kappa_t } = spec.interaction {
+                validate_coulomb(case, spec, mu, kappa_t, &self.source, &at)?;
+            }
             let family_of = |e| crate::contact::enforcement::method(e).kernel().family();
             if newton
                 && !matches!(
@@ -967,6 +1085,93 @@ impl Model {
         }
         Ok(())
     }
+}
+
+/// A Coulomb pair: its parameters, and what this slice of friction solves (the Newton scheme,
+/// penalty-type normal laws, node-based rows with master normals, the reference geometry).
+fn validate_coulomb(
+    case: &Case,
+    spec: &crate::io::scene::ContactSpec,
+    mu: f64,
+    kappa_t: Option<f64>,
+    source: &str,
+    at: &str,
+) -> Result<()> {
+    let here = format!("{at}.interaction.coulomb");
+    if !(mu.is_finite() && mu >= 0.0) {
+        return Err(Error::invalid(
+            source,
+            format!("{here}.mu"),
+            format!("the friction coefficient mu must be a finite number >= 0, got {mu}"),
+            "give e.g. \"mu\": 0.3 (mu = 0 is frictionless with tangential rows)",
+        ));
+    }
+    if let Some(k) = kappa_t {
+        if !(k.is_finite() && k > 0.0) {
+            return Err(Error::invalid(
+                source,
+                format!("{here}.kappa_t"),
+                format!("the tangential penalty kappa_t must be positive and finite, got {k}"),
+                "leave it out to use the pair's normal kappa, or give a positive value",
+            ));
+        }
+    }
+    if case.solver.scheme != crate::io::scene::Scheme::Newton {
+        return Err(Error::invalid(
+            source,
+            &here,
+            "Coulomb friction is solved by the Newton scheme only".to_string(),
+            "set \"solver\": {\"scheme\": \"newton\"}",
+        ));
+    }
+    if matches!(spec.enforcement, EnforcementSpec::AugmentedLagrange { .. }) {
+        // the Uzawa multipliers restart from zero in every load step; with friction the
+        // second step of the slip patch test cycled between branches (both update rules)
+        return Err(Error::invalid(
+            source,
+            format!("{at}.enforcement"),
+            "Coulomb friction with the augmented Lagrangian is not solved yet (its Newton iteration cycled between stick/slip and open/closed branches after the first load step)".to_string(),
+            "use the penalty or the perturbed Lagrangian for this pair",
+        ));
+    }
+    if !matches!(
+        spec.enforcement,
+        EnforcementSpec::Penalty { .. } | EnforcementSpec::PerturbedLagrange { .. }
+    ) {
+        return Err(Error::invalid(
+            source,
+            format!("{at}.enforcement"),
+            format!(
+                "Coulomb friction is regularized by a tangential penalty and needs a penalty-type normal law, not {}",
+                crate::contact::enforcement::method(&spec.enforcement).name()
+            ),
+            "use the penalty or the perturbed Lagrangian for this pair",
+        ));
+    }
+    let node_based = match spec.discretization {
+        DiscretizationSpec::NodeToNode => true,
+        DiscretizationSpec::NodeToSurface { passes, normal } => {
+            passes == 1 && normal == crate::io::scene::NormalChoice::Master
+        }
+        DiscretizationSpec::Mortar { .. } => false,
+    };
+    if !node_based {
+        return Err(Error::invalid(
+            source,
+            format!("{at}.discretization"),
+            "Coulomb friction has tangential rows for node-to-node and one-pass node-to-surface with master normals (and rigid masters) only, so far".to_string(),
+            "use {\"kind\": \"node_to_node\"} or {\"kind\": \"node_to_surface\", \"passes\": 1, \"normal\": \"master\"}",
+        ));
+    }
+    if case.physics.contact_geometry != crate::io::scene::ContactGeometry::Reference {
+        return Err(Error::invalid(
+            source,
+            &here,
+            "Coulomb friction is solved in the reference contact geometry only, so far".to_string(),
+            "set \"physics\": {\"contact_geometry\": \"reference\"}",
+        ));
+    }
+    Ok(())
 }
 
 fn validate_enforcement(e: &EnforcementSpec, source: &str, at: &str) -> Result<()> {

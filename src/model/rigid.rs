@@ -186,7 +186,7 @@ impl<'a> RigidModes<'a> {
                 rows.iter()
                     .zip(active.iter())
                     .filter(|(_, &a)| a)
-                    .map(|(r, _)| (&r.dofs[..], &r.coeffs[..])),
+                    .flat_map(|(r, _)| r.gradients()),
             );
             if basis.is_empty() {
                 return;
@@ -194,14 +194,17 @@ impl<'a> RigidModes<'a> {
             let holding: Vec<usize> = (0..rows.len())
                 .filter(|&i| !active[i])
                 .filter(|&i| {
-                    let a = self.restraint(&rows[i].dofs, &rows[i].coeffs);
-                    let norm = a.iter().map(|v| v * v).sum::<f64>().sqrt();
-                    let seen = basis
-                        .iter()
-                        .map(|q| q.iter().zip(&a).map(|(x, y)| x * y).sum::<f64>().powi(2))
-                        .sum::<f64>()
-                        .sqrt();
-                    seen > 1e-8 * norm
+                    // a frictional row restrains along its tangent too (it sticks when closed)
+                    rows[i].gradients().any(|(dofs, coeffs)| {
+                        let a = self.restraint(dofs, coeffs);
+                        let norm = a.iter().map(|v| v * v).sum::<f64>().sqrt();
+                        let seen = basis
+                            .iter()
+                            .map(|q| q.iter().zip(&a).map(|(x, y)| x * y).sum::<f64>().powi(2))
+                            .sum::<f64>()
+                            .sqrt();
+                        seen > 1e-8 * norm
+                    })
                 })
                 .collect();
             let Some(smallest) = holding.iter().map(|&i| gaps[i]).min_by(f64::total_cmp) else {
@@ -339,7 +342,7 @@ fn add_outer(gram: &mut [f64], a: &[f64]) {
 /// free: which body, which mode, and why.
 pub fn free_rigid_mode(model: &Model, rows: &[&Constraint]) -> Option<FreeMode> {
     let modes = RigidModes::new(model);
-    let basis = modes.free_motions(rows.iter().map(|r| (&r.dofs[..], &r.coeffs[..])));
+    let basis = modes.free_motions(rows.iter().flat_map(|r| r.gradients()));
     (!basis.is_empty()).then(|| modes.describe(&basis, rows))
 }
 

@@ -90,6 +90,8 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
     let mut previous: Option<HashSet<RowKey>> = None;
     let mut records: Vec<StepRecord> = Vec::new();
     let mut start: Option<Vec<f64>> = None;
+    // the committed plastic slip of every frictional point (Coulomb pairs)
+    let mut friction: HashMap<RowKey, f64> = HashMap::new();
     let mut departures: Vec<Departure> = Vec::new();
     let mut history: Vec<IterationRecord> = Vec::new();
     let mut timings = crate::solver::linear::Timings::default();
@@ -100,10 +102,16 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
         let at = if n == 1 {
             model
         } else {
-            scaled = model.with_load_factor(t);
+            scaled = model.at_step(step, n);
             &scaled
         };
-        let mut solution = solve_step(at, previous.take(), start.take(), progress)?;
+        let mut solution = solve_step(
+            at,
+            previous.take(),
+            start.take(),
+            std::mem::take(&mut friction),
+            progress,
+        )?;
         timings.accumulate(&solution.timings);
         solution.timings = timings.clone();
         let state = solution.contact.as_mut().expect("a contact solve");
@@ -114,6 +122,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
             iterations: state.iterations,
             geometry_updates: state.geometry_updates,
             geometry_changes: std::mem::take(&mut state.geometry_changes),
+            friction: crate::contact::friction::step_summary(state),
         });
         state.steps = records.clone();
         for r in &mut state.history {
@@ -128,6 +137,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
             return Ok(solution);
         }
         previous = Some(active_keys(state));
+        friction = state.friction_history();
         start = Some(solution.u);
         step += 1;
     }
@@ -150,10 +160,13 @@ fn solve_step(
     model: &Model,
     mut previous: Option<HashSet<RowKey>>,
     start: Option<Vec<f64>>,
+    friction: HashMap<RowKey, f64>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Solution> {
     if model.solver.scheme == crate::io::scene::Scheme::Newton {
-        return crate::solver::contact_newton::solve_step(model, previous, start, progress);
+        return crate::solver::contact_newton::solve_step(
+            model, previous, start, friction, progress,
+        );
     }
     match model.physics.contact_geometry {
         ContactGeometry::Reference => solve_at(model, None, previous.as_ref(), None, progress),
@@ -538,6 +551,7 @@ fn solve_at(
     let rank_deficiency = (multipliers || active_rows.len() <= RANK_CHECK_LIMIT)
         .then(|| rank_deficiency(&active_rows, sys.n));
     let mut solution = finish(model, &sys, u, &contact_force, timings)?;
+    let n_rows = rows.len();
     solution.contact = Some(ContactState {
         rows,
         active,
@@ -553,6 +567,7 @@ fn solve_at(
         steps: Vec::new(),
         history,
         geometry_changes: Vec::new(),
+        friction: vec![None; n_rows],
     });
     Ok(solution)
 }

@@ -45,6 +45,18 @@
 //! singular: the step ends `Singular` with the reason, where the active-set scheme picks the
 //! minimum-norm multipliers.
 //!
+//! **Coulomb friction** (pairs with `interaction: {"coulomb": ..}`, the penalty or the
+//! perturbed Lagrangian as normal law):
+//! every row carries its tangential slip `g_t` with gradient `b_t`, and the return map of
+//! [`crate::contact::friction`] gives the tangential force `lambda_t` from the plastic slip
+//! committed at the end of the last load step (`committed`, carried from step to step by
+//! [`crate::solver::active_set::solve`]). The residual gains `- lambda_t b_t`, the tangent
+//! `w_t b_t b_t^T` in stick and `s mu w b_t b_n^T` in slip (unsymmetric: solved by LU); with
+//! `solver.friction_tangent: "symmetrized"` the slip coupling is dropped (a symmetric tangent
+//! that is not the derivative: Newton converges linearly in slip; the coupling's symmetric part
+//! instead makes the matrix indefinite, and the iteration diverged on the patch test). A change of a point's
+//! frictional status (open, stick, slip) counts as a status change of the iteration.
+//!
 //! A body held by nothing but contact rows that are open at the start has a singular tangent:
 //! in the first evaluation the rows that would hold it are closed, nearest first
 //! ([`RigidModes::close_free_bodies`]), as in the active-set scheme; their forces may then be
@@ -57,10 +69,11 @@ use super::newton::{self, Evaluation, System, Tangent};
 use super::sparse::{GeneralPattern, PatternBuilder, SymmetricPattern};
 use crate::contact::discretization::gap_second_derivative;
 use crate::contact::enforcement::{method, Method};
+use crate::contact::friction::{return_map, FrictionPoint, ReturnMap, Status};
 use crate::contact::state::{ContactState, Departure, Termination};
 use crate::contact::Constraint;
 use crate::error::Result;
-use crate::io::scene::{ContactGeometry, MultiplierUpdate};
+use crate::io::scene::{ContactGeometry, FrictionTangent, Interaction, MultiplierUpdate};
 use crate::model::rigid::RigidModes;
 use crate::model::Model;
 use std::collections::{HashMap, HashSet};
@@ -112,6 +125,10 @@ pub(crate) struct ContactSystem<'a> {
     /// each node left.
     departures: Vec<Departure>,
     pub(crate) search_seconds: f64,
+    /// Coulomb pairs: the plastic slip committed at the end of the last load step, by point,
+    /// and the frictional status of the last evaluation (with the direction of a slip).
+    committed: HashMap<RowKey, f64>,
+    status: HashMap<RowKey, (Status, bool)>,
 }
 
 impl<'a> ContactSystem<'a> {
@@ -121,12 +138,13 @@ impl<'a> ContactSystem<'a> {
         model: &'a Model,
         u: Option<&[f64]>,
         previous: Option<&HashSet<RowKey>>,
+        committed: HashMap<RowKey, f64>,
     ) -> Result<Self> {
         let current = model.physics.contact_geometry == ContactGeometry::Current;
         let t = Instant::now();
         let rows = rows_at(model, if current { u } else { None })?;
         let search_seconds = t.elapsed().as_secs_f64();
-        let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.dofs.clone()).collect();
+        let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.all_dofs()).collect();
         let sys = assemble(model, &blocks);
         sys.check_assembled(model)?;
         let rho = (0..sys.n)
@@ -171,6 +189,8 @@ impl<'a> ContactSystem<'a> {
             force_tolerance: 0.0,
             departures: Vec::new(),
             search_seconds,
+            committed,
+            status: HashMap::new(),
         };
         system.number_unknowns();
         Ok(system)
@@ -194,6 +214,39 @@ impl<'a> ContactSystem<'a> {
             Method::Lagrange => RowLaw::Multiplier,
             other => unreachable!("the model refuses {other:?} with the Newton scheme"),
         }
+    }
+
+    /// The friction coefficient and tangential weight `w_t = kappa_t A` of a frictional row.
+    fn coulomb(&self, r: &Constraint) -> Option<(f64, f64)> {
+        r.tangent.as_ref()?;
+        let pair = &self.model.contact[r.pair];
+        let Interaction::Coulomb { mu, kappa_t } = pair.interaction else {
+            return None;
+        };
+        let kappa_t = kappa_t
+            .or_else(|| method(&pair.enforcement).kappa())
+            .expect("the model admits friction with penalty-type methods only");
+        Some((mu, kappa_t * r.area))
+    }
+
+    /// The return map of frictional row `i` at `u`, with its normal force and status.
+    fn friction_at(&self, i: usize, u: &[f64], lambda_n: f64, on: bool) -> Option<ReturnMap> {
+        let r = &self.rows[i];
+        let (mu, w_t) = self.coulomb(r)?;
+        let t = r.tangent.as_ref()?;
+        let committed = self.committed.get(&row_key(r)).copied().unwrap_or(0.0);
+        Some(return_map(mu, w_t, lambda_n, on, t.slip(u), committed))
+    }
+
+    /// The free equations of a gradient with their coefficients.
+    fn free_of(&self, dofs: &[usize], coeffs: &[f64]) -> Vec<(usize, f64)> {
+        dofs.iter()
+            .zip(coeffs)
+            .filter_map(|(&d, &c)| {
+                let e = self.sys.eq(d);
+                (e != NO_EQUATION).then_some((e, c))
+            })
+            .collect()
     }
 
     /// The free equations of row `r` with their coefficients.
@@ -290,7 +343,7 @@ impl<'a> ContactSystem<'a> {
         let sys = &self.sys;
         let covered = self.rows.iter().all(|r| {
             let eqs: Vec<usize> = r
-                .dofs
+                .all_dofs()
                 .iter()
                 .map(|&d| sys.eq(d))
                 .filter(|&e| e != NO_EQUATION)
@@ -309,7 +362,7 @@ impl<'a> ContactSystem<'a> {
         let same_multipliers = multipliers.len() == self.carried.len()
             && multipliers.iter().all(|k| self.carried.contains_key(k));
         if !covered {
-            let blocks: Vec<Vec<usize>> = self.rows.iter().map(|r| r.dofs.clone()).collect();
+            let blocks: Vec<Vec<usize>> = self.rows.iter().map(|r| r.all_dofs()).collect();
             self.sys = assemble(self.model, &blocks);
         }
         if !covered || !same_multipliers {
@@ -326,17 +379,38 @@ impl<'a> ContactSystem<'a> {
     }
 
     /// The contact state at the unknowns `x` (after the solve).
-    fn state(&self, x: &[f64]) -> (Vec<bool>, Vec<f64>, Vec<f64>) {
+    #[allow(clippy::type_complexity)]
+    fn state(&self, x: &[f64]) -> (Vec<bool>, Vec<f64>, Vec<f64>, Vec<Option<FrictionPoint>>) {
         let u = self.sys.expand(&x[..self.sys.n]);
         let mut active = Vec::with_capacity(self.rows.len());
         let mut forces = Vec::with_capacity(self.rows.len());
+        let mut friction = Vec::with_capacity(self.rows.len());
         for i in 0..self.rows.len() {
             let (f, a) = self.force(i, &u, x);
             active.push(a);
             forces.push(if a { f } else { 0.0 });
+            let r = &self.rows[i];
+            friction.push(self.friction_at(i, &u, f, a).map(|m| {
+                let committed = self.committed.get(&row_key(r)).copied().unwrap_or(0.0);
+                FrictionPoint {
+                    status: m.status,
+                    force: m.force,
+                    direction: r.tangent.as_ref().expect("frictional").direction,
+                    mu: self.coulomb(r).expect("frictional").0,
+                    normal_force: if a { f } else { 0.0 },
+                    slip: r.tangent.as_ref().expect("frictional").slip(&u),
+                    plastic_slip: m.plastic_slip,
+                    committed,
+                    dissipation: if m.status == Status::Open {
+                        0.0
+                    } else {
+                        -m.force * (m.plastic_slip - committed)
+                    },
+                }
+            }));
         }
         let gaps = self.rows.iter().map(|r| r.gap(&u)).collect();
-        (active, forces, gaps)
+        (active, forces, gaps, friction)
     }
 
     /// The active points of the last evaluation that have no row at `u`: their slave nodes
@@ -464,6 +538,10 @@ impl System for ContactSystem<'_> {
             ..Evaluation::default()
         };
         let geometric = current && self.model.solver.geometric_stiffness;
+        let symmetrized = self.model.solver.friction_tangent == FrictionTangent::Symmetrized;
+        // unsymmetric entries (row equation, column equation, value) of slipping points
+        let mut coupling: Vec<(usize, usize, f64)> = Vec::new();
+        let mut status = HashMap::new();
         let mut active = HashMap::with_capacity(self.rows.len());
         let mut forces = HashMap::with_capacity(self.rows.len());
         let mut terms: Vec<(usize, f64)> = Vec::new();
@@ -484,6 +562,44 @@ impl System for ContactSystem<'_> {
             }
             active.insert(key, on);
             forces.insert(key, shown);
+            if let Some(map) = self.friction_at(i, &u, lambda, on) {
+                // the branch of the return map: a slip that reverses is a change too
+                let branch = (map.status, map.force > 0.0 && map.status == Status::Slip);
+                if self.evaluations > 0 && self.status.get(&key) != Some(&branch) {
+                    eval.status_changes += 1;
+                }
+                status.insert(key, branch);
+                let t = r.tangent.as_ref().expect("frictional");
+                let tangential = self.free_of(&t.dofs, &t.coeffs);
+                for &(e, c) in &tangential {
+                    residual[e] -= map.force * c;
+                    eval.force_scale = eval.force_scale.max((map.force * c).abs());
+                }
+                if map.d_slip != 0.0 {
+                    // stick: -d lambda_t/d g_t b_t b_t^T = w_t b_t b_t^T
+                    for (a, &(ea, ca)) in tangential.iter().enumerate() {
+                        for &(eb, cb) in &tangential[a..] {
+                            upper[self
+                                .pattern
+                                .position(ea.min(eb), ea.max(eb))
+                                .expect("covered")] -= map.d_slip * ca * cb;
+                        }
+                    }
+                }
+                if map.d_normal != 0.0 {
+                    // slip: -b_t (d lambda_t/d lambda_n) (d lambda_n/du)^T, with
+                    // d lambda_n/du = -w b_n for the penalty-type normal law
+                    let RowLaw::Penalty { w, .. } = self.law(r) else {
+                        unreachable!("the model admits friction with penalty-type methods only")
+                    };
+                    let normal = self.free_terms(r);
+                    for &(ea, ca) in &tangential {
+                        for &(eb, cb) in &normal {
+                            coupling.push((ea, eb, map.d_normal * w * ca * cb));
+                        }
+                    }
+                }
+            }
             terms.clear();
             terms.extend(self.free_terms(r));
             // the weight of b b^T in the displacement block, and the force on the equations
@@ -548,12 +664,20 @@ impl System for ContactSystem<'_> {
             }
         }
         tangent.values = general.symmetric_values(&upper);
-        tangent.symmetric = true;
+        // the symmetrized tangent drops the slip coupling (its symmetric part would make the
+        // matrix indefinite and Newton diverge)
+        tangent.symmetric = coupling.is_empty() || symmetrized;
+        if !symmetrized {
+            for (a, b, v) in coupling {
+                tangent.values[general.position(a, b).expect("covered")] += v;
+            }
+        }
         tangent.multipliers = self.pattern.n - n;
         tangent.scale = rho;
         self.force_tolerance = 1e-10 * forces.values().fold(0.0f64, |m, f| m.max(f.abs()));
         self.active = active;
         self.forces = forces;
+        self.status = status;
         self.evaluations += 1;
         Ok(eval)
     }
@@ -597,12 +721,13 @@ pub(crate) fn solve_step(
     model: &Model,
     previous: Option<HashSet<RowKey>>,
     start: Option<Vec<f64>>,
+    committed: HashMap<RowKey, f64>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Solution> {
     let mut timings = Timings::default();
     let t = Instant::now();
     progress("assembling");
-    let mut system = ContactSystem::new(model, start.as_deref(), previous.as_ref())?;
+    let mut system = ContactSystem::new(model, start.as_deref(), previous.as_ref(), committed)?;
     timings.assembly = (t.elapsed().as_secs_f64() - system.search_seconds).max(0.0);
     let mut x: Vec<f64> = vec![0.0; system.pattern.n];
     if let Some(u) = &start {
@@ -626,11 +751,16 @@ pub(crate) fn solve_step(
         (t.elapsed().as_secs_f64() - outcome.factorization_seconds - timings.contact_search)
             .max(0.0);
     let u = system.sys.expand(&x[..system.sys.n]);
-    let (active, forces, gaps) = system.state(&x);
+    let (active, forces, gaps, friction) = system.state(&x);
     let mut contact_force = vec![0.0; model.dof_count];
-    for (r, &f) in system.rows.iter().zip(&forces) {
+    for ((r, &f), fr) in system.rows.iter().zip(&forces).zip(&friction) {
         for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
             contact_force[d] += c * f;
+        }
+        if let (Some(t), Some(fr)) = (&r.tangent, fr) {
+            for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
+                contact_force[d] += c * fr.force;
+            }
         }
     }
     let current = model.physics.contact_geometry == ContactGeometry::Current;
@@ -656,6 +786,88 @@ pub(crate) fn solve_step(
         steps: Vec::new(),
         history: outcome.history,
         geometry_changes: Vec::new(),
+        friction,
     });
     Ok(solution)
+}
+
+/// The residual and the tangent of the Newton scheme's contact system, one evaluation at a time,
+/// for finite-difference checks of the tangent (`tests/friction.rs`): not part of the solver's
+/// interface.
+#[doc(hidden)]
+pub struct Probe<'a> {
+    system: ContactSystem<'a>,
+    general: GeneralPattern,
+}
+
+/// One evaluation of a [`Probe`].
+#[doc(hidden)]
+pub struct ProbeEvaluation {
+    pub residual: Vec<f64>,
+    /// Dense, row-major: `tangent[i][j] = dR_i / dx_j`.
+    pub tangent: Vec<Vec<f64>>,
+    pub symmetric: bool,
+    /// The frictional status of every frictional row.
+    pub statuses: Vec<Status>,
+}
+
+impl<'a> Probe<'a> {
+    /// The system of `model`'s first load step, every frictional point with the committed
+    /// plastic slip `committed`.
+    pub fn new(model: &'a Model, committed: f64) -> Result<Self> {
+        let mut system = ContactSystem::new(model, None, None, HashMap::new())?;
+        system.committed = system
+            .rows
+            .iter()
+            .filter(|r| r.tangent.is_some())
+            .map(|r| (row_key(r), committed))
+            .collect();
+        // past the first evaluation, which closes rows to hold free bodies
+        system.evaluations = 1;
+        let general = GeneralPattern::from_symmetric(&system.pattern);
+        Ok(Probe { system, general })
+    }
+
+    /// The free unknowns of the global displacement `u`.
+    pub fn unknowns(&self, u: &[f64]) -> Vec<f64> {
+        self.system
+            .sys
+            .constraints
+            .free_dofs()
+            .iter()
+            .map(|&d| u[d])
+            .collect()
+    }
+
+    pub fn evaluate(&mut self, x: &[f64]) -> Result<ProbeEvaluation> {
+        let n = self.general.n;
+        let mut residual = vec![0.0; n];
+        let mut tangent = Tangent {
+            values: vec![0.0; self.general.nnz()],
+            symmetric: true,
+            multipliers: 0,
+            scale: 1.0,
+        };
+        self.system
+            .evaluate(x, &self.general, &mut residual, &mut tangent)?;
+        let g = &self.general;
+        let mut dense = vec![vec![0.0; n]; n];
+        for j in 0..n {
+            for k in g.col_ptr[j]..g.col_ptr[j + 1] {
+                dense[g.row_idx[k]][j] = tangent.values[k];
+            }
+        }
+        let statuses = self
+            .system
+            .rows
+            .iter()
+            .filter_map(|r| self.system.status.get(&row_key(r)).map(|b| b.0))
+            .collect();
+        Ok(ProbeEvaluation {
+            residual,
+            tangent: dense,
+            symmetric: tangent.symmetric,
+            statuses,
+        })
+    }
 }

@@ -23,6 +23,10 @@
 //! * **Tied** pairs use the same weights with one bilateral row per global direction
 //!   (`e_x`, `e_y`) and zero initial gap: the interface keeps its initial geometry.
 //!
+//! * **Coulomb** pairs (node-based rows) add to every row its tangential slip measure
+//!   `g_t = t . (u_s - sum_b N_b u_b)`, `t = (-nu_y, nu_x)`, with the normal row's weights
+//!   ([`crate::contact::TangentRow`]).
+//!
 //! Every row carries the slave node's tributary area, so penalty forces (`kappa A g`) do not
 //! depend on the mesh. Geometry is evaluated in the reference configuration (small strain).
 
@@ -51,6 +55,8 @@ pub const END_EXTENSION: f64 = 0.25;
 pub(crate) struct Rows<'a> {
     pub model: &'a Model,
     pub tied: bool,
+    /// A Coulomb pair: every row carries its tangential slip measure.
+    pub friction: bool,
     /// How far from the master surface a slave node is still a candidate.
     pub search_distance: Option<f64>,
     pub out: Vec<Constraint>,
@@ -86,7 +92,7 @@ impl Rows<'_> {
                 self.out.push(r);
             }
         } else {
-            let r = weighted_row(
+            let mut r = weighted_row(
                 self.model,
                 slave,
                 node,
@@ -98,6 +104,28 @@ impl Rows<'_> {
                 pass,
                 false,
             );
+            if self.friction {
+                // the same weights along the unit tangent of the (unit) contact normal
+                let l = (nu[0] * nu[0] + nu[1] * nu[1]).sqrt();
+                let t = [-nu[1] / l, nu[0] / l];
+                let s = weighted_row(
+                    self.model,
+                    slave,
+                    node,
+                    t,
+                    0.0,
+                    slave_terms,
+                    master,
+                    area,
+                    pass,
+                    false,
+                );
+                r.tangent = Some(crate::contact::TangentRow {
+                    dofs: s.dofs,
+                    coeffs: s.coeffs,
+                    direction: t,
+                });
+            }
             self.out.push(r);
         }
     }
@@ -136,6 +164,7 @@ pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>,
     let mut rows = Rows {
         model,
         tied: pair.interaction == Interaction::Tied,
+        friction: pair.interaction.friction().is_some(),
         search_distance: pair.search_distance,
         out: Vec::new(),
     };
@@ -263,6 +292,7 @@ pub(crate) fn weighted_row(
         pair: 0,
         bilateral,
         mass: Vec::new(),
+        tangent: None,
     }
 }
 

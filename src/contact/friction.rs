@@ -1,0 +1,205 @@
+//! Coulomb friction with penalty regularization: the return map of one contact point.
+//!
+//! Reference: P. Wriggers, *Computational Contact Mechanics* (2nd ed., Springer 2006),
+//! section 5.2 (elasto-plastic analogy of friction) and 6.3 (penalty return map); T. A.
+//! Laursen, *Computational Contact and Impact Mechanics* (Springer 2002), ch. 5; Taylor's talk
+//! (2004), "1988: Friction": Coulomb's law `|lambda_t| <= mu |lambda_n|`, stick `g_t = 0`, slip
+//! `|lambda_t| = mu |lambda_n|`, an unsymmetric tangent.
+//!
+//! A contact row carries its normal force `lambda_n >= 0` (compression positive) and its
+//! tangential slip measure `g_t(u) = t . (u_s - sum_m N_m u_m)` ([`super::TangentRow`]). The
+//! slip splits into an elastic part (the penalty spring) and a plastic part `g_t^p` (the
+//! sliding), committed at the end of every converged load step (`g_t^{p,n}`). With the
+//! tangential weight `w_t = kappa_t A` (tributary area `A`):
+//!
+//! ```text
+//! trial:  lambda_t^tr = -w_t (g_t - g_t^{p,n})
+//! stick:  |lambda_t^tr| <= mu lambda_n    =>  lambda_t = lambda_t^tr,            g_t^p = g_t^{p,n}
+//! slip:   otherwise, s = sign(lambda_t^tr) =>  lambda_t = s mu lambda_n,
+//!                                             g_t^p = g_t + lambda_t / w_t
+//! open:   lambda_n inactive               =>  lambda_t = 0,                      g_t^p = g_t
+//! ```
+//!
+//! The tangential force on the row's dofs is `lambda_t b_t` (`b_t = dg_t/du`), like the normal
+//! force `lambda_n b_n`, so the residual `R = K u - f - lambda_n b_n - lambda_t b_t` has the
+//! tangent contributions
+//!
+//! ```text
+//! stick:  + w_t b_t b_t^T
+//! slip:   - b_t (d lambda_t / du)^T = - s mu b_t (d lambda_n / du)^T = + s mu w_n b_t b_n^T
+//! ```
+//!
+//! (penalty normal law `lambda_n = lambda_bar - w_n g_n`): unsymmetric in slip (Ju & Taylor
+//! 1988). The open branch resets the elastic slip, so a point that closes again starts to
+//! stick where it lands. The frictional dissipation of a step is `D = -lambda_t (g_t^p -
+//! g_t^{p,n}) = mu lambda_n (|lambda_t^tr| - mu lambda_n) / w_t >= 0` in slip (zero in stick).
+
+use serde::Serialize;
+
+/// The frictional status of a contact point.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    Open,
+    Stick,
+    Slip,
+}
+
+/// The return map at one point.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct ReturnMap {
+    pub status: Status,
+    /// The tangential force `lambda_t` (along the row's tangent, on the slave node).
+    pub force: f64,
+    /// The plastic slip after the map, `g_t^p`.
+    pub plastic_slip: f64,
+    /// `d lambda_t / d g_t` (`-w_t` in stick, zero otherwise).
+    pub d_slip: f64,
+    /// `d lambda_t / d lambda_n` (`s mu` in slip, zero otherwise).
+    pub d_normal: f64,
+}
+
+/// The return map of a point with normal force `lambda_n` (`active`: the normal row carries
+/// force), slip `g_t`, committed plastic slip `committed`, friction coefficient `mu` and
+/// tangential weight `w_t = kappa_t A`. A tensile normal force (a row closed at the start of a
+/// step) bounds nothing: it counts as zero.
+pub fn return_map(
+    mu: f64,
+    w_t: f64,
+    lambda_n: f64,
+    active: bool,
+    g_t: f64,
+    committed: f64,
+) -> ReturnMap {
+    if !active {
+        return ReturnMap {
+            status: Status::Open,
+            force: 0.0,
+            plastic_slip: g_t,
+            d_slip: 0.0,
+            d_normal: 0.0,
+        };
+    }
+    let trial = -w_t * (g_t - committed);
+    let bound = mu * lambda_n.max(0.0);
+    if trial.abs() <= bound {
+        return ReturnMap {
+            status: Status::Stick,
+            force: trial,
+            plastic_slip: committed,
+            d_slip: -w_t,
+            d_normal: 0.0,
+        };
+    }
+    let s = trial.signum();
+    let force = s * bound;
+    ReturnMap {
+        status: Status::Slip,
+        force,
+        plastic_slip: g_t + force / w_t,
+        d_slip: 0.0,
+        d_normal: if lambda_n > 0.0 { s * mu } else { 0.0 },
+    }
+}
+
+/// What a solve found at one frictional contact point (aligned with the rows of
+/// [`super::state::ContactState`]).
+#[derive(Copy, Clone, Debug, PartialEq, Serialize)]
+pub struct FrictionPoint {
+    pub status: Status,
+    /// Tangential force `lambda_t` along the row's tangent `t`, on the slave node.
+    pub force: f64,
+    /// The unit tangent `t`.
+    pub direction: [f64; 2],
+    /// The friction coefficient of the point's pair.
+    pub mu: f64,
+    /// The normal force bounding it, `lambda_n` (zero when open).
+    pub normal_force: f64,
+    /// Slip measure `g_t` and plastic slip `g_t^p` at the end of the step, and the plastic slip
+    /// committed at the start of the step.
+    pub slip: f64,
+    pub plastic_slip: f64,
+    pub committed: f64,
+    /// Frictional dissipation of the step, `-lambda_t (g_t^p - g_t^{p,n})` (>= 0; zero open).
+    pub dissipation: f64,
+}
+
+/// The frictional totals of one pair at the end of a solve.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FrictionSummary {
+    /// Sum of the tangential forces `lambda_t t` on the slave nodes, `[x, y]` (the pair's
+    /// `force_on_slave` is that of the normal rows).
+    pub tangential_force: [f64; 2],
+    pub open: usize,
+    pub stick: usize,
+    pub slip: usize,
+    /// Frictional dissipation of the last load step (sum over the points, >= 0).
+    pub dissipation: f64,
+    /// Largest `|lambda_t| / (mu lambda_n)` over the closed points (<= 1: Coulomb's cone).
+    pub max_cone_ratio: f64,
+}
+
+/// The frictional totals of all pairs of `state` (`None`: no frictional row).
+pub fn step_summary(state: &super::state::ContactState) -> Option<FrictionSummary> {
+    summarize(state, None)
+}
+
+/// The frictional totals of pair `pair` of `state` (`None`: no frictional row).
+pub fn pair_summary(state: &super::state::ContactState, pair: usize) -> Option<FrictionSummary> {
+    summarize(state, Some(pair))
+}
+
+fn summarize(state: &super::state::ContactState, pair: Option<usize>) -> Option<FrictionSummary> {
+    let mut out = FrictionSummary {
+        tangential_force: [0.0; 2],
+        open: 0,
+        stick: 0,
+        slip: 0,
+        dissipation: 0.0,
+        max_cone_ratio: 0.0,
+    };
+    let mut any = false;
+    for (r, f) in state.rows.iter().zip(&state.friction) {
+        let (Some(f), true) = (f, pair.is_none_or(|p| p == r.pair)) else {
+            continue;
+        };
+        any = true;
+        for k in 0..2 {
+            out.tangential_force[k] += f.force * f.direction[k];
+        }
+        match f.status {
+            Status::Open => out.open += 1,
+            Status::Stick => out.stick += 1,
+            Status::Slip => out.slip += 1,
+        }
+        out.dissipation += f.dissipation;
+        if f.status != Status::Open && f.force != 0.0 {
+            out.max_cone_ratio = out
+                .max_cone_ratio
+                .max(f.force.abs() / (f.mu * f.normal_force.max(0.0)));
+        }
+    }
+    any.then_some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stick_slip_and_open_branches() {
+        let stick = return_map(0.5, 10.0, 4.0, true, 0.1, 0.0);
+        assert_eq!(stick.status, Status::Stick);
+        assert_eq!(stick.force, -1.0);
+        let slip = return_map(0.5, 10.0, 4.0, true, 0.5, 0.0);
+        assert_eq!(slip.status, Status::Slip);
+        assert_eq!(slip.force, -2.0);
+        // the elastic part of the slip carries the force
+        assert!((-10.0 * (0.5 - slip.plastic_slip) - slip.force).abs() < 1e-15);
+        let open = return_map(0.5, 10.0, 0.0, false, 0.5, 0.2);
+        assert_eq!(
+            (open.status, open.force, open.plastic_slip),
+            (Status::Open, 0.0, 0.5)
+        );
+    }
+}

@@ -1,0 +1,707 @@
+//! Coulomb friction with penalty regularization in the Newton scheme (penalty and perturbed
+//! Lagrangian normal laws)
+//! (`src/contact/friction.rs`, `src/solver/contact_newton.rs`), every check against a closed
+//! form:
+//!
+//! * the tangent of the contact system against central differences of its residual, at a stick
+//!   and at a slip state (node-to-node, node-to-surface, rigid line and circle);
+//! * the frictional patch test (meshes A, D node-to-node; C, E node-to-surface one-pass): a
+//!   uniform stress field `[0, -p, q]` loaded by its own tractions on every free boundary;
+//!   `q < mu p` sticks (uniform stress exactly where the frictionless penalty passes the patch
+//!   test), a prescribed tangential displacement of the punch top slips with `|lambda_t| = mu
+//!   lambda_n` at every slave node (`mu p` per unit area where the frictionless test passes);
+//! * the sliding limit of a block on an incline, `F/G = (tan a + mu) / (1 - mu tan a)`, with
+//!   Coulomb's inequality and non-negative dissipation in every converged step;
+//! * Newton's residual history with the consistent (unsymmetric) and the symmetrized tangent.
+
+use contact_patch::contact::friction::Status;
+use contact_patch::model::{parse, Model};
+use contact_patch::run::{run_model, Outcome};
+use contact_patch::solver::active_set::Termination;
+use contact_patch::solver::contact_newton::Probe;
+use serde_json::{json, Value};
+use std::path::Path;
+
+const P: f64 = 10.0;
+const MU: f64 = 0.3;
+const KAPPA: f64 = 1e4;
+
+fn read(case: &str) -> Value {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(case);
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn build(v: &Value) -> contact_patch::Result<Model> {
+    let case = parse(&v.to_string(), "friction")?;
+    Model::build(&case, "friction")
+}
+
+fn run(v: &Value) -> Outcome {
+    run_model(
+        build(v).unwrap(),
+        0.0,
+        std::time::Instant::now(),
+        &mut |_| {},
+    )
+    .unwrap()
+}
+
+fn termination(o: &Outcome) -> Termination {
+    o.solution.contact.as_ref().unwrap().termination.clone()
+}
+
+/// How the punch top is loaded along x.
+#[derive(Clone, Copy)]
+enum Top {
+    /// The traction of the uniform field (`q = sigma_xy`).
+    Traction,
+    /// Pressure `p` with the tangential displacement `d` prescribed.
+    Displacement(f64),
+}
+
+/// A patch case with the uniform field `[0, -p, sxy]`, loaded along a path: in the first
+/// step (of `steps >= 2`) the pressure `p` alone (on the punch top and the foundation's exposed
+/// top), then the shear part of the field's traction `(sxy n_y, sxy n_x)` on every free
+/// boundary of both bodies (the foundation's bottom along x too) in the later steps. The field
+/// is then the exact solution of the bonded (stick) problem, and of the slip problem with
+/// `sxy = mu p`. With one step, both at once.
+fn patch(mesh: &str, nu: &str, discretization: Value, sxy: f64, top: Top, steps: usize) -> Value {
+    let mut v = read(&format!("cases/patch/patch-{mesh}-nu{nu}.json"));
+    let o = v.as_object_mut().unwrap();
+    o.remove("sweep");
+    o.remove("checks");
+    v["exact"] = json!({"kind": "uniform_stress", "stress": [0.0, -P, sxy]});
+    // normal first, then tangential
+    let normal: Vec<f64> = vec![1.0; steps];
+    let tangential: Vec<f64> = (1..=steps)
+        .map(|k| {
+            if steps == 1 {
+                1.0
+            } else {
+                (k - 1) as f64 / (steps - 1) as f64
+            }
+        })
+        .collect();
+    let pressure =
+        |body: &str, set: &str| json!({"body": body, "set": set, "pressure": P, "path": normal});
+    let shear = |body: &str, set: &str, t: [f64; 2]| json!({"body": body, "set": set, "traction": [t[0] * sxy, t[1] * sxy], "path": tangential});
+    let mut supports = vec![
+        json!({"body": "foundation", "set": "bottom", "y": 0.0}),
+        json!({"body": "foundation", "set": "bottom_left", "x": 0.0}),
+    ];
+    let mut loads = vec![
+        pressure("punch", "top"),
+        pressure("foundation", "exposed_left"),
+        pressure("foundation", "exposed_right"),
+        shear("punch", "left", [0.0, -1.0]),
+        shear("punch", "right", [0.0, 1.0]),
+        shear("foundation", "exposed_left", [1.0, 0.0]),
+        shear("foundation", "exposed_right", [1.0, 0.0]),
+        shear("foundation", "left", [0.0, -1.0]),
+        shear("foundation", "right", [0.0, 1.0]),
+        shear("foundation", "bottom", [-1.0, 0.0]),
+    ];
+    match top {
+        Top::Traction => loads.push(shear("punch", "top", [1.0, 0.0])),
+        Top::Displacement(d) => {
+            supports.push(json!({"body": "punch", "set": "top", "x": d, "path": tangential}))
+        }
+    }
+    v["supports"] = json!(supports);
+    v["loads"] = json!(loads);
+    v["contact"] = json!([{
+        "name": "interface",
+        "slave": {"body": "punch", "set": "bottom"},
+        "master": {"body": "foundation", "set": "contact"},
+        "discretization": discretization,
+        "enforcement": {"kind": "penalty", "kappa": KAPPA},
+        "interaction": {"coulomb": {"mu": MU}},
+    }]);
+    v["solver"] = json!({"scheme": "newton", "load_steps": steps});
+    v
+}
+
+fn node_to_node() -> Value {
+    json!({"kind": "node_to_node"})
+}
+fn node_to_surface() -> Value {
+    json!({"kind": "node_to_surface", "passes": 1})
+}
+
+/// Largest `|sigma - sigma_exact|` over the quadrature points of every body.
+fn stress_error(o: &Outcome, exact: [f64; 3]) -> f64 {
+    let mut e = 0.0f64;
+    for b in &o.model.bodies {
+        contact_patch::post::for_each_quadrature_stress(b, &o.solution.u, |_, _, s| {
+            for k in 0..3 {
+                e = e.max((s[k] - exact[k]).abs());
+            }
+        });
+    }
+    e
+}
+
+/// The frictional points of the last step: (status, lambda_t, lambda_n, area, direction).
+fn points(o: &Outcome) -> Vec<(Status, f64, f64, f64, [f64; 2])> {
+    let c = o.solution.contact.as_ref().unwrap();
+    c.rows
+        .iter()
+        .zip(&c.friction)
+        .map(|(r, f)| {
+            let f = f.expect("a frictional row");
+            (f.status, f.force, f.normal_force, r.area, f.direction)
+        })
+        .collect()
+}
+
+/// The total tangential force on the slave body, x component.
+fn tangential_x(o: &Outcome) -> f64 {
+    points(o).iter().map(|p| p.1 * p.4[0]).sum()
+}
+
+#[test]
+fn frictional_patch_test_sticks_below_the_cone_with_the_uniform_stress() {
+    let q = 0.5 * MU * P;
+    for (mesh, disc, exact_patch) in [
+        ("A", node_to_node(), true),
+        ("D", node_to_node(), true),
+        ("A", node_to_surface(), true),
+        ("C", node_to_surface(), false),
+        ("E", node_to_surface(), false),
+    ] {
+        let o = run(&patch(mesh, "0.3", disc.clone(), q, Top::Traction, 2));
+        assert_eq!(termination(&o), Termination::Converged, "{mesh} {disc}");
+        let pts = points(&o);
+        assert!(pts.iter().all(|p| p.0 == Status::Stick), "{mesh} {disc}");
+        // the tangential forces carry the applied tangential load 2 q (equilibrium of the punch)
+        let t = tangential_x(&o);
+        assert!((t + 2.0 * q).abs() <= 1e-10 * 2.0 * q, "{mesh} {disc}: {t}");
+        for p in &pts {
+            assert!(p.1.abs() <= MU * p.2 * (1.0 + 1e-12));
+        }
+        // the first step pressed the punch without tangential force: every point stuck
+        let steps = &o.solution.contact.as_ref().unwrap().steps;
+        let first = steps[0].friction.as_ref().unwrap();
+        assert_eq!(first.stick, pts.len());
+        assert!(first.tangential_force[0].abs() <= 1e-10 * P, "{first:?}");
+        let e = stress_error(&o, [0.0, -P, q]) / P;
+        println!("stick, mesh {mesh}, {disc}: stress error {e:.1e} p");
+        if exact_patch {
+            assert!(e < 1e-8, "{mesh} {disc}: stress error {e:e}");
+        } else {
+            // one-pass node-to-surface on non-matching meshes fails the frictionless patch test
+            // (reports/patch-table.md: 4e-2 on C, 6e-2 on E with the penalty); friction keeps
+            // that error, it does not add one of its own order
+            assert!(e < 0.15, "{mesh} {disc}: stress error {e:e}");
+        }
+    }
+}
+
+#[test]
+fn frictional_patch_test_slips_with_traction_mu_p_under_a_prescribed_tangential_displacement() {
+    let sxy = MU * P;
+    for (mesh, disc, exact_patch) in [
+        ("A", node_to_node(), true),
+        ("D", node_to_node(), true),
+        ("A", node_to_surface(), true),
+        ("C", node_to_surface(), false),
+        ("E", node_to_surface(), false),
+    ] {
+        let o = run(&patch(
+            mesh,
+            "0.0",
+            disc.clone(),
+            sxy,
+            Top::Displacement(0.05),
+            2,
+        ));
+        assert_eq!(termination(&o), Termination::Converged, "{mesh} {disc}");
+        let pts = points(&o);
+        let normal: f64 = pts.iter().map(|p| p.2).sum();
+        for p in &pts {
+            assert_eq!(p.0, Status::Slip, "{mesh} {disc}");
+            // Coulomb's law holds to round-off at every slave node, against the motion (+x)
+            assert!(
+                (p.1.abs() - MU * p.2).abs() <= 1e-12 * MU * P,
+                "{mesh} {disc}"
+            );
+            assert!(p.1 * p.4[0] < 0.0);
+            if exact_patch {
+                // and the traction is mu p at every node where the patch test passes
+                assert!(
+                    (p.1.abs() / p.3 - MU * P).abs() <= 1e-9 * MU * P,
+                    "{mesh} {disc}: {}",
+                    p.1 / p.3
+                );
+            }
+        }
+        // the pressures sum to the load 2 p; the tangential forces to mu times that
+        assert!((normal - 2.0 * P).abs() <= 1e-10 * P, "{mesh} {disc}");
+        let t = tangential_x(&o);
+        assert!((t + 2.0 * MU * P).abs() <= 1e-10 * P, "{mesh} {disc}: {t}");
+        let e = stress_error(&o, [0.0, -P, sxy]) / P;
+        println!("slip, mesh {mesh}, {disc}: stress error {e:.1e} p");
+        if exact_patch {
+            assert!(e < 1e-8, "{mesh} {disc}: stress error {e:e}");
+        } else {
+            assert!(e < 0.15, "{mesh} {disc}: stress error {e:e}");
+        }
+        let s = o.solution.contact.as_ref().unwrap().steps.clone();
+        for step in &s {
+            let f = step.friction.as_ref().unwrap();
+            assert!(f.dissipation >= 0.0 && f.max_cone_ratio <= 1.0 + 1e-12);
+        }
+        // pressed without sliding in the first step, sliding with dissipation in the last
+        assert_eq!(s[0].friction.as_ref().unwrap().slip, 0);
+        let last = s.last().unwrap().friction.as_ref().unwrap();
+        assert!(last.dissipation > 0.0);
+    }
+}
+
+/// A block `[0, 2] x [0, 1]` on a rigid master, loaded by a uniform body force: the weight `G`
+/// and a horizontal push `F` of an incline at angle `a`, written in the incline's frame (the
+/// rigid line is `y = 0`).
+fn incline(f_over_g: f64, tan_a: f64, steps: usize) -> Value {
+    let g = 10.0;
+    let (s, c) = (
+        tan_a / (1.0 + tan_a * tan_a).sqrt(),
+        1.0 / (1.0 + tan_a * tan_a).sqrt(),
+    );
+    let f = f_over_g * g;
+    let area = 2.0;
+    json!({
+        "name": "incline",
+        "analysis": {"plane": "strain", "thickness": 1.0},
+        "materials": {"m": {"E": 1000.0, "nu": 0.3}},
+        "bodies": [{"name": "block", "material": "m",
+            "mesh": {"block": {"element": "Q4", "x": [0, 0.5, 1, 1.5, 2], "y": [0, 0.5, 1]}}}],
+        "supports": [],
+        "loads": [{"body": "block", "body_force": [(f * c - g * s) / area, -(g * c + f * s) / area]}],
+        "contact": [{
+            "name": "base",
+            "slave": {"body": "block", "set": "bottom"},
+            "master": {"rigid": {"kind": "line", "point": [0.0, 0.0], "normal": [0.0, 1.0]}},
+            "discretization": {"kind": "node_to_surface", "passes": 1},
+            "enforcement": {"kind": "penalty", "kappa": 1e5},
+            "interaction": {"coulomb": {"mu": MU}},
+        }],
+        "solver": {"scheme": "newton", "load_steps": steps},
+    })
+}
+
+#[test]
+fn a_block_on_an_incline_slides_at_the_coulomb_limit() {
+    let tan_a: f64 = 0.1;
+    let limit = (tan_a + MU) / (1.0 - MU * tan_a);
+    assert!((limit - 0.412371).abs() < 1e-6);
+    let (s, c) = (
+        tan_a / (1.0 + tan_a * tan_a).sqrt(),
+        1.0 / (1.0 + tan_a * tan_a).sqrt(),
+    );
+    for ratio in [0.5, 0.98, 0.995] {
+        let o = run(&incline(ratio * limit, tan_a, 4));
+        assert_eq!(
+            termination(&o),
+            Termination::Converged,
+            "F/G = {ratio} limit"
+        );
+        let state = o.solution.contact.as_ref().unwrap();
+        // Coulomb's inequality and non-negative dissipation in every converged step
+        assert_eq!(state.steps.len(), 4);
+        for step in &state.steps {
+            let f = step.friction.as_ref().unwrap();
+            assert!(f.max_cone_ratio <= 1.0 + 1e-12, "{f:?}");
+            assert!(f.dissipation >= 0.0, "{f:?}");
+        }
+        // the contact forces carry the load along and across the incline
+        let (g, f) = (10.0, ratio * limit * 10.0);
+        let tangential = tangential_x(&o);
+        let normal: f64 = points(&o).iter().map(|p| p.2).sum();
+        assert!(
+            (tangential + (f * c - g * s)).abs() <= 1e-9 * g,
+            "{tangential}"
+        );
+        assert!((normal - (g * c + f * s)).abs() <= 1e-9 * g, "{normal}");
+        assert!(tangential.abs() <= MU * normal * (1.0 + 1e-12));
+        let last = state.steps.last().unwrap().friction.clone().unwrap();
+        println!(
+            "F/G = {ratio} x limit: stick {}, slip {}, |T|/(mu N) = {:.6}",
+            last.stick,
+            last.slip,
+            tangential.abs() / (MU * normal)
+        );
+    }
+    // just past the limit no equilibrium exists: the block slides away
+    let o = run(&incline(1.01 * limit, tan_a, 4));
+    assert_ne!(termination(&o), Termination::Converged);
+}
+
+#[test]
+fn on_a_load_path_the_block_starts_to_slide_at_the_coulomb_limit() {
+    // the weight first, then the push ramped across the limit: the solve converges in every
+    // step below it and stops at the first step past it
+    let tan_a: f64 = 0.1;
+    let limit = (tan_a + MU) / (1.0 - MU * tan_a);
+    let ramp = [0.0, 0.25, 0.5, 0.75, 0.9, 0.97, 0.99, 0.998, 1.005, 1.02];
+    let (g, area) = (10.0, 2.0);
+    let (s, c) = (
+        tan_a / (1.0 + tan_a * tan_a).sqrt(),
+        1.0 / (1.0 + tan_a * tan_a).sqrt(),
+    );
+    let f = limit * g;
+    let mut v = incline(0.0, tan_a, ramp.len());
+    v["loads"] = json!([
+        {"body": "block", "body_force": [-g * s / area, -g * c / area], "path": vec![1.0; ramp.len()]},
+        {"body": "block", "body_force": [f * c / area, -f * s / area], "path": ramp},
+    ]);
+    let o = run(&v);
+    let steps = &o.solution.contact.as_ref().unwrap().steps;
+    let past = ramp.iter().position(|&r| r > 1.0).unwrap();
+    assert_eq!(steps.len(), past + 1, "{steps:?}");
+    for (k, step) in steps.iter().enumerate() {
+        if k < past {
+            assert_eq!(step.termination, Termination::Converged, "step {}", k + 1);
+            let fr = step.friction.as_ref().unwrap();
+            assert!(fr.max_cone_ratio <= 1.0 + 1e-12, "{fr:?}");
+            assert!(fr.dissipation >= 0.0, "{fr:?}");
+            // the tangential forces carry the tangential load of the step
+            let load = ramp[k] * f * c - g * s;
+            assert!((fr.tangential_force[0] + load).abs() <= 1e-9 * g, "{fr:?}");
+        } else {
+            assert_ne!(step.termination, Termination::Converged);
+        }
+    }
+    // under its weight alone (tan a < mu) the block holds; an edge node may slip locally
+    // (Poisson's expansion against friction), as the counts show
+    let first = steps[0].friction.as_ref().unwrap();
+    assert!(first.stick > first.slip, "{first:?}");
+}
+
+/// A block `[0, 2] x [0, 1]` pressed by `p` onto a rigid master and dragged by a prescribed
+/// displacement `d` of its top along x (`nu = 0`: no Poisson expansion for friction to resist,
+/// so a small `d` sticks at every point).
+fn dragged(master: Value, d: f64) -> Value {
+    json!({
+        "name": "dragged",
+        "analysis": {"plane": "strain", "thickness": 1.0},
+        "materials": {"m": {"E": 1000.0, "nu": 0.0}},
+        "bodies": [{"name": "block", "material": "m",
+            "mesh": {"block": {"element": "Q4", "x": [0, 0.5, 1, 1.5, 2], "y": [0, 0.5, 1]}}}],
+        "supports": [{"body": "block", "set": "top", "x": d}],
+        "loads": [{"body": "block", "set": "top", "pressure": P}],
+        "contact": [{
+            "name": "base",
+            "slave": {"body": "block", "set": "bottom"},
+            "master": {"rigid": master},
+            "discretization": {"kind": "node_to_surface", "passes": 1},
+            "enforcement": {"kind": "penalty", "kappa": 1e4},
+            "interaction": {"coulomb": {"mu": MU}},
+        }],
+        "solver": {"scheme": "newton"},
+    })
+}
+
+/// Largest difference between the tangent's columns and central differences of the residual,
+/// relative to the largest tangent entry.
+fn fd_error(model: &Model, u: &[f64], expect: Status) -> f64 {
+    let mut probe = Probe::new(model, 0.0).unwrap();
+    let x = probe.unknowns(u);
+    let at = probe.evaluate(&x).unwrap();
+    // every closed point in the expected status (open points may stay open)
+    let same = |st: &[Status]| st.iter().all(|&s| s == expect || s == Status::Open);
+    assert!(same(&at.statuses), "{:?}", at.statuses);
+    assert!(at.statuses.contains(&expect));
+    assert_eq!(at.symmetric, !at.statuses.contains(&Status::Slip));
+    let scale = at
+        .tangent
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let h = 1e-7 * x.iter().fold(1e-3f64, |m, v| m.max(v.abs()));
+    let mut worst = 0.0f64;
+    for j in 0..x.len() {
+        let mut xp = x.clone();
+        xp[j] += h;
+        let rp = probe.evaluate(&xp).unwrap();
+        let mut xm = x.clone();
+        xm[j] -= h;
+        let rm = probe.evaluate(&xm).unwrap();
+        assert!(rp.statuses == at.statuses && rm.statuses == at.statuses);
+        for i in 0..x.len() {
+            let fd = (rp.residual[i] - rm.residual[i]) / (2.0 * h);
+            worst = worst.max((fd - at.tangent[i][j]).abs() / scale);
+        }
+    }
+    worst
+}
+
+fn line() -> Value {
+    json!({"kind": "line", "point": [0.0, 0.0], "normal": [0.0, 1.0]})
+}
+
+/// A circle of radius 1000 touching the block's bottom at its middle: under the load every
+/// slave node touches it (the gap at the ends, 5e-4, is below the penetration p / kappa), and
+/// the tilt of its normal there, 1e-3, stays well inside the friction cone.
+fn circle() -> Value {
+    json!({"kind": "circle", "centre": [1.0, -1000.0], "radius": 1000.0})
+}
+
+#[test]
+fn the_frictional_tangent_is_the_derivative_of_the_residual_in_stick_and_in_slip() {
+    let cases = [
+        (
+            "A node-to-node",
+            patch(
+                "A",
+                "0.0",
+                node_to_node(),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+            patch("A", "0.3", node_to_node(), 0.5 * MU * P, Top::Traction, 1),
+        ),
+        (
+            "C node-to-surface",
+            patch(
+                "C",
+                "0.0",
+                node_to_surface(),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+            patch(
+                "C",
+                "0.3",
+                node_to_surface(),
+                0.5 * MU * P,
+                Top::Traction,
+                1,
+            ),
+        ),
+        ("rigid line", dragged(line(), 0.05), dragged(line(), 1e-6)),
+        (
+            "rigid circle",
+            dragged(circle(), 0.05),
+            dragged(circle(), 1e-6),
+        ),
+    ];
+    for (name, slip, stick) in cases {
+        for (v, status) in [(stick, Status::Stick), (slip, Status::Slip)] {
+            let o = run(&v);
+            assert_eq!(termination(&o), Termination::Converged, "{name} {status:?}");
+            let model = build(&v).unwrap();
+            let e = fd_error(&model, &o.solution.u, status);
+            println!("{name}, {status:?}: tangent vs central differences {e:.1e}");
+            assert!(e < 1e-6, "{name} {status:?}: {e:e}");
+        }
+    }
+}
+
+/// Residual history of the first step of `v` with the given friction tangent.
+fn history(v: &Value, tangent: &str) -> (Termination, Vec<(f64, usize, &'static str)>) {
+    let mut v = v.clone();
+    v["solver"]["friction_tangent"] = json!(tangent);
+    let o = run(&v);
+    let c = o.solution.contact.as_ref().unwrap();
+    (
+        c.termination.clone(),
+        c.history
+            .iter()
+            .map(|h| (h.residual, h.status_changes, h.linear_solver))
+            .collect(),
+    )
+}
+
+#[test]
+fn newton_with_the_consistent_tangent_beats_the_symmetrized_one_in_slip() {
+    for (name, v) in [
+        (
+            "patch A, node-to-node",
+            patch(
+                "A",
+                "0.0",
+                node_to_node(),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+        ),
+        (
+            "patch C, node-to-surface",
+            patch(
+                "C",
+                "0.0",
+                node_to_surface(),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+        ),
+    ] {
+        let (t_c, consistent) = history(&v, "consistent");
+        let (t_s, symmetrized) = history(&v, "symmetrized");
+        println!("{name}\n  consistent  {consistent:?}\n  symmetrized {symmetrized:?}");
+        assert_eq!(t_c, Termination::Converged, "{name}");
+        assert_eq!(t_s, Termination::Converged, "{name}");
+        // the consistent tangent is unsymmetric in slip: LU
+        assert_eq!(consistent.last().unwrap().2, "lu");
+        // with the branch fixed the residual is affine in u and the consistent tangent exact:
+        // the first iteration without a status change lands on the solution
+        let settled = consistent.iter().position(|h| h.1 == 0).unwrap();
+        assert_eq!(settled, consistent.len() - 1, "{name}");
+        assert!(consistent.last().unwrap().0 <= 1e-10);
+        // the symmetrized tangent converges linearly: more iterations, the residual falling
+        // by a bounded factor per iteration once the branch is fixed
+        assert!(symmetrized.len() > consistent.len() + 2, "{name}");
+        let tail: Vec<f64> = symmetrized
+            .iter()
+            .filter(|h| h.1 == 0)
+            .map(|h| h.0)
+            .collect();
+        let rates: Vec<f64> = tail.windows(2).map(|w| w[1] / w[0]).collect();
+        assert!(rates.iter().all(|&r| r < 1.0), "{name}: {rates:?}");
+    }
+    // on the rigid circle (points opening and closing on the way) the consistent tangent
+    // settles its branches in four iterations and then lands on the solution; the symmetrized
+    // one was seen to cycle between two branch sets there (iteration limit), not asserted
+    let (t, consistent) = history(&dragged(circle(), 0.05), "consistent");
+    assert_eq!(t, Termination::Converged);
+    assert_eq!(
+        consistent.iter().position(|h| h.1 == 0),
+        Some(consistent.len() - 1)
+    );
+}
+
+fn refusal(v: &Value) -> String {
+    match build(v) {
+        Ok(_) => panic!("accepted"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn friction_is_refused_where_this_slice_does_not_solve_it_with_the_fix() {
+    let base = patch("A", "0.3", node_to_node(), 0.0, Top::Traction, 1);
+    assert!(build(&base).is_ok());
+    let with = |f: &dyn Fn(&mut Value)| {
+        let mut v = base.clone();
+        f(&mut v);
+        refusal(&v)
+    };
+    let m = with(&|v| v["contact"][0]["interaction"]["coulomb"]["mu"] = json!(-0.1));
+    assert!(m.contains("mu must be a finite number >= 0"), "{m}");
+    let m = with(&|v| v["contact"][0]["interaction"]["coulomb"]["kappa_t"] = json!(0.0));
+    assert!(m.contains("kappa_t must be positive"), "{m}");
+    let m = with(&|v| v["solver"]["scheme"] = json!("active_set"));
+    assert!(
+        m.contains("Newton scheme only") && m.contains("\"newton\""),
+        "{m}"
+    );
+    let m = with(&|v| v["contact"][0]["enforcement"] = json!({"kind": "lagrange"}));
+    assert!(m.contains("penalty-type normal law"), "{m}");
+    let m = with(&|v| v["contact"][0]["discretization"] = json!({"kind": "mortar"}));
+    assert!(
+        m.contains("node-to-node and one-pass node-to-surface"),
+        "{m}"
+    );
+    let m = with(&|v| {
+        v["contact"][0]["discretization"] = json!({"kind": "node_to_surface", "passes": 2})
+    });
+    assert!(m.contains("one-pass"), "{m}");
+    let m = with(&|v| v["physics"] = json!({"contact_geometry": "current"}));
+    assert!(m.contains("reference contact geometry"), "{m}");
+    let m = with(&|v| v["loads"][0]["path"] = json!([0.0, 1.0]));
+    assert!(
+        m.contains("one factor per load step: 2 given, solver.load_steps is 1"),
+        "{m}"
+    );
+    // unknown fields of the interaction are refused by the parser
+    let mut v = base.clone();
+    v["contact"][0]["interaction"]["coulomb"]["m"] = json!(0.3);
+    assert!(parse(&v.to_string(), "friction").is_err());
+}
+
+#[test]
+fn a_frictionless_scene_builds_no_tangential_row() {
+    let mut v = patch("A", "0.3", node_to_node(), 0.0, Top::Traction, 1);
+    v["contact"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("interaction");
+    // the punch needs its x support back without friction
+    v["supports"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"body": "punch", "set": "top_left", "x": 0.0}));
+    let o = run(&v);
+    let c = o.solution.contact.as_ref().unwrap();
+    assert!(c.rows.iter().all(|r| r.tangent.is_none()));
+    assert!(c.friction.iter().all(|f| f.is_none()));
+    assert!(c.steps.iter().all(|s| s.friction.is_none()));
+}
+
+#[test]
+fn the_summary_reports_the_tangential_force_and_the_stick_and_slip_counts() {
+    let o = run(&patch(
+        "A",
+        "0.0",
+        node_to_node(),
+        MU * P,
+        Top::Displacement(0.05),
+        2,
+    ));
+    let nodal: Vec<Vec<[f64; 3]>> = o
+        .model
+        .bodies
+        .iter()
+        .map(|b| contact_patch::post::nodal_stresses(b, &o.solution.u))
+        .collect();
+    let summary = serde_json::to_value(contact_patch::io::output::summary(&o, &nodal)).unwrap();
+    let pair = &summary["contact"]["pairs"][0];
+    let f = &pair["friction"];
+    assert_eq!(f["slip"], json!(3), "{f}");
+    assert_eq!(f["stick"], json!(0), "{f}");
+    let t = f["tangential_force"][0].as_f64().unwrap();
+    assert!((t + 2.0 * MU * P).abs() <= 1e-10 * P, "{f}");
+    // the punch top moved d = 0.05; the uniform shear gamma = mu p / G carries it through the
+    // punch and the foundation (heights 2 and 5, u_x = gamma y), the penalty spring takes
+    // mu p / kappa_t: the rest slid, against the traction mu p over the width 2
+    let (d, gamma) = (0.05, MU * P / 500.0);
+    let slid = d - gamma * 7.0 - MU * P / KAPPA;
+    let dissipation = f["dissipation"].as_f64().unwrap();
+    assert!(
+        (dissipation - 2.0 * MU * P * slid).abs() <= 1e-10,
+        "{dissipation} against {}",
+        2.0 * MU * P * slid
+    );
+    // per step too
+    let steps = summary["contact"]["steps"].as_array().unwrap();
+    assert_eq!(steps[0]["friction"]["slip"], json!(0));
+    assert_eq!(steps[1]["friction"]["slip"], json!(3));
+}
+
+#[test]
+fn the_perturbed_lagrangian_carries_friction_as_the_penalty_does() {
+    let mut v = patch(
+        "A",
+        "0.0",
+        node_to_node(),
+        MU * P,
+        Top::Displacement(0.05),
+        2,
+    );
+    v["contact"][0]["enforcement"] = json!({"kind": "perturbed_lagrange", "kappa": KAPPA});
+    let o = run(&v);
+    assert_eq!(termination(&o), Termination::Converged);
+    for p in points(&o) {
+        assert_eq!(p.0, Status::Slip);
+        assert!((p.1.abs() / p.3 - MU * P).abs() <= 1e-9 * MU * P);
+    }
+    assert!(stress_error(&o, [0.0, -P, MU * P]) < 1e-8 * P);
+    // the augmented Lagrangian is refused with friction, for now (see Model::build)
+    v["contact"][0]["enforcement"] = json!({"kind": "augmented_lagrange", "kappa": KAPPA});
+    let m = refusal(&v);
+    assert!(m.contains("augmented Lagrangian is not solved yet"), "{m}");
+}
