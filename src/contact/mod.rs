@@ -106,6 +106,16 @@ impl TangentRow {
     }
 }
 
+/// A row's identity across iterations, geometry updates and load steps: pair, pass, slave body
+/// and node, and for ties the direction (0 = x, 1 = y).
+pub(crate) type RowKey = (usize, u8, usize, usize, u8);
+
+/// The identity of row `r`.
+pub(crate) fn row_key(r: &Constraint) -> RowKey {
+    let direction = u8::from(r.bilateral && r.normal[1].abs() > r.normal[0].abs());
+    (r.pair, r.pass, r.slave_body, r.slave_node, direction)
+}
+
 impl Constraint {
     /// Gap for the displacement `u`.
     pub fn gap(&self, u: &[f64]) -> f64 {

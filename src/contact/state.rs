@@ -57,11 +57,11 @@ impl ContactState {
     /// the next load step starts from.
     pub(crate) fn friction_history(
         &self,
-    ) -> std::collections::HashMap<crate::solver::active_set::RowKey, f64> {
+    ) -> std::collections::HashMap<crate::contact::RowKey, f64> {
         self.rows
             .iter()
             .zip(&self.friction)
-            .filter_map(|(r, f)| f.map(|f| (crate::solver::active_set::row_key(r), f.plastic_slip)))
+            .filter_map(|(r, f)| f.map(|f| (crate::contact::row_key(r), f.plastic_slip)))
             .collect()
     }
 }

@@ -20,7 +20,7 @@
 //! so the displacement is still returned when it exists. Perturbed Lagrangian rows with a
 //! consistent multiplier mass (standard mortar) are solved in the same saddle-point system with
 //! their perturbation `C` on its multiplier block, the other rows of the penalty family entering
-//! it with their weights (see [`Kernel::saddle_ldlt`]).
+//! it with their weights (see `Kernel::saddle_ldlt`).
 //!
 //! Rigid modes: before each solve the rigid modes of every body are tested against the
 //! prescribed dofs and the ACTIVE rows (`crate::model::rigid`, three modes per body). The first
@@ -258,14 +258,7 @@ fn solve_step(
     }
 }
 
-/// A row's identity across geometry updates: pair, pass, slave body and node, and for ties the
-/// direction (0 = x, 1 = y).
-pub(crate) type RowKey = (usize, u8, usize, usize, u8);
-
-pub(crate) fn row_key(r: &Constraint) -> RowKey {
-    let direction = u8::from(r.bilateral && r.normal[1].abs() > r.normal[0].abs());
-    (r.pair, r.pass, r.slave_body, r.slave_node, direction)
-}
+pub(crate) use crate::contact::{row_key, RowKey};
 
 /// The rows active in `previous` that have no row in `rows` (their slave nodes left the master
 /// surface), in order.

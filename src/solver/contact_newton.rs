@@ -59,7 +59,7 @@
 //!
 //! A body held by nothing but contact rows that are open at the start has a singular tangent:
 //! in the first evaluation the rows that would hold it are closed, nearest first
-//! ([`RigidModes::close_free_bodies`]), as in the active-set scheme; their forces may then be
+//! (`RigidModes::close_free_bodies`), as in the active-set scheme; their forces may then be
 //! tensile, which pulls the body onto the surface, and the next evaluation decides their status
 //! from the gaps.
 
