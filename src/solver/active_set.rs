@@ -181,10 +181,11 @@ fn solve_step(
             let mut timings = crate::solver::linear::Timings::default();
             let mut changes: Vec<f64> = Vec::new();
             let max_updates = model.solver.max_geometry_updates;
+            let areas = reference_areas(model)?;
             for update in 1..=max_updates {
                 let mut solution = solve_at(
                     model,
-                    Some(&u),
+                    Some((&u, &areas)),
                     previous.as_ref(),
                     forces.as_ref(),
                     progress,
@@ -273,13 +274,30 @@ fn slid_off(previous: &HashSet<RowKey>, rows: &[Constraint]) -> Vec<RowKey> {
     lost
 }
 
-/// The contact rows of every pair, evaluated at `X + u` (reference configuration if `None`)
-/// and linearized there. A row's `area`, the weight of a penalty (`kappa A`), stays its area in
-/// the reference configuration when the point has a row there: the penalty acts per unit
+/// The tributary area of every row of the reference configuration, by point: computed once per
+/// solve and handed to [`rows_at`] for the current configuration.
+pub(crate) type ReferenceAreas = HashMap<RowKey, f64>;
+
+/// The rows' areas in the reference configuration.
+pub(crate) fn reference_areas(model: &Model) -> Result<ReferenceAreas> {
+    Ok(rows_at(model, None)?
+        .iter()
+        .map(|r| (row_key(r), r.area))
+        .collect())
+}
+
+/// The contact rows of every pair, evaluated at `X + u` for `current = Some((u, areas))`
+/// (the reference configuration if `None`) and linearized there. A row's `area`, the weight of
+/// a penalty (`kappa A`), stays its area in the reference configuration (`areas`, from
+/// [`reference_areas`]) when the point has a row there: the penalty acts per unit
 /// reference area (a nominal pressure), so the penalty force `kappa A_0 g(u)` has the exact
 /// derivative `kappa A_0 dg/du` (the current area would add the variation of the tributary
 /// lengths, which no tangent carries, and Newton would converge only linearly).
-pub(crate) fn rows_at(model: &Model, u: Option<&[f64]>) -> Result<Vec<Constraint>> {
+pub(crate) fn rows_at(
+    model: &Model,
+    current: Option<(&[f64], &ReferenceAreas)>,
+) -> Result<Vec<Constraint>> {
+    let u = current.map(|(u, _)| u);
     let moved;
     let geometry = match u {
         None => model,
@@ -320,11 +338,7 @@ pub(crate) fn rows_at(model: &Model, u: Option<&[f64]>) -> Result<Vec<Constraint
             c
         }));
     }
-    if u.is_some() {
-        let reference: HashMap<RowKey, f64> = rows_at(model, None)?
-            .iter()
-            .map(|r| (row_key(r), r.area))
-            .collect();
+    if let Some((_, reference)) = current {
         for r in &mut rows {
             if let Some(&area) = reference.get(&row_key(r)) {
                 r.area = area;
@@ -373,21 +387,22 @@ fn add_geometric_stiffness(
     }
 }
 
-/// One contact solve with the rows of `rows_at(model, u)`; `previous` (the active rows of the
+/// One contact solve with the rows of `rows_at(model, current)`; `previous` (the active rows of the
 /// last geometry update) starts the active set together with the rows closed at `u`;
 /// `previous_forces` (of the last geometry update) give Newton's geometric term.
 fn solve_at(
     model: &Model,
-    u: Option<&[f64]>,
+    current: Option<(&[f64], &ReferenceAreas)>,
     previous: Option<&HashSet<RowKey>>,
     previous_forces: Option<&HashMap<RowKey, f64>>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Solution> {
+    let u = current.map(|(u, _)| u);
     let configuration = u.map(|u| u.to_vec());
     let mut timings = Timings::default();
     let t = Instant::now();
     progress("contact search");
-    let mut rows = rows_at(model, u)?;
+    let mut rows = rows_at(model, current)?;
     timings.contact_search = t.elapsed().as_secs_f64();
     let t = Instant::now();
     // each pair is enforced by its own method; the pairs of one solve share a family

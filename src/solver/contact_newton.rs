@@ -63,7 +63,7 @@
 //! tensile, which pulls the body onto the surface, and the next evaluation decides their status
 //! from the gaps.
 
-use super::active_set::{row_key, rows_at, RowKey};
+use super::active_set::{reference_areas, row_key, rows_at, ReferenceAreas, RowKey};
 use super::linear::{assemble, finish, max_abs, LinearSystem, Solution, Timings, NO_EQUATION};
 use super::newton::{self, Evaluation, System, Tangent};
 use super::sparse::{GeneralPattern, PatternBuilder, SymmetricPattern};
@@ -125,6 +125,8 @@ pub(crate) struct ContactSystem<'a> {
     /// each node left.
     departures: Vec<Departure>,
     pub(crate) search_seconds: f64,
+    /// The rows' reference areas (current geometry), searched once per step.
+    reference_areas: ReferenceAreas,
     /// Coulomb pairs: the plastic slip committed at the end of the last load step, by point,
     /// and the frictional status of the last evaluation (with the direction of a slip).
     committed: HashMap<RowKey, f64>,
@@ -142,7 +144,13 @@ impl<'a> ContactSystem<'a> {
     ) -> Result<Self> {
         let current = model.physics.contact_geometry == ContactGeometry::Current;
         let t = Instant::now();
-        let rows = rows_at(model, if current { u } else { None })?;
+        let areas = if current {
+            reference_areas(model)?
+        } else {
+            ReferenceAreas::new()
+        };
+        let start = vec![0.0; model.dof_count];
+        let rows = rows_at(model, current.then(|| (u.unwrap_or(&start), &areas)))?;
         let search_seconds = t.elapsed().as_secs_f64();
         let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.all_dofs()).collect();
         let sys = assemble(model, &blocks);
@@ -189,6 +197,7 @@ impl<'a> ContactSystem<'a> {
             force_tolerance: 0.0,
             departures: Vec::new(),
             search_seconds,
+            reference_areas: areas,
             committed,
             status: HashMap::new(),
         };
@@ -511,7 +520,7 @@ impl System for ContactSystem<'_> {
         let current = self.model.physics.contact_geometry == ContactGeometry::Current;
         if current && self.evaluations > 0 {
             let t = Instant::now();
-            self.rows = rows_at(self.model, Some(&u))?;
+            self.rows = rows_at(self.model, Some((&u, &self.reference_areas)))?;
             self.search_seconds += t.elapsed().as_secs_f64();
             self.record_departures(&u);
             let version = self.version;
