@@ -74,6 +74,18 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// The stability suite: run every hard case and write reports/hard-cases.md and .json (each
+    /// case with method, expected and actual outcome, iterations, condition estimate, accuracy).
+    #[command(
+        after_help = "Example:\n  contact-patch hard\n  contact-patch hard cases/hard --out /tmp/reports\n\nExit 1 when a case does not meet the outcome it states, 2 on bad input."
+    )]
+    Hard {
+        /// Case files or folders (default: cases/hard).
+        paths: Vec<PathBuf>,
+        /// Folder for hard-cases.md and hard-cases.json.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
     /// Print the JSON Schema of the case format (committed as cases/case.schema.json; a case
     /// file may name it in "$schema" so that editors validate and complete it).
     #[command(after_help = "Example:\n  contact-patch schema > cases/case.schema.json")]
@@ -105,6 +117,7 @@ fn main() -> ExitCode {
             baseline_factor,
         } => table(&paths, &out, junit.as_deref(), &baseline, baseline_factor),
         Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
+        Command::Hard { paths, out } => hard(&paths, &out),
         Command::Schema => {
             print!("{}", contact_patch::io::scene::case_schema());
             ExitCode::SUCCESS
@@ -557,6 +570,82 @@ fn table(
 }
 
 /// The most refinement levels `tied-layer` accepts, and the largest level.
+/// Run the hard cases and write their report.
+fn hard(paths: &[PathBuf], out: &Path) -> ExitCode {
+    let folder = match ReportFolder::new(out) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let default = [PathBuf::from("cases/hard")];
+    let paths = if paths.is_empty() {
+        &default[..]
+    } else {
+        paths
+    };
+    let cases = match collect_cases(paths) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let bar = progress_bar(cases.len());
+    let mut rows = Vec::new();
+    for case in &cases {
+        if let Some(b) = &bar {
+            b.set_message(case.display().to_string());
+        }
+        let row = match guarded(case, || run_case(case, &mut |_| {})) {
+            Ok(outcome) => contact_patch::harness::hard::row(&outcome),
+            Err(e) => {
+                contact_patch::harness::hard::error_row(&case.display().to_string(), &e.to_string())
+            }
+        };
+        rows.push(row);
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let markdown = contact_patch::harness::hard::markdown(&rows);
+    let json = serde_json::to_string_pretty(&rows).expect("rows serialize") + "\n";
+    let written = folder
+        .write_file("hard-cases.md", &markdown)
+        .and_then(|_| folder.write_file("hard-cases.json", &json));
+    if let Err(e) = written {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
+    let met = rows.iter().filter(|r| r.met).count();
+    for r in rows.iter().filter(|r| !r.met) {
+        eprintln!(
+            "FAIL {}: expected {}, got {}{}",
+            r.case,
+            r.expected,
+            r.outcome,
+            r.error
+                .as_deref()
+                .map(|e| format!(" ({e})"))
+                .unwrap_or_default()
+        );
+    }
+    println!(
+        "{met} of {} hard cases meet their expected outcome; wrote {}",
+        rows.len(),
+        folder.shown("hard-cases.md").display()
+    );
+    if met == rows.len() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}
+
 const MAX_LEVELS: usize = 16;
 const MAX_LEVEL: usize = 64;
 

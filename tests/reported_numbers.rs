@@ -207,11 +207,25 @@ fn d14_absurd_penetration_warns_and_a_check_can_fail_it() {
     );
     let share = num(&s["contact"]["max_penetration_share"]);
     assert!(share > 100.0, "{share}");
-    assert_eq!(
-        s["warnings"].as_array().unwrap().len(),
-        1,
-        "{}",
-        s["warnings"]
+    // one penetration warning; the soft penalty also leaves the punch nearly unsupported, and
+    // the ill-conditioned system's equilibrium (not at round-off) is the other warning
+    let warnings: Vec<&str> = s["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    let penetration = warnings
+        .iter()
+        .filter(|w| w.contains("times the contact element size"))
+        .count();
+    assert_eq!(penetration, 1, "{warnings:?}");
+    assert!(
+        warnings
+            .iter()
+            .all(|w| w.contains("times the contact element size")
+                || w.contains("equilibrium is not at round-off")),
+        "{warnings:?}"
     );
     let (code, _, s) = run(&defect("D14"), |v| {
         v["checks"] = serde_json::json!([{"check": "max_penetration", "share": 0.01}]);

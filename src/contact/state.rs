@@ -117,5 +117,8 @@ pub struct IterationRecord {
     /// geometry update or step counts from zero).
     pub multiplier_change: f64,
     pub linear_solver: &'static str,
+    /// Estimated 1-norm condition number of the last system factored for this iteration
+    /// ([`crate::solver::conditioning`]); `None` when the solver has no estimate (LU).
+    pub condition_estimate: Option<f64>,
     pub seconds: f64,
 }

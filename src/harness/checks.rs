@@ -19,7 +19,8 @@
 //! and the loads were scaled by 1e9, while the stress was exact to 1.5e-15).
 
 use crate::contact::forces::{pair_forces, PairForces};
-use crate::io::scene::{Check, Interaction};
+use crate::contact::state::Termination;
+use crate::io::scene::{Check, Interaction, TerminationReason};
 use crate::model::{MasterSide, Model};
 use crate::post::{for_each_quadrature_stress, relative_l2_displacement_error};
 use crate::solver::linear::Solution;
@@ -214,7 +215,10 @@ pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
                 model.contact[f.pair].name, f.penetration.depth, f.penetration.share_of_element
             )
         });
-    departures.chain(penetrations).collect()
+    departures
+        .chain(penetrations)
+        .chain(crate::harness::stability::warnings(model, solution))
+        .collect()
 }
 
 fn pair_of<'a>(forces: &'a [PairForces], model: &Model, name: &str) -> Option<&'a PairForces> {
@@ -233,9 +237,15 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
         .as_ref()
         .map(|state| pair_forces(model, state))
         .unwrap_or_default();
+    // a case that names its expected termination judges it itself
+    let expects_termination = model
+        .checks
+        .iter()
+        .any(|c| matches!(c, Check::TerminatesWith { .. }));
     let convergence = solution
         .contact
         .as_ref()
+        .filter(|_| !expects_termination)
         .and_then(|c| match &c.termination {
             crate::solver::active_set::Termination::Converged => None,
             t => Some(CheckResult {
@@ -306,6 +316,50 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
                         .fold(if solution.contact.is_some() { 0.0 } else { f64::NAN }, |m, f| worst(m, f.penetration.share_of_element));
                     let of = pair.as_ref().map(|p| format!(" of '{p}'")).unwrap_or_default();
                     (format!("largest penetration{of} relative to the contact element size"), got, *share)
+                }
+                Check::TerminatesWith { reason, contains } => {
+                    let (got, text) = match solution.contact.as_ref().map(|c| &c.termination) {
+                        Some(Termination::Converged) => (Some(TerminationReason::Converged), String::new()),
+                        Some(Termination::IterationLimit) => (Some(TerminationReason::IterationLimit), String::new()),
+                        Some(Termination::ActiveSetCycling) => (Some(TerminationReason::ActiveSetCycling), String::new()),
+                        Some(Termination::Singular(m)) => (Some(TerminationReason::Singular), m.clone()),
+                        None => (None, String::new()),
+                    };
+                    // the message of the stop and the run's warnings (diagnoses) are searched
+                    let said = format!("{text}\n{}", warnings(model, solution).join("\n"));
+                    let found = contains.as_ref().is_none_or(|c| said.contains(c.as_str()));
+                    let with = contains.as_ref().map(|c| format!(" with a message containing {c:?}")).unwrap_or_default();
+                    (
+                        format!("the contact solve ends {reason:?}{with} (it ended {got:?})"),
+                        if got == Some(*reason) && found { 0.0 } else { f64::INFINITY },
+                        0.0,
+                    )
+                }
+                Check::Equilibrium { tol, per_condition } => {
+                    let kappa = crate::harness::stability::conditioning(model, solution).condition_estimate;
+                    let (tol, stated) = match (per_condition, kappa) {
+                        (Some(c), Some(k)) => {
+                            let t = tol.max(c * f64::EPSILON * k);
+                            (t, format!(", tol max({tol:.1e}, {c} eps kappa) with kappa {k:.2e}"))
+                        }
+                        (Some(_), None) => (*tol, ", no condition estimate".to_string()),
+                        _ => (*tol, String::new()),
+                    };
+                    (format!("relative equilibrium residual{stated}"), solution.relative_residual, tol)
+                }
+                Check::StatusChanges { per_iteration, per_step } => {
+                    let (it, step) = solution.contact.as_ref().map(crate::harness::stability::status_changes).unwrap_or((usize::MAX, usize::MAX));
+                    let over = (it as f64 / (*per_iteration).max(1) as f64).max(step as f64 / (*per_step).max(1) as f64);
+                    let within = it <= *per_iteration && step <= *per_step;
+                    (
+                        format!("status changes {it} per iteration (at most {per_iteration}) and {step} per step (at most {per_step})"),
+                        if within { 0.0 } else { over },
+                        0.0,
+                    )
+                }
+                Check::Warns { contains } => {
+                    let found = warnings(model, solution).iter().any(|w| w.contains(contains.as_str()));
+                    (format!("the run warns {contains:?}"), if found { 0.0 } else { f64::INFINITY }, 0.0)
                 }
                 Check::ForceBalance { tol } => ("force balance of the contact forces and equilibrium".to_string(), force_balance(model, solution, &forces), *tol),
                 Check::Displacement { body, point, component, value, tol } => {

@@ -31,9 +31,11 @@
 pub mod baseline;
 pub mod checks;
 pub(crate) mod exact;
+pub mod hard;
 pub mod junit;
 pub mod layer;
 pub mod report;
+pub mod stability;
 
 use crate::contact::discretization::constraints;
 use crate::contact::enforcement::method;

@@ -41,6 +41,10 @@ pub struct Summary {
     /// What the contact solve found (absent without contact).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact: Option<ContactSummary>,
+    /// The conditioning and equilibrium of the answer (absent without contact), see
+    /// [`crate::harness::stability`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub conditioning: Option<crate::harness::stability::Conditioning>,
     pub timings: Timings,
     /// The effects the scene asked for and simulated, with the time each took.
     pub effects: Vec<EffectSummary>,
@@ -338,6 +342,10 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
         reactions,
         checks: checks.clone(),
         warnings: outcome.warnings.clone(),
+        conditioning: solution
+            .contact
+            .as_ref()
+            .map(|_| crate::harness::stability::conditioning(model, solution)),
         timings: solution.timings.clone(),
         effects: effects(outcome),
     }

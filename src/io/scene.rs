@@ -799,4 +799,40 @@ pub enum Check {
         value: f64,
         tol: f64,
     },
+    /// The expected outcome of the contact solve: it ends with `reason` (and, when given, its
+    /// message or diagnosis contains `contains`). Replaces the implicit "the contact solve
+    /// converged" check, so that a case can expect a named stop.
+    TerminatesWith {
+        reason: TerminationReason,
+        #[serde(default)]
+        contains: Option<String>,
+    },
+    /// The relative equilibrium residual of the answer is at most `tol`, or, with
+    /// `per_condition`, at most `max(tol, per_condition * eps * kappa)` with `kappa` the
+    /// estimated condition number of the last factored system (a tolerance stated relative to
+    /// the conditioning).
+    Equilibrium {
+        tol: f64,
+        #[serde(default)]
+        per_condition: Option<f64>,
+    },
+    /// Chattering bound: the most contact points that change status after one iteration, and
+    /// in all iterations of one load step, over the whole solve.
+    StatusChanges {
+        per_iteration: usize,
+        per_step: usize,
+    },
+    /// The run warns, with a warning that contains `contains` (e.g. a diagnosis expected of a
+    /// hard case).
+    Warns { contains: String },
+}
+
+/// How a contact solve ended, as a case names it (see [`Check::TerminatesWith`]).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum TerminationReason {
+    Converged,
+    IterationLimit,
+    ActiveSetCycling,
+    Singular,
 }

@@ -1061,6 +1061,29 @@ impl Model {
                     self.require_exact(&at)?;
                     *tol
                 }
+                Check::TerminatesWith { .. } | Check::StatusChanges { .. } => {
+                    if self.contact.is_empty() {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "terminates_with and status_changes judge the contact solve, but the case has no contact",
+                            "remove the check or add a contact pair",
+                        ));
+                    }
+                    0.0
+                }
+                Check::Warns { .. } => 0.0,
+                Check::Equilibrium { tol, per_condition } => {
+                    if per_condition.is_some_and(|c| !(c.is_finite() && c >= 0.0)) {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            format!("per_condition must be a non-negative number, got {per_condition:?}"),
+                            "give e.g. 10 (the tolerance becomes 10 eps times the condition estimate)",
+                        ));
+                    }
+                    *tol
+                }
                 Check::ForceBalance { tol } => {
                     if self.contact.is_empty() {
                         return Err(Error::invalid(

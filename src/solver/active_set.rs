@@ -44,6 +44,7 @@ use crate::error::{Error, Result};
 use crate::io::scene::{ContactGeometry, MultiplierUpdate};
 use crate::model::rigid::{FreeMode, RigidModes};
 use crate::model::Model;
+use crate::solver::conditioning::{condition_estimate_symmetric, EQUILIBRIUM_ROUND_OFF};
 use crate::solver::constraints::{ConstraintBuilder, ConstraintError};
 use crate::solver::dense::symmetric_eigen;
 use crate::solver::linear::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
@@ -512,6 +513,7 @@ fn solve_at(
         prepared_for: None,
         initial_active,
         history: Vec::new(),
+        condition: None,
         model,
         sys: &sys,
         rows: &eq_rows,
@@ -739,6 +741,9 @@ struct Kernel<'a> {
     initial_active: Option<Vec<bool>>,
     /// One record per iteration.
     history: Vec<IterationRecord>,
+    /// The estimated 1-norm condition number of the last factored system
+    /// ([`crate::solver::conditioning`]).
+    condition: Option<f64>,
 }
 
 type LoopResult = (Vec<f64>, Vec<f64>, Vec<bool>, Termination, usize);
@@ -835,6 +840,11 @@ impl Kernel<'_> {
             .chol
             .factor(&self.sys.pattern, &values)
             .map_err(|e| self.sys.factor_error(self.model, e).to_string())?;
+        self.condition = Some(condition_estimate_symmetric(
+            &self.sys.pattern,
+            &values,
+            |b| f.solve_in_place(b),
+        ));
         self.factorizations += t.elapsed().as_secs_f64();
         let f = std::rc::Rc::new(f);
         self.cache = Some((active.to_vec(), w.to_vec(), f.clone()));
@@ -983,6 +993,11 @@ impl Kernel<'_> {
             .factor(&saddle.pattern, &values, &signs, 1e-13 * rho, rho)
         {
             Ok(factor) => {
+                self.condition = Some(condition_estimate_symmetric(
+                    &saddle.pattern,
+                    &values,
+                    |b| factor.solve_in_place(b),
+                ));
                 let mut x = rhs.clone();
                 factor.solve_in_place(&mut x);
                 // a finite matrix and right-hand side with a non-finite solution or residual:
@@ -1086,7 +1101,9 @@ impl Kernel<'_> {
         }
     }
 
-    /// Penalty-type solve: `M u = rhs + sum_active b_i (lambda_k,i - w_i g0_i)`.
+    /// Penalty-type solve: `M u = rhs + sum_active b_i (lambda_k,i - w_i g0_i)`, refined
+    /// against the unpenalized equilibrium residual when that is not at round-off (see
+    /// [`Kernel::penalty_equilibrium`]).
     fn regularized(&mut self, active: &[bool], w: &[f64], lambda_k: &[f64]) -> Step<Vec<f64>> {
         let f = self.factor(active, w)?;
         let mut x = self.rhs.clone();
@@ -1096,7 +1113,54 @@ impl Kernel<'_> {
             }
         }
         f.solve_in_place(&mut x);
+        // iterative refinement with the residual of equilibrium `f - K u + B^T lambda(u)`,
+        // `lambda_i = lambda_k,i - w_i (g0_i + b_i u)` (equal to `rhs - M u` in exact
+        // arithmetic, but computed from the forces the run reports, with an accurate `K u`):
+        // only when the first solve left it above round-off (a stiff penalty), and only while
+        // it at least halves; the best iterate is kept
+        let mut r = vec![0.0; self.sys.n];
+        let mut best = self.penalty_equilibrium(&x, active, w, lambda_k, &mut r);
+        if best.is_finite() && best > EQUILIBRIUM_ROUND_OFF {
+            for _ in 0..MAX_REFINEMENT {
+                f.solve_in_place(&mut r);
+                let trial: Vec<f64> = x.iter().zip(&r).map(|(a, d)| a + d).collect();
+                let mut r_trial = vec![0.0; self.sys.n];
+                let e = self.penalty_equilibrium(&trial, active, w, lambda_k, &mut r_trial);
+                if e.is_nan() || e > 0.5 * best {
+                    break;
+                }
+                (x, r, best) = (trial, r_trial, e);
+                if best <= EQUILIBRIUM_ROUND_OFF {
+                    break;
+                }
+            }
+        }
         Ok(x)
+    }
+
+    /// `r = f - K u + sum_active b_i lambda_i(u)` with `lambda_i = lambda_k,i - w_i (g0_i +
+    /// b_i u)` (`K u` accumulated in twice the working precision); returns `max |r|` relative
+    /// to the largest of `|f|` and `|b_i lambda_i|` (NaN when not finite).
+    fn penalty_equilibrium(
+        &self,
+        x: &[f64],
+        active: &[bool],
+        w: &[f64],
+        lambda_k: &[f64],
+        r: &mut [f64],
+    ) -> f64 {
+        self.sys.pattern.residual_accurate(&self.k, x, &self.rhs, r);
+        let mut contact = vec![0.0; self.sys.n];
+        for (i, row) in self.rows.iter().enumerate() {
+            if active[i] {
+                let lambda = lambda_k[i] - w[i] * (row.g0 + row.dot(x));
+                row.add_to(lambda, &mut contact);
+            }
+        }
+        r.iter_mut().zip(&contact).for_each(|(a, c)| *a += c);
+        let scale =
+            crate::solver::linear::max_abs(self.rhs.iter().chain(&contact)).max(f64::MIN_POSITIVE);
+        crate::solver::linear::max_abs(r.iter()) / scale
     }
 
     /// The stiffness scale `rho` (the largest diagonal entry of `K`, 1 without one), which
@@ -1315,6 +1379,11 @@ impl Kernel<'_> {
                 .factor_error(self.model, e.map_equation(|q| free[q]))
                 .to_string()
         })?;
+        self.condition = Some(condition_estimate_symmetric(
+            &reduction.pattern,
+            &values,
+            |b| f.solve_in_place(b),
+        ));
         self.factorizations += t.elapsed().as_secs_f64();
         f.solve_in_place(&mut y);
         let x = constraints.expand(&y);
@@ -1754,6 +1823,7 @@ impl Kernel<'_> {
                     .zip(&previous_forces)
                     .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())),
                 linear_solver: self.linear_solver,
+                condition_estimate: self.condition,
                 seconds: iteration_start.elapsed().as_secs_f64(),
             });
             let converged = match method {

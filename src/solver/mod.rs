@@ -3,6 +3,7 @@
 //! steps, active sets, geometry updates). A scene without contact builds no contact row.
 
 pub mod active_set;
+pub mod conditioning;
 pub mod constraints;
 pub mod contact_newton;
 pub(crate) mod dense;

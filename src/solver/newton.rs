@@ -22,6 +22,7 @@ use super::sparse::{
 };
 use crate::contact::state::{IterationRecord, Termination};
 use crate::error::Result;
+use crate::solver::conditioning::condition_estimate_symmetric;
 use std::time::Instant;
 
 /// The tangent of one evaluation, on the system's pattern (both triangles).
@@ -158,6 +159,7 @@ pub fn solve(system: &mut dyn System, x: &mut Vec<f64>, settings: Settings) -> R
                 max_gap_violation: eval.max_gap_violation,
                 multiplier_change: eval.multiplier_change,
                 linear_solver: last_solver,
+                condition_estimate: linear.last_condition,
                 seconds: start.elapsed().as_secs_f64(),
             });
             start = Instant::now();
@@ -248,6 +250,9 @@ pub struct LinearSolver {
     pub reused: usize,
     pub seconds: f64,
     pub last_solver: &'static str,
+    /// Estimated 1-norm condition number of the last factorization (symmetric tangents;
+    /// `None` for LU), see [`crate::solver::conditioning`].
+    pub last_condition: Option<f64>,
 }
 
 impl LinearSolver {
@@ -263,6 +268,7 @@ impl LinearSolver {
             reused: 0,
             seconds: 0.0,
             last_solver: "none",
+            last_condition: None,
         }
     }
 
@@ -305,6 +311,10 @@ impl LinearSolver {
             match ldlt.factor(&self.symmetric, &upper, &signs, 1e-13 * scale, scale) {
                 Ok(f) => {
                     self.last_solver = "ldlt";
+                    self.last_condition =
+                        Some(condition_estimate_symmetric(&self.symmetric, &upper, |b| {
+                            f.solve_in_place(b)
+                        }));
                     return Ok(Factorization::Ldlt(f));
                 }
                 // singular: dependent rows (two passes), a body the active rows leave free
@@ -323,6 +333,10 @@ impl LinearSolver {
             match chol.factor(&self.symmetric, &upper) {
                 Ok(f) => {
                     self.last_solver = "cholesky";
+                    self.last_condition =
+                        Some(condition_estimate_symmetric(&self.symmetric, &upper, |b| {
+                            f.solve_in_place(b)
+                        }));
                     return Ok(Factorization::Cholesky(f));
                 }
                 // indefinite (a geometric term): LU below; a zero pivot is singular either way
@@ -339,6 +353,7 @@ impl LinearSolver {
             .expect("analysed")
             .factor(&self.general, &tangent.values)?;
         self.last_solver = "lu";
+        self.last_condition = None;
         Ok(Factorization::Lu(Box::new(f)))
     }
 }

@@ -1,0 +1,418 @@
+"""Write the hard cases of the stability suite (cases/hard/*.json).
+
+Each case states its expected outcome in its own checks: `terminates_with` (converged, or a
+named stop with the words its diagnosis must contain) and accuracy checks against closed forms
+(the contact patch test's uniform stress sigma_yy = -p, the load carried by the contact, a
+Signorini block's uniform compression). Run from the repository root:
+
+    python3 cases/hard/make_cases.py && contact-patch check cases/hard
+
+The bases are the patch-test meshes of cases/patch (written by cases/patch/make_cases.py) and
+the Signorini block of cases/contact; see the description of each case for what makes it hard.
+"""
+
+import copy
+import json
+import math
+import os
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+
+def load(rel):
+    with open(os.path.join(ROOT, rel)) as f:
+        return json.load(f)
+
+
+def patch(mesh, nu="0.3"):
+    """A patch-test case (punch on foundation) without its sweep and checks."""
+    c = load(f"cases/patch/patch-{mesh}-nu{nu}.json")
+    c.pop("sweep", None)
+    c["checks"] = []
+    c["$schema"] = "../case.schema.json"
+    return c
+
+
+def enforcement(kind, kappa=None, update=None):
+    e = {"kind": kind}
+    if kappa is not None:
+        e["kappa"] = kappa
+    if update is not None:
+        e["update"] = update
+    return e
+
+
+def converged():
+    return {"check": "terminates_with", "reason": "converged"}
+
+
+def stops(reason, contains):
+    return {"check": "terminates_with", "reason": reason, "contains": contains}
+
+
+def stress(p, tol=1e-10):
+    return {"check": "uniform_stress", "stress": [0.0, -p, 0.0], "tol": tol}
+
+
+def load_carried(pair, value, tol=1e-12):
+    """The contact carries the punch's load: a closed form of equilibrium of the slave body."""
+    return {"check": "contact_force", "pair": pair, "component": "y", "value": value, "tol": tol}
+
+
+CASES = {}
+
+
+def case(name, description, c, checks):
+    c = copy.deepcopy(c)
+    c["name"] = name
+    c["description"] = description
+    c["checks"] = checks
+    c["$schema"] = "../case.schema.json"
+    CASES[name] = c
+
+
+E, P = 1000.0, 10.0
+# the punch's load on mesh C (width 2, pressure 10) and the smallest slave element of mesh C
+PUNCH_LOAD = 20.0
+H_C = 2.0 / 3.0
+
+# 1. penalty from 1e-6 to 1e12 times E / h (node-to-surface one-pass on mesh C, punch slave)
+for exponent in [-6, -3, 0, 3, 6, 9, 12]:
+    kappa = 10.0**exponent * E / H_C
+    c = patch("C")
+    c["contact"][0]["enforcement"] = enforcement("penalty", kappa)
+    if exponent >= 12:
+        checks = [stops("singular", "a penalty far stiffer than the bodies")]
+        what = "stops: the matrix is singular to working precision, and the message names the penalty"
+    elif exponent >= 6:
+        checks = [
+            converged(),
+            load_carried("interface", PUNCH_LOAD, 1e-6),
+            {"check": "equilibrium", "tol": 1e-12, "per_condition": 1.0},
+            {"check": "warns", "contains": "equilibrium is not at round-off"},
+        ]
+        what = "converges, but the penalty forces come from gaps known only to the displacement's round-off: the run warns with the penalty that would keep equilibrium at round-off, and equilibrium is judged relative to the condition estimate"
+    else:
+        checks = [
+            converged(),
+            load_carried("interface", PUNCH_LOAD),
+            {"check": "force_balance", "tol": 1e-12},
+        ]
+        if exponent <= -6:
+            checks = [
+                converged(),
+                load_carried("interface", PUNCH_LOAD, 1e-8),
+                {"check": "equilibrium", "tol": 1e-12, "per_condition": 1.0},
+                {"check": "warns", "contains": "penetration"},
+            ]
+            what = "converges to a very soft interface (a penetration 1e4 times the element, which the run warns of); the punch, held almost only by the soft penalty, makes the system ill conditioned (condition estimate about 5e8), so equilibrium is judged relative to the estimate and the load carried to 1e-8 (above eps kappa = 1e-7 would not be round-off)"
+        elif exponent <= -3:
+            checks.append({"check": "warns", "contains": "penetration"})
+            what = "converges to a soft interface (a deep penetration that the run warns of); equilibrium at round-off"
+        else:
+            what = "converges; equilibrium at round-off"
+    case(
+        f"penalty-1e{exponent}-E-over-h",
+        f"Mesh C, node-to-surface one-pass, penalty kappa = 1e{exponent} E / h (E = 1000, h = 2/3): {what}.",
+        c,
+        checks,
+    )
+
+# 2. stiffness ratio 1e6 between the bodies (mesh A, matching, node-to-node Lagrange)
+c = patch("A")
+c["materials"]["stiff"] = {"E": 1e9, "nu": 0.3}
+c["bodies"][1]["material"] = "stiff"
+c["contact"][0]["discretization"] = {"kind": "node_to_node"}
+case(
+    "stiffness-ratio-1e6",
+    "Mesh A, node-to-node Lagrange multipliers, the punch 1e6 times stiffer than the foundation (E = 1e9 against 1e3): the uniform stress sigma_yy = -10 holds in both bodies whatever their moduli; the system's condition estimate is about 6e8, so the stress is judged to 1e-7 (eps kappa = 1.3e-7) and equilibrium relative to the estimate.",
+    c,
+    [converged(), stress(P, 1e-7), {"check": "equilibrium", "tol": 1e-12, "per_condition": 1.0}],
+)
+
+# 3. nu = 0.4999 (nearly incompressible, plane strain), Lagrange on mesh A and mesh C two-pass
+for mesh, disc, label in [
+    ("A", {"kind": "node_to_node"}, "node-to-node"),
+    ("B", {"kind": "mortar", "multiplier": "dual"}, "dual mortar"),
+]:
+    c = patch(mesh)
+    c["materials"]["m"]["nu"] = 0.4999
+    c["contact"][0]["discretization"] = disc
+    case(
+        f"nu-0.4999-{mesh}",
+        f"Mesh {mesh}, {label}, Lagrange multipliers, nu = 0.4999 (plane strain, nearly incompressible): the patch test still holds; equilibrium is judged relative to the condition estimate (the stiffness's conditioning grows like 1 / (1 - 2 nu)).",
+        c,
+        [converged(), stress(P, 1e-9), {"check": "equilibrium", "tol": 1e-12, "per_condition": 1.0}],
+    )
+
+# 4. E from 1e-3 to 1e12 in the units of the case (load scaled alike), mesh B one-pass Lagrange
+for e in [1e-3, 1e12]:
+    c = patch("B")
+    c["materials"]["m"]["E"] = e
+    p = P * e / E
+    for ld in c["loads"]:
+        ld["pressure"] = p
+    c["exact"] = {"kind": "uniform_stress", "stress": [0.0, -p, 0.0]}
+    case(
+        f"youngs-modulus-{e:.0e}".replace("+", ""),
+        f"Mesh B, node-to-surface one-pass (punch slave), Lagrange multipliers, E = {e:g} and pressure {p:g}: the same patch test in other units.",
+        c,
+        [converged(), stress(p), {"check": "contact_pressure", "pair": "interface", "tol": 1e-10}, {"check": "force_balance", "tol": 1e-12}],
+    )
+
+# Signorini block on a rigid line (Q9, exact uniform compression)
+SIGNORINI = load("cases/contact/signorini-block-on-rigid-line.json")
+
+# 5. grazing contact: zero gap, no load
+c = copy.deepcopy(SIGNORINI)
+c["loads"] = []
+c.pop("exact")
+c["supports"] = [{"body": "block", "set": "top_left", "x": 0.0, "y": 0.0}]
+case(
+    "grazing-zero-gap-no-load",
+    "A Q9 block touching a rigid line (zero gap) with no load, held at its top-left node: the rows close at zero gap and carry no force; the answer is u = 0.",
+    c,
+    [
+        converged(),
+        {"check": "displacement", "body": "block", "point": [3, 0], "component": "y", "value": 0.0, "tol": 1e-12},
+        {"check": "contact_force", "pair": "ground", "component": "y", "value": 0.0, "tol": 1e-12},
+    ],
+)
+
+# 6. touching with zero load, the block held only by contact vertically
+c = copy.deepcopy(SIGNORINI)
+c["loads"] = []
+c.pop("exact")
+case(
+    "touching-zero-load",
+    "The Signorini block touching the rigid line with zero load, held only by contact vertically (and a roller in x at its bottom-left node): the zero-gap rows hold it and carry no force; u = 0.",
+    c,
+    [
+        converged(),
+        {"check": "displacement", "body": "block", "point": [3, 2], "component": "y", "value": 0.0, "tol": 1e-12},
+        {"check": "contact_force", "pair": "ground", "component": "y", "value": 0.0, "tol": 1e-12},
+    ],
+)
+
+# 7. initial penetration: the rigid line 0.01 above the block's bottom, the top held at y = 0
+depth, height, nu, e_mod = 0.01, 2.0, 0.25, 200.0
+c = copy.deepcopy(SIGNORINI)
+c["loads"] = []
+c["contact"][0]["master"]["rigid"]["point"] = [0, depth]
+c["supports"] = [
+    {"body": "block", "set": "top", "y": 0.0},
+    {"body": "block", "set": "top_left", "x": 0.0},
+]
+# plane strain with sigma_xx = 0: eps_yy = (1 - nu^2) sigma_yy / E; the block shortens by depth
+sigma = -e_mod * (depth / height) / (1 - nu * nu)
+c["exact"] = {"kind": "uniform_stress", "stress": [0.0, sigma, 0.0]}
+case(
+    "initial-penetration",
+    f"The Signorini block starts 0.01 into the rigid line (line at y = 0.01), its top held at y = 0: contact pushes the bottom out, a uniform compression sigma_yy = -E (d / H) / (1 - nu^2) = {sigma:.10g}, carried by the contact.",
+    c,
+    [
+        converged(),
+        stress(-sigma),
+        {"check": "contact_pressure", "pair": "ground", "tol": 1e-10},
+        load_carried("ground", -sigma * 3.0, 1e-10),
+    ],
+)
+
+# 8. a tilted master: the Signorini block rotated by 30 degrees with its rigid line
+theta = math.radians(30.0)
+ct, st = math.cos(theta), math.sin(theta)
+nx, ny = 6, 4
+xs = [3.0 * i / nx for i in range(nx + 1)]
+ys = [2.0 * j / ny for j in range(ny + 1)]
+nodes = []
+for j in range(ny + 1):
+    for i in range(nx + 1):
+        x, y = xs[i], ys[j]
+        nodes.append([ct * x - st * y, st * x + ct * y])
+cells = []
+for j in range(ny):
+    for i in range(nx):
+        a = j * (nx + 1) + i
+        cells.append([a, a + 1, a + nx + 2, a + nx + 1])
+bottom = [[i, 0] for i in range(nx)]
+top = [[(ny - 1) * nx + i, 2] for i in range(nx)]
+# uniform stress sigma_nn = -p in the rotated frame: sigma = -p n n^T with n = (-sin, cos)
+p = 5.0
+n = (-st, ct)
+rot_stress = [-p * n[0] * n[0], -p * n[1] * n[1], -p * n[0] * n[1]]
+c = {
+    "analysis": {"plane": "strain", "thickness": 1.0},
+    "materials": {"m": {"E": 200.0, "nu": 0.25}},
+    "bodies": [
+        {
+            "name": "block",
+            "material": "m",
+            "mesh": {"explicit": {"element": "Q4", "nodes": nodes, "cells": cells}},
+            "node_sets": {"origin": {"nodes": [0]}},
+            "facet_sets": {"base": {"facets": bottom}, "lid": {"facets": top}},
+        }
+    ],
+    "supports": [{"body": "block", "set": "origin", "x": 0.0, "y": 0.0}],
+    "loads": [{"body": "block", "set": "lid", "pressure": p}],
+    "exact": {"kind": "uniform_stress", "stress": rot_stress},
+    "contact": [
+        {
+            "name": "ground",
+            "slave": {"body": "block", "set": "base"},
+            "master": {"rigid": {"kind": "line", "point": [0, 0], "normal": [-st, ct]}},
+            "discretization": {"kind": "node_to_surface", "passes": 1},
+            "enforcement": {"kind": "lagrange"},
+        }
+    ],
+}
+case(
+    "tilted-master-30deg",
+    "The Signorini block (Q4, 6 x 4) and its rigid line rotated by 30 degrees, pressed by p = 5 normal to its top and held at its bottom-left node (whose exact displacement is 0): the exact stress is -p n n^T with n the line's normal.",
+    c,
+    [
+        converged(),
+        {"check": "uniform_stress", "stress": rot_stress, "tol": 1e-10},
+        {"check": "contact_pressure", "pair": "ground", "tol": 1e-10},
+        {"check": "force_balance", "tol": 1e-12},
+    ],
+)
+
+# 9. a curved master: a coarse block on a rigid cylinder (load balance)
+cyl = load("cases/contact/block-on-rigid-cylinder-lagrange.json")
+cyl["bodies"][0]["mesh"]["block"]["x"]["divisions"] = 20
+cyl["bodies"][0]["mesh"]["block"]["y"]["divisions"] = 10
+case(
+    "curved-master-cylinder",
+    "A Q4 block (20 x 10) pressed onto a rigid cylinder of radius 10 (Lagrange multipliers): the contact carries the load P = 4 exactly and the forces balance.",
+    cyl,
+    [converged(), load_carried("cylinder", 4.0, 1e-10), {"check": "force_balance", "tol": 1e-10}],
+)
+
+# 10. a rigid circle much smaller than the slave elements
+c = copy.deepcopy(cyl)
+c["contact"][0]["master"]["rigid"] = {"kind": "circle", "centre": [0, -0.01], "radius": 0.01}
+case(
+    "tiny-rigid-circle",
+    "The block on a rigid circle of radius 0.01 against elements of size 0.4: the circle touches one slave node, and a single frictionless point contact with one u_x support on the same vertical line leaves the rotation about the support free; the solve stops and names the body, the motion and a remedy.",
+    c,
+    [stops("singular", "can rotate about")],
+)
+c = copy.deepcopy(c)
+c["supports"].append({"body": "block", "set": "bottom_left", "x": 0.0})
+case(
+    "tiny-rigid-circle-held",
+    "The block on a rigid circle of radius 0.01 (elements of size 0.4), with u_x also held at its bottom-left node: the one slave node the circle touches carries the whole load P = 4.",
+    c,
+    [converged(), load_carried("cylinder", 4.0, 1e-10), {"check": "force_balance", "tol": 1e-10}],
+)
+
+# 11. near-zero gaps: penalty on the cylinder, chattering bounded
+c = copy.deepcopy(cyl)
+c["contact"][0]["enforcement"] = enforcement("penalty", 2e4)
+case(
+    "near-zero-gap-chattering",
+    "The block on the rigid cylinder with a penalty (kappa = 2e4 = 10 E / h): the nodes at the edge of the contact zone sit at near-zero gaps, where the active set can chatter. Bound: no more status changes after one iteration than the rows that end active, and no more in the step than twice that.",
+    c,
+    [
+        converged(),
+        load_carried("cylinder", 4.0, 1e-10),
+        {"check": "status_changes", "per_iteration": 21, "per_step": 42},
+    ],
+)
+
+# 12. two-pass with Lagrange multipliers and with elimination (mesh C)
+c = patch("C")
+c["contact"][0]["discretization"] = {"kind": "node_to_surface", "passes": 2}
+case(
+    "two-pass-lagrange",
+    "Mesh C, node-to-surface two-pass with Lagrange multipliers: the two passes' rows are dependent, so the multipliers are not unique (the minimum-norm ones are taken); the stress is exact and the load is carried, but no single contact pressure can be checked.",
+    c,
+    [converged(), stress(P), load_carried("interface", PUNCH_LOAD, 1e-10), {"check": "force_balance", "tol": 1e-12}],
+)
+c = copy.deepcopy(c)
+c["contact"][0]["enforcement"] = enforcement("penalty", 10.0 * E / H_C)
+case(
+    "two-pass-penalty",
+    "Mesh C, node-to-surface two-pass with a penalty (10 E / h): Taylor's 'penalty passes (penetrate)'; the dependent rows of the two passes do no harm to a penalty, the load is carried and equilibrium is at round-off. (Two-pass constraint elimination is refused as bad input before any solve: no row owns the shared slave dof.)",
+    c,
+    [converged(), load_carried("interface", PUNCH_LOAD), {"check": "force_balance", "tol": 1e-12}],
+)
+
+# 13. mortar with the slave ten times finer and ten times coarser than the master
+for label, punch_div, found in [("finer", 20, [4, 6]), ("coarser", 2, None)]:
+    c = patch("C")
+    c["bodies"][1]["mesh"]["block"]["x"] = {"from": 4, "to": 6, "divisions": punch_div}
+    if found is None:
+        c["bodies"][0]["mesh"]["block"]["x"] = [0, 2, 4] + [4 + 0.1 * k for k in range(1, 20)] + [6, 7, 8]
+    else:
+        c["bodies"][0]["mesh"]["block"]["x"] = [0, 2, 4, 6, 7, 8]
+    c["contact"][0]["discretization"] = {"kind": "mortar", "multiplier": "standard"}
+    case(
+        f"mortar-slave-10x-{label}",
+        f"Mortar (standard multipliers, Lagrange), the punch (slave) ten times {label} than the foundation on the interface: segment-based mortar passes the patch test at any ratio.",
+        c,
+        [converged(), stress(P), {"check": "contact_pressure", "pair": "interface", "tol": 1e-10}, {"check": "force_balance", "tol": 1e-12}],
+    )
+
+# 14. iterative methods with a small penalty (kappa = 1e-3 E): a diagnosed stall
+for kind, update in [("augmented_lagrange", "outer_loop"), ("augmented_lagrange", "per_iteration"), ("perturbed_tangent", None)]:
+    c = patch("C")
+    c["contact"][0]["enforcement"] = enforcement(kind, 1e-3 * E, update)
+    label = kind.replace("_", "-") + (f"-{update.replace('_', '-')}" if update else "")
+    case(
+        f"{label}-small-penalty",
+        f"Mesh C, {kind.replace('_', ' ')}{' (' + update.replace('_', ' ') + ')' if update else ''} with kappa = 1e-3 E: each iteration closes the gap by a factor close to 1, so the solve stops at its iteration limit, with a diagnosis that names the penalty and one that works.",
+        c,
+        [stops("iteration_limit", "is too small against the bodies' stiffness")],
+    )
+
+# 15. iterative methods with a huge penalty (kappa = 1e12 E)
+for kind, update in [("augmented_lagrange", "per_iteration"), ("perturbed_tangent", None)]:
+    c = patch("C")
+    c["contact"][0]["enforcement"] = enforcement(kind, 1e12 * E, update)
+    label = kind.replace("_", "-")
+    case(
+        f"{label}-huge-penalty",
+        f"Mesh C, {kind.replace('_', ' ')} with kappa = 1e12 E: the penalized matrix is singular to working precision; the solve stops and says so, instead of converging to forces that lost their digits.",
+        c,
+        [stops("singular", "a penalty far stiffer than the bodies")],
+    )
+
+# 16. a slave node sliding past the master's end (current geometry)
+c = patch("A")
+c["bodies"][1]["mesh"]["block"]["x"] = [4.5, 5.5, 6.5]
+c["exact"] = None
+c.pop("exact")
+c["physics"] = {"contact_geometry": "current"}
+case(
+    "slave-past-master-end",
+    "Mesh A with the punch shifted to [4.5, 6.5], so that its right end hangs 0.5 past the master surface [4, 6]: the node beyond the end has no master facet and carries no force; the others carry the punch's load.",
+    c,
+    [converged(), load_carried("interface", PUNCH_LOAD, 1e-10), {"check": "force_balance", "tol": 1e-12}],
+)
+
+# 17. Newton scheme with a stiff penalty: the same diagnosis
+c = patch("C")
+c["contact"][0]["enforcement"] = enforcement("penalty", 1e9 * E / H_C)
+c["solver"] = {"scheme": "newton"}
+case(
+    "newton-penalty-1e9-E-over-h",
+    "Mesh C, penalty kappa = 1e9 E / h solved by the Newton core: its residual cannot reach the Newton tolerance because the penalty forces are known only to round-off of the displacement; the solve stops at the iteration limit with a diagnosis naming the penalty and how far to lower it.",
+    c,
+    [stops("iteration_limit", "the residual stagnated")],
+)
+
+
+def main():
+    for name, c in CASES.items():
+        ordered = {"$schema": c.pop("$schema"), "name": c.pop("name"), "description": c.pop("description")}
+        ordered.update(c)
+        with open(os.path.join(HERE, f"{name}.json"), "w") as f:
+            json.dump(ordered, f, indent=2)
+            f.write("\n")
+    print(f"{len(CASES)} cases written to {HERE}")
+
+
+if __name__ == "__main__":
+    main()

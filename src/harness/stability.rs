@@ -1,0 +1,268 @@
+//! Numerical stability of a solved case: how well conditioned its systems were, whether its
+//! equilibrium is at round-off, how much its active set chattered, and why an iterative method
+//! stalled.
+//!
+//! * Conditioning: the estimated 1-norm condition number `kappa` of the last factored system
+//!   (Hager-Higham, [`crate::solver::conditioning`]) and the digits it can cost,
+//!   `log10(kappa)`.
+//! * Equilibrium: the relative residual `max |K u - f - B^T lambda| / F` of the answer is at
+//!   round-off when it is at most [`EQUILIBRIUM_ROUND_OFF`]. A penalty row's force
+//!   `lambda = kappa A g` is computed from a gap `g = g0 + b . u` that is only known to about
+//!   `eps |b| |u|` (the displacement is stored to `eps` relative), so the force cannot be
+//!   better than `kappa A eps |b| |u|`: the penalty floor
+//!   `max_i kappa_i A_i |b_i| eps max|u| / F`, which names the penalty as the cause when it
+//!   is above round-off and says how far to lower it.
+//! * Chattering: the number of contact points that change status after an iteration, per
+//!   iteration and summed over a load step (the history's `status_changes`).
+//! * A stalled Uzawa iteration (augmented Lagrangian) or perturbed-tangent iteration: each
+//!   iteration reduces the penetration by about `1 / (1 + kappa A c)` with `c` the
+//!   compliance of the bodies at the point (Bertsekas, *Constrained Optimization and Lagrange
+//!   Multiplier Methods*, 1982, ch. 2; Laursen, *Computational Contact and Impact Mechanics*,
+//!   2002, sec. 5.3), so a penalty far below the stiffness of the bodies, `E / h`, needs
+//!   thousands of iterations; the diagnosis gives the measured rate and a penalty that works.
+
+use crate::contact::enforcement::{method, Method};
+use crate::contact::state::{ContactState, Termination};
+use crate::model::Model;
+use crate::solver::conditioning::{lost_digits, EQUILIBRIUM_ROUND_OFF};
+use crate::solver::linear::Solution;
+use serde::Serialize;
+
+/// What `summary.json` says of the conditioning and the equilibrium of an answer.
+#[derive(Clone, Debug, Serialize)]
+pub struct Conditioning {
+    /// Estimated 1-norm condition number of the last factored system (`None` without an
+    /// estimate: no contact, or an LU solve).
+    pub condition_estimate: Option<f64>,
+    /// `log10` of the estimate.
+    pub lost_digits: Option<f64>,
+    /// The relative equilibrium residual of the answer.
+    pub equilibrium_residual: f64,
+    /// Whether it is at most [`EQUILIBRIUM_ROUND_OFF`].
+    pub equilibrium_at_round_off: bool,
+    /// The penalty floor of the equilibrium residual (penalty-type rows only, see the module).
+    pub penalty_floor: Option<f64>,
+    /// The most status changes after one iteration and in one load step (chattering).
+    pub status_changes_per_iteration: usize,
+    pub status_changes_per_step: usize,
+}
+
+/// The most status changes after one iteration, and summed over one load step.
+pub fn status_changes(state: &ContactState) -> (usize, usize) {
+    let per_iteration = state
+        .history
+        .iter()
+        .map(|r| r.status_changes)
+        .max()
+        .unwrap_or(0);
+    let mut per_step = std::collections::BTreeMap::new();
+    for r in &state.history {
+        *per_step.entry(r.step).or_insert(0) += r.status_changes;
+    }
+    (per_iteration, per_step.into_values().max().unwrap_or(0))
+}
+
+/// The penalty weight `kappa A` of a row of a penalty-type method (`None` for methods whose
+/// force is a multiplier).
+fn penalty_weight(model: &Model, row: &crate::contact::Constraint) -> Option<f64> {
+    match method(&model.contact[row.pair].enforcement).kernel() {
+        Method::Regularized { .. } | Method::PerturbedLagrange { .. } => {
+            method(&model.contact[row.pair].enforcement)
+                .kappa()
+                .map(|k| k * row.area)
+        }
+        _ => None,
+    }
+}
+
+/// The penalty floor of the relative equilibrium residual (see the module), `None` without
+/// penalty rows.
+pub fn penalty_floor(model: &Model, solution: &Solution) -> Option<f64> {
+    let state = solution.contact.as_ref()?;
+    let u = crate::solver::linear::max_abs(&solution.u);
+    let force = crate::solver::linear::max_abs(&model.external_force).max(f64::MIN_POSITIVE);
+    state
+        .rows
+        .iter()
+        .zip(&state.active)
+        .filter(|(_, &a)| a)
+        .filter_map(|(r, _)| {
+            let w = penalty_weight(model, r)?;
+            let b = r
+                .coeffs
+                .iter()
+                .map(|c| c.abs())
+                .sum::<f64>()
+                .max(f64::MIN_POSITIVE);
+            Some(w * b * f64::EPSILON * u / force)
+        })
+        .reduce(f64::max)
+}
+
+/// The conditioning and equilibrium of `solution`.
+pub fn conditioning(model: &Model, solution: &Solution) -> Conditioning {
+    let condition_estimate = solution
+        .contact
+        .as_ref()
+        .and_then(|c| c.history.last().and_then(|r| r.condition_estimate));
+    let (per_iteration, per_step) = solution
+        .contact
+        .as_ref()
+        .map(status_changes)
+        .unwrap_or((0, 0));
+    let residual = solution.relative_residual;
+    Conditioning {
+        condition_estimate,
+        lost_digits: condition_estimate.map(lost_digits),
+        equilibrium_residual: residual,
+        equilibrium_at_round_off: residual <= EQUILIBRIUM_ROUND_OFF,
+        penalty_floor: penalty_floor(model, solution),
+        status_changes_per_iteration: per_iteration,
+        status_changes_per_step: per_step,
+    }
+}
+
+/// The largest penalty of a pair that keeps its floor at round-off: `kappa` scaled by
+/// `EQUILIBRIUM_ROUND_OFF / floor`.
+fn largest_sound_penalty(model: &Model, floor: f64) -> Option<(String, f64)> {
+    model.contact.iter().find_map(|p| {
+        let m = method(&p.enforcement);
+        match m.kernel() {
+            Method::Regularized { .. } | Method::PerturbedLagrange { .. } => m
+                .kappa()
+                .map(|k| (p.name.clone(), k * EQUILIBRIUM_ROUND_OFF / floor)),
+            _ => None,
+        }
+    })
+}
+
+/// The warning for a converged answer whose equilibrium is not at round-off, with the
+/// condition estimate and, when a penalty explains it, how far to lower the penalty.
+pub fn equilibrium_warning(model: &Model, solution: &Solution) -> Option<String> {
+    let state = solution.contact.as_ref()?;
+    if state.termination != Termination::Converged {
+        return None;
+    }
+    let c = conditioning(model, solution);
+    if c.equilibrium_at_round_off || !c.equilibrium_residual.is_finite() {
+        return None;
+    }
+    let kappa = c
+        .condition_estimate
+        .map(|k| {
+            format!(
+                "; the last factored system has condition estimate {k:.2e} ({:.1} of 16 digits lost)",
+                lost_digits(k)
+            )
+        })
+        .unwrap_or_default();
+    let cause = match c.penalty_floor {
+        Some(floor) if floor > 0.1 * c.equilibrium_residual => {
+            let lower = largest_sound_penalty(model, floor)
+                .map(|(pair, k)| format!("lower kappa of '{pair}' to about {k:.1e} or below, "))
+                .unwrap_or_default();
+            format!(
+                "the penalty forces kappa A g come from gaps known only to round-off of the displacement, which limits equilibrium to about {floor:.1e}: {lower}or use Lagrange multipliers or the augmented Lagrangian"
+            )
+        }
+        _ => "the answer has lost digits to the conditioning of the system (a body held only by a very soft penalty, a nearly incompressible material, or moduli far apart make it ill conditioned): hold such a body with a support or a stiffer penalty, or judge equilibrium relative to the condition estimate (the `equilibrium` check with `per_condition`)".to_string(),
+    };
+    Some(format!(
+        "equilibrium is not at round-off: relative residual {:.2e} (round-off is {EQUILIBRIUM_ROUND_OFF:.0e}){kappa}; {cause}",
+        c.equilibrium_residual
+    ))
+}
+
+/// Why a solve hit its iteration limit, and what would work: an augmented Lagrangian or
+/// perturbed-tangent iteration with too small a penalty ([`iterative_stall`]), or a Newton
+/// residual that stagnates at the floor of too stiff a penalty; `None` for other stops.
+pub fn stall_diagnosis(model: &Model, solution: &Solution) -> Option<String> {
+    let state = solution.contact.as_ref()?;
+    if state.termination != Termination::IterationLimit {
+        return None;
+    }
+    iterative_stall(model, state).or_else(|| {
+        let floor = penalty_floor(model, solution)?;
+        let last = state.history.last()?.residual;
+        // the residual stays within a factor 100 of the floor: the penalty, not the iteration,
+        // limits it
+        (floor.is_finite() && last <= 100.0 * floor && last > EQUILIBRIUM_ROUND_OFF).then(|| {
+            let lower = largest_sound_penalty(model, floor)
+                .map(|(pair, k)| format!("lower kappa of '{pair}' to about {k:.1e} or below"))
+                .unwrap_or_else(|| "lower the penalty".into());
+            format!(
+                "the residual stagnated at {last:.2e} after {} iterations: the penalty forces kappa A g come from gaps known only to round-off of the displacement, which limits the residual to about {floor:.1e}, above the solver's tolerance; {lower}, or use Lagrange multipliers",
+                state.iterations
+            )
+        })
+    })
+}
+
+/// The diagnosis of an augmented Lagrangian or perturbed-tangent iteration that reached its
+/// limit: the measured contraction of the penetration and a penalty that works.
+fn iterative_stall(model: &Model, state: &ContactState) -> Option<String> {
+    let (pair, kappa) = model.contact.iter().find_map(|p| {
+        let m = method(&p.enforcement);
+        match m.kernel() {
+            Method::AugmentedLagrange { .. } | Method::PerturbedTangent { .. } => {
+                m.kappa().map(|k| (p, k))
+            }
+            _ => None,
+        }
+    })?;
+    // the stiffness of the bodies at the interface: the largest E over the smallest
+    // tributary length of a row of the pair
+    let youngs = model
+        .bodies
+        .iter()
+        .map(|b| b.material.youngs_modulus)
+        .fold(0.0f64, f64::max);
+    let h = state
+        .rows
+        .iter()
+        .filter(|r| std::ptr::eq(&model.contact[r.pair], pair) && r.area > 0.0)
+        .map(|r| r.area)
+        .fold(f64::INFINITY, f64::min);
+    let stiffness = if h.is_finite() { youngs / h } else { youngs };
+    // the measured contraction of the penetration over the last iterations
+    let gaps: Vec<f64> = state
+        .history
+        .iter()
+        .map(|r| r.max_gap_violation)
+        .filter(|g| *g > 0.0)
+        .collect();
+    let rate = if gaps.len() >= 11 {
+        let (a, b) = (gaps[gaps.len() - 11], gaps[gaps.len() - 1]);
+        Some((b / a).powf(0.1))
+    } else {
+        None
+    };
+    let measured = match rate {
+        Some(r) if r.is_finite() && r > 0.0 && r < 1.0 => {
+            let last = *gaps.last().expect("eleven gaps");
+            let more = ((1e-15 * model.size() / last).ln() / r.ln()).ceil();
+            format!(
+                "the penetration fell by a factor {r:.4} per iteration over the last ten (about {more:.0} more iterations to reach round-off)"
+            )
+        }
+        Some(r) if r.is_finite() => format!(
+            "the penetration did not fall over the last ten iterations (factor {r:.4} per iteration)"
+        ),
+        _ => "the penetration did not settle".to_string(),
+    };
+    Some(format!(
+        "contact '{}': the iteration stalled after {} iterations: {measured}; the penalty kappa = {kappa:.3e} is too small against the bodies' stiffness E / h = {stiffness:.3e}: try kappa >= {:.1e} (10 E / h), or raise solver.max_iterations",
+        pair.name,
+        state.iterations,
+        10.0 * stiffness
+    ))
+}
+
+/// The stability warnings of a run: equilibrium not at round-off, a stalled iteration.
+pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
+    let stall = stall_diagnosis(model, solution);
+    equilibrium_warning(model, solution)
+        .into_iter()
+        .chain(stall)
+        .collect()
+}
