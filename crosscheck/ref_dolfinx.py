@@ -24,7 +24,8 @@ mesh); their reference file says so.
 
 The solution is also written by DOLFINx itself (`dolfinx.io.VTKFile`, ASCII) as
 OUT_ROOT/<case>/dolfinx.pvd + dolfinx_p0_000000.vtu, with the point fields `displacement` and
-`stress` (sigma(u_h) interpolated at the nodes of a tensor Lagrange space of the same degree),
+`stress` (xx, yy, xy of sigma(u_h) interpolated at the nodes of a Lagrange space of the same
+degree),
 so that `contact-patch judge` can apply the case's checks to it (crosscheck/run.sh does).
 """
 
@@ -62,10 +63,14 @@ DCELL = {"quadrilateral": dmesh.CellType.quadrilateral, "triangle": dmesh.CellTy
 def write_vtu(path, msh, degree, uh, sigma):
     """DOLFINx's own VTK output of u_h and sigma(u_h) (see the module text)."""
     uh.name = "displacement"
-    W = fem.functionspace(msh, ("Lagrange", degree, (2, 2)))
+    # xx, yy, xy as a 3-vector: DOLFINx pads a 2x2 tensor to 9 values as xx, xy, yx, yy, 0..
+    # (not the 3x3 row-by-row layout VTK readers expect)
+    W = fem.functionspace(msh, ("Lagrange", degree, (3,)))
     s = fem.Function(W)
     s.name = "stress"
-    s.interpolate(fem.Expression(sigma(uh), W.element.interpolation_points))
+    S = sigma(uh)
+    s.interpolate(fem.Expression(ufl.as_vector([S[0, 0], S[1, 1], S[0, 1]]),
+                                 W.element.interpolation_points))
     with dolfinx.io.VTKFile(MPI.COMM_SELF, str(path), "w") as f:
         f.write_function([uh, s])
 

@@ -248,13 +248,22 @@ fn field<'a>(
 }
 
 /// `xx, yy, xy` of a stress field value: 3 components as they are, 4 as a 2x2 and 9 as a 3x3
-/// tensor row by row.
-fn stress_of(v: &[f64]) -> Option<[f64; 3]> {
+/// tensor row by row, which must be symmetric (within `1e-10` of its largest entry): a 2x2
+/// tensor padded to 9 values as `xx, xy, yx, yy, 0, ..` (DOLFINx's VTK output) is not a 3x3
+/// one and is refused rather than misread.
+fn stress_of(v: &[f64]) -> std::result::Result<[f64; 3], String> {
+    let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-10 * largest;
     match v.len() {
-        3 => Some([v[0], v[1], v[2]]),
-        4 => Some([v[0], v[3], v[1]]),
-        9 => Some([v[0], v[4], v[1]]),
-        _ => None,
+        3 => Ok([v[0], v[1], v[2]]),
+        4 if same(v[1], v[2]) => Ok([v[0], v[3], v[1]]),
+        9 if same(v[1], v[3]) && same(v[2], v[6]) && same(v[5], v[7]) => Ok([v[0], v[4], v[1]]),
+        4 | 9 => Err(format!(
+            "{} components {v:?} are not a symmetric {} tensor row by row",
+            v.len(),
+            if v.len() == 4 { "2x2" } else { "3x3" }
+        )),
+        n => Err(format!("{n} components per point")),
     }
 }
 
@@ -394,13 +403,14 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
                 let file = results.of_body(b);
                 let s = field(file, STRESS_FIELD, 3)?.expect("found above");
                 for &k in &matched[b] {
-                    let v = stress_of(s.at(k)).ok_or_else(|| {
+                    let v = stress_of(s.at(k)).map_err(|why| {
                         Error::invalid(
                             &file.shown,
-                            format!("point field '{STRESS_FIELD}'"),
-                            format!("{} components per point", s.components),
-                            "write stress as xx, yy, xy (3 components) or as a 2x2 or 3x3 \
-                             tensor (4 or 9, row by row)",
+                            format!("point field '{STRESS_FIELD}' at point {k}"),
+                            why,
+                            "write stress as xx, yy, xy (3 components) or as a symmetric 2x2 or \
+                             3x3 tensor (4 or 9, row by row); DOLFINx pads a 2x2 tensor to 9 \
+                             values in another order: write a 3-vector (xx, yy, xy) instead",
                         )
                     })?;
                     for i in 0..3 {
@@ -498,5 +508,23 @@ fn solution_of(model: &Model, u: Vec<f64>) -> Solution {
         relative_residual: largest_free / scale,
         timings: Timings::default(),
         contact: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::stress_of;
+
+    #[test]
+    fn stress_layouts_are_read_or_refused() {
+        assert_eq!(stress_of(&[3.0, -10.0, 2.0]), Ok([3.0, -10.0, 2.0]));
+        assert_eq!(stress_of(&[3.0, 2.0, 2.0, -10.0]), Ok([3.0, -10.0, 2.0]));
+        let full = [3.0, 2.0, 0.0, 2.0, -10.0, 0.0, 0.0, 0.0, 1.5];
+        assert_eq!(stress_of(&full), Ok([3.0, -10.0, 2.0]));
+        // DOLFINx's padding of a 2x2 tensor
+        let padded = [3.0, 2.0, 2.0, -10.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let e = stress_of(&padded).unwrap_err();
+        assert!(e.contains("not a symmetric 3x3 tensor"), "{e}");
+        assert!(stress_of(&[1.0, 2.0]).unwrap_err().contains("2 components"));
     }
 }
