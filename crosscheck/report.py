@@ -37,7 +37,9 @@ Exit status 1 when any verdict fails (including a missing or failed reference so
 import json
 import math
 import os
+import re
 import subprocess
+import xml.etree.ElementTree as ET
 import sys
 import time
 from datetime import datetime, timezone
@@ -586,6 +588,61 @@ def diff_cell(q, s):
     return sci(d)
 
 
+JUDGE_LINE = re.compile(r"^  (pass|FAIL) (.*) \(error ([^,]+), tol ([^)]+)\)$")
+
+
+def check_words(text):
+    """A check's words without its measured value (`reaction ... = 1.2e-15 (...)`)."""
+    return text.split(" = ")[0]
+
+
+def judged_entry(case_path, root):
+    """DOLFINx's own .vtu of a case judged by `contact-patch judge` (crosscheck/run.sh step 5):
+    every judged check's error and verdict from the judge's output, its verdicts from its JUnit
+    file (which must agree), and our run's verdict of the same check (summary.json). The entry
+    passes when the judge ran (exit 0 or 1) and every judged verdict equals ours; a check of
+    the results' own stress field is compared with our uniform-stress verdict."""
+    name = Path(case_path).stem
+    folder = root / name
+    xml = folder / "judge-dolfinx.xml"
+    rc_file = folder / "judge-dolfinx.rc"
+    if not rc_file.exists():
+        return None
+    rc = int(rc_file.read_text())
+    text = (folder / "judge-dolfinx.txt").read_text()
+    entry = {"case": name, "exit": rc, "rows": [], "not_judged": [], "verdict": "fail"}
+    if rc not in (0, 1) or not xml.exists():
+        entry["error"] = text.strip().splitlines()[-1] if text.strip() else f"exit {rc}"
+        return entry
+    statuses = []
+    for tc in ET.parse(xml).getroot().iter("testcase"):
+        if tc.find("skipped") is not None:
+            entry["not_judged"].append(tc.get("name"))
+        else:
+            statuses.append("fail" if tc.find("failure") is not None else "pass")
+    summary = json.loads((folder / "summary.json").read_text())
+    ours = {check_words(c["check"]): c for c in summary["checks"]}
+    uniform = next((c for c in summary["checks"] if c["check"].startswith("uniform stress")),
+                   None)
+    lines = [m for m in (JUDGE_LINE.match(ln) for ln in text.splitlines()) if m]
+    agree = len(lines) == len(statuses)     # a case with contact checks only judges none
+    for m, status in zip(lines, statuses):
+        verdict, check, error, tol = m.groups()
+        mine = ours.get(check_words(check))
+        if mine is None and "results' own nodal 'stress'" in check:
+            mine = uniform
+        row = {"check": check, "error": float(error), "tol": float(tol),
+               "verdict": "pass" if verdict == "pass" else "fail", "junit": status,
+               "ours_error": mine["error"] if mine else None,
+               "ours_verdict": ("pass" if mine["passed"] else "fail") if mine else None}
+        row["agree"] = row["verdict"] == status and (mine is None
+                                                     or row["verdict"] == row["ours_verdict"])
+        agree &= row["agree"]
+        entry["rows"].append(row)
+    entry["verdict"] = "pass" if agree else "fail"
+    return entry
+
+
 def write_md(path, report):
     v = report["versions"]
     tl = report["studies"]["tied_layer"]
@@ -763,7 +820,38 @@ def write_md(path, report):
     else:
         lines.append("No cylinder case in this run.")
 
+    judged = report.get("judged", [])
+    lines += ["", "## DOLFINx's own output judged by `contact-patch judge`", ""]
+    if judged:
+        lines += [
+            "DOLFINx writes its solution of each single-body case itself (`dolfinx.io.VTKFile`: "
+            "point fields `displacement` and `stress`, sigma(u_h) interpolated at the nodes); "
+            "`contact-patch judge CASE dolfinx_p0_000000.vtu --junit ...` applies the case's "
+            "checks to it, as for an outside code. *ours*: the same check on our own run. "
+            f"**{report['judged_passed']} of {len(judged)} cases agree** (every judged verdict "
+            "equal to ours, and to the JUnit file's).",
+            "",
+            "| case | check | DOLFINx error (judged) | tol | verdict | ours | our verdict |",
+            "|---|---|---:|---:|---|---:|---|",
+        ]
+        for e in judged:
+            if not e["rows"]:
+                verdict = "n/a" if e["verdict"] == "pass" else "**FAIL**"
+                lines.append(f"| {e['case']} | {e.get('error', 'no check judged')} | | | "
+                             f"{verdict} | | |")
+            for i, r in enumerate(e["rows"]):
+                ours = sci(r["ours_error"]) if r["ours_error"] is not None else "-"
+                verdict = r["verdict"] if r["agree"] else f"**{r['verdict']} (disagrees)**"
+                lines.append(f"| {e['case'] if i == 0 else ''} | {r['check']} | "
+                             f"{sci(r['error'])} | {tol_text(r['tol'])} | {verdict} | {ours} | "
+                             f"{r['ours_verdict'] or '-'} |")
+            if e["not_judged"]:
+                lines.append(f"| | not judged (contact checks need the solve's contact "
+                             f"forces): {len(e['not_judged'])} | | | | | |")
+    else:
+        lines.append("No DOLFINx .vtu was judged in this run.")
     lines += [
+        "",
         "## Cases",
         "",
         "- `cases/patch-single/*`: constant-stress patch tests on distorted meshes; all three "
@@ -822,6 +910,7 @@ def main(argv):
         studies["tied_layer"] = [tied_layer_study(s, root, repo) for s in m.get("tied_layer", [])]
         studies["two_block"] = [two_block_study(s, root) for s in m.get("two_block", [])]
     all_studies = studies["tied_layer"] + studies["two_block"]
+    judged = [j for j in (judged_entry(c, root) for c in cases) if j is not None]
 
     versions = {}
     for e in results:
@@ -875,6 +964,8 @@ def main(argv):
         "results": results,
         "hertz": hertz,
         "studies": studies,
+        "judged": judged,
+        "judged_passed": sum(j["verdict"] == "pass" for j in judged),
     }
     report["report_seconds"] = time.perf_counter() - t0
     md.parent.mkdir(parents=True, exist_ok=True)
@@ -884,9 +975,11 @@ def main(argv):
     failed += [s["study"] for s in all_studies if s["verdict"] != "pass"]
     failed += [f"Hertz {h['case']} {r['quantity']}" for h in hertz for r in h["rows"]
                if r["verdict"] != "pass"]
+    failed += [f"judge {j['case']} (DOLFINx .vtu)" for j in judged if j["verdict"] != "pass"]
     print(f"crosscheck: {report['passed']} of {report['total']} entries pass (cases and "
           f"studies); Hertz table: {hertz_passed} of {len(hertz_rows)} rows pass; worst "
-          f"relative difference between codes: {worst_text}; wrote {md} and {js}")
+          f"relative difference between codes: {worst_text}; DOLFINx .vtu judged: "
+          f"{report['judged_passed']} of {len(judged)} cases agree; wrote {md} and {js}")
     if failed:
         print("crosscheck: FAILED: " + ", ".join(failed))
         return 1

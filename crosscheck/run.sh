@@ -10,7 +10,9 @@
 # 3. builds our tool (cargo build --release; XCHECK_SKIP_BUILD=1 uses the binary already in
 #    target/release) and runs every case into a temporary folder (kept when XCHECK_OUT=DIR);
 # 4. solves the same cases on the meshes our tool wrote with DOLFINx and scikit-fem;
-# 5. writes reports/crosscheck.md and reports/crosscheck.json; exits 1 when any verdict fails.
+# 5. judges DOLFINx's own .vtu output of each case with `contact-patch judge` (the case's
+#    checks applied to an outside code's results, JUnit in the run folder);
+# 6. writes reports/crosscheck.md and reports/crosscheck.json; exits 1 when any verdict fails.
 #
 # Default cases: cases/patch-single, cases/convergence (single-body elasticity),
 # crosscheck/cases (cross-check-only elasticity cases), crosscheck/cases/contact (penalty
@@ -62,7 +64,7 @@ fi
 PY="$VENV/bin/python"
 
 # --- 3. our tool -------------------------------------------------------------------------------
-TOOL="$ROOT/target/release/contact-patch"
+TOOL="${CARGO_TARGET_DIR:-$ROOT/target}/release/contact-patch"
 XCHECK_OURS_VERSION="$(git describe --always --dirty 2>/dev/null || echo unknown)"
 if [ -z "${XCHECK_SKIP_BUILD:-}" ]; then
     cargo build --release -q
@@ -111,6 +113,17 @@ echo "crosscheck: our tool ran ${#CASES[@]} cases ($SECONDS s so far)"
 "$PY" crosscheck/ref_skfem.py "$OUT" "${CASES[@]}" > "$OUT/skfem.log" 2>&1 \
     || { echo "crosscheck: scikit-fem reported errors:" >&2; cat "$OUT/skfem.log" >&2; }
 
-# --- 5. the verdicts ------------------------------------------------------------------------------
+# --- 5. DOLFINx's results judged by our tool ------------------------------------------------------
+for c in "${CASES[@]}"; do
+    name="$(basename "$c" .json)"
+    vtu="$OUT/$name/dolfinx_p0_000000.vtu"
+    [ -f "$vtu" ] || continue
+    rc=0
+    "$TOOL" judge "$c" "$vtu" --junit "$OUT/$name/judge-dolfinx.xml" \
+        > "$OUT/$name/judge-dolfinx.txt" 2>&1 || rc=$?
+    echo "$rc" > "$OUT/$name/judge-dolfinx.rc"
+done
+
+# --- 6. the verdicts ------------------------------------------------------------------------------
 echo "$SECONDS" > "$OUT/elapsed"
 "$PY" crosscheck/report.py "$OUT" reports/crosscheck.md reports/crosscheck.json "${CASES[@]}"

@@ -102,6 +102,35 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         junit: Option<PathBuf>,
     },
+    /// Write cases as files other contact codes read: a Gmsh .msh (physical groups for every
+    /// body, node set and facet set), one .vtu per body, and a JSON sidecar with the problem.
+    #[command(
+        after_help = "Example:\n  contact-patch export cases/patch cases/patch-single --out export\n\nEach case goes to <out>/<case name>/ (replaced as a whole): <case name>.msh, <case name>.json,\n<body>.vtu. Judge the other code's results with `contact-patch judge`."
+    )]
+    Export {
+        /// Case files or folders of case files.
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// Folder that receives one sub-folder per case.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Judge another code's results for a case with the case's checks (see `export`).
+    #[command(
+        after_help = "Example:\n  contact-patch judge cases/patch-single/q4-distorted.json results/q4-distorted.vtu\n  contact-patch judge cases/patch/patch-A-nu0.3.json results/patch-A-nu0.3/ --junit judge.xml\n\nRESULTS is a .vtu file with the point field 'displacement' (optional: 'stress'), or a folder\nwith one <body name>.vtu per body. Each node is matched to the result point within\n--match-tol times the model size. Checks that need the solve's contact forces are listed as\nnot judged. Exit codes: 0 every judged check passes, 1 one fails, 2 bad input."
+    )]
+    Judge {
+        /// The case file (JSON).
+        case: PathBuf,
+        /// The results: a .vtu file, or a folder with <body name>.vtu per body.
+        results: PathBuf,
+        /// Node-matching distance, as a share of the model size.
+        #[arg(long, value_name = "SHARE", default_value_t = contact_patch::harness::judge::DEFAULT_MATCH_SHARE)]
+        match_tol: f64,
+        /// Also write JUnit XML to this file (one test case per check; its folder must exist).
+        #[arg(long, value_name = "FILE")]
+        junit: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -109,6 +138,13 @@ fn main() -> ExitCode {
     match cli.command {
         Command::Run { case, out } => run(&case, out),
         Command::Check { paths, junit } => check(&paths, junit.as_deref()),
+        Command::Export { paths, out } => export(&paths, &out),
+        Command::Judge {
+            case,
+            results,
+            match_tol,
+            junit,
+        } => judge(&case, &results, match_tol, junit.as_deref()),
         Command::Table {
             paths,
             out,
@@ -369,6 +405,126 @@ fn check(paths: &[PathBuf], junit_path: Option<&Path>) -> ExitCode {
         cases.len()
     );
     ExitCode::from(if errors > 0 || !written { 2 } else { 1 })
+}
+
+fn export(paths: &[PathBuf], out: &Path) -> ExitCode {
+    let folder = match ReportFolder::new(out) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let cases = match collect_cases(paths) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let mut errors = 0;
+    for case in &cases {
+        let result = guarded(case, || {
+            contact_patch::io::export::export_case(case, &folder)
+        });
+        match result {
+            Ok((target, files)) => println!(
+                "{}: wrote {} ({})",
+                case.display(),
+                target.path().display(),
+                files.join(", ")
+            ),
+            Err(e) => {
+                eprintln!("error: {e}");
+                errors += 1;
+            }
+        }
+    }
+    if errors > 0 {
+        eprintln!(
+            "error: {errors} of {} cases could not be exported",
+            cases.len()
+        );
+        return ExitCode::from(2);
+    }
+    ExitCode::SUCCESS
+}
+
+fn judge(case: &Path, results: &Path, match_tol: f64, junit_path: Option<&Path>) -> ExitCode {
+    use contact_patch::harness::judge;
+    let junit_out = match junit_file(junit_path) {
+        Ok(f) => f,
+        Err(code) => return code,
+    };
+    let judged = contact_patch::model::admit::load(case).and_then(|model| {
+        let found = judge::load_results(&model, results)?;
+        let j = judge::judge(&model, &found, match_tol)?;
+        Ok((model, j))
+    });
+    let (model, j) = match judged {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    println!(
+        "{}: {} nodes matched to {} (largest distance {:.3e}, allowed {:.3e})",
+        model.name,
+        j.nodes,
+        results.display(),
+        j.largest_distance,
+        j.match_distance
+    );
+    for f in &j.fields {
+        println!(
+            "  field '{}': {} ({})",
+            f.field,
+            if f.found { "found" } else { "missing" },
+            f.use_
+        );
+    }
+    for c in &j.checks {
+        println!(
+            "  {} {} (error {:.3e}, tol {:.1e})",
+            if c.passed { "pass" } else { "FAIL" },
+            c.check,
+            c.error,
+            c.tol
+        );
+    }
+    for n in &j.not_judged {
+        println!("  not judged {}: {}", n.check, n.why);
+    }
+    let mut cases = junit::check_cases(&model.name, &j.checks);
+    cases.extend(j.not_judged.iter().map(|n| junit::TestCase {
+        classname: model.name.clone(),
+        name: n.check.clone(),
+        seconds: 0.0,
+        verdict: junit::Verdict::Skipped {
+            message: format!("not judged: {}", n.why),
+        },
+    }));
+    let suite = junit::TestSuite {
+        name: format!("{} judged on {}", case.display(), results.display()),
+        seconds: 0.0,
+        cases,
+    };
+    if !write_junit(junit_out.as_ref(), "contact-patch judge", &[suite]) {
+        return ExitCode::from(2);
+    }
+    let failed = j.checks.iter().filter(|c| !c.passed).count();
+    println!(
+        "{} judged checks: {} pass, {failed} fail; {} not judged",
+        j.checks.len(),
+        j.checks.len() - failed,
+        j.not_judged.len()
+    );
+    if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
 }
 
 /// Run `job` on one case, turning a panic (a bug, never expected) into an error so that a

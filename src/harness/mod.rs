@@ -32,6 +32,7 @@ pub mod baseline;
 pub mod checks;
 pub(crate) mod exact;
 pub mod hard;
+pub mod judge;
 pub mod junit;
 pub mod layer;
 pub mod report;

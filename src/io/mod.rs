@@ -2,7 +2,10 @@
 //! the paths the tool writes ([`paths`], the one owner of every written path), the results it
 //! writes ([`output`]: `summary.json` and `.vtu` files) and its plots (`svg`).
 
+pub mod export;
+pub mod gmsh;
 pub mod output;
 pub mod paths;
 pub mod scene;
 pub(crate) mod svg;
+pub mod vtu_read;

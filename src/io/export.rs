@@ -1,0 +1,247 @@
+//! `contact-patch export`: a case as files other contact codes read, so that they can solve the
+//! same problem on the same meshes and be judged by `contact-patch judge`.
+//!
+//! Per case, a folder `<case name>/` (an [`OutputFolder`], replaced as a whole) holding
+//!
+//! * `<case name>.msh`: every body's mesh in one Gmsh MSH 4.1 file, with physical groups for
+//!   the bodies, node sets and facet sets ([`crate::io::gmsh`]);
+//! * `<body>.vtu`: each body's mesh as a VTK XML unstructured grid with the point field
+//!   `node` (our node number) and no results;
+//! * `<case name>.json`: the problem in data: analysis, materials, bodies (element, node and
+//!   facet sets with their group names, node-tag offsets), supports, loads, contact pairs (with
+//!   discretization and enforcement), the checks with their tolerances, the exact solution as
+//!   a closed form (`sigma = const`, `u = [e_xx x + g/2 y, g/2 x + e_yy y]` with `e = D^-1
+//!   sigma`, or Timoshenko & Goodier's cantilever, see [`crate::harness::exact`]), and the same
+//!   data resolved on the mesh: every prescribed dof with its value and every nonzero
+//!   consistent nodal load (`f_a = int N_a t ds`), by body, node number and Gmsh node tag.
+
+use crate::error::{Error, Result};
+use crate::harness::exact::ExactField;
+use crate::io::gmsh;
+use crate::io::paths::{file_name, OutputFolder, ReportFolder};
+use crate::io::scene::{Case, Plane};
+use crate::model::admit::admit;
+use crate::model::{parse, Model};
+use serde_json::{json, Value};
+use std::fs;
+use std::path::Path;
+
+/// The version of the sidecar's layout.
+pub const SIDECAR_FORMAT: &str = "contact-patch export 1";
+
+/// The parsed case file and its validated model.
+pub fn load_case(path: &Path) -> Result<(Case, Model)> {
+    let source = path.display().to_string();
+    let text = fs::read_to_string(path).map_err(|e| Error::io(&source, "reading the case", e))?;
+    let case = parse(&text, &source)?;
+    let model = admit(Model::build(&case, &source)?)?;
+    Ok((case, model))
+}
+
+/// The closed form of the exact field in words, with its parameters.
+fn exact_description(model: &Model) -> Value {
+    match &model.exact {
+        None => Value::Null,
+        Some(ExactField::UniformStress { stress }) => {
+            let strains: serde_json::Map<String, Value> = model
+                .bodies
+                .iter()
+                .map(|b| {
+                    let e = b.material.strain_of_stress(*stress);
+                    (
+                        b.name.clone(),
+                        json!({"eps_xx": e[0], "eps_yy": e[1], "gamma_xy": e[2]}),
+                    )
+                })
+                .collect();
+            json!({
+                "kind": "uniform_stress",
+                "stress": {"xx": stress[0], "yy": stress[1], "xy": stress[2]},
+                "closed_form": "sigma(x, y) = stress everywhere; strain e = D^-1 sigma (plane strain or stress as in analysis.plane, material of the body); u_x = eps_xx x + gamma_xy / 2 y, u_y = gamma_xy / 2 x + eps_yy y (no rigid motion)",
+                "strain_by_body": strains,
+                "traction": "t = sigma n on a boundary with outward normal n",
+            })
+        }
+        Some(ExactField::TimoshenkoCantilever {
+            load,
+            length,
+            depth,
+        }) => json!({
+            "kind": "timoshenko_cantilever",
+            "load": load, "length": length, "depth": depth,
+            "closed_form": "Timoshenko & Goodier (1970) sec. 21, x in [0, L], y in [-D/2, D/2], I = D^3/12, plane stress E, nu (plane strain: E/(1-nu^2), nu/(1-nu)): u_x = -P y / (6 E I) [(6L - 3x) x + (2 + nu)(y^2 - D^2/4)], u_y = P / (6 E I) [3 nu y^2 (L - x) + (4 + 5 nu) D^2 x / 4 + (3L - x) x^2], sigma_xx = -P (L - x) y / I, sigma_yy = 0, sigma_xy = P / (2 I) (D^2/4 - y^2)",
+        }),
+    }
+}
+
+/// The sidecar JSON of a case.
+pub fn sidecar(case: &Case, model: &Model, case_file: &Path) -> Value {
+    let scene = serde_json::to_value(case).expect("a case serializes");
+    let pick = |key: &str| scene.get(key).cloned().unwrap_or(Value::Null);
+    let mut offset = 0usize;
+    let mut bodies = Vec::new();
+    let mut prescribed = Vec::new();
+    let mut forces = Vec::new();
+    for body in &model.bodies {
+        let mesh = &body.mesh;
+        let node_sets: serde_json::Map<String, Value> = mesh
+            .node_sets
+            .iter()
+            .map(|(set, nodes)| {
+                let group = if set == gmsh::ALL_NODES_SET {
+                    format!("{} (the body's physical surface)", body.name)
+                } else {
+                    gmsh::group_name(&body.name, set)
+                };
+                (
+                    set.clone(),
+                    json!({"physical_group": group, "dimension": 0, "nodes": nodes}),
+                )
+            })
+            .collect();
+        let facet_sets: serde_json::Map<String, Value> = mesh
+            .facet_sets
+            .iter()
+            .map(|(set, facets)| {
+                let nodes: Vec<Vec<usize>> =
+                    facets.iter().map(|&f| mesh.facet_nodes(f)).collect();
+                (
+                    set.clone(),
+                    json!({"physical_group": gmsh::group_name(&body.name, set), "dimension": 1, "facets": nodes}),
+                )
+            })
+            .collect();
+        bodies.push(json!({
+            "name": body.name,
+            "material": {"name": body.material_name, "E": body.material.youngs_modulus, "nu": body.material.nu},
+            "element": format!("{:?}", mesh.kind),
+            "nodes": mesh.nodes.len(),
+            "cells": mesh.cell_count(),
+            "physical_surface": body.name,
+            "gmsh_node_tag": format!("node n of this body has Gmsh tag {} + n + 1", offset),
+            "node_tag_offset": offset,
+            "vtu": format!("{}.vtu", body.name),
+            "node_sets": node_sets,
+            "facet_sets": facet_sets,
+        }));
+        for n in 0..mesh.nodes.len() {
+            for (c, axis) in ["x", "y"].iter().enumerate() {
+                let d = body.dof(n, c);
+                if let Some(v) = model.prescribed[d] {
+                    prescribed.push(json!({"body": body.name, "node": n, "gmsh_node_tag": offset + n + 1, "component": axis, "value": v}));
+                }
+                let f = model.external_force[d];
+                if f != 0.0 {
+                    forces.push(json!({"body": body.name, "node": n, "gmsh_node_tag": offset + n + 1, "component": axis, "force": f}));
+                }
+            }
+        }
+        offset += mesh.nodes.len();
+    }
+    json!({
+        "format": SIDECAR_FORMAT,
+        "case": model.name,
+        "description": model.description,
+        "case_file": case_file.display().to_string(),
+        "analysis": {
+            "plane": match model.plane { Plane::Strain => "strain", Plane::Stress => "stress" },
+            "thickness": model.thickness,
+            "small_strain": true,
+        },
+        "mesh": {
+            "gmsh": format!("{}.msh", model.name),
+            "gmsh_format": "MSH 4.1 ASCII; physical surface per body, physical curve '<body>/<facet set>' per facet set, physical point group '<body>/<node set>' per node set",
+            "node_order": "element node orders as Gmsh and VTK: corners counter-clockwise, then edge midpoints (edge 0-1 first), then the centre",
+        },
+        "materials": pick("materials"),
+        "bodies": bodies,
+        "supports": pick("supports"),
+        "loads": pick("loads"),
+        "exact": exact_description(model),
+        "contact": pick("contact"),
+        "sweep": pick("sweep"),
+        "checks": pick("checks"),
+        "words": "supports and loads as the case file states them: a value 'exact' means the exact solution's displacement at the nodes (supports) or its traction sigma n (loads); 'resolved' holds the same data on the mesh",
+        "resolved": {
+            "prescribed_displacements": prescribed,
+            "consistent_nodal_forces": forces,
+        },
+        "results": {
+            "judge": format!("contact-patch judge {} RESULTS", case_file.display()),
+            "expected": "a .vtu with point data 'displacement' (2 or 3 components) at the mesh's nodes, optionally 'stress' (xx, yy, xy, or a 2x2 / 3x3 tensor); or a folder with <body>.vtu per body when bodies touch",
+        },
+    })
+}
+
+/// One body's mesh as VTK XML with the point field `node` (our node number).
+fn mesh_vtu(body: &crate::model::Body) -> String {
+    use std::fmt::Write as _;
+    let mesh = &body.mesh;
+    let mut s = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n");
+    let _ = writeln!(
+        s,
+        "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
+        mesh.nodes.len(),
+        mesh.cell_count()
+    );
+    s += "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    for p in &mesh.nodes {
+        let _ = writeln!(s, "{} {} 0", p[0], p[1]);
+    }
+    s += "</DataArray></Points>\n<Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+    for c in 0..mesh.cell_count() {
+        let ids: Vec<String> = mesh.cell(c).iter().map(|n| n.to_string()).collect();
+        let _ = writeln!(s, "{}", ids.join(" "));
+    }
+    s += "</DataArray><DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+    let nn = mesh.kind.node_count();
+    for c in 0..mesh.cell_count() {
+        let _ = writeln!(s, "{}", (c + 1) * nn);
+    }
+    s += "</DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+    for _ in 0..mesh.cell_count() {
+        let _ = writeln!(s, "{}", mesh.kind.vtk_cell_type());
+    }
+    s += "</DataArray></Cells>\n<PointData><DataArray type=\"Int64\" Name=\"node\" format=\"ascii\">\n";
+    for n in 0..mesh.nodes.len() {
+        let _ = writeln!(s, "{n}");
+    }
+    s += "</DataArray></PointData>\n</Piece></UnstructuredGrid></VTKFile>\n";
+    s
+}
+
+/// Write the export of the case at `case_file` into the sub-folder of `out` named after the
+/// case; returns that folder and the files written.
+pub fn export_case(case_file: &Path, out: &ReportFolder) -> Result<(OutputFolder, Vec<String>)> {
+    let (case, model) = load_case(case_file)?;
+    let folder = out.run_folder(&model.name)?;
+    let mut names = Vec::new();
+    let meshes: Vec<(&str, &crate::mesh::Mesh)> = model
+        .bodies
+        .iter()
+        .map(|b| (b.name.as_str(), &b.mesh))
+        .collect();
+    let msh_name = file_name("case name", &model.name, ".msh")?;
+    let json_name = file_name("case name", &model.name, ".json")?;
+    let mut files = vec![
+        (msh_name, gmsh::msh(&meshes)),
+        (
+            json_name,
+            serde_json::to_string_pretty(&sidecar(&case, &model, case_file))
+                .expect("the sidecar serializes")
+                + "\n",
+        ),
+    ];
+    for b in &model.bodies {
+        files.push((file_name("body name", &b.name, ".vtu")?, mesh_vtu(b)));
+    }
+    folder.write(|tmp| {
+        for (name, text) in &files {
+            let path = tmp.join(name);
+            fs::write(&path, text).map_err(|e| Error::io(path.display(), "writing", e))?;
+        }
+        Ok(())
+    })?;
+    names.extend(files.into_iter().map(|(n, _)| n));
+    Ok((folder, names))
+}

@@ -1,0 +1,387 @@
+//! A harness for any contact code (issue 17, items 1-2): `export` writes meshes other codes
+//! read (checked by reading the Gmsh file back with the `mshio` crate), and `judge` applies a
+//! case's checks to outside `.vtu` results. The round trip: our own results, written as `.vtu`
+//! and judged through the outside-results path, give the verdicts and errors of the direct run.
+
+use contact_patch::harness::judge::{judge, load_results, Results, DEFAULT_MATCH_SHARE};
+use contact_patch::io::export::export_case;
+use contact_patch::io::output::write_run;
+use contact_patch::io::paths::{OutputFolder, ReportFolder};
+use contact_patch::run::run_case;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_contact-patch");
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Every case of the single-body catalogue, the rigid-obstacle contact cases that have a
+/// closed form, and the contact patch test on meshes A and C.
+fn round_trip_cases() -> Vec<PathBuf> {
+    let mut cases: Vec<PathBuf> = std::fs::read_dir(root().join("cases/patch-single"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    cases.sort();
+    for c in [
+        "cases/contact/signorini-block-on-rigid-line.json",
+        "cases/contact/block-on-rigid-cylinder-lagrange.json",
+        "cases/patch/patch-A-nu0.3.json",
+        "cases/patch/patch-C-nu0.4.json",
+        "cases/convergence/cantilever-q9.json",
+    ] {
+        cases.push(root().join(c));
+    }
+    cases
+}
+
+#[test]
+fn our_results_judged_as_outside_results_give_the_direct_verdicts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut judged_checks = 0;
+    for case in round_trip_cases() {
+        let direct = run_case(&case, &mut |_| {}).unwrap();
+        let name = direct.model.name.clone();
+        let folder = OutputFolder::new(&tmp.path().join(&name)).unwrap();
+        write_run(&folder, &direct).unwrap();
+        let results = load_results(&direct.model, folder.path()).unwrap();
+        let j = judge(&direct.model, &results, DEFAULT_MATCH_SHARE).unwrap();
+        assert_eq!(j.nodes, direct.model.dof_count / 2, "{name}");
+        assert_eq!(
+            j.largest_distance, 0.0,
+            "{name}: coordinates are written exactly"
+        );
+        // every direct check is either judged with the same verdict and error, or listed as
+        // not judged (the contact checks)
+        let mut judged = j.checks.iter();
+        for d in &direct.checks {
+            if d.check.starts_with("the contact solve converged") {
+                continue;
+            }
+            let contact_check = [
+                "contact pressure",
+                "force balance",
+                "total contact force",
+                "max contact pressure",
+                "largest penetration",
+            ]
+            .iter()
+            .any(|w| d.check.contains(w));
+            if contact_check {
+                continue;
+            }
+            let o = judged
+                .next()
+                .unwrap_or_else(|| panic!("{name}: {} not judged", d.check));
+            // a check's words carry its measured value (a reaction's round-off differs)
+            let words = |c: &str| c.split(" = ").next().unwrap().to_string();
+            assert_eq!(words(&o.check), words(&d.check), "{name}");
+            assert_eq!(o.passed, d.passed, "{name}: {}", d.check);
+            // u is read back bit for bit; reactions K u - f are summed in another order
+            let scale = d.error.abs().max(1e-300);
+            assert!(
+                (o.error - d.error).abs() <= 1e-12 * scale.max(1e-3),
+                "{name}: {}: judged {:e} vs direct {:e}",
+                d.check,
+                o.error,
+                d.error
+            );
+            judged_checks += 1;
+        }
+        let declared_contact = direct
+            .model
+            .checks
+            .iter()
+            .filter(|c| {
+                let text = serde_json::to_string(c).unwrap();
+                [
+                    "contact_pressure",
+                    "force_balance",
+                    "contact_force",
+                    "max_contact_pressure",
+                    "max_penetration",
+                ]
+                .iter()
+                .any(|k| text.contains(&format!("\"check\":\"{k}\"")))
+            })
+            .count();
+        assert_eq!(j.not_judged.len(), declared_contact, "{name}");
+        // the rest are the results' own stress-field checks, which pass where the direct
+        // uniform-stress check does (nodal averages of a uniform field are that field)
+        let uniform = direct
+            .checks
+            .iter()
+            .find(|c| c.check.starts_with("uniform stress"));
+        for extra in judged {
+            assert!(
+                extra.check.contains("results' own nodal 'stress'"),
+                "{name}: {}",
+                extra.check
+            );
+            assert_eq!(
+                extra.passed,
+                uniform.unwrap().passed,
+                "{name}: {} error {:e}",
+                extra.check,
+                extra.error
+            );
+        }
+    }
+    assert!(judged_checks >= 20, "{judged_checks} checks compared");
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(BIN)
+        .current_dir(root())
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn say(o: &Output) -> String {
+    format!(
+        "exit {:?}\nstdout:\n{}\nstderr:\n{}",
+        o.status.code(),
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+#[test]
+fn exported_gmsh_file_reads_back_with_mshio() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = ReportFolder::new(tmp.path()).unwrap();
+    for case in [
+        "cases/patch/patch-C-nu0.3.json",
+        "cases/patch-single/t6-distorted.json",
+    ] {
+        let (folder, files) = export_case(&root().join(case), &out).unwrap();
+        let model = contact_patch::model::admit::load(&root().join(case)).unwrap();
+        let msh_path = folder.path().join(format!("{}.msh", model.name));
+        assert!(files.contains(&format!("{}.msh", model.name)));
+        let bytes = std::fs::read(&msh_path).unwrap();
+        let msh = mshio::parse_msh_bytes(bytes.as_slice()).unwrap();
+        assert_eq!(msh.header.version, 4.1);
+        let nodes: usize = model.bodies.iter().map(|b| b.mesh.nodes.len()).sum();
+        assert_eq!(msh.total_node_count(), nodes, "{case}");
+        let ents = msh.data.entities.as_ref().unwrap();
+        assert_eq!(ents.surfaces.len(), model.bodies.len());
+        let facet_sets: usize = model.bodies.iter().map(|b| b.mesh.facet_sets.len()).sum();
+        assert_eq!(ents.curves.len(), facet_sets, "{case}");
+        // node coordinates, tag by tag
+        let data = msh.data.nodes.as_ref().unwrap();
+        for (b, block) in model.bodies.iter().zip(&data.node_blocks) {
+            for (n, p) in block.nodes.iter().enumerate() {
+                assert_eq!([p.x, p.y], b.mesh.nodes[n], "{case}");
+            }
+        }
+        // cells and facets, by element type
+        let counts = msh.count_element_types();
+        let cells: usize = model.bodies.iter().map(|b| b.mesh.cell_count()).sum();
+        let facets: usize = model
+            .bodies
+            .iter()
+            .flat_map(|b| b.mesh.facet_sets.values())
+            .map(Vec::len)
+            .sum();
+        let element_cells: usize = counts
+            .iter()
+            .filter(|(t, _)| {
+                matches!(
+                    t,
+                    mshio::ElementType::Qua4
+                        | mshio::ElementType::Qua9
+                        | mshio::ElementType::Tri3
+                        | mshio::ElementType::Tri6
+                )
+            })
+            .map(|(_, n)| n)
+            .sum();
+        let element_lines: usize = counts
+            .iter()
+            .filter(|(t, _)| matches!(t, mshio::ElementType::Lin2 | mshio::ElementType::Lin3))
+            .map(|(_, n)| n)
+            .sum();
+        assert_eq!(element_cells, cells, "{case}");
+        assert_eq!(element_lines, facets, "{case}");
+        // every node of a named node set is a point entity in that set's group
+        let text = String::from_utf8(bytes).unwrap();
+        let names: Vec<&str> = text
+            .split("$PhysicalNames\n")
+            .nth(1)
+            .unwrap()
+            .split("$EndPhysicalNames")
+            .next()
+            .unwrap()
+            .lines()
+            .skip(1)
+            .collect();
+        for b in &model.bodies {
+            for (set, nodes) in b.mesh.node_sets.iter().filter(|(s, _)| *s != "all") {
+                let line = names
+                    .iter()
+                    .find(|l| l.starts_with("0 ") && l.ends_with(&format!("\"{}/{set}\"", b.name)))
+                    .unwrap_or_else(|| panic!("{case}: no group for {}/{set}", b.name));
+                let tag: i32 = line.split(' ').nth(1).unwrap().parse().unwrap();
+                let in_group = ents
+                    .points
+                    .iter()
+                    .filter(|p| p.physical_tags.contains(&tag))
+                    .count();
+                assert_eq!(in_group, nodes.len(), "{case}: {}/{set}", b.name);
+            }
+        }
+    }
+}
+
+/// The single-body Q4 patch test run by us, its `.vtu` rewritten by `edit`.
+fn edited_results(tmp: &Path, edit: impl Fn(&str) -> String) -> PathBuf {
+    let case = "cases/patch-single/q4-distorted.json";
+    let out = tmp.join("run");
+    let o = run(&["run", case, "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", say(&o));
+    let text = std::fs::read_to_string(out.join("patch.vtu")).unwrap();
+    let path = tmp.join("edited.vtu");
+    std::fs::write(&path, edit(&text)).unwrap();
+    path
+}
+
+#[test]
+fn a_wrong_displacement_fails_with_its_error_and_a_junit_failure() {
+    let tmp = tempfile::tempdir().unwrap();
+    // the displacement array: scale every x by 1.01 (a 1% error in e_xx)
+    let results = edited_results(tmp.path(), |t| {
+        let (head, rest) = t.split_once("Name=\"displacement\"").unwrap();
+        let (data, tail) = rest.split_once("</DataArray>").unwrap();
+        let (attrs, values) = data.split_once('>').unwrap();
+        let scaled: Vec<String> = values
+            .trim()
+            .lines()
+            .map(|l| {
+                let v: Vec<f64> = l.split(' ').map(|w| w.parse().unwrap()).collect();
+                format!("{} {} {}", v[0] * 1.01, v[1], v[2])
+            })
+            .collect();
+        format!(
+            "{head}Name=\"displacement\"{attrs}>\n{}\n</DataArray>{tail}",
+            scaled.join("\n")
+        )
+    });
+    let junit = tmp.path().join("judge.xml");
+    let o = run(&[
+        "judge",
+        "cases/patch-single/q4-distorted.json",
+        results.to_str().unwrap(),
+        "--junit",
+        junit.to_str().unwrap(),
+    ]);
+    let s = say(&o);
+    assert_eq!(o.status.code(), Some(1), "{s}");
+    assert!(
+        s.contains("FAIL uniform stress [3.0, -10.0, 2.0] (error"),
+        "{s}"
+    );
+    assert!(s.contains("FAIL relative L2 displacement error"), "{s}");
+    let xml = std::fs::read_to_string(&junit).unwrap();
+    let doc = roxmltree::Document::parse(&xml).unwrap();
+    let failures: Vec<_> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("failure"))
+        .collect();
+    assert!(failures.len() >= 2, "{xml}");
+    assert!(
+        failures
+            .iter()
+            .all(|f| f.attribute("message").unwrap().contains("> tol 1.0e-10")),
+        "{xml}"
+    );
+}
+
+#[test]
+fn judge_refuses_results_it_cannot_use_and_says_how_to_fix_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    let case = "cases/patch-single/q4-distorted.json";
+    let renamed = edited_results(tmp.path(), |t| {
+        t.replace("Name=\"displacement\"", "Name=\"u\"")
+    });
+    let o = run(&["judge", case, renamed.to_str().unwrap()]);
+    let s = say(&o);
+    assert_eq!(o.status.code(), Some(2), "{s}");
+    assert!(
+        s.contains("no point field 'displacement' (the file has: stress, stress_zz, u)"),
+        "{s}"
+    );
+    assert!(s.contains("u.name = \"displacement\""), "{s}");
+    // a node moved by 1e-3: no point within the matching distance
+    let moved = edited_results(tmp.path(), |t| {
+        t.replacen("<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n0 0 0", "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n0.001 0 0", 1)
+    });
+    let o = run(&["judge", case, moved.to_str().unwrap()]);
+    let s = say(&o);
+    assert_eq!(o.status.code(), Some(2), "{s}");
+    assert!(
+        s.contains("node 0 of body 'patch' at (0, 0)") && s.contains("1.000e-3 away"),
+        "{s}"
+    );
+    assert!(s.contains("--match-tol"), "{s}");
+    // ... which a looser matching distance accepts
+    let o = run(&[
+        "judge",
+        case,
+        moved.to_str().unwrap(),
+        "--match-tol",
+        "1e-3",
+    ]);
+    assert!(say(&o).contains("largest distance 1.000e-3"), "{}", say(&o));
+    // binary arrays
+    let binary = edited_results(tmp.path(), |t| {
+        t.replacen("format=\"ascii\"", "format=\"binary\"", 1)
+    });
+    let o = run(&["judge", case, binary.to_str().unwrap()]);
+    let s = say(&o);
+    assert_eq!(o.status.code(), Some(2), "{s}");
+    assert!(s.contains("only ASCII data arrays are read"), "{s}");
+    // a folder without the body's file
+    let o = run(&["judge", case, tmp.path().to_str().unwrap()]);
+    let s = say(&o);
+    assert_eq!(o.status.code(), Some(2), "{s}");
+    assert!(
+        s.contains("the folder holds no") && s.contains("patch.vtu"),
+        "{s}"
+    );
+}
+
+#[test]
+fn one_file_for_two_bodies_is_refused_where_their_displacements_differ() {
+    // two bodies meet at an interface; in one file the coincident points are ambiguous as soon
+    // as the two sides carry different displacements
+    let tmp = tempfile::tempdir().unwrap();
+    let case = root().join("cases/patch/patch-C-nu0.3.json");
+    let direct = run_case(&case, &mut |_| {}).unwrap();
+    let folder = OutputFolder::new(&tmp.path().join("run")).unwrap();
+    write_run(&folder, &direct).unwrap();
+    let Results::PerBody(files) = load_results(&direct.model, folder.path()).unwrap() else {
+        panic!("a folder gives one file per body");
+    };
+    let mut shared = files[0].clone();
+    for f in &files[1..] {
+        shared.grid.points.extend(&f.grid.points);
+        let d = shared.grid.fields.get_mut("displacement").unwrap();
+        let mut other = f.grid.fields["displacement"].values.clone();
+        // the second body moved rigidly by 1e-3 in x
+        for k in (0..other.len()).step_by(3) {
+            other[k] += 1e-3;
+        }
+        d.values.extend(other);
+    }
+    shared.grid.fields.retain(|k, _| k == "displacement");
+    let e = judge(&direct.model, &Results::Shared(shared), DEFAULT_MATCH_SHARE)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("carry different displacements") && e.contains("<body name>.vtu"),
+        "{e}"
+    );
+}
