@@ -10,7 +10,7 @@
 //!   `lambda = kappa A g` is computed from a gap `g = g0 + b . u` that is only known to about
 //!   `eps |b| |u|` (the displacement is stored to `eps` relative), so the force cannot be
 //!   better than `kappa A eps |b| |u|`: the penalty floor
-//!   `max_i kappa_i A_i |b_i| eps max|u| / F`, which names the penalty as the cause when it
+//!   `max_i kappa_i A_i |b_i| eps max|u| / F` (`F` the largest applied or contact force), which names the penalty as the cause when it
 //!   is above round-off and says how far to lower it.
 //! * Chattering: the number of contact points that change status after an iteration, per
 //!   iteration and summed over a load step (the history's `status_changes`).
@@ -80,7 +80,9 @@ fn penalty_weight(model: &Model, row: &crate::contact::Constraint) -> Option<f64
 pub fn penalty_floor(model: &Model, solution: &Solution) -> Option<f64> {
     let state = solution.contact.as_ref()?;
     let u = crate::solver::linear::max_abs(&solution.u);
-    let force = crate::solver::linear::max_abs(&model.external_force).max(f64::MIN_POSITIVE);
+    // the force scale of the relative residual: the largest applied or contact force
+    let force = crate::solver::linear::max_abs(model.external_force.iter().chain(&state.forces))
+        .max(f64::MIN_POSITIVE);
     state
         .rows
         .iter()
@@ -174,7 +176,7 @@ pub fn equilibrium_warning(model: &Model, solution: &Solution) -> Option<String>
 }
 
 /// Why a solve hit its iteration limit, and what would work: an augmented Lagrangian or
-/// perturbed-tangent iteration with too small a penalty ([`iterative_stall`]), or a Newton
+/// perturbed-tangent iteration with too small a penalty, or a Newton
 /// residual that stagnates at the floor of too stiff a penalty; `None` for other stops.
 pub fn stall_diagnosis(model: &Model, solution: &Solution) -> Option<String> {
     let state = solution.contact.as_ref()?;
