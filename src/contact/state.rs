@@ -28,8 +28,10 @@ pub struct ContactState {
     /// Linear solves performed (Newton iterations, inner and outer).
     pub iterations: usize,
     /// Number of dependent rows among the active constraints (rank deficiency of `B B^T`):
-    /// always computed for Lagrange multipliers and elimination (multiplier systems), for the
-    /// other methods only up to [`crate::solver::active_set::RANK_CHECK_LIMIT`] active rows (it costs `O(m^3)`).
+    /// computed for Lagrange multipliers and elimination (multiplier systems) up to
+    /// [`crate::solver::active_set::DENSE_MULTIPLIER_LIMIT`] active rows, for the other
+    /// methods up to [`crate::solver::active_set::RANK_CHECK_LIMIT`] (it costs `O(m^3)`);
+    /// `None` when not measured.
     pub rank_deficiency: Option<usize>,
     /// The linear solver of the last iteration: `cholesky` (penalty-type, perturbed tangent,
     /// augmented Lagrangian, elimination), `ldlt` (Lagrange, independent rows), `lu` (Lagrange,

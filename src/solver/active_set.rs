@@ -55,6 +55,13 @@ use std::time::Instant;
 /// Largest active set whose rank deficiency is measured for methods without multipliers.
 pub const RANK_CHECK_LIMIT: usize = 500;
 
+/// Largest active set of a multiplier method whose rank deficiency is measured, and whose
+/// dependent rows may be solved by the dense pseudo-inverse of the Schur complement: both
+/// hold an `m x m` dense matrix and cost `O(m^3)` (2000 rows: 32 MB, a few seconds). Above it
+/// the saddle-point LDL^T is tried directly, and dependent rows are reported as a singular
+/// system instead of exhausting memory.
+pub const DENSE_MULTIPLIER_LIMIT: usize = 2000;
+
 /// Most steps of iterative refinement of one LDL^T solve (it stops earlier once the correction
 /// no longer halves or reaches round-off).
 pub const MAX_REFINEMENT: usize = 10;
@@ -558,8 +565,13 @@ fn solve_at(
         .map(|(r, _)| r)
         .collect();
     let multipliers = matches!(method, Method::Lagrange | Method::Elimination);
-    let rank_deficiency = (multipliers || active_rows.len() <= RANK_CHECK_LIMIT)
-        .then(|| rank_deficiency(&active_rows, sys.n));
+    let rank_limit = if multipliers {
+        DENSE_MULTIPLIER_LIMIT
+    } else {
+        RANK_CHECK_LIMIT
+    };
+    let rank_deficiency =
+        (active_rows.len() <= rank_limit).then(|| rank_deficiency(&active_rows, sys.n));
     let mut solution = finish(model, &sys, u, &contact_force, timings)?;
     let n_rows = rows.len();
     solution.contact = Some(ContactState {
@@ -1245,12 +1257,22 @@ impl Kernel<'_> {
             .filter(|(_, &a)| a)
             .map(|(r, _)| r)
             .collect();
-        if rank_deficiency(&active_rows, n) == 0 {
+        let dense_allowed = active_rows.len() <= DENSE_MULTIPLIER_LIMIT;
+        if !dense_allowed || rank_deficiency(&active_rows, n) == 0 {
             let w = vec![rho; self.rows.len()];
             let rhs = self.rhs.clone();
             if let Some(solution) = self.saddle_ldlt(active, active, &w, rhs, rho, rho)? {
                 return Ok(solution);
             }
+        }
+        if !dense_allowed {
+            return Err(StepError::Singular(format!(
+                "the saddle-point system of {} active Lagrange-multiplier rows cannot be \
+                 factored (dependent rows), and the dense pseudo-inverse that would give \
+                 minimum-norm multipliers is limited to {DENSE_MULTIPLIER_LIMIT} rows; use a \
+                 penalty-type method or elimination for this interface, or a coarser mesh",
+                active_rows.len()
+            )));
         }
         self.linear_solver = "schur-pseudo-inverse";
         // rank-deficient (or LDL^T refused): minimum-norm multipliers from the Schur complement
