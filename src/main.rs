@@ -39,7 +39,7 @@ enum Command {
     },
     /// Run the contact patch-test catalogue and write reports/patch-table.md and .json.
     #[command(
-        after_help = "Example:\n  contact-patch table\n  contact-patch table cases/patch/patch-C-nu0.3.json --out /tmp/reports\n  contact-patch table --out new --junit table.xml --baseline old/patch-table.json --baseline old/tied-table.json\n\nWith --baseline the exit code is 1 only on a regression against the baseline (a verdict lost,\na cell gone, an error grown by more than --baseline-factor above 1e-10), not on failing cells."
+        after_help = "Example:\n  contact-patch table\n  contact-patch table cases/patch/patch-C-nu0.3.json --out /tmp/reports\n  contact-patch table --out new --junit table.xml --baseline old/patch-table.json --baseline old/tied-table.json\n  contact-patch table cases/patch --results their-results --code mycode --out their-tables\n\nWith --baseline the exit code is 1 only on a regression against the baseline (a verdict lost,\na cell gone, an error grown by more than --baseline-factor above 1e-10), not on failing cells."
     )]
     Table {
         /// Case files or folders with a sweep (default: cases/patch and cases/tied).
@@ -56,6 +56,18 @@ enum Command {
         /// How much an error may grow against the baseline before it is a regression.
         #[arg(long, value_name = "FACTOR", default_value_t = baseline::DEFAULT_FACTOR)]
         baseline_factor: f64,
+        /// Judge another code's results instead of solving: DIR/<case>.vtu or DIR/<case>/
+        /// (one <body>.vtu per body) for each case; one cell per case.
+        #[arg(long, value_name = "DIR")]
+        results: Option<PathBuf>,
+        /// The other code's name, shown in the enforcement column (with --results).
+        #[arg(
+            long,
+            value_name = "NAME",
+            default_value = "outside",
+            requires = "results"
+        )]
+        code: String,
     },
     /// The seed's tied layer: node-to-surface and mortar ties against one body, under refinement;
     /// writes reports/tied-layer.md, SVG plots and .vtu files.
@@ -151,7 +163,16 @@ fn main() -> ExitCode {
             junit,
             baseline,
             baseline_factor,
-        } => table(&paths, &out, junit.as_deref(), &baseline, baseline_factor),
+            results,
+            code,
+        } => table(
+            &paths,
+            &out,
+            junit.as_deref(),
+            &baseline,
+            baseline_factor,
+            results.as_deref().map(|dir| (dir, code.as_str())),
+        ),
         Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
         Command::Hard { paths, out } => hard(&paths, &out),
         Command::Schema => {
@@ -545,6 +566,7 @@ fn table(
     junit_path: Option<&Path>,
     baseline_paths: &[PathBuf],
     baseline_factor: f64,
+    outside: Option<(&Path, &str)>,
 ) -> ExitCode {
     let paths = if paths.is_empty() {
         vec![PathBuf::from("cases/patch"), PathBuf::from("cases/tied")]
@@ -565,6 +587,12 @@ fn table(
     if !(baseline_factor.is_finite() && baseline_factor > 1.0) {
         eprintln!("error: --baseline-factor {baseline_factor}: must be a number above 1\n  hint: it is how many times an error may grow before it is a regression, e.g. --baseline-factor 10");
         return ExitCode::from(2);
+    }
+    if let Some((dir, _)) = outside {
+        if !dir.is_dir() {
+            eprintln!("error: --results {}: no such folder\n  hint: give the folder that holds <case name>.vtu (or <case name>/<body>.vtu) for each case", dir.display());
+            return ExitCode::from(2);
+        }
     }
     let old_cells = match baseline::load(baseline_paths) {
         Ok(c) => c,
@@ -590,8 +618,14 @@ fn table(
                 b.set_message(m.to_string());
             }
         };
-        match guarded(case, || {
-            contact_patch::harness::run_sweep(case, &mut progress)
+        match guarded(case, || match outside {
+            Some((dir, code)) => contact_patch::harness::judge::outside_cells(
+                case,
+                dir,
+                code,
+                contact_patch::harness::judge::DEFAULT_MATCH_SHARE,
+            ),
+            None => contact_patch::harness::run_sweep(case, &mut progress),
         }) {
             Ok(c) => cells.extend(c),
             Err(e) => {

@@ -385,3 +385,70 @@ fn one_file_for_two_bodies_is_refused_where_their_displacements_differ() {
         "{e}"
     );
 }
+
+#[test]
+fn table_of_outside_results_matches_the_direct_cells_of_the_same_method() {
+    // our own runs of the cases as written (node-to-surface, one pass, slave punch, Lagrange)
+    // stand in for another code; `table --results` must find the stress errors and verdicts of
+    // the direct table's cells of that method
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    std::fs::create_dir(&results).unwrap();
+    let cases = [
+        "cases/patch/patch-A-nu0.3.json",
+        "cases/patch/patch-C-nu0.3.json",
+    ];
+    for case in cases {
+        let direct = run_case(&root().join(case), &mut |_| {}).unwrap();
+        let folder = OutputFolder::new(&results.join(&direct.model.name)).unwrap();
+        write_run(&folder, &direct).unwrap();
+    }
+    let out = tmp.path().join("tables");
+    let mut args = vec!["table"];
+    args.extend(cases);
+    args.extend(["--results", results.to_str().unwrap(), "--code", "stand-in"]);
+    args.extend(["--out", out.to_str().unwrap()]);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", say(&o));
+    let table: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("patch-table.json")).unwrap())
+            .unwrap();
+    let cells = table.as_array().unwrap();
+    assert_eq!(cells.len(), 2);
+    let mut verdicts = Vec::new();
+    for (case, cell) in cases.iter().zip(cells) {
+        assert_eq!(cell["enforcement"], "stand-in");
+        assert_eq!(cell["discretization"], "outside");
+        let direct = contact_patch::harness::run_sweep(&root().join(case), &mut |_| {}).unwrap();
+        let same = direct
+            .iter()
+            .find(|c| {
+                c.discretization == "node_to_surface"
+                    && c.passes == Some(1)
+                    && c.slave.as_deref() == Some("punch")
+                    && c.enforcement == "lagrange"
+            })
+            .unwrap();
+        let got = cell["stress_error"].as_f64().unwrap();
+        let want = same.stress_error.unwrap();
+        assert!(
+            (got - want).abs() <= 1e-12 * want.max(1e-3),
+            "{case}: {got:e} vs {want:e}"
+        );
+        assert_eq!(cell["verdict"], same.verdict.as_str(), "{case}");
+        verdicts.push(same.verdict.clone());
+    }
+    // the seed's verdicts: mesh A passes, mesh C one-pass fails
+    assert_eq!(verdicts, ["pass", "fail"]);
+    // a missing results folder is refused before any work
+    let o = run(&[
+        "table",
+        cases[0],
+        "--results",
+        "no/such/folder",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", say(&o));
+    assert!(say(&o).contains("--results no/such/folder: no such folder"));
+}

@@ -18,6 +18,11 @@
 //! * the contact checks (`contact_pressure`, `contact_force`, `max_contact_pressure`,
 //!   `max_penetration`, `force_balance`) need the contact forces of the solve and are listed as
 //!   not judged, with that reason.
+//!
+//! `table --results DIR` makes one table cell per swept case from the results in `DIR`
+//! ([`outside_cells`]): its verdict is the sweep's stress criterion,
+//! `max_qp max_i |sigma_i(u) - sigma_exact,i| / p <= tol` (the contact patch test's uniform
+//! stress), the other columns of a cell being contact quantities that results do not carry.
 
 use crate::error::{Error, Result};
 use crate::harness::checks::{evaluate, CheckResult, Magnitudes};
@@ -516,6 +521,82 @@ fn solution_of(model: &Model, u: Vec<f64>) -> Solution {
         timings: Timings::default(),
         contact: None,
     }
+}
+
+/// The results of case `name` in `dir`: `<name>.vtu`, or the folder `<name>/` with one
+/// `<body>.vtu` per body; `None` when neither exists.
+pub fn results_in(dir: &Path, name: &str) -> Result<Option<std::path::PathBuf>> {
+    let file = dir.join(file_name("case name", name, ".vtu")?);
+    let folder = dir.join(file_name("case name", name, "")?);
+    Ok(if file.is_file() {
+        Some(file)
+    } else if folder.is_dir() {
+        Some(folder)
+    } else {
+        None
+    })
+}
+
+/// One table cell for the swept case at `case_file` from another code's results in `dir`
+/// (see [`results_in`]), named `code` in the enforcement column; no cell for a case without
+/// a sweep. A case without results is an `n/a` cell that says so.
+pub fn outside_cells(
+    case_file: &Path,
+    dir: &Path,
+    code: &str,
+    match_share: f64,
+) -> Result<Vec<crate::harness::Cell>> {
+    let model = crate::model::admit::load(case_file)?;
+    let Some(sweep) = model.sweep.clone() else {
+        return Ok(Vec::new());
+    };
+    let mut cell = crate::harness::Cell {
+        catalogue: sweep.catalogue,
+        case: model.name.clone(),
+        mesh: sweep.mesh.clone(),
+        nu: model.bodies[0].material.nu,
+        discretization: "outside".into(),
+        passes: None,
+        slave: None,
+        enforcement: code.to_string(),
+        kappa: None,
+        pressure: sweep.pressure,
+        verdict: "n/a".into(),
+        stress_error: None,
+        stress_error_stiff: None,
+        penalty_trend: None,
+        pressure_error: None,
+        force_balance: None,
+        load_error: None,
+        max_penetration: None,
+        rank_deficiency: None,
+        stability: "-".into(),
+        newton_iterations: None,
+        termination: None,
+        linear_solver: None,
+        vs_penalty: None,
+        time_ms: 0.0,
+        note: String::new(),
+        tol: sweep.tol,
+    };
+    let Some(path) = results_in(dir, &model.name)? else {
+        cell.note = format!(
+            "no results: neither {0}/{1}.vtu nor {0}/{1}/ exists",
+            dir.display(),
+            model.name
+        );
+        return Ok(vec![cell]);
+    };
+    let results = load_results(&model, &path)?;
+    let judged = judge(&model, &results, match_share)?;
+    let e = crate::harness::stress_error(&model, &judged.solution.u, sweep.pressure);
+    cell.stress_error = Some(e);
+    cell.verdict = if e <= sweep.tol { "pass" } else { "fail" }.into();
+    cell.note = format!(
+        "{}: judged on the stress of its displacement; contact forces are not in the results",
+        path.display()
+    );
+    Ok(vec![cell])
 }
 
 #[cfg(test)]

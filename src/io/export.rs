@@ -11,7 +11,7 @@
 //!   facet sets with their group names, node-tag offsets), supports, loads, contact pairs (with
 //!   discretization and enforcement), the checks with their tolerances, the exact solution as
 //!   a closed form (`sigma = const`, `u = [e_xx x + g/2 y, g/2 x + e_yy y]` with `e = D^-1
-//!   sigma`, or Timoshenko & Goodier's cantilever, see [`crate::harness::exact`]), and the same
+//!   sigma`, or Timoshenko & Goodier's cantilever, see `src/harness/exact.rs`), and the same
 //!   data resolved on the mesh: every prescribed dof with its value and every nonzero
 //!   consistent nodal load (`f_a = int N_a t ds`), by body, node number and Gmsh node tag.
 
