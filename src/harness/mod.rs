@@ -31,6 +31,7 @@
 pub mod baseline;
 pub mod checks;
 pub(crate) mod exact;
+pub mod impact;
 pub mod junit;
 pub mod layer;
 pub mod report;

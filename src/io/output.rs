@@ -362,7 +362,9 @@ pub fn write_run(folder: &OutputFolder, outcome: &Outcome) -> Result<()> {
             write_vtu(&path, b, &outcome.solution.u, s)?;
         }
         if let Some(history) = &outcome.solution.dynamics {
-            crate::io::timeline::write_history(tmp, &outcome.model, history)?;
+            crate::io::timeline::write_history(tmp, &outcome.model, history, &|path, body, u| {
+                write_vtu(path, body, u, &nodal_stresses(body, u))
+            })?;
         }
         Ok(())
     })

@@ -143,9 +143,18 @@ pub struct Limits {
     /// times the 1M-dof case in `cases/large`).
     #[serde(default = "default_max_nodes")]
     pub nodes: usize,
+    /// The most time steps times dofs a dynamic run may ask for (default 100,000,000, about a
+    /// minute of stepping on one core).
+    #[serde(default = "default_max_step_dofs")]
+    pub step_dofs: u64,
 }
 
 pub const DEFAULT_MAX_NODES: usize = 2_000_000;
+pub const DEFAULT_MAX_STEP_DOFS: u64 = 100_000_000;
+
+fn default_max_step_dofs() -> u64 {
+    DEFAULT_MAX_STEP_DOFS
+}
 
 fn default_max_nodes() -> usize {
     DEFAULT_MAX_NODES
@@ -155,6 +164,7 @@ impl Default for Limits {
     fn default() -> Self {
         Limits {
             nodes: DEFAULT_MAX_NODES,
+            step_dofs: DEFAULT_MAX_STEP_DOFS,
         }
     }
 }

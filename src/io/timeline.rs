@@ -6,18 +6,22 @@
 //! `<body>.frame-NNNN.vtu`, written like the run's `.vtu` files.
 
 use crate::error::{Error, Result};
-use crate::io::output::write_vtu;
 use crate::io::paths::file_name;
 use crate::io::svg::{line_plot, Series};
-use crate::model::Model;
-use crate::post::nodal_stresses;
+use crate::model::{Body, Model};
 use crate::solver::history::DynamicHistory;
 use std::collections::HashSet;
 use std::fs;
 use std::path::Path;
 
-/// The files of a time integration, written into the (temporary) run folder `dir`.
-pub fn write_history(dir: &Path, model: &Model, history: &DynamicHistory) -> Result<()> {
+/// The files of a time integration, written into the (temporary) run folder `dir`;
+/// `write_frame(path, body, u)` writes one `.vtu` frame (the run's own `.vtu` writer).
+pub fn write_history(
+    dir: &Path,
+    model: &Model,
+    history: &DynamicHistory,
+    write_frame: &dyn Fn(&Path, &Body, &[f64]) -> Result<()>,
+) -> Result<()> {
     let write = |name: &str, text: &str| {
         let path = dir.join(name);
         fs::write(&path, text).map_err(|e| Error::io(path.display(), "writing", e))
@@ -49,7 +53,7 @@ pub fn write_history(dir: &Path, model: &Model, history: &DynamicHistory) -> Res
                     "rename the body so that no body is called like another's frame (<body>.frame-NNNN)",
                 ));
             }
-            write_vtu(&dir.join(&name), body, u, &nodal_stresses(body, u))?;
+            write_frame(&dir.join(&name), body, u)?;
             collection.push_str(&format!(
                 "<DataSet timestep=\"{time:e}\" group=\"\" part=\"0\" file=\"{name}\"/>\n"
             ));

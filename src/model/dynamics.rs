@@ -17,6 +17,8 @@ use crate::model::Model;
 pub const MAX_TIME_STEPS: usize = 1_000_000;
 /// Most `.vtu` frames (per body) a run writes.
 pub const MAX_FRAMES: usize = 1000;
+/// Most frames times dofs a run keeps and writes (80 MB of displacements).
+pub const MAX_FRAME_DOFS: usize = 10_000_000;
 
 /// A validated `physics.dynamics`.
 #[derive(Clone, Debug)]
@@ -89,6 +91,17 @@ pub fn resolve(case: &Case, model: &Model) -> Result<Option<Dynamics>> {
     }
     // a step count that is an integer up to round-off is that integer
     let steps = ((ratio - 1e-9 * ratio).ceil() as usize).max(1);
+    let work = steps as u128 * model.dof_count as u128;
+    if work > case.limits.step_dofs as u128 {
+        return Err(invalid(
+            "physics.dynamics",
+            format!(
+                "{steps} time steps of {} dofs ({work} step-dofs) are more than the limit {}",
+                model.dof_count, case.limits.step_dofs
+            ),
+            "take a larger dt, a shorter end_time or a coarser mesh, or raise \"limits\": {\"step_dofs\": N}",
+        ));
+    }
     if beta == 0.0 && spec.mass != MassKind::Lumped {
         return Err(invalid(
             "physics.dynamics.mass",
@@ -239,6 +252,20 @@ pub fn resolve(case: &Case, model: &Model) -> Result<Option<Dynamics>> {
             &format!(
                 "take frame_every of at least {}",
                 steps.div_ceil(MAX_FRAMES)
+            ),
+        ));
+    }
+    let frames = steps.div_ceil(frame_every) + 1;
+    if frames.saturating_mul(model.dof_count) > MAX_FRAME_DOFS {
+        return Err(invalid(
+            "physics.dynamics.frame_every",
+            format!(
+                "{frames} frames of {} dofs are more than the {MAX_FRAME_DOFS} values a run keeps for its .vtu frames",
+                model.dof_count
+            ),
+            &format!(
+                "take frame_every of at least {}",
+                steps.div_ceil((MAX_FRAME_DOFS / model.dof_count.max(1)).saturating_sub(1).max(1))
             ),
         ));
     }

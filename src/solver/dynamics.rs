@@ -815,3 +815,56 @@ fn newton_step(
     }
     Ok(outcome.iterations)
 }
+
+/// The residual and tangent of the first implicit step of a dynamic `model`,
+/// `R(x) = (K + c0 M) x - f - c0 M d~ - B^T lambda(x)` (`d~` the predictor from the initial
+/// state), at the free displacements `x`, for finite-difference checks of the dynamic tangent
+/// (`tests/dynamics.rs`): not part of the solver's interface. Penalty-type rows only (the
+/// unknowns are the free displacements). Dense, row-major: `tangent[i][j] = dR_i / dx_j`.
+#[doc(hidden)]
+pub fn probe_first_step(model: &Model, x: &[f64]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+    let dynamics = model
+        .dynamics
+        .as_ref()
+        .expect("probe_first_step takes a dynamic model");
+    let mut integrator = Integrator::new(model, dynamics, &mut |_| {})?;
+    let dt = dynamics.dt;
+    let beta = dynamics.beta;
+    let free: Vec<usize> = integrator
+        .system
+        .linear_system()
+        .constraints
+        .free_dofs()
+        .to_vec();
+    let target: Vec<f64> = free
+        .iter()
+        .map(|&d| integrator.d[d] + dt * integrator.v[d] + dt * dt * (0.5 - beta) * integrator.a[d])
+        .collect();
+    let m_t = mass_times(&integrator.mass, integrator.system.linear_system(), &target);
+    let rhs: Vec<f64> = integrator
+        .rhs0
+        .iter()
+        .zip(&m_t)
+        .map(|(r, m)| r + integrator.c0 * m)
+        .collect();
+    integrator.system.set_right_hand_side(rhs);
+    let general = GeneralPattern::from_symmetric(integrator.system.pattern());
+    let n = general.n;
+    let mut residual = vec![0.0; n];
+    let mut tangent = Tangent {
+        values: vec![0.0; general.nnz()],
+        symmetric: true,
+        multipliers: 0,
+        scale: 1.0,
+    };
+    integrator
+        .system
+        .evaluate(x, &general, &mut residual, &mut tangent)?;
+    let mut dense = vec![vec![0.0; n]; n];
+    for j in 0..n {
+        for k in general.col_ptr[j]..general.col_ptr[j + 1] {
+            dense[general.row_idx[k]][j] = tangent.values[k];
+        }
+    }
+    Ok((residual, dense))
+}
