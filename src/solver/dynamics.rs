@@ -34,7 +34,8 @@
 //!   `v_+ = v_- - Z^-1 B^T (B Z^-1 B^T)^-1 B v_-` with `Z` the impedance `rho c_p` of each dof's
 //!   body (`c_p` the dilatational wave speed), which for a node pair is
 //!   `v_+ = (Z1 v1 + Z2 v2) / (Z1 + Z2)` and for a rigid master `0`. A row that opens carries no
-//!   force and is not corrected: its nodes separate with their own velocities.
+//!   force and is not corrected: its nodes separate with their own velocities; so is a row
+//!   whose corrected force would pull (`c_+ < 0`: it is opening), the others corrected again.
 //! * `contact_stabilized`: the contact-stabilized Newmark method of Deuflhard, Krause & Ertel,
 //!   "A contact-stabilized Newmark method for dynamical contact problems", IJNME 73 (2008)
 //!   1274-1290, on the trapezoidal rule: the predictor `d_n + dt v_n` is first projected onto
@@ -55,7 +56,7 @@ use super::sparse::{Cholesky, Factor, GeneralPattern, PatternBuilder, SymmetricP
 use crate::contact::enforcement::{method, Method};
 use crate::contact::state::{ContactState, Termination};
 use crate::error::{Error, Result};
-use crate::io::scene::{ImpactTreatment, MassKind, Plane};
+use crate::io::scene::{ImpactTreatment, MassKind};
 use crate::model::dynamics::Dynamics;
 use crate::model::Model;
 use crate::solid::{element_mass, lumped_mass};
@@ -154,11 +155,8 @@ pub fn mass_matrix(model: &Model, density: &[f64], kind: MassKind) -> MassMatrix
 /// plane-stress modulus `E / (1 - nu^2)` in plane stress); with `nu = 0` the bar speed
 /// `sqrt(E / rho)`.
 pub fn wave_speed(model: &Model, body: usize, density: f64) -> f64 {
-    let m = &model.bodies[body].material;
-    let modulus = match m.plane {
-        Plane::Strain | Plane::Stress => m.d[(0, 0)],
-    };
-    (modulus / density).sqrt()
+    // D_xx: lambda + 2 mu in plane strain, E / (1 - nu^2) in plane stress
+    (model.bodies[body].material.d[(0, 0)] / density).sqrt()
 }
 
 /// The energies of the state `(d, v)` and the penalty energy of the rows.
@@ -593,28 +591,42 @@ impl<'a> Integrator<'a> {
         mu.iter().map(|v| -v).collect()
     }
 
-    /// The seed's post-impact correction of the active rows (see the module doc).
+    /// The seed's post-impact correction of the active rows (see the module doc). A row whose
+    /// corrected force would pull (it is opening) is released and left out, and the others are
+    /// corrected again.
     fn post_impact(&mut self, active: &[usize], forces: &mut [f64]) {
-        if active.is_empty() {
+        let mut rows_in = active.to_vec();
+        while !rows_in.is_empty() {
+            let rows = self.free_rows(&rows_in);
+            let mut a = self.a.clone();
+            let change = self.project(&rows, None, &mut a);
+            let all = self.system.rows();
+            let opening: Vec<usize> = rows_in
+                .iter()
+                .zip(&change)
+                .filter(|&(&i, dc)| !all[i].bilateral && forces[i] + dc < 0.0)
+                .map(|(&i, _)| i)
+                .collect();
+            if !opening.is_empty() {
+                rows_in.retain(|i| !opening.contains(i));
+                continue;
+            }
+            self.a = a;
+            for (&i, dc) in rows_in.iter().zip(change) {
+                forces[i] += dc;
+            }
+            let sys = self.system.linear_system();
+            let weights: Vec<f64> = sys
+                .constraints
+                .free_dofs()
+                .iter()
+                .map(|&d| self.impedance[d])
+                .collect();
+            let mut v = std::mem::take(&mut self.v);
+            self.project(&rows, Some(&weights), &mut v);
+            self.v = v;
             return;
         }
-        let rows = self.free_rows(active);
-        let mut a = std::mem::take(&mut self.a);
-        let change = self.project(&rows, None, &mut a);
-        self.a = a;
-        for (&i, dc) in active.iter().zip(change) {
-            forces[i] += dc;
-        }
-        let sys = self.system.linear_system();
-        let weights: Vec<f64> = sys
-            .constraints
-            .free_dofs()
-            .iter()
-            .map(|&d| self.impedance[d])
-            .collect();
-        let mut v = std::mem::take(&mut self.v);
-        self.project(&rows, Some(&weights), &mut v);
-        self.v = v;
     }
 
     fn energies(&self) -> Energies {
