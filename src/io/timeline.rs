@@ -14,13 +14,16 @@ use std::collections::HashSet;
 use std::fs;
 use std::path::Path;
 
+/// Writes one `.vtu` frame: `(path, body, global displacement)`.
+pub type FrameWriter<'a> = &'a dyn Fn(&Path, &Body, &[f64]) -> Result<()>;
+
 /// The files of a time integration, written into the (temporary) run folder `dir`;
 /// `write_frame(path, body, u)` writes one `.vtu` frame (the run's own `.vtu` writer).
 pub fn write_history(
     dir: &Path,
     model: &Model,
     history: &DynamicHistory,
-    write_frame: &dyn Fn(&Path, &Body, &[f64]) -> Result<()>,
+    write_frame: FrameWriter<'_>,
 ) -> Result<()> {
     let write = |name: &str, text: &str| {
         let path = dir.join(name);
