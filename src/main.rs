@@ -98,6 +98,19 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// The impact study: the dynamic cases with every impact treatment and mass against the
+    /// 1D wave solutions; writes reports/impact.md and reports/impact.json.
+    #[command(
+        name = "impact-report",
+        after_help = "Example:\n  contact-patch impact-report\n  contact-patch impact-report cases/dynamics/bar-on-rigid-wall.json --out /tmp/reports"
+    )]
+    ImpactReport {
+        /// Dynamic case files (default: the three of cases/dynamics).
+        paths: Vec<PathBuf>,
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
     /// Print the JSON Schema of the case format (committed as cases/case.schema.json; a case
     /// file may name it in "$schema" so that editors validate and complete it).
     #[command(after_help = "Example:\n  contact-patch schema > cases/case.schema.json")]
@@ -175,6 +188,7 @@ fn main() -> ExitCode {
         ),
         Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
         Command::Hard { paths, out } => hard(&paths, &out),
+        Command::ImpactReport { paths, out } => impact_report(&paths, &out),
         Command::Schema => {
             print!("{}", contact_patch::io::scene::case_schema());
             ExitCode::SUCCESS
@@ -909,6 +923,51 @@ fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
                 }
             }
             println!("wrote {}", folder.shown("tied-layer.md").display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// The cases of `contact-patch impact-report` when none are given.
+const IMPACT_CASES: [&str; 3] = [
+    "cases/dynamics/bar-on-rigid-wall.json",
+    "cases/dynamics/two-identical-bars.json",
+    "cases/dynamics/two-bars-different-impedance.json",
+];
+
+fn impact_report(paths: &[PathBuf], out: &Path) -> ExitCode {
+    let folder = match ReportFolder::new(out) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let paths: Vec<&Path> = if paths.is_empty() {
+        IMPACT_CASES.iter().map(Path::new).collect()
+    } else {
+        paths.iter().map(PathBuf::as_path).collect()
+    };
+    let result = (|| -> contact_patch::Result<()> {
+        let measures = contact_patch::harness::impact::study(&paths)?;
+        folder.write_file(
+            "impact.md",
+            &contact_patch::harness::impact::report(&measures),
+        )?;
+        let json = serde_json::to_string_pretty(&measures).expect("measures serialize") + "\n";
+        folder.write_file("impact.json", &json)
+    })();
+    match result {
+        Ok(()) => {
+            println!(
+                "wrote {} and {}",
+                folder.shown("impact.md").display(),
+                folder.shown("impact.json").display()
+            );
             ExitCode::SUCCESS
         }
         Err(e) => {

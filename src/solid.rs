@@ -16,6 +16,13 @@
 //! The strain comes from the displacement gradient `H = du/dx = sum_a u_a (grad N_a)^T` as
 //! `eps = [H_xx, H_yy, H_xy + H_yx]`. Equilibrium is `f_int(u) = f_ext` (+ contact forces).
 //!
+//! **Mass.** For dynamics ([`crate::solver::dynamics`]) an element also gives its consistent
+//! mass `M_e = int rho N^T N t dA` ([`element_mass`], both components alike, with a rule exact
+//! for `N_a N_b` on straight-sided elements) and its lumped mass by the HRZ scaling of the
+//! consistent diagonal (Hinton, Rock & Zienkiewicz, Earthquake Eng. Struct. Dyn. 4 (1976)
+//! 245-249): `m_a = M_aa m / sum_b M_bb`, `m` the element's mass, positive for every element
+//! (row sums are zero or negative at the corners of T6 and Q9 would be wrong for T6).
+//!
 //! **Kinematics seam.** [`Kinematics`] says how strain follows from displacement. With small
 //! strain (the only kind today) `sigma = D eps` is linear in `u_e`, so
 //! `f_int = K_e u_e` and `K_T = K_e = int B^T D B t dA`, the element stiffness; the kernel still
@@ -770,5 +777,115 @@ mod tests {
         // a bow-tie (non-convex beyond repair) is inverted somewhere inside
         let bowtie = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
         assert!(check_geometry(ElementKind::Q4, &bowtie).is_err());
+    }
+}
+
+/// The quadrature rule of [`element_mass`]: exact for `N_a N_b det J` on straight-sided
+/// (affine) elements and for `N_a N_b` on distorted Q4 up to the bilinear `det J`.
+fn mass_rule(kind: ElementKind) -> Vec<QuadPoint> {
+    match kind {
+        ElementKind::Q4 => crate::fe::gauss_square(3),
+        ElementKind::Q9 => crate::fe::gauss_square(4),
+        ElementKind::T3 => crate::fe::triangle_rule(2),
+        ElementKind::T6 => crate::fe::triangle_rule(5),
+    }
+}
+
+/// Consistent mass of one element per displacement component: `M_ab = int rho N_a N_b t dA`
+/// (`n x n`, row-major into `me`); the element's `2 n x 2 n` mass is `M_ab I_2`.
+pub fn element_mass(
+    kind: ElementKind,
+    coords: &[[f64; 2]],
+    density: f64,
+    thickness: f64,
+    me: &mut [f64],
+) {
+    let n = kind.node_count();
+    let me = &mut me[..n * n];
+    me.fill(0.0);
+    for q in mass_rule(kind) {
+        let pv = point_values(kind, coords, q.xi);
+        let w = q.weight * pv.det_j * density * thickness;
+        for a in 0..n {
+            for b in 0..n {
+                me[a * n + b] += w * pv.n[a] * pv.n[b];
+            }
+        }
+    }
+}
+
+/// Lumped (HRZ) mass of one element per displacement component, from its consistent mass
+/// `me` (`n x n`): `m_a = M_aa (sum_ab M_ab) / (sum_b M_bb)`.
+pub fn lumped_mass(me: &[f64], n: usize) -> Vec<f64> {
+    let total: f64 = me[..n * n].iter().sum();
+    let diagonal: f64 = (0..n).map(|a| me[a * n + a]).sum();
+    (0..n).map(|a| me[a * n + a] * total / diagonal).collect()
+}
+
+#[cfg(test)]
+mod mass_tests {
+    use super::*;
+
+    fn total(kind: ElementKind, coords: &[[f64; 2]]) -> (f64, Vec<f64>) {
+        let n = kind.node_count();
+        let mut me = vec![0.0; n * n];
+        element_mass(kind, coords, 7.5, 0.5, &mut me);
+        (me.iter().sum(), lumped_mass(&me, n))
+    }
+
+    /// The consistent and the lumped mass of every element sum to `rho t A`, and the lumped
+    /// masses are positive (a distorted Q4 of area 1.25, a T6 of area 1/2, Q9 and T3).
+    #[test]
+    fn element_masses_sum_to_the_element_mass_and_lumped_masses_are_positive() {
+        let q4 = [[0.0, 0.0], [1.0, 0.0], [1.5, 1.0], [0.0, 1.0]];
+        let q9 = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+            [0.0, 1.0],
+            [1.0, 0.0],
+            [2.0, 0.5],
+            [1.0, 1.0],
+            [0.0, 0.5],
+            [1.0, 0.5],
+        ];
+        let t3 = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        let t6 = [
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [0.0, 1.0],
+            [0.5, 0.0],
+            [0.5, 0.5],
+            [0.0, 0.5],
+        ];
+        let cases: [(ElementKind, &[[f64; 2]], f64); 4] = [
+            (ElementKind::Q4, &q4, 1.25),
+            (ElementKind::Q9, &q9, 2.0),
+            (ElementKind::T3, &t3, 0.5),
+            (ElementKind::T6, &t6, 0.5),
+        ];
+        for (kind, coords, area) in cases {
+            let exact = 7.5 * 0.5 * area;
+            let (sum, lumped) = total(kind, coords);
+            assert!(
+                (sum - exact).abs() < 1e-14 * exact,
+                "{kind:?}: {sum} vs {exact}"
+            );
+            let l: f64 = lumped.iter().sum();
+            assert!(
+                (l - exact).abs() < 1e-14 * exact,
+                "{kind:?}: {l} vs {exact}"
+            );
+            assert!(lumped.iter().all(|&m| m > 0.0), "{kind:?}: {lumped:?}");
+        }
+        // T3: the closed form M = rho t A / 12 [[2, 1, 1], [1, 2, 1], [1, 1, 2]]
+        let mut me = [0.0; 9];
+        element_mass(ElementKind::T3, &t3, 12.0, 1.0, &mut me);
+        for a in 0..3 {
+            for b in 0..3 {
+                let exact = 0.5 * if a == b { 2.0 } else { 1.0 };
+                assert!((me[a * 3 + b] - exact).abs() < 1e-15, "{me:?}");
+            }
+        }
     }
 }

@@ -290,6 +290,15 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
             "give e.g. --match-tol 1e-8 (the default)",
         ));
     }
+    if model.dynamics.is_some() {
+        return Err(Error::invalid(
+            &model.source,
+            "physics.dynamics",
+            "a dynamic case's checks concern its whole time history, which one .vtu of point \
+             results does not hold",
+            "judge a static case (export and judge cover the static catalogue)",
+        ));
+    }
     let delta = match_share * model.size();
     let mut u = vec![0.0; model.dof_count];
     // per body: the matched point of each node
@@ -520,6 +529,7 @@ fn solution_of(model: &Model, u: Vec<f64>) -> Solution {
         relative_residual: largest_free / scale,
         timings: Timings::default(),
         contact: None,
+        dynamics: None,
     }
 }
 

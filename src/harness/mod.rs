@@ -33,6 +33,7 @@ pub mod checks;
 pub(crate) mod exact;
 pub mod hard;
 pub mod judge;
+pub mod impact;
 pub mod junit;
 pub mod layer;
 pub mod report;

@@ -1,4 +1,5 @@
-//! Run output: `summary.json` and one VTK XML unstructured grid (`<body>.vtu`) per body.
+//! Run output: `summary.json` and one VTK XML unstructured grid (`<body>.vtu`) per body (and,
+//! for a time integration, the files of [`crate::io::timeline`]).
 //!
 //! The folder is an [`OutputFolder`]: written under a temporary name next to the target and
 //! renamed into place only when every file is complete, so a folder named like the target is
@@ -367,6 +368,11 @@ pub fn write_run(folder: &OutputFolder, outcome: &Outcome) -> Result<()> {
         for (b, s) in outcome.model.bodies.iter().zip(&nodal) {
             let path = tmp.join(file_name("body name", &b.name, ".vtu")?);
             write_vtu(&path, b, &outcome.solution.u, s)?;
+        }
+        if let Some(history) = &outcome.solution.dynamics {
+            crate::io::timeline::write_history(tmp, &outcome.model, history, &|path, body, u| {
+                write_vtu(path, body, u, &nodal_stresses(body, u))
+            })?;
         }
         Ok(())
     })

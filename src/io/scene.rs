@@ -143,9 +143,18 @@ pub struct Limits {
     /// times the 1M-dof case in `cases/large`).
     #[serde(default = "default_max_nodes")]
     pub nodes: usize,
+    /// The most time steps times dofs a dynamic run may ask for (default 100,000,000, about a
+    /// minute of stepping on one core).
+    #[serde(default = "default_max_step_dofs")]
+    pub step_dofs: u64,
 }
 
 pub const DEFAULT_MAX_NODES: usize = 2_000_000;
+pub const DEFAULT_MAX_STEP_DOFS: u64 = 100_000_000;
+
+fn default_max_step_dofs() -> u64 {
+    DEFAULT_MAX_STEP_DOFS
+}
 
 fn default_max_nodes() -> usize {
     DEFAULT_MAX_NODES
@@ -155,6 +164,7 @@ impl Default for Limits {
     fn default() -> Self {
         Limits {
             nodes: DEFAULT_MAX_NODES,
+            step_dofs: DEFAULT_MAX_STEP_DOFS,
         }
     }
 }
@@ -469,6 +479,10 @@ pub struct MaterialSpec {
     #[serde(rename = "E")]
     pub youngs_modulus: f64,
     pub nu: f64,
+    /// Mass per unit volume; required by `physics.dynamics` for every material a body uses,
+    /// read by nothing else.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
@@ -709,6 +723,101 @@ pub struct Physics {
     /// Where contact gaps, normals and projections are evaluated.
     #[serde(default)]
     pub contact_geometry: ContactGeometry,
+    /// Time stepping (Newmark) instead of a static solve; absent: static, no mass matrix.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dynamics: Option<DynamicsSpec>,
+}
+
+/// `physics.dynamics`: Newmark's method from `t = 0` to `end_time` in steps of `dt`, loads and
+/// supports constant in time, the bodies at rest and undeformed at `t = 0` except for
+/// `initial_velocity`.
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsSpec {
+    /// The member of Newmark's family.
+    #[serde(default)]
+    pub integrator: Integrator,
+    /// Time step.
+    pub dt: f64,
+    /// Last time; the number of steps is `end_time / dt` rounded up.
+    pub end_time: f64,
+    #[serde(default)]
+    pub mass: MassKind,
+    /// What happens to the velocities, accelerations and contact forces of contacting nodes.
+    #[serde(default)]
+    pub impact: ImpactTreatment,
+    /// Initial velocity of every node of a body, or of a node set of it (later entries win).
+    #[serde(default)]
+    pub initial_velocity: Vec<InitialVelocity>,
+    /// Write a `.vtu` frame every this many steps (and the last); default: about 50 frames.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame_every: Option<usize>,
+}
+
+/// A member of Newmark's family `d+ = d + dt v + dt^2 ((1/2 - beta) a + beta a+)`,
+/// `v+ = v + dt ((1 - gamma) a + gamma a+)`.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Integrator {
+    /// `beta = 1/4, gamma = 1/2`: the trapezoidal rule, implicit, unconditionally stable,
+    /// energy-conserving for linear elasticity.
+    #[default]
+    AverageAcceleration,
+    /// `beta = 0, gamma = 1/2`: explicit with lumped mass, stable for `dt` below `2 / omega_max`.
+    CentralDifference,
+    /// Any `0 <= beta <= 1/2`, `gamma >= 1/2`.
+    Newmark { beta: f64, gamma: f64 },
+}
+
+impl Integrator {
+    /// `(beta, gamma)`.
+    pub fn parameters(self) -> (f64, f64) {
+        match self {
+            Integrator::AverageAcceleration => (0.25, 0.5),
+            Integrator::CentralDifference => (0.0, 0.5),
+            Integrator::Newmark { beta, gamma } => (beta, gamma),
+        }
+    }
+}
+
+/// The mass matrix.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum MassKind {
+    /// Diagonal, by the HRZ scaling of the consistent diagonal (positive for every element).
+    #[default]
+    Lumped,
+    /// `int rho N^T N dV`.
+    Consistent,
+}
+
+/// The treatment of impact and release.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ImpactTreatment {
+    /// Newmark's updates as they are.
+    #[default]
+    Plain,
+    /// Taylor's post-impact correction (Hughes, Taylor et al. 1976): the accelerations of
+    /// contacting nodes averaged with their masses, the contact forces corrected to match, the
+    /// velocities set to the 1D impedance (wave) solution.
+    PostImpact,
+    /// The contact-stabilized Newmark method of Deuflhard, Krause & Ertel (2008): the predictor
+    /// `d_n + dt v_n` is projected onto the admissible set in the mass norm before the
+    /// trapezoidal step; energy is conserved away from contact and never gained at impact or
+    /// release (average acceleration only).
+    ContactStabilized,
+}
+
+/// An initial velocity.
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InitialVelocity {
+    pub body: String,
+    /// A node set of the body; absent: every node.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub set: Option<String>,
+    pub velocity: [f64; 2],
 }
 
 /// The configuration in which the contact geometry is evaluated.

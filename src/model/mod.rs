@@ -19,6 +19,7 @@
 //! [`crate::model::admit`] before any solve.
 
 pub mod admit;
+pub mod dynamics;
 pub(crate) mod rigid;
 
 use crate::contact::enforcement::Family;
@@ -156,6 +157,8 @@ pub struct Model {
     pub sweep: Option<SweepSpec>,
     /// Load steps, limits and tolerances of the solve.
     pub solver: SolverSpec,
+    /// Time stepping (`physics.dynamics`); `None`: a static run, no mass matrix.
+    pub dynamics: Option<dynamics::Dynamics>,
 }
 
 /// Parse case JSON; errors carry line, column and a hint.
@@ -471,11 +474,13 @@ impl Model {
             contact: Vec::new(),
             sweep: case.sweep.clone(),
             solver: case.solver.clone(),
+            dynamics: None,
         };
         model.apply_supports(case)?;
         model.apply_loads(case)?;
         model.resolve_contact(case)?;
         model.resolve_checks(case)?;
+        model.dynamics = dynamics::resolve(case, &model)?;
         Ok(model)
     }
 

@@ -464,6 +464,45 @@ impl<'a> ContactSystem<'a> {
     }
 }
 
+/// The hook of time integration ([`super::dynamics`]): the inertia `c0 M` joins the
+/// stiffness and `c0 M d_pred` the right-hand side (`R = (K + c0 M) x - f - c0 M d_pred - ...`),
+/// and the rows and their state are read after each step.
+impl ContactSystem<'_> {
+    /// Add `values` (on the pattern of [`LinearSystem::pattern`]) to the stiffness. The mass
+    /// holds every body, so no row is closed at the start to hold a free one.
+    pub(crate) fn add_to_stiffness(&mut self, values: &[f64]) {
+        self.sys.k.iter_mut().zip(values).for_each(|(k, m)| *k += m);
+        self.closed_at_start.clear();
+    }
+
+    /// Replace the stiffness by `values` (on the pattern of [`LinearSystem::pattern`]): a
+    /// mass-norm projection onto the admissible set has the mass as its only stiffness.
+    pub(crate) fn replace_stiffness(&mut self, values: Vec<f64>) {
+        self.sys.k = values;
+        self.closed_at_start.clear();
+    }
+
+    /// The stiffness system over the free equations (numbering, pattern, `K`, `f`).
+    pub(crate) fn linear_system(&self) -> &LinearSystem {
+        &self.sys
+    }
+
+    /// Replace the right-hand side of the displacement equations.
+    pub(crate) fn set_right_hand_side(&mut self, rhs: Vec<f64>) {
+        self.sys.rhs = rhs;
+    }
+
+    pub(crate) fn rows(&self) -> &[Constraint] {
+        &self.rows
+    }
+
+    /// Active flags, forces (compression positive) and gaps of the rows at the unknowns `x`.
+    pub(crate) fn row_state(&self, x: &[f64]) -> (Vec<bool>, Vec<f64>, Vec<f64>) {
+        let (active, forces, gaps, _) = self.state(x);
+        (active, forces, gaps)
+    }
+}
+
 impl System for ContactSystem<'_> {
     fn pattern(&self) -> &SymmetricPattern {
         &self.pattern

@@ -65,6 +65,8 @@ pub struct Solution {
     pub timings: Timings,
     /// What the contact solve found, when the model has contact pairs.
     pub contact: Option<crate::contact::state::ContactState>,
+    /// The record of a time integration (`physics.dynamics`); `None` for a static run.
+    pub dynamics: Option<Box<crate::solver::history::DynamicHistory>>,
 }
 
 /// Calls `visit(dofs, ke)` for every cell of every body.
@@ -405,6 +407,7 @@ pub fn finish(
         relative_residual: if scale > 0.0 { worst / scale } else { worst },
         timings,
         contact: None,
+        dynamics: None,
     })
 }
 

@@ -1,12 +1,16 @@
 //! One static analysis of a model, with only the effects its scene names: elasticity alone
 //! ([`crate::solver::linear`]), or with the contact pairs it declares ([`crate::solver::active_set`]: load
-//! steps, active sets, geometry updates). A scene without contact builds no contact row.
+//! steps, active sets, geometry updates). A scene without contact builds no contact row. A
+//! scene with `physics.dynamics` is time-stepped instead ([`crate::solver::dynamics`]); a static
+//! scene builds no mass matrix.
 
 pub mod active_set;
 pub mod conditioning;
 pub mod constraints;
 pub mod contact_newton;
 pub(crate) mod dense;
+pub mod dynamics;
+pub mod history;
 pub mod linear;
 pub mod newton;
 pub mod sparse;
@@ -17,7 +21,9 @@ use crate::solver::linear::Solution;
 
 /// Solve `model`; `progress` is told the name of each stage as it starts.
 pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
-    if model.contact.is_empty() {
+    if model.dynamics.is_some() {
+        crate::solver::dynamics::solve(model, progress)
+    } else if model.contact.is_empty() {
         crate::solver::linear::solve_elastic(model, progress)
     } else {
         crate::solver::active_set::solve(model, progress)

@@ -109,8 +109,22 @@ pub struct Outcome {
 
 /// Run Newton's method on `system` from `x` (overwritten with the last iterate).
 pub fn solve(system: &mut dyn System, x: &mut Vec<f64>, settings: Settings) -> Result<Outcome> {
-    let n = x.len();
     let mut linear = LinearSolver::new(system.pattern());
+    solve_with(system, x, settings, &mut linear)
+}
+
+/// [`solve`] with a linear solver built on `system.pattern()` by the caller, whose last
+/// factorization is reused while the tangent is unchanged (a sequence of solves of one system,
+/// e.g. the steps of a time integration; a new pattern replaces it).
+pub fn solve_with(
+    system: &mut dyn System,
+    x: &mut Vec<f64>,
+    settings: Settings,
+    linear: &mut LinearSolver,
+) -> Result<Outcome> {
+    let n = x.len();
+    // factoring seconds the solver had before this solve
+    let mut base_seconds = linear.seconds;
     let mut version = system.pattern_version();
     let mut residual = vec![0.0; n];
     let mut history = Vec::new();
@@ -122,8 +136,9 @@ pub fn solve(system: &mut dyn System, x: &mut Vec<f64>, settings: Settings) -> R
     let mut last_solver = "none";
     let termination = loop {
         if system.pattern_version() != version {
-            earlier_seconds += linear.seconds;
-            linear = LinearSolver::new(system.pattern());
+            earlier_seconds += linear.seconds - base_seconds;
+            *linear = LinearSolver::new(system.pattern());
+            base_seconds = 0.0;
             version = system.pattern_version();
             *x = system.carry(x);
             residual = vec![0.0; x.len()];
@@ -213,7 +228,7 @@ pub fn solve(system: &mut dyn System, x: &mut Vec<f64>, settings: Settings) -> R
         termination,
         iterations: solves,
         history,
-        factorization_seconds: earlier_seconds + linear.seconds,
+        factorization_seconds: earlier_seconds + linear.seconds - base_seconds,
         linear_solver: last_solver,
     })
 }

@@ -1,0 +1,71 @@
+#!/usr/bin/env python3
+"""Writes the dynamic impact cases of benchmarks.md section 6 (1D wave solutions, c = sqrt(E/rho)).
+
+A 2D strip with nu = 0 whose every node has u_y = 0 (rollers) is exactly 1D. Run from this folder:
+python3 make_cases.py. The exact values each case is judged against are in its description and in
+tests/dynamics.rs; `contact-patch impact-report` runs every treatment and mass on them."""
+import json
+
+def strip(name, material, x0, x1, nx, h=0.1, element="Q4"):
+    return {"name": name, "material": material,
+            "mesh": {"block": {"element": element, "x": {"from": x0, "to": x1, "divisions": nx},
+                               "y": {"from": 0.0, "to": h, "divisions": 1}}}}
+
+def case(name, description, materials, bodies, contact, velocity, dt, end, enforcement):
+    return {
+        "$schema": "../case.schema.json",
+        "name": name,
+        "description": description,
+        "analysis": {"plane": "strain", "thickness": 1.0},
+        "materials": materials,
+        "bodies": bodies,
+        "supports": [{"body": b["name"], "set": "all", "y": 0.0} for b in bodies],
+        "physics": {"dynamics": {"integrator": "average_acceleration", "dt": dt, "end_time": end,
+                                 "mass": "lumped", "impact": "plain",
+                                 "initial_velocity": velocity}},
+        "contact": [dict(c, enforcement=enforcement) for c in contact],
+        "solver": {"scheme": "newton"},
+        # at end_time (twice the contact duration) the bars have separated: no contact force
+        # is left, and Lagrange multipliers never let a node penetrate
+        "checks": [
+            {"check": "contact_force", "pair": contact[0]["name"], "component": "x",
+             "value": 0.0, "tol": 1e-12},
+            {"check": "max_penetration", "share": 1e-12},
+        ],
+    }
+
+def write(c):
+    with open(c["name"] + ".json", "w") as f:
+        json.dump(c, f, indent=2)
+        f.write("\n")
+
+lagrange = {"kind": "lagrange"}
+# bar on a rigid wall: L = 1, E = 100, rho = 1 (c = 10), v0 = 0.01, touching the wall at t = 0
+write(case("bar-on-rigid-wall",
+           "A bar (L = 1, height 0.1, Q4 20 x 1, nu = 0, u_y = 0: exactly 1D; E = 100, rho = 1, c = 10) moving at v0 = 0.01 touches a rigid wall at x = 1 at t = 0. Exact: contact stress rho c v0 = 0.1 for 0 < t < 2L/c = 0.2, then the bar leaves with -v0. dt = h/c = 0.005 (Courant number 1).",
+           {"bar": {"E": 100.0, "nu": 0.0, "density": 1.0}},
+           [strip("bar", "bar", 0.0, 1.0, 20)],
+           [{"name": "wall", "slave": {"body": "bar", "set": "right"},
+             "master": {"rigid": {"kind": "line", "point": [1.0, 0.0], "normal": [-1.0, 0.0]}},
+             "discretization": {"kind": "node_to_surface", "passes": 1}}],
+           [{"body": "bar", "velocity": [0.01, 0.0]}], 0.005, 0.4, lagrange))
+# two identical bars: striker [0, 1] at v0, target [1, 2] at rest, node to node
+write(case("two-identical-bars",
+           "Two identical bars (L = 1 each, Q4 20 x 1, nu = 0, u_y = 0; E = 100, rho = 1, c = 10): the striker [0, 1] at v0 = 0.01 touches the target [1, 2] at rest at t = 0. Exact: contact stress rho c v0 / 2 = 0.05 for 0 < t < 2L/c = 0.2; then the striker is at rest and the target moves at v0.",
+           {"bar": {"E": 100.0, "nu": 0.0, "density": 1.0}},
+           [strip("striker", "bar", 0.0, 1.0, 20), strip("target", "bar", 1.0, 2.0, 20)],
+           [{"name": "interface", "slave": {"body": "striker", "set": "right"},
+             "master": {"body": "target", "set": "left"},
+             "discretization": {"kind": "node_to_node"}}],
+           [{"body": "striker", "velocity": [0.01, 0.0]}], 0.005, 0.4, lagrange))
+# bars of different impedance with L1/c1 = L2/c2: striker E = 100, rho = 1 (c = 10, Z = 10),
+# L = 1; target E = 400, rho = 4 (c = 10, Z = 40), L = 1: v* = Z1 v1 / (Z1 + Z2) = 0.2 v1
+write(case("two-bars-different-impedance",
+           "Striker [0, 1] (E = 100, rho = 1: c = 10, Z = 10) at v1 = 0.01 touches the target [1, 2] (E = 400, rho = 4: c = 10, Z = 40) at rest at t = 0; both Q4 20 x 1, nu = 0, u_y = 0, L1/c1 = L2/c2. Exact (benchmarks.md 6): the interface moves at v* = (Z1 v1 + Z2 v2)/(Z1 + Z2) = 0.002, contact stress Z1 Z2 (v1 - v2)/(Z1 + Z2) = 0.08 for 0 < t < 0.2; after separation the striker moves at v1 (Z1 - Z2)/(Z1 + Z2) = -0.006 and the target at 2 Z1 v1/(Z1 + Z2) = 0.004 (momentum and energy conserved).",
+           {"soft": {"E": 100.0, "nu": 0.0, "density": 1.0},
+            "stiff": {"E": 400.0, "nu": 0.0, "density": 4.0}},
+           [strip("striker", "soft", 0.0, 1.0, 20), strip("target", "stiff", 1.0, 2.0, 20)],
+           [{"name": "interface", "slave": {"body": "striker", "set": "right"},
+             "master": {"body": "target", "set": "left"},
+             "discretization": {"kind": "node_to_node"}}],
+           [{"body": "striker", "velocity": [0.01, 0.0]}], 0.005, 0.4, lagrange))

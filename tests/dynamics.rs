@@ -1,0 +1,416 @@
+//! Time integration (`physics.dynamics`, `src/solver/dynamics.rs`) against closed forms and the
+//! 1D wave solutions of `benchmarks.md` section 6:
+//!
+//! * Newmark on one free dof (`m x'' + k x = 0`, `x_0 = 0`, `v_0` given) against the closed-form
+//!   discrete solutions: average acceleration `x_n = (v0 / w) sin(n theta)`,
+//!   `tan(theta / 2) = w dt / 2` (period error, no amplitude error); central difference
+//!   `x_n = (v0 dt / sin theta) sin(n theta)`, `sin(theta / 2) = w dt / 2`;
+//! * average acceleration conserves the discrete energy of an elastic body to round-off, with
+//!   the lumped and the consistent mass; the mass matrix sums to the body's mass;
+//! * the dynamic tangent `K + c0 M + kappa A b b^T` against central differences of the residual;
+//! * bar on a rigid wall, two identical bars, two bars of different impedance, with every
+//!   impact treatment and mass: contact duration within one step of `2 L / c`, momentum after
+//!   separation to round-off between bars, no energy gain with the post-impact correction and
+//!   the contact-stabilized method (and the gain of plain Newmark shown), the seed's velocity
+//!   and acceleration jumps removed by the post-impact correction, plateau stress and velocity
+//!   after separation converging to the exact values under refinement of h and dt together;
+//! * the factorization reused while the active set does not change;
+//! * bad input refused with the field named.
+
+use contact_patch::harness::impact::{measure, run, variant, wave_solution, MASSES, TREATMENTS};
+use contact_patch::io::scene::{ImpactTreatment, Integrator, MassKind};
+use contact_patch::model::admit::admit;
+use contact_patch::model::{parse, Model};
+use contact_patch::solid::element_stiffness;
+use contact_patch::solver::dynamics::probe_first_step;
+use contact_patch::solver::history::DynamicHistory;
+use serde_json::{json, Value};
+use std::path::Path;
+
+fn read(case: &str) -> Value {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(case);
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn history(v: &Value) -> (Model, DynamicHistory) {
+    let case = parse(&v.to_string(), "dynamics").unwrap();
+    let (model, history, _) = run(&case, "dynamics").unwrap();
+    (model, history)
+}
+
+fn build_error(v: &Value) -> String {
+    let case = parse(&v.to_string(), "dynamics").unwrap();
+    match Model::build(&case, "dynamics").and_then(admit) {
+        Ok(_) => panic!("the case was accepted"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// One Q4 unit square with every dof supported but `u_x` of its top-right node, which starts at
+/// `v0`: a single-dof oscillator with `m = rho t / 4` (HRZ) and `k = K_ii`.
+fn oscillator(integrator: Value, dt: f64, steps: usize) -> Value {
+    json!({
+        "name": "oscillator",
+        "analysis": {"plane": "strain", "thickness": 1.0},
+        "materials": {"m": {"E": 100.0, "nu": 0.25, "density": 2.0}},
+        "bodies": [{"name": "square", "material": "m", "mesh": {"block": {"element": "Q4",
+            "x": {"from": 0.0, "to": 1.0, "divisions": 1},
+            "y": {"from": 0.0, "to": 1.0, "divisions": 1}}}}],
+        "supports": [
+            {"body": "square", "set": "all", "y": 0.0},
+            {"body": "square", "set": "left", "x": 0.0},
+            {"body": "square", "set": "bottom_right", "x": 0.0}
+        ],
+        "physics": {"dynamics": {"integrator": integrator, "dt": dt, "end_time": dt * steps as f64,
+            "mass": "lumped", "frame_every": 1,
+            "initial_velocity": [{"body": "square", "set": "top_right", "velocity": [0.3, 0.0]}]}}
+    })
+}
+
+#[test]
+fn newmark_on_one_dof_matches_the_closed_form_discrete_solutions() {
+    // k = K_ii of the top-right u_x of the unit square (node 2 in Q4 order), m = rho t A / 4
+    let mut ke = [0.0; 64];
+    let material =
+        contact_patch::solid::Elasticity::new(100.0, 0.25, contact_patch::io::scene::Plane::Strain);
+    let coords = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let kind = contact_patch::fe::ElementKind::Q4;
+    element_stiffness(
+        kind,
+        &coords,
+        &material,
+        1.0,
+        &kind.stiffness_rule(),
+        &mut ke,
+    );
+    let k = ke[4 * 8 + 4];
+    let m = 2.0 / 4.0;
+    let w = (k / m).sqrt();
+    let v0 = 0.3;
+    let steps = 200;
+    for (integrator, dt) in [
+        (json!("average_acceleration"), 0.7 / w),
+        (json!("average_acceleration"), 3.0 / w),
+        (json!("central_difference"), 0.7 / w),
+        (json!("central_difference"), 1.9 / w),
+    ] {
+        let explicit = integrator == json!("central_difference");
+        let (model, h) = history(&oscillator(integrator.clone(), dt, steps));
+        let body = &model.bodies[0];
+        let node = body.mesh.node_sets["top_right"][0];
+        let d = body.dof(node, 0);
+        assert_eq!(h.frames.len(), steps + 1);
+        let (theta, amplitude) = if explicit {
+            let theta = 2.0 * (w * dt / 2.0).asin();
+            (theta, v0 * dt / theta.sin())
+        } else {
+            (2.0 * (w * dt / 2.0).atan(), v0 / w)
+        };
+        let mut worst: f64 = 0.0;
+        for (n, (t, u)) in h.frames.iter().enumerate() {
+            assert!((t - n as f64 * dt).abs() <= 1e-12 * t.max(dt));
+            let exact = amplitude * (n as f64 * theta).sin();
+            worst = worst.max((u[d] - exact).abs() / amplitude);
+        }
+        assert!(
+            worst < 1e-11,
+            "{integrator} w dt = {}: largest error {worst:e} of the amplitude",
+            w * dt
+        );
+    }
+}
+
+#[test]
+fn average_acceleration_conserves_energy_without_contact_and_the_mass_sums_to_the_body_mass() {
+    for mass in ["lumped", "consistent"] {
+        for element in ["Q4", "Q9", "T3", "T6"] {
+            let v = json!({
+                "name": "free-block",
+                "analysis": {"plane": "stress", "thickness": 0.5},
+                "materials": {"m": {"E": 1000.0, "nu": 0.3, "density": 3.0}},
+                "bodies": [{"name": "block", "material": "m", "mesh": {"block": {"element": element,
+                    "x": {"from": 0.0, "to": 2.0, "divisions": 4},
+                    "y": {"from": 0.0, "to": 1.0, "divisions": 3},
+                    "moves": [{"from": [1.0, 1.0 / 3.0], "to": [1.1, 0.4]}]}}}],
+                "supports": [{"body": "block", "set": "bottom_left", "x": 0.0, "y": 0.0},
+                             {"body": "block", "set": "bottom_right", "y": 0.0}],
+                "physics": {"dynamics": {"dt": 0.01, "end_time": 2.0, "mass": mass,
+                    "initial_velocity": [{"body": "block", "set": "top", "velocity": [0.2, -0.1]},
+                                         {"body": "block", "set": "top_right", "velocity": [0.0, 0.3]}]}}
+            });
+            let (_, h) = history(&v);
+            let exact_mass = 3.0 * 2.0 * 1.0 * 0.5;
+            assert!(
+                (h.body_mass[0] - exact_mass).abs() < 1e-13 * exact_mass,
+                "{mass} {element}: {} vs {exact_mass}",
+                h.body_mass[0]
+            );
+            let e0 = h.steps[0].total;
+            assert!(e0 > 0.0);
+            let drift = h
+                .steps
+                .iter()
+                .map(|s| (s.total / e0 - 1.0).abs())
+                .fold(0.0, f64::max);
+            assert!(drift < 1e-12, "{mass} {element}: energy drift {drift:e}");
+            // the body vibrates: strain energy takes a real share
+            let most_strain = h.steps.iter().map(|s| s.strain).fold(0.0, f64::max);
+            assert!(most_strain > 0.1 * e0, "{mass} {element}");
+        }
+    }
+}
+
+#[test]
+fn the_dynamic_tangent_matches_central_differences_of_the_residual() {
+    // the bar of the wall case with penalty rows on a rigid line, the bar pushed 1e-3 into it
+    for (mass, discretization) in [
+        ("lumped", json!({"kind": "node_to_surface", "passes": 1})),
+        (
+            "consistent",
+            json!({"kind": "node_to_surface", "passes": 1}),
+        ),
+    ] {
+        let mut v = read("cases/dynamics/bar-on-rigid-wall.json");
+        v["physics"]["dynamics"]["mass"] = json!(mass);
+        v["contact"][0]["enforcement"] = json!({"kind": "penalty", "kappa": 1e4});
+        v["contact"][0]["discretization"] = discretization;
+        let case = parse(&v.to_string(), "tangent").unwrap();
+        let model = admit(Model::build(&case, "tangent").unwrap()).unwrap();
+        let free: Vec<usize> = (0..model.dof_count)
+            .filter(|&d| model.prescribed[d].is_none())
+            .collect();
+        let x: Vec<f64> = free
+            .iter()
+            .map(|&d| 1e-3 * (1.0 + 0.3 * ((d * 7 % 11) as f64 / 11.0)))
+            .collect();
+        let (_, tangent) = probe_first_step(&model, &x).unwrap();
+        let h = 1e-7;
+        let scale = tangent.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        let mut worst: f64 = 0.0;
+        for j in 0..x.len() {
+            let (mut xp, mut xm) = (x.clone(), x.clone());
+            xp[j] += h;
+            xm[j] -= h;
+            let (rp, _) = probe_first_step(&model, &xp).unwrap();
+            let (rm, _) = probe_first_step(&model, &xm).unwrap();
+            for i in 0..x.len() {
+                let fd = (rp[i] - rm[i]) / (2.0 * h);
+                worst = worst.max((fd - tangent[i][j]).abs() / scale);
+            }
+        }
+        assert!(
+            worst < 1e-7,
+            "{mass}: tangent error {worst:e} of its largest entry"
+        );
+    }
+}
+
+const CASES: [&str; 3] = [
+    "cases/dynamics/bar-on-rigid-wall.json",
+    "cases/dynamics/two-identical-bars.json",
+    "cases/dynamics/two-bars-different-impedance.json",
+];
+
+#[test]
+fn impact_against_the_wave_solutions_with_every_treatment_and_mass() {
+    for path in CASES {
+        let v = read(path);
+        let case = parse(&v.to_string(), path).unwrap();
+        let rigid = path.contains("wall");
+        for impact in TREATMENTS {
+            for mass in MASSES {
+                let c = variant(&case, impact, mass, Integrator::AverageAcceleration);
+                let (model, h, seconds) = run(&c, path).unwrap();
+                let exact = wave_solution(&model).unwrap();
+                let m = measure(&c.name, &h, &exact, seconds);
+                let at = format!("{path} {impact:?} {mass:?}");
+                let v0 = exact.striker_velocity;
+                // momentum: unchanged to round-off between two bars, -v0 M at a wall
+                if !rigid {
+                    assert!(
+                        (m.momentum_end - m.momentum_start).abs() < 1e-12 * m.momentum_start,
+                        "{at}: momentum {} -> {}",
+                        m.momentum_start,
+                        m.momentum_end
+                    );
+                }
+                match impact {
+                    ImpactTreatment::Plain => {
+                        // the seed's point: the contact nodes chatter (release after one step)
+                        // and plain Newmark gains energy
+                        assert_eq!(m.first_release, Some(2.0 * h.dt), "{at}");
+                        assert!(m.largest_energy_gain > 1.0, "{at}: {m:?}");
+                    }
+                    ImpactTreatment::PostImpact | ImpactTreatment::ContactStabilized => {
+                        let last = m.last_contact.unwrap();
+                        assert!(
+                            (last - exact.contact_duration).abs() <= h.dt * (1.0 + 1e-9),
+                            "{at}: last contact at {last}, exact duration {}",
+                            exact.contact_duration
+                        );
+                        assert!(m.largest_energy_gain < 1e-12, "{at}: {m:?}");
+                        assert!(m.energy_drift < 0.0, "{at}");
+                    }
+                }
+                if impact == ImpactTreatment::PostImpact {
+                    // Newmark leaves the contact nodes with different velocities and
+                    // accelerations; the correction removes the difference
+                    assert!(m.velocity_jump[0] > 0.5 * v0, "{at}: {:?}", m.velocity_jump);
+                    assert!(
+                        m.velocity_jump[1] < 1e-12 * v0,
+                        "{at}: {:?}",
+                        m.velocity_jump
+                    );
+                    let a_scale = v0 / h.dt;
+                    assert!(m.acceleration_jump[0] > a_scale, "{at}");
+                    assert!(m.acceleration_jump[1] < 1e-10 * a_scale, "{at}");
+                }
+            }
+        }
+    }
+}
+
+/// A case with its bars divided `factor` times finer and `dt` divided as much (same Courant
+/// number).
+fn refined(path: &str, factor: usize) -> Value {
+    let mut v = read(path);
+    for b in v["bodies"].as_array_mut().unwrap() {
+        let x = &mut b["mesh"]["block"]["x"]["divisions"];
+        *x = json!(x.as_u64().unwrap() as usize * factor);
+    }
+    let dt = v["physics"]["dynamics"]["dt"].as_f64().unwrap();
+    v["physics"]["dynamics"]["dt"] = json!(dt / factor as f64);
+    v
+}
+
+#[test]
+fn plateau_stress_and_velocity_after_separation_converge_under_refinement() {
+    // the impact is a discontinuity that a mesh resolves only to within a few elements: each
+    // halving of h and dt must shrink both errors by more than sqrt(2) (a rate of at least 1/2;
+    // the measured rates are 0.55 to 0.76)
+    for path in CASES {
+        for impact in [
+            ImpactTreatment::PostImpact,
+            ImpactTreatment::ContactStabilized,
+        ] {
+            for mass in MASSES {
+                let mut errors = Vec::new();
+                for factor in [1, 2, 4] {
+                    let v = refined(path, factor);
+                    let case = parse(&v.to_string(), path).unwrap();
+                    let c = variant(&case, impact, mass, Integrator::AverageAcceleration);
+                    let (model, h, s) = run(&c, path).unwrap();
+                    let exact = wave_solution(&model).unwrap();
+                    let m = measure(&c.name, &h, &exact, s);
+                    let stress = (m.plateau_stress / exact.contact_stress - 1.0).abs();
+                    let velocity = m
+                        .velocity_after
+                        .iter()
+                        .zip(&exact.velocity_after)
+                        .map(|(a, b)| (a - b).abs() / exact.striker_velocity)
+                        .fold(0.0, f64::max);
+                    errors.push((stress, velocity));
+                }
+                for w in errors.windows(2) {
+                    assert!(
+                        w[1].0 < w[0].0 / 2f64.sqrt() && w[1].1 < w[0].1 / 2f64.sqrt(),
+                        "{path} {impact:?} {mass:?}: errors (stress, velocity) {errors:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_step_that_changes_nothing_reuses_the_factorization() {
+    for impact in TREATMENTS {
+        let mut v = read("cases/dynamics/two-identical-bars.json");
+        v["physics"]["dynamics"]["impact"] = serde_json::to_value(impact).unwrap();
+        let (_, h) = history(&v);
+        // a step with the active set of the step before and one Newton solve refactors nothing
+        // (both rows of the pair open and close together, so equal counts are equal sets)
+        let mut quiet = 0;
+        for w in h.steps.windows(2) {
+            if w[1].step > 1 && w[0].active == w[1].active && w[1].iterations == 1 {
+                quiet += 1;
+                assert_eq!(
+                    w[1].factorizations, w[0].factorizations,
+                    "{impact:?}: step {} refactored",
+                    w[1].step
+                );
+                assert_eq!(w[1].reused_factorizations, w[0].reused_factorizations + 1);
+            }
+        }
+        let last = h.steps.last().unwrap();
+        assert!(quiet > 20, "{impact:?}: {quiet} quiet steps");
+        if impact != ImpactTreatment::Plain {
+            // one factorization before contact, one with the rows active, one after release
+            assert!(last.factorizations <= 3, "{impact:?}: {last:?}");
+        }
+    }
+}
+
+#[test]
+fn a_static_scene_has_no_time_history() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("cases/contact/signorini-block-on-rigid-line.json");
+    let outcome = contact_patch::run::run_case(&path, &mut |_| {}).unwrap();
+    assert!(outcome.model.dynamics.is_none());
+    assert!(outcome.solution.dynamics.is_none());
+}
+
+#[test]
+fn bad_dynamic_input_is_refused_with_the_field_named() {
+    let base = read("cases/dynamics/bar-on-rigid-wall.json");
+    let mut cases: Vec<(Value, &str)> = Vec::new();
+    let mut v = base.clone();
+    v["materials"]["bar"]
+        .as_object_mut()
+        .unwrap()
+        .remove("density");
+    cases.push((v, "materials.bar.density"));
+    let mut v = base.clone();
+    v["physics"]["dynamics"]["integrator"] = json!("central_difference");
+    v["physics"]["dynamics"]["mass"] = json!("consistent");
+    cases.push((v, "physics.dynamics.mass"));
+    let mut v = base.clone();
+    v["physics"]["dynamics"]["integrator"] = json!("central_difference");
+    cases.push((v, "contact[0] 'wall'.enforcement"));
+    let mut v = base.clone();
+    v["physics"]["dynamics"]["initial_velocity"] =
+        json!([{"body": "bar", "velocity": [0.01, 0.5]}]);
+    cases.push((v, "physics.dynamics.initial_velocity[0]"));
+    let mut v = base.clone();
+    v["physics"]["dynamics"]["impact"] = json!("contact_stabilized");
+    v["physics"]["dynamics"]["integrator"] = json!({"newmark": {"beta": 0.3, "gamma": 0.6}});
+    cases.push((v, "physics.dynamics.impact"));
+    let mut v = base.clone();
+    v["physics"]["dynamics"]["dt"] = json!(0.0);
+    cases.push((v, "physics.dynamics.dt"));
+    let mut v = base.clone();
+    v["physics"]["dynamics"]["end_time"] = json!(1e9);
+    cases.push((v, "physics.dynamics"));
+    let mut v = base.clone();
+    v["physics"]["dynamics"]["integrator"] = json!({"newmark": {"beta": 0.25, "gamma": 0.4}});
+    cases.push((v, "physics.dynamics.integrator"));
+    let mut v = base.clone();
+    v["solver"]["scheme"] = json!("active_set");
+    cases.push((v, "solver.scheme"));
+    for (v, field) in cases {
+        let e = build_error(&v);
+        assert!(e.contains(field), "expected '{field}' in: {e}");
+    }
+}
+
+#[test]
+fn lumped_and_consistent_masses_weigh_each_body_the_same() {
+    // lumped and consistent masses weigh the same body
+    for mass in [MassKind::Lumped, MassKind::Consistent] {
+        let mut v = read("cases/dynamics/two-bars-different-impedance.json");
+        v["physics"]["dynamics"]["mass"] = serde_json::to_value(mass).unwrap();
+        let (_, h) = history(&v);
+        assert!((h.body_mass[0] - 0.1).abs() < 1e-15, "{mass:?}");
+        assert!((h.body_mass[1] - 0.4).abs() < 1e-15, "{mass:?}");
+    }
+}
