@@ -10,7 +10,7 @@
 //!   `|lambda_t| = mu lambda_n` against the motion, and the tangential traction is `mu p` at
 //!   every node, the uniform field again exact.
 //!
-//! Besides the patch table's measures ([`super::measure`]: stress, normal pressure, the total
+//! Besides the patch table's measures (`harness::measure`: stress, normal pressure, the total
 //! interaction force, which now includes the tangential forces, force balance) a friction cell
 //! records
 //!
