@@ -597,6 +597,28 @@ fn newton_with_the_consistent_tangent_beats_the_symmetrized_one_in_slip() {
                 1,
             ),
         ),
+        (
+            "patch C, mortar",
+            patch(
+                "C",
+                "0.0",
+                mortar("standard"),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+        ),
+        (
+            "patch E, dual mortar",
+            patch(
+                "E",
+                "0.0",
+                mortar("dual"),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+        ),
     ] {
         let (t_c, consistent) = history(&v, "consistent");
         let (t_s, symmetrized) = history(&v, "symmetrized");
