@@ -37,12 +37,12 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Run the contact patch-test catalogue and write reports/patch-table.md and .json.
+    /// Run the patch-test catalogues (contact, tied, friction) and write reports/patch-table.md, tied-table.md, friction-table.md and their .json.
     #[command(
         after_help = "Example:\n  contact-patch table\n  contact-patch table cases/patch/patch-C-nu0.3.json --out /tmp/reports\n  contact-patch table --out new --junit table.xml --baseline old/patch-table.json --baseline old/tied-table.json\n  contact-patch table cases/patch --results their-results --code mycode --out their-tables\n\nWith --baseline the exit code is 1 only on a regression against the baseline (a verdict lost,\na cell gone, an error grown by more than --baseline-factor above 1e-10), not on failing cells."
     )]
     Table {
-        /// Case files or folders with a sweep (default: cases/patch and cases/tied).
+        /// Case files or folders with a sweep (default: cases/patch, cases/tied and cases/friction).
         paths: Vec<PathBuf>,
         /// Folder for patch-table.md and patch-table.json.
         #[arg(long, default_value = "reports")]
@@ -583,7 +583,11 @@ fn table(
     outside: Option<(&Path, &str)>,
 ) -> ExitCode {
     let paths = if paths.is_empty() {
-        vec![PathBuf::from("cases/patch"), PathBuf::from("cases/tied")]
+        vec![
+            PathBuf::from("cases/patch"),
+            PathBuf::from("cases/tied"),
+            PathBuf::from("cases/friction"),
+        ]
     } else {
         paths.to_vec()
     };
@@ -671,6 +675,7 @@ fn table(
         let report = match catalogue {
             Catalogue::Tied => contact_patch::harness::report::tied_report(&part),
             Catalogue::Patch => contact_patch::harness::report::patch_report(&part, seconds),
+            Catalogue::Friction => contact_patch::harness::report::friction_report(&part, seconds),
         };
         let json = serde_json::to_string_pretty(&part).expect("cells serialize") + "\n";
         let (md, js) = (

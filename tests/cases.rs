@@ -1,7 +1,7 @@
 //! Every case under `cases/` runs and passes the checks it declares, except the size
-//! benchmarks in `cases/large/` and the patch-test catalogue `cases/patch/`, whose cases fail
-//! by design for some methods and are judged cell by cell in the snapshot-tested table
-//! (`tests/patch_table.rs`). A case without checks is itself a failure: it could not fail.
+//! benchmarks in `cases/large/` and the patch-test catalogues `cases/patch/` and
+//! `cases/friction/`, whose cases fail by design for some methods and are judged cell by cell in
+//! the snapshot-tested tables (`tests/patch_table.rs`, `tests/friction_table.rs`). A case without checks is itself a failure: it could not fail.
 
 use contact_patch::run::run_case;
 use std::path::{Path, PathBuf};
@@ -14,7 +14,9 @@ fn case_files(dir: &Path, out: &mut Vec<PathBuf>) {
     entries.sort();
     for p in entries {
         if p.is_dir() {
-            if p.file_name().is_some_and(|n| n == "large" || n == "patch") {
+            if p.file_name()
+                .is_some_and(|n| n == "large" || n == "patch" || n == "friction")
+            {
                 continue;
             }
             case_files(&p, out);

@@ -199,7 +199,10 @@ fn d07_sweep_catalogue_cannot_escape() {
             &["table", case.to_str().unwrap(), "--out", "a/b/tables"],
             &["a"],
         ),
-        &["unknown variant `../../escaped`", "`patch` or `tied`"],
+        &[
+            "unknown variant `../../escaped`",
+            "`patch`, `tied`, `friction`",
+        ],
     );
 }
 

@@ -4,7 +4,8 @@
 //! form:
 //!
 //! * the tangent of the contact system against central differences of its residual, at a stick
-//!   and at a slip state (node-to-node, node-to-surface, rigid line and circle);
+//!   and at a slip state (node-to-node, node-to-surface one- and two-pass, master and slave
+//!   normals, rigid line and circle, standard and dual mortar);
 //! * the frictional patch test (meshes A, D node-to-node; C, E node-to-surface one-pass): a
 //!   uniform stress field `[0, -p, q]` loaded by its own tractions on every free boundary;
 //!   `q < mu p` sticks (uniform stress exactly where the frictionless penalty passes the patch
@@ -126,6 +127,15 @@ fn node_to_node() -> Value {
 }
 fn node_to_surface() -> Value {
     json!({"kind": "node_to_surface", "passes": 1})
+}
+fn two_pass() -> Value {
+    json!({"kind": "node_to_surface", "passes": 2})
+}
+fn slave_normals() -> Value {
+    json!({"kind": "node_to_surface", "passes": 1, "normal": "slave"})
+}
+fn mortar(multiplier: &str) -> Value {
+    json!({"kind": "mortar", "multiplier": multiplier})
 }
 
 /// Largest `|sigma - sigma_exact|` over the quadrature points of every body.
@@ -482,6 +492,54 @@ fn the_frictional_tangent_is_the_derivative_of_the_residual_in_stick_and_in_slip
         ),
         ("rigid line", dragged(line(), 0.05), dragged(line(), 1e-6)),
         (
+            "C two-pass node-to-surface",
+            patch("C", "0.0", two_pass(), MU * P, Top::Displacement(0.05), 1),
+            patch("C", "0.3", two_pass(), 0.5 * MU * P, Top::Traction, 1),
+        ),
+        (
+            "C node-to-surface, slave normals",
+            patch(
+                "C",
+                "0.0",
+                slave_normals(),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+            patch("C", "0.3", slave_normals(), 0.5 * MU * P, Top::Traction, 1),
+        ),
+        (
+            "C mortar",
+            patch(
+                "C",
+                "0.0",
+                mortar("standard"),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+            patch(
+                "C",
+                "0.3",
+                mortar("standard"),
+                0.5 * MU * P,
+                Top::Traction,
+                1,
+            ),
+        ),
+        (
+            "E dual mortar",
+            patch(
+                "E",
+                "0.0",
+                mortar("dual"),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+            patch("E", "0.3", mortar("dual"), 0.5 * MU * P, Top::Traction, 1),
+        ),
+        (
             "rigid circle",
             dragged(circle(), 0.05),
             dragged(circle(), 1e-6),
@@ -534,6 +592,28 @@ fn newton_with_the_consistent_tangent_beats_the_symmetrized_one_in_slip() {
                 "C",
                 "0.0",
                 node_to_surface(),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+        ),
+        (
+            "patch C, mortar",
+            patch(
+                "C",
+                "0.0",
+                mortar("standard"),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+        ),
+        (
+            "patch E, dual mortar",
+            patch(
+                "E",
+                "0.0",
+                mortar("dual"),
                 MU * P,
                 Top::Displacement(0.05),
                 1,
@@ -601,15 +681,17 @@ fn friction_is_refused_where_this_slice_does_not_solve_it_with_the_fix() {
     );
     let m = with(&|v| v["contact"][0]["enforcement"] = json!({"kind": "lagrange"}));
     assert!(m.contains("penalty-type normal law"), "{m}");
-    let m = with(&|v| v["contact"][0]["discretization"] = json!({"kind": "mortar"}));
-    assert!(
-        m.contains("node-to-node and one-pass node-to-surface"),
-        "{m}"
-    );
-    let m = with(&|v| {
-        v["contact"][0]["discretization"] = json!({"kind": "node_to_surface", "passes": 2})
-    });
-    assert!(m.contains("one-pass"), "{m}");
+    // every discretization carries friction (tests/friction_table.rs)
+    for d in [
+        json!({"kind": "mortar", "multiplier": "standard"}),
+        json!({"kind": "mortar", "multiplier": "dual"}),
+        json!({"kind": "node_to_surface", "passes": 2}),
+        json!({"kind": "node_to_surface", "passes": 1, "normal": "slave"}),
+    ] {
+        let mut v = base.clone();
+        v["contact"][0]["discretization"] = d.clone();
+        assert!(build(&v).is_ok(), "{d}");
+    }
     let m = with(&|v| v["physics"] = json!({"contact_geometry": "current"}));
     assert!(m.contains("reference contact geometry"), "{m}");
     let m = with(&|v| v["loads"][0]["path"] = json!([0.0, 1.0]));

@@ -7,7 +7,9 @@
 //! f^k = B_k^T lambda_k,     f^k_d = sum_{rows i of k} c_id lambda_i
 //! ```
 //!
-//! which is unique even when `lambda` is not (the dependent rows of a two-pass pair, whose
+//! plus, for Coulomb pairs, the tangential forces `B_t^T lambda_t` of the slip rows
+//! ([`crate::contact::TangentRow`]), so the force of a frictional pair is the whole traction it
+//! transmits. The nodal force is unique even when `lambda` is not (the dependent rows of a two-pass pair, whose
 //! minimum-norm multipliers split the load between the passes: `B^T lambda = K u - f` on the
 //! contact dofs whatever the split). The force the pair puts on a body is the sum of `f^k` over
 //! that body's dofs; a rigid master takes minus the force on the slave.
@@ -149,7 +151,7 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
     // f^k, per (body, node).
     let mut nodal: BTreeMap<(usize, usize), [f64; 2]> = BTreeMap::new();
     let mut slave_nodes = std::collections::BTreeSet::new();
-    for (r, &lambda) in state.rows.iter().zip(&state.forces) {
+    for (i, (r, &lambda)) in state.rows.iter().zip(&state.forces).enumerate() {
         if r.pair != k {
             continue;
         }
@@ -157,6 +159,13 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
         for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
             let (b, n, comp) = owner(model, d);
             nodal.entry((b, n)).or_insert([0.0; 2])[comp] += c * lambda;
+        }
+        // a frictional row's tangential force acts along its slip gradient
+        if let (Some(t), Some(Some(f))) = (&r.tangent, state.friction.get(i)) {
+            for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
+                let (b, n, comp) = owner(model, d);
+                nodal.entry((b, n)).or_insert([0.0; 2])[comp] += c * f.force;
+            }
         }
     }
     let position = |b: usize, n: usize| {

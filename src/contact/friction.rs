@@ -128,7 +128,7 @@ pub struct FrictionPoint {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FrictionSummary {
     /// Sum of the tangential forces `lambda_t t` on the slave nodes, `[x, y]` (the pair's
-    /// `force_on_slave` is that of the normal rows).
+    /// `force_on_slave` holds the normal and the tangential forces together).
     pub tangential_force: [f64; 2],
     pub open: usize,
     pub stick: usize,

@@ -372,6 +372,7 @@ mod tests {
             vs_penalty: None,
             time_ms: 0.0,
             note: String::new(),
+            friction: None,
             tol: 1e-10,
         }
     }

@@ -588,6 +588,7 @@ pub fn outside_cells(
         time_ms: 0.0,
         note: String::new(),
         tol: sweep.tol,
+        friction: None,
     };
     let Some(path) = results_in(dir, &model.name)? else {
         cell.note = format!(

@@ -34,6 +34,7 @@ pub(crate) mod exact;
 pub mod hard;
 pub mod judge;
 pub mod impact;
+pub mod friction;
 pub mod junit;
 pub mod layer;
 pub mod report;
@@ -96,10 +97,28 @@ pub struct Cell {
     pub vs_penalty: Option<f64>,
     pub time_ms: f64,
     pub note: String,
+    /// The frictional patch test's own measures (catalogue `friction`, see [`friction`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionCell>,
     /// The sweep's tolerance (relative to `pressure`); not in the table files (their cells are
     /// compared by `table --baseline`), shown in JUnit messages.
     #[serde(skip)]
     pub tol: f64,
+}
+
+/// The friction part of a cell of the friction table ([`friction`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct FrictionCell {
+    /// `stick` or `slip`: the status every point must end in.
+    pub expect: String,
+    /// How many points ended the last step in that status, of all: `slip 3/3`.
+    pub statuses: Option<String>,
+    /// Largest error of the nodal tangential traction over `p`.
+    pub tangential_error: Option<f64>,
+    /// Largest `|lambda_t| / (mu lambda_n)` over the closed points of every step (<= 1).
+    pub cone_ratio: Option<f64>,
+    /// Smallest frictional dissipation of a load step (>= 0).
+    pub min_dissipation: Option<f64>,
 }
 
 /// What one solve measured.
@@ -292,11 +311,23 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 vs_penalty: None,
                 time_ms: 0.0,
                 note: String::new(),
+                friction: sweep.expect.map(|x| FrictionCell {
+                    expect: friction::name(x).into(),
+                    statuses: None,
+                    tangential_error: None,
+                    cone_ratio: None,
+                    min_dissipation: None,
+                }),
                 tol: sweep.tol,
             };
             let mut model = base.clone();
             pair.enforcement = e.clone();
             model.contact = vec![pair.clone()];
+            if let Some(why) = friction::obstacle(&model, &pair) {
+                cell.note = why;
+                cells.push(cell);
+                continue;
+            }
             let rows = match constraints(&model, &pair) {
                 Ok(r) => r,
                 Err(why) => {
@@ -313,6 +344,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             let start = Instant::now();
             let solved = solve_static(&model, &mut |_| {});
             cell.time_ms = start.elapsed().as_secs_f64() * 1e3;
+            let mut frictional = None;
             let m = match solved {
                 Ok(s) => {
                     // the perturbed Lagrangian with a consistent multiplier mass against the
@@ -329,6 +361,17 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                             Err(_) => f64::NAN,
                         });
                         cell.time_ms += start.elapsed().as_secs_f64() * 1e3;
+                    }
+                    if let Some(expect) = sweep.expect {
+                        let state = s.contact.as_ref().expect("a contact solve");
+                        let forces = pair_forces(&model, state);
+                        frictional = Some(friction::measure(
+                            &model,
+                            &s,
+                            &forces,
+                            expect,
+                            sweep.pressure,
+                        ));
                     }
                     measure(&model, &s, sweep.pressure)
                 }
@@ -446,7 +489,32 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 let pressure_ok = !unique || m.pressure_error <= sweep.tol;
                 converged && balanced && loaded && m.stress_error <= sweep.tol && pressure_ok
             };
-            cell.verdict = if pass { "pass" } else { "fail" }.into();
+            // the frictional patch test: statuses, Coulomb's inequality, dissipation and, for
+            // the methods judged on their multipliers, the tangential traction
+            let friction_pass = match (&frictional, sweep.expect, cell.friction.as_mut()) {
+                (Some(f), Some(expect), Some(fc)) => {
+                    fc.statuses = Some(f.statuses(expect));
+                    fc.tangential_error = Some(f.tangential_error);
+                    fc.cone_ratio = Some(f.cone_ratio);
+                    fc.min_dissipation = Some(f.min_dissipation);
+                    let exact = !method(e).penalty_like();
+                    if exact && f.tangential_error > sweep.tol {
+                        notes.push(format!(
+                            "tangential traction off by {:.1e} p",
+                            f.tangential_error
+                        ));
+                    }
+                    notes.extend(f.notes(expect));
+                    f.passes(exact, sweep.tol)
+                }
+                _ => true,
+            };
+            cell.verdict = if pass && friction_pass {
+                "pass"
+            } else {
+                "fail"
+            }
+            .into();
             cell.note = notes.join("; ");
             cells.push(cell);
         }

@@ -399,8 +399,8 @@ pub struct SweepDiscretization {
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SweepSpec {
-    /// Which table the cells go to: `patch` (default, `reports/patch-table.*`) or `tied`
-    /// (`reports/tied-table.*`).
+    /// Which table the cells go to: `patch` (default, `reports/patch-table.*`), `tied`
+    /// (`reports/tied-table.*`) or `friction` (`reports/friction-table.*`).
     #[serde(default)]
     pub catalogue: Catalogue,
     /// Label of the mesh in tables (e.g. "A").
@@ -414,6 +414,21 @@ pub struct SweepSpec {
     pub pressure: f64,
     /// Tolerance of the patch-test verdict (relative to the pressure).
     pub tol: f64,
+    /// The frictional patch test (catalogue `friction`): the status every contact point must
+    /// end the last load step in, `stick` (tangential traction below the cone) or `slip` (the
+    /// punch dragged past it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub expect: Option<ExpectedFriction>,
+}
+
+/// The frictional status a friction sweep expects at every contact point of its last step.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ExpectedFriction {
+    /// `|lambda_t| < mu lambda_n` everywhere: the bodies move together (uniform stress).
+    Stick,
+    /// `|lambda_t| = mu lambda_n` everywhere, against the sliding.
+    Slip,
 }
 
 /// The tables a sweep's cells go to; the name is the stem of the table's files.
@@ -427,6 +442,8 @@ pub enum Catalogue {
     Patch,
     /// The tied patch tests (`tied-table.*`).
     Tied,
+    /// The frictional patch tests (`friction-table.*`).
+    Friction,
 }
 
 impl Catalogue {
@@ -434,6 +451,7 @@ impl Catalogue {
         match self {
             Catalogue::Patch => "patch",
             Catalogue::Tied => "tied",
+            Catalogue::Friction => "friction",
         }
     }
 }

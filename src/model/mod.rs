@@ -890,15 +890,7 @@ impl Model {
                     "use penalty, the perturbed Lagrangian, the augmented Lagrangian or Lagrange multipliers, or solver.scheme \"active_set\"",
                 ));
             }
-            if newton
-                && matches!(spec.enforcement, EnforcementSpec::PerturbedLagrange { .. })
-                && matches!(
-                    spec.discretization,
-                    DiscretizationSpec::Mortar {
-                        multiplier: MultiplierSpace::Standard
-                    }
-                )
-            {
+            if newton && newton_mortar_obstacle(&spec.enforcement, &spec.discretization) {
                 return Err(Error::invalid(
                     &self.source,
                     format!("{at}.enforcement"),
@@ -1014,6 +1006,19 @@ impl Model {
                     "sweep",
                     "penalty_factor and tol must be positive and pressure non-zero",
                     "e.g. \"penalty_factor\": 1000, \"tol\": 1e-10, \"pressure\": 10",
+                ));
+            }
+            let friction = sweep.catalogue == crate::io::scene::Catalogue::Friction;
+            let coulomb = case
+                .contact
+                .first()
+                .is_some_and(|c| c.interaction.friction().is_some());
+            if friction != (sweep.expect.is_some() && coulomb) {
+                return Err(Error::invalid(
+                    &self.source,
+                    "sweep",
+                    "a friction sweep (\"catalogue\": \"friction\") needs a Coulomb first pair and the status it expects (\"expect\"), and only a friction sweep takes \"expect\"",
+                    "with a Coulomb pair give \"catalogue\": \"friction\" and \"expect\": \"stick\" or \"slip\"; otherwise leave \"expect\" out",
                 ));
             }
         }
@@ -1144,62 +1149,99 @@ fn validate_coulomb(
             ));
         }
     }
-    if case.solver.scheme != crate::io::scene::Scheme::Newton {
-        return Err(Error::invalid(
-            source,
-            &here,
-            "Coulomb friction is solved by the Newton scheme only".to_string(),
-            "set \"solver\": {\"scheme\": \"newton\"}",
-        ));
-    }
-    if matches!(spec.enforcement, EnforcementSpec::AugmentedLagrange { .. }) {
-        // the Uzawa multipliers restart from zero in every load step; with friction the
-        // second step of the slip patch test cycled between branches (both update rules)
-        return Err(Error::invalid(
-            source,
-            format!("{at}.enforcement"),
-            "Coulomb friction with the augmented Lagrangian is not solved yet (its Newton iteration cycled between stick/slip and open/closed branches after the first load step)".to_string(),
-            "use the penalty or the perturbed Lagrangian for this pair",
-        ));
-    }
-    if !matches!(
-        spec.enforcement,
-        EnforcementSpec::Penalty { .. } | EnforcementSpec::PerturbedLagrange { .. }
+    if let Some(o) = coulomb_obstacle(
+        case.solver.scheme,
+        case.physics.contact_geometry,
+        &spec.enforcement,
     ) {
-        return Err(Error::invalid(
-            source,
-            format!("{at}.enforcement"),
-            format!(
-                "Coulomb friction is regularized by a tangential penalty and needs a penalty-type normal law, not {}",
-                crate::contact::enforcement::method(&spec.enforcement).name()
-            ),
-            "use the penalty or the perturbed Lagrangian for this pair",
-        ));
-    }
-    let node_based = match spec.discretization {
-        DiscretizationSpec::NodeToNode => true,
-        DiscretizationSpec::NodeToSurface { passes, normal } => {
-            passes == 1 && normal == crate::io::scene::NormalChoice::Master
-        }
-        DiscretizationSpec::Mortar { .. } => false,
-    };
-    if !node_based {
-        return Err(Error::invalid(
-            source,
-            format!("{at}.discretization"),
-            "Coulomb friction has tangential rows for node-to-node and one-pass node-to-surface with master normals (and rigid masters) only, so far".to_string(),
-            "use {\"kind\": \"node_to_node\"} or {\"kind\": \"node_to_surface\", \"passes\": 1, \"normal\": \"master\"}",
-        ));
-    }
-    if case.physics.contact_geometry != crate::io::scene::ContactGeometry::Reference {
-        return Err(Error::invalid(
-            source,
-            &here,
-            "Coulomb friction is solved in the reference contact geometry only, so far".to_string(),
-            "set \"physics\": {\"contact_geometry\": \"reference\"}",
-        ));
+        let field = match o.field {
+            "coulomb" => here,
+            f => format!("{at}.{f}"),
+        };
+        return Err(Error::invalid(source, field, o.why, o.fix));
     }
     Ok(())
+}
+
+/// Whether the Newton scheme refuses this pair: the perturbed Lagrangian's consistent
+/// (non-diagonal) coupling of standard mortar multipliers is not solved there yet.
+pub fn newton_mortar_obstacle(
+    enforcement: &EnforcementSpec,
+    discretization: &DiscretizationSpec,
+) -> bool {
+    matches!(enforcement, EnforcementSpec::PerturbedLagrange { .. })
+        && matches!(
+            discretization,
+            DiscretizationSpec::Mortar {
+                multiplier: MultiplierSpace::Standard
+            }
+        )
+}
+
+/// Why a Coulomb pair cannot be solved as specified, and how to fix it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CoulombObstacle {
+    /// The field of the pair at fault: `enforcement`, `discretization` or `coulomb` (the
+    /// interaction itself, for the scheme and the geometry).
+    pub field: &'static str,
+    pub why: String,
+    pub fix: String,
+}
+
+/// What this slice of friction solves: the Newton scheme, penalty-type normal laws, the
+/// reference geometry; every discretization (node-to-node, node-to-surface one- and two-pass
+/// with master or slave normals, rigid masters, standard and dual mortar with the weighted
+/// tangential slip). `None` when the combination is solved;
+/// used by [`Model::build`] and by the friction table (its `n/a` cells).
+pub fn coulomb_obstacle(
+    scheme: crate::io::scene::Scheme,
+    geometry: crate::io::scene::ContactGeometry,
+    enforcement: &EnforcementSpec,
+) -> Option<CoulombObstacle> {
+    let obstacle = |field, why: &str, fix: &str| {
+        Some(CoulombObstacle {
+            field,
+            why: why.to_string(),
+            fix: fix.to_string(),
+        })
+    };
+    if scheme != crate::io::scene::Scheme::Newton {
+        return obstacle(
+            "coulomb",
+            "Coulomb friction is solved by the Newton scheme only",
+            "set \"solver\": {\"scheme\": \"newton\"}",
+        );
+    }
+    if matches!(enforcement, EnforcementSpec::AugmentedLagrange { .. }) {
+        // the Uzawa multipliers restart from zero in every load step; with friction the
+        // second step of the slip patch test cycled between branches (both update rules)
+        return obstacle(
+            "enforcement",
+            "Coulomb friction with the augmented Lagrangian is not solved yet (its Newton iteration cycled between stick/slip and open/closed branches after the first load step)",
+            "use the penalty or the perturbed Lagrangian for this pair",
+        );
+    }
+    if !matches!(
+        enforcement,
+        EnforcementSpec::Penalty { .. } | EnforcementSpec::PerturbedLagrange { .. }
+    ) {
+        return obstacle(
+            "enforcement",
+            &format!(
+                "Coulomb friction is regularized by a tangential penalty and needs a penalty-type normal law, not {}",
+                crate::contact::enforcement::method(enforcement).name()
+            ),
+            "use the penalty or the perturbed Lagrangian for this pair",
+        );
+    }
+    if geometry != crate::io::scene::ContactGeometry::Reference {
+        return obstacle(
+            "coulomb",
+            "Coulomb friction is solved in the reference contact geometry only, so far",
+            "set \"physics\": {\"contact_geometry\": \"reference\"}",
+        );
+    }
+    None
 }
 
 fn validate_enforcement(e: &EnforcementSpec, source: &str, at: &str) -> Result<()> {

@@ -23,9 +23,11 @@
 //! * **Tied** pairs use the same weights with one bilateral row per global direction
 //!   (`e_x`, `e_y`) and zero initial gap: the interface keeps its initial geometry.
 //!
-//! * **Coulomb** pairs (node-based rows) add to every row its tangential slip measure
-//!   `g_t = t . (u_s - sum_b N_b u_b)`, `t = (-nu_y, nu_x)`, with the normal row's weights
-//!   ([`crate::contact::TangentRow`]).
+//! * **Coulomb** pairs add to every row its tangential slip measure
+//!   `g_t = t . (u_s - sum_b N_b u_b)`, `t = (-nu_y, nu_x)` (unit), with the normal row's
+//!   weights ([`crate::contact::TangentRow`]): node-to-node, node-to-surface (either pass,
+//!   master or slave normals), rigid masters, and for mortar the weighted tangential slip
+//!   `g_t,j = t_j . (sum_k D_jk u_k - sum_l M_jl u_l) / A_j`.
 //!
 //! Every row carries the slave node's tributary area, so penalty forces (`kappa A g`) do not
 //! depend on the mesh. Geometry is evaluated in the reference configuration (small strain).
