@@ -33,6 +33,7 @@ pub mod checks;
 pub(crate) mod exact;
 pub mod junit;
 pub mod layer;
+pub mod profile;
 pub mod report;
 
 use crate::contact::discretization::constraints;

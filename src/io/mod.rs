@@ -1,8 +1,10 @@
 //! Everything that crosses the tool's boundary: the case file ([`scene`], plain serde data),
 //! the paths the tool writes ([`paths`], the one owner of every written path), the results it
-//! writes ([`output`]: `summary.json` and `.vtu` files) and its plots (`svg`).
+//! writes ([`output`]: `summary.json` and `.vtu` files) and its plots (`svg`); [`contact_output`] writes the per-pair contact results through [`vtu`].
 
+pub mod contact_output;
 pub mod output;
 pub mod paths;
 pub mod scene;
 pub(crate) mod svg;
+pub mod vtu;
