@@ -103,8 +103,13 @@ fn effects(outcome: &Outcome) -> Vec<EffectSummary> {
             .map(|p| {
                 // in the case file's words
                 let words = |v: serde_json::Value| v.to_string().replace('"', "");
+                let halved = if p.penalty_share() < 1.0 {
+                    ", two-pass penalty halved"
+                } else {
+                    ""
+                };
                 format!(
-                    "'{}': {}, {}, {}",
+                    "'{}': {}, {}, {}{halved}",
                     p.name,
                     words(serde_json::json!(p.interaction)),
                     words(serde_json::json!(p.discretization)),

@@ -249,6 +249,32 @@ pub struct ContactSpec {
     /// the largest master facet). Node-to-surface and mortar only.
     #[serde(default)]
     pub search_distance: Option<f64>,
+    /// Two-pass node-to-surface with a penalty-type method (penalty, perturbed Lagrangian,
+    /// augmented Lagrangian, perturbed tangent): the penalty each pass applies. `full`
+    /// (default): `kappa` on the rows of each pass, so where both passes act the interface is
+    /// about twice as stiff as one pass's (the penalty error about halves); `halved`:
+    /// `kappa / 2` on each pass, the convention of codes that split the penalty between the
+    /// passes (the penalty error then matches one pass at `kappa`). Lagrange multipliers and
+    /// elimination have no penalty and ignore it.
+    #[serde(default, skip_serializing_if = "TwoPassPenalty::is_full")]
+    pub two_pass_penalty: TwoPassPenalty,
+}
+
+/// The penalty of each pass of a two-pass pair.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum TwoPassPenalty {
+    /// `kappa` on each pass.
+    #[default]
+    Full,
+    /// `kappa / 2` on each pass.
+    Halved,
+}
+
+impl TwoPassPenalty {
+    pub fn is_full(&self) -> bool {
+        *self == TwoPassPenalty::Full
+    }
 }
 
 /// What a pair enforces.

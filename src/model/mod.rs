@@ -106,9 +106,25 @@ pub struct ContactPair {
     pub interaction: Interaction,
     /// Candidate distance of the search (`None`: the largest master facet).
     pub search_distance: Option<f64>,
+    /// The penalty of each pass when the discretization has two passes.
+    pub two_pass_penalty: crate::io::scene::TwoPassPenalty,
 }
 
 impl ContactPair {
+    /// The share of the enforcement's `kappa` each row of this pair applies: 1/2 for two-pass
+    /// node-to-surface with `two_pass_penalty: "halved"`, 1 otherwise.
+    pub fn penalty_share(&self) -> f64 {
+        let two_pass = matches!(
+            self.discretization,
+            DiscretizationSpec::NodeToSurface { passes: 2, .. }
+        );
+        if two_pass && self.two_pass_penalty == crate::io::scene::TwoPassPenalty::Halved {
+            0.5
+        } else {
+            1.0
+        }
+    }
+
     /// The same pair with slave and master exchanged (a body master is required).
     pub fn swapped(&self) -> Option<ContactPair> {
         match &self.master {
@@ -854,6 +870,24 @@ impl Model {
                 &self.source,
                 &format!("{at}.enforcement"),
             )?;
+            let two_pass = |d: &DiscretizationSpec| {
+                matches!(d, DiscretizationSpec::NodeToSurface { passes: 2, .. })
+            };
+            if !spec.two_pass_penalty.is_full()
+                && !two_pass(&spec.discretization)
+                && !case.sweep.as_ref().is_some_and(|sw| {
+                    sw.discretizations
+                        .iter()
+                        .any(|d| two_pass(&d.discretization))
+                })
+            {
+                return Err(Error::invalid(
+                    &self.source,
+                    format!("{at}.two_pass_penalty"),
+                    "is \"halved\", but neither the pair nor its sweep has a two-pass discretization, so it would change nothing",
+                    "remove it, or use {\"kind\": \"node_to_surface\", \"passes\": 2}",
+                ));
+            }
             if let Some(d) = spec.search_distance {
                 if !(d.is_finite() && d > 0.0) {
                     return Err(Error::invalid(
@@ -963,6 +997,7 @@ impl Model {
                 enforcement: spec.enforcement.clone(),
                 interaction: spec.interaction,
                 search_distance: spec.search_distance,
+                two_pass_penalty: spec.two_pass_penalty,
             });
         }
         if let Some(sweep) = &case.sweep {
