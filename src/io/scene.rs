@@ -633,9 +633,13 @@ pub enum NodeSetSpec {
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum FacetSetSpec {
-    /// Boundary facets whose nodes all lie in a closed axis-aligned box.
+    /// Boundary facets whose nodes all lie in a closed axis-aligned box (within 1e-9 x the
+    /// body size; a node taken in only by that tolerance is named in a warning).
     Box(BoxSpec),
-    /// `[cell, local edge]` pairs.
+    /// `[cell, local edge]` pairs. Local edges run counter-clockwise from the cell's first
+    /// corner: Q4 and Q9 edge 0 = corners 0-1 (Q9 mid-node 4), 1 = 1-2 (5), 2 = 2-3 (6),
+    /// 3 = 3-0 (7); T3 and T6 edge 0 = corners 0-1 (T6 mid-node 3), 1 = 1-2 (4), 2 = 2-0 (5).
+    /// Corners are numbered counter-clockwise; a block's cell starts at its lower-left corner.
     Facets(Vec<[usize; 2]>),
 }
 
