@@ -253,13 +253,17 @@ fn range(values: impl Iterator<Item = f64>) -> [f64; 2] {
 }
 
 pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
-    let results = outcome
+    summary_with(outcome, nodal, &contact_results(outcome))
+}
+
+/// The per-point contact results of `outcome` (none without contact).
+fn contact_results(outcome: &Outcome) -> Vec<PairResults> {
+    outcome
         .solution
         .contact
         .as_ref()
         .map(|c| pair_results(&outcome.model, c, &outcome.solution.u))
-        .unwrap_or_default();
-    summary_with(outcome, nodal, &results)
+        .unwrap_or_default()
 }
 
 /// [`summary`] with the contact results already computed.
@@ -400,12 +404,7 @@ pub fn write_run(folder: &OutputFolder, outcome: &Outcome) -> Result<()> {
         .iter()
         .map(|b| nodal_stresses(b, &outcome.solution.u))
         .collect();
-    let results = outcome
-        .solution
-        .contact
-        .as_ref()
-        .map(|c| pair_results(&outcome.model, c, &outcome.solution.u))
-        .unwrap_or_default();
+    let results = contact_results(outcome);
     let summary = summary_with(outcome, &nodal, &results);
     folder.write(|tmp| {
         let path = tmp.join("summary.json");
