@@ -111,6 +111,21 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// Solve one case and plot a contact pair's pressure profile (against Hertz's closed form
+    /// when the master is a rigid circle); writes <case>.<pair>.pressure.svg and .md.
+    #[command(
+        after_help = "Example:\n  contact-patch profile cases/contact/hertz-profile.json --pair cylinder\n\nThe pressures are those of <pair>.contact.csv in the folder `run` writes."
+    )]
+    Profile {
+        /// The case file (JSON).
+        case: PathBuf,
+        /// The contact pair.
+        #[arg(long)]
+        pair: String,
+        /// Folder for the plot and its table.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
     /// Print the JSON Schema of the case format (committed as cases/case.schema.json; a case
     /// file may name it in "$schema" so that editors validate and complete it).
     #[command(after_help = "Example:\n  contact-patch schema > cases/case.schema.json")]
@@ -189,6 +204,7 @@ fn main() -> ExitCode {
         Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
         Command::Hard { paths, out } => hard(&paths, &out),
         Command::ImpactReport { paths, out } => impact_report(&paths, &out),
+        Command::Profile { case, pair, out } => profile(&case, &pair, &out),
         Command::Schema => {
             print!("{}", contact_patch::io::scene::case_schema());
             ExitCode::SUCCESS
@@ -857,6 +873,39 @@ fn hard(paths: &[PathBuf], out: &Path) -> ExitCode {
 
 const MAX_LEVELS: usize = 16;
 const MAX_LEVEL: usize = 64;
+
+fn profile(case: &Path, pair: &str, out: &Path) -> ExitCode {
+    let result = (|| -> contact_patch::Result<()> {
+        let folder = ReportFolder::new(out)?;
+        let outcome = run_case(case, &mut |_| {})?;
+        let profile = contact_patch::harness::profile::pressure_profile(&outcome, pair)?;
+        let files = contact_patch::harness::profile::write_profile(&folder, &profile)?;
+        if let Some(h) = profile.hertz {
+            println!(
+                "{} '{}': Hertz a = {:.6}, p0 = {:.6}; largest |p - p_Hertz| / p0 {:.3e} over |s| <= {} a, {:.3e} over all points; outermost closed point |s| = {:.6}",
+                profile.case,
+                profile.pair,
+                h.half_width(),
+                h.peak(),
+                profile.deviation(contact_patch::harness::profile::INTERIOR_SHARE).unwrap_or(f64::NAN),
+                contact_patch::harness::profile::INTERIOR_SHARE,
+                profile.deviation(f64::INFINITY).unwrap_or(f64::NAN),
+                profile.contact_extent()
+            );
+        }
+        for f in files {
+            println!("wrote {}", folder.shown(&f).display());
+        }
+        Ok(())
+    })();
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
 
 fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
     if levels.is_empty()

@@ -45,7 +45,12 @@ pub fn run_model(
     crate::post::check_finite_stresses(&model, &solution.u)?;
     progress("checking");
     let checks = evaluate(&model, &solution);
-    let warnings = warnings(&model, &solution);
+    let warnings = model
+        .warnings
+        .iter()
+        .cloned()
+        .chain(warnings(&model, &solution))
+        .collect();
     solution.timings.mesh = mesh_time;
     solution.timings.total = start.elapsed().as_secs_f64();
     Ok(Outcome {

@@ -38,6 +38,7 @@ pub mod discretization;
 pub mod enforcement;
 pub mod forces;
 pub mod friction;
+pub mod results;
 pub mod state;
 
 /// One linearized contact constraint (a row of `B`).

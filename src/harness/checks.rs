@@ -140,16 +140,29 @@ pub fn pressure_error(
     error
 }
 
-/// Largest over the pairs between deformable bodies of: the net force and moment the pair puts
-/// on its two bodies (relative to the sum of the nodal |contact forces|, moments divided by the
-/// model size; moments about the points where the forces act, in the configuration of the rows),
-/// and the relative equilibrium residual of the solve (`forces` from [`pair_forces`]).
+/// Largest over the pairs between deformable bodies of: the net force `|F_s + F_m|` (largest
+/// component) and net moment `|M| / L` the pair puts on its two bodies, relative to the applied
+/// load `F` of [`Magnitudes`] (the larger of the summed |external forces| and the summed
+/// |reactions|; `L` the model size; moments about the origin of the points where the forces
+/// act, in the configuration of the rows), and the out-of-balance force of the solve,
+/// `sum |K u - f - B^T lambda|` over the free dofs, relative to the same `F` (`forces` from
+/// [`pair_forces`]). A pair that carries nothing is skipped. (Until issue 16 the pairs' terms
+/// were relative to the sum of the nodal |contact forces| and the residual to the largest nodal
+/// force, scales that depend on the mesh rather than on the load the user applied.)
 pub fn force_balance(model: &Model, solution: &Solution, forces: &[PairForces]) -> f64 {
     if solution.contact.is_none() {
         return f64::INFINITY;
     }
     let size = model.size();
-    let mut error = solution.relative_residual;
+    let load = Magnitudes::of(model, solution).force.max(f64::MIN_POSITIVE);
+    let out_of_balance: f64 = model
+        .prescribed
+        .iter()
+        .zip(&solution.reactions)
+        .filter(|(p, _)| p.is_none())
+        .map(|(_, r)| r.abs())
+        .sum();
+    let mut error = out_of_balance / load;
     for pf in forces {
         if !matches!(model.contact[pf.pair].master, MasterSide::Body { .. })
             || pf.force_scale == 0.0
@@ -164,7 +177,7 @@ pub fn force_balance(model: &Model, solution: &Solution, forces: &[PairForces]) 
             .abs()
             .max(net[1].abs())
             .max(pf.net_moment.abs() / size)
-            / pf.force_scale;
+            / load;
         error = worst(error, e);
     }
     error
@@ -361,7 +374,15 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
                     let found = warnings(model, solution).iter().any(|w| w.contains(contains.as_str()));
                     (format!("the run warns {contains:?}"), if found { 0.0 } else { f64::INFINITY }, 0.0)
                 }
-                Check::ForceBalance { tol } => ("force balance of the contact forces and equilibrium".to_string(), force_balance(model, solution, &forces), *tol),
+                Check::ForceBalance { tol } => (
+                    format!(
+                        "force balance: net force and net moment / L (L = {:.3e}) of each pair between bodies and the out-of-balance force, relative to the applied load {:.3e}",
+                        model.size(),
+                        magnitudes.force
+                    ),
+                    force_balance(model, solution, &forces),
+                    *tol,
+                ),
                 Check::Displacement { body, point, component, value, tol } => {
                     let b = model.body(body).expect("resolved when the model was built");
                     let (n, _) = b.mesh.nearest_node(*point).expect("a body has nodes");

@@ -10,6 +10,11 @@
 //!   `sigma_xx = -P (L - x) y / I`, `sigma_yy = 0`, `sigma_xy = P / (2 I) (D^2/4 - y^2)`.
 //!   It is cubic, so Q4/T3 converge as h^2 and Q9/T6 as h^3 in the L2 norm of displacement.
 //!   Plane strain uses `E/(1 - nu^2)` and `nu/(1 - nu)` in the same formulas.
+//! * Hertz's contact of a rigid cylinder (radius `R`) on an elastic half-space, per unit
+//!   thickness under the normal load `P` (K. L. Johnson, *Contact Mechanics*, 1985, sec. 4.2,
+//!   eqs. 4.43 and 4.45, with a rigid indenter): half-width `a = sqrt(4 P R / (pi E*))`, pressure
+//!   `p(x) = p0 sqrt(1 - x^2/a^2)` for `|x| <= a` (zero outside), `p0 = 2 P / (pi a)`, with
+//!   `E* = E/(1 - nu^2)` in plane strain and `E` in plane stress.
 
 use crate::io::scene::ExactSpec;
 use crate::solid::Elasticity;
@@ -84,6 +89,34 @@ impl ExactField {
     }
 }
 
+/// Hertz's pressure under a rigid cylinder on an elastic half-space (see the module notes).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct HertzCylinder {
+    /// Normal load per unit thickness `P`.
+    pub load: f64,
+    pub radius: f64,
+    /// `E*` (plane strain `E/(1 - nu^2)`, plane stress `E`).
+    pub modulus: f64,
+}
+
+impl HertzCylinder {
+    /// The half-width `a`.
+    pub fn half_width(&self) -> f64 {
+        (4.0 * self.load * self.radius / (std::f64::consts::PI * self.modulus)).sqrt()
+    }
+
+    /// The peak pressure `p0`.
+    pub fn peak(&self) -> f64 {
+        2.0 * self.load / (std::f64::consts::PI * self.half_width())
+    }
+
+    /// `p(x)`, `x` measured from the first point of contact.
+    pub fn pressure(&self, x: f64) -> f64 {
+        let a = self.half_width();
+        self.peak() * (1.0 - (x / a).powi(2)).max(0.0).sqrt()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,5 +161,30 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The pressure integrates to the load (P = pi a p0 / 2) and the numbers of the committed
+    /// cylinder cases (P = 4, R = 10, E = 200, nu = 0.3, plane strain: a = 0.48138, p0 = 5.2899).
+    #[test]
+    fn hertz_pressure_integrates_to_the_load() {
+        let h = HertzCylinder {
+            load: 4.0,
+            radius: 10.0,
+            modulus: 200.0 / (1.0 - 0.09),
+        };
+        let a = h.half_width();
+        assert!((a - 0.48138).abs() < 5e-6, "{a}");
+        assert!((h.peak() - 5.2899).abs() < 5e-5, "{}", h.peak());
+        // midpoint rule in the angle: x = a sin(theta), p dx = p0 a cos^2(theta) dtheta
+        let n = 2000;
+        let total: f64 = (0..n)
+            .map(|k| {
+                let th = -std::f64::consts::FRAC_PI_2
+                    + (k as f64 + 0.5) * std::f64::consts::PI / n as f64;
+                h.pressure(a * th.sin()) * a * th.cos() * std::f64::consts::PI / n as f64
+            })
+            .sum();
+        assert!((total - 4.0).abs() < 1e-6, "{total}");
+        assert_eq!(h.pressure(1.01 * a), 0.0);
     }
 }

@@ -11,7 +11,8 @@
 //! * `load_error`: the total interaction force (all rows, both passes) against the exact
 //!   traction integrated over the interface.
 //! * Exact methods (Lagrange, elimination, perturbed tangent, augmented Lagrangian) pass when
-//!   the stress error, the load error and, if the rows are independent, the pressure error are
+//!   the stress error, the load error and the pressure error (from `B^T lambda`, unique even
+//!   for dependent rows) are
 //!   within the sweep's tolerance, the force balance within the case's `force_balance`
 //!   tolerance (1e-12 if it declares none), and the active-set loop converged.
 //! * The perturbed Lagrangian on standard mortar rows (a consistent, non-diagonal multiplier
@@ -31,12 +32,13 @@
 pub mod baseline;
 pub mod checks;
 pub(crate) mod exact;
-pub mod hard;
-pub mod judge;
-pub mod impact;
 pub mod friction;
+pub mod hard;
+pub mod impact;
+pub mod judge;
 pub mod junit;
 pub mod layer;
+pub mod profile;
 pub mod report;
 pub mod stability;
 
@@ -44,7 +46,9 @@ use crate::contact::discretization::constraints;
 use crate::contact::enforcement::method;
 use crate::contact::forces::pair_forces;
 use crate::error::Result;
-use crate::io::scene::{Catalogue, DiscretizationSpec, EnforcementSpec, MultiplierSpace};
+use crate::io::scene::{
+    Catalogue, DiscretizationSpec, EnforcementSpec, MultiplierSpace, TwoPassPenalty,
+};
 use crate::model::admit::load;
 use crate::model::Model;
 use crate::post::for_each_quadrature_stress;
@@ -482,12 +486,26 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                     "kappa = {k:e}: stress error {trend} as kappa grows {}x",
                     sweep.penalty_factor
                 ));
+                if cell.passes == Some(2) {
+                    notes.push(match model.contact[0].two_pass_penalty {
+                        TwoPassPenalty::Full => "two-pass penalty full: kappa on each pass".into(),
+                        TwoPassPenalty::Halved => {
+                            format!(
+                                "two-pass penalty halved: kappa/2 = {:e} on each pass",
+                                k / 2.0
+                            )
+                        }
+                    });
+                }
                 converged && balanced && loaded && trend != "no fall"
             } else {
-                // dependent rows make the individual forces arbitrary: then only their total
-                // (the load error) is judged
-                let pressure_ok = !unique || m.pressure_error <= sweep.tol;
-                converged && balanced && loaded && m.stress_error <= sweep.tol && pressure_ok
+                // the pressures come from the nodal forces B^T lambda, unique even where the
+                // multipliers of dependent rows are not, so they are judged for every cell
+                converged
+                    && balanced
+                    && loaded
+                    && m.stress_error <= sweep.tol
+                    && m.pressure_error <= sweep.tol
             };
             // the frictional patch test: statuses, Coulomb's inequality, dissipation and, for
             // the methods judged on their multipliers, the tangential traction

@@ -7,13 +7,18 @@
 //! The `.vtu` files are ASCII VTK XML (version 0.1) with point data `displacement` (3
 //! components, z = 0) and `stress` (`xx, yy, xy`, averaged at nodes), `stress_zz`, and cell
 //! data `stress` at cell centres; VTK cell types 9 (Q4), 28 (Q9), 5 (T3), 22 (T6), whose node
-//! orders match ours.
+//! orders match ours. A scene with contact adds the contact point data and the per-pair files
+//! of [`crate::io::contact_output`] (`<pair>.contact.vtu`, `.csv`, `.json`); a scene without
+//! contact writes exactly what it wrote before.
 
 use crate::contact::enforcement::method;
 use crate::contact::forces::pair_forces;
+use crate::contact::results::{pair_results, PairResults};
 use crate::error::{Error, Result};
 use crate::harness::checks::CheckResult;
+use crate::io::contact_output::{body_point_arrays, pair_file_names, write_pair_files};
 use crate::io::paths::{file_name, OutputFolder};
+use crate::io::vtu::PointArray;
 use crate::model::Body;
 use crate::post::{cell_stresses, nodal_stresses};
 use crate::run::Outcome;
@@ -103,8 +108,13 @@ fn effects(outcome: &Outcome) -> Vec<EffectSummary> {
             .map(|p| {
                 // in the case file's words
                 let words = |v: serde_json::Value| v.to_string().replace('"', "");
+                let halved = if p.penalty_share() < 1.0 {
+                    ", two-pass penalty halved"
+                } else {
+                    ""
+                };
                 format!(
-                    "'{}': {}, {}, {}",
+                    "'{}': {}, {}, {}{halved}",
                     p.name,
                     words(serde_json::json!(p.interaction)),
                     words(serde_json::json!(p.discretization)),
@@ -190,6 +200,23 @@ pub struct PairSummary {
     /// Coulomb pairs: total tangential force, stick/slip/open counts, dissipation.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub friction: Option<crate::contact::friction::FrictionSummary>,
+    /// `sum_a p_a A_a` over the slave surface, the tributary area of its closed points, and the
+    /// points of each status (both surfaces; see [`crate::contact::results`]).
+    pub normal_force: f64,
+    pub closed_area: f64,
+    pub point_status: PointStatusCounts,
+    /// The pair's per-point files in this folder: contact `.vtu`, `.csv`, `.json`.
+    pub files: [String; 3],
+}
+
+/// How many points of a pair's surfaces have each status.
+#[derive(Serialize)]
+pub struct PointStatusCounts {
+    pub unmeasured: usize,
+    pub open: usize,
+    pub closed: usize,
+    pub stick: usize,
+    pub slip: usize,
 }
 
 /// A node named for a user: body name, node number, position.
@@ -231,6 +258,21 @@ fn range(values: impl Iterator<Item = f64>) -> [f64; 2] {
 }
 
 pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
+    summary_with(outcome, nodal, &contact_results(outcome))
+}
+
+/// The per-point contact results of `outcome` (none without contact).
+fn contact_results(outcome: &Outcome) -> Vec<PairResults> {
+    outcome
+        .solution
+        .contact
+        .as_ref()
+        .map(|c| pair_results(&outcome.model, c, &outcome.solution.u))
+        .unwrap_or_default()
+}
+
+/// [`summary`] with the contact results already computed.
+fn summary_with(outcome: &Outcome, nodal: &[Vec<[f64; 3]>], results: &[PairResults]) -> Summary {
     let Outcome {
         model,
         solution,
@@ -284,7 +326,8 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
         }
         let pairs: Vec<PairSummary> = forces
             .iter()
-            .map(|f| PairSummary {
+            .zip(results)
+            .map(|(f, r)| PairSummary {
                 name: model.contact[f.pair].name.clone(),
                 force_on_slave: f.on_slave,
                 force_on_master: f.on_master,
@@ -297,6 +340,16 @@ pub fn summary(outcome: &Outcome, nodal: &[Vec<[f64; 3]>]) -> Summary {
                     point,
                 }),
                 friction: crate::contact::friction::pair_summary(c, f.pair),
+                normal_force: r.totals.normal_force,
+                closed_area: r.totals.closed_area,
+                point_status: PointStatusCounts {
+                    unmeasured: r.totals.unmeasured,
+                    open: r.totals.open,
+                    closed: r.totals.closed,
+                    stick: r.totals.stick,
+                    slip: r.totals.slip,
+                },
+                files: pair_file_names(&r.name).unwrap_or_default(),
             })
             .collect();
         let most = |get: fn(&PairSummary) -> f64| pairs.iter().map(get).fold(0.0, f64::max);
@@ -360,15 +413,18 @@ pub fn write_run(folder: &OutputFolder, outcome: &Outcome) -> Result<()> {
         .iter()
         .map(|b| nodal_stresses(b, &outcome.solution.u))
         .collect();
-    let summary = summary(outcome, &nodal);
+    let results = contact_results(outcome);
+    let summary = summary_with(outcome, &nodal, &results);
     folder.write(|tmp| {
         let path = tmp.join("summary.json");
         let text = serde_json::to_string_pretty(&summary).expect("the summary serializes");
         fs::write(&path, text + "\n").map_err(|e| Error::io(path.display(), "writing", e))?;
-        for (b, s) in outcome.model.bodies.iter().zip(&nodal) {
+        for (k, (b, s)) in outcome.model.bodies.iter().zip(&nodal).enumerate() {
             let path = tmp.join(file_name("body name", &b.name, ".vtu")?);
-            write_vtu(&path, b, &outcome.solution.u, s)?;
+            let contact = body_point_arrays(&outcome.model, k, &results);
+            write_vtu_with(&path, b, &outcome.solution.u, s, &contact)?;
         }
+        write_pair_files(tmp, &outcome.model, &results)?;
         if let Some(history) = &outcome.solution.dynamics {
             crate::io::timeline::write_history(tmp, &outcome.model, history, &|path, body, u| {
                 write_vtu(path, body, u, &nodal_stresses(body, u))
@@ -380,6 +436,17 @@ pub fn write_run(folder: &OutputFolder, outcome: &Outcome) -> Result<()> {
 
 /// One VTK XML unstructured grid for one body.
 pub fn write_vtu(path: &Path, body: &Body, u: &[f64], nodal_stress: &[[f64; 3]]) -> Result<()> {
+    write_vtu_with(path, body, u, nodal_stress, &[])
+}
+
+/// [`write_vtu`] with more point data (`extra`, e.g. the contact fields).
+pub fn write_vtu_with(
+    path: &Path,
+    body: &Body,
+    u: &[f64],
+    nodal_stress: &[[f64; 3]],
+    extra: &[PointArray],
+) -> Result<()> {
     let io = |e| Error::io(path.display(), "writing", e);
     let file = fs::File::create(path).map_err(io)?;
     let mut w = BufWriter::new(file);
@@ -449,7 +516,15 @@ pub fn write_vtu(path: &Path, body: &Body, u: &[f64], nodal_stress: &[[f64; 3]])
     for s in nodal_stress {
         let _ = writeln!(text, "{}", body.material.sigma_zz(*s));
     }
-    let _ = writeln!(text, "</DataArray></PointData>");
+    if extra.is_empty() {
+        let _ = writeln!(text, "</DataArray></PointData>");
+    } else {
+        let _ = writeln!(text, "</DataArray>");
+        for a in extra {
+            text += &a.xml();
+        }
+        let _ = writeln!(text, "</PointData>");
+    }
     let _ = writeln!(text, "<CellData Tensors=\"\">");
     let _ = writeln!(text, "<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"3\" ComponentName0=\"xx\" ComponentName1=\"yy\" ComponentName2=\"xy\" format=\"ascii\">");
     for s in &cells {

@@ -259,6 +259,32 @@ pub struct ContactSpec {
     /// the largest master facet). Node-to-surface and mortar only.
     #[serde(default)]
     pub search_distance: Option<f64>,
+    /// Two-pass node-to-surface with a penalty-type method (penalty, perturbed Lagrangian,
+    /// augmented Lagrangian, perturbed tangent): the penalty each pass applies. `full`
+    /// (default): `kappa` on the rows of each pass, so where both passes act the interface is
+    /// about twice as stiff as one pass's (the penalty error about halves); `halved`:
+    /// `kappa / 2` on each pass, the convention of codes that split the penalty between the
+    /// passes (the penalty error then matches one pass at `kappa`). Lagrange multipliers and
+    /// elimination have no penalty and ignore it.
+    #[serde(default, skip_serializing_if = "TwoPassPenalty::is_full")]
+    pub two_pass_penalty: TwoPassPenalty,
+}
+
+/// The penalty of each pass of a two-pass pair.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum TwoPassPenalty {
+    /// `kappa` on each pass.
+    #[default]
+    Full,
+    /// `kappa / 2` on each pass.
+    Halved,
+}
+
+impl TwoPassPenalty {
+    pub fn is_full(&self) -> bool {
+        *self == TwoPassPenalty::Full
+    }
 }
 
 /// What a pair enforces.
@@ -639,9 +665,13 @@ pub enum NodeSetSpec {
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum FacetSetSpec {
-    /// Boundary facets whose nodes all lie in a closed axis-aligned box.
+    /// Boundary facets whose nodes all lie in a closed axis-aligned box (within 1e-9 x the
+    /// body size; a node taken in only by that tolerance is named in a warning).
     Box(BoxSpec),
-    /// `[cell, local edge]` pairs.
+    /// `[cell, local edge]` pairs. Local edges run counter-clockwise from the cell's first
+    /// corner: Q4 and Q9 edge 0 = corners 0-1 (Q9 mid-node 4), 1 = 1-2 (5), 2 = 2-3 (6),
+    /// 3 = 3-0 (7); T3 and T6 edge 0 = corners 0-1 (T6 mid-node 3), 1 = 1-2 (4), 2 = 2-0 (5).
+    /// Corners are numbered counter-clockwise; a block's cell starts at its lower-left corner.
     Facets(Vec<[usize; 2]>),
 }
 

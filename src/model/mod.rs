@@ -107,9 +107,25 @@ pub struct ContactPair {
     pub interaction: Interaction,
     /// Candidate distance of the search (`None`: the largest master facet).
     pub search_distance: Option<f64>,
+    /// The penalty of each pass when the discretization has two passes.
+    pub two_pass_penalty: crate::io::scene::TwoPassPenalty,
 }
 
 impl ContactPair {
+    /// The share of the enforcement's `kappa` each row of this pair applies: 1/2 for two-pass
+    /// node-to-surface with `two_pass_penalty: "halved"`, 1 otherwise.
+    pub fn penalty_share(&self) -> f64 {
+        let two_pass = matches!(
+            self.discretization,
+            DiscretizationSpec::NodeToSurface { passes: 2, .. }
+        );
+        if two_pass && self.two_pass_penalty == crate::io::scene::TwoPassPenalty::Halved {
+            0.5
+        } else {
+            1.0
+        }
+    }
+
     /// The same pair with slave and master exchanged (a body master is required).
     pub fn swapped(&self) -> Option<ContactPair> {
         match &self.master {
@@ -159,6 +175,9 @@ pub struct Model {
     pub solver: SolverSpec,
     /// Time stepping (`physics.dynamics`); `None`: a static run, no mass matrix.
     pub dynamics: Option<dynamics::Dynamics>,
+    /// What building the model found worth saying although nothing is wrong (e.g. a box set
+    /// that takes in nodes only by its tolerance); reported with the run's warnings.
+    pub warnings: Vec<String>,
 }
 
 /// Parse case JSON; errors carry line, column and a hint.
@@ -395,6 +414,7 @@ impl Model {
             ));
         }
         let mut bodies: Vec<Body> = Vec::new();
+        let mut set_warnings = Vec::new();
         let mut offset = 0;
         for (bi, spec) in case.bodies.iter().enumerate() {
             let at = format!("bodies[{bi}] '{}'", spec.name);
@@ -415,7 +435,7 @@ impl Model {
             };
             let mut mesh = build_mesh(&spec.mesh, source, &at)?;
             check_cells(&mesh, source, &at)?;
-            add_user_sets(&mut mesh, spec, source, &at)?;
+            set_warnings.extend(add_user_sets(&mut mesh, spec, source, &at)?);
             let body = Body {
                 name: spec.name.clone(),
                 material_name: spec.material.clone(),
@@ -457,6 +477,7 @@ impl Model {
         }
         let exact = case.exact.as_ref().map(ExactField::from);
         let mut model = Model {
+            warnings: set_warnings,
             name: case.name.clone(),
             description: case.description.clone(),
             source: source.to_string(),
@@ -859,6 +880,24 @@ impl Model {
                 &self.source,
                 &format!("{at}.enforcement"),
             )?;
+            let two_pass = |d: &DiscretizationSpec| {
+                matches!(d, DiscretizationSpec::NodeToSurface { passes: 2, .. })
+            };
+            if !spec.two_pass_penalty.is_full()
+                && !two_pass(&spec.discretization)
+                && !case.sweep.as_ref().is_some_and(|sw| {
+                    sw.discretizations
+                        .iter()
+                        .any(|d| two_pass(&d.discretization))
+                })
+            {
+                return Err(Error::invalid(
+                    &self.source,
+                    format!("{at}.two_pass_penalty"),
+                    "is \"halved\", but neither the pair nor its sweep has a two-pass discretization, so it would change nothing",
+                    "remove it, or use {\"kind\": \"node_to_surface\", \"passes\": 2}",
+                ));
+            }
             if let Some(d) = spec.search_distance {
                 if !(d.is_finite() && d > 0.0) {
                     return Err(Error::invalid(
@@ -960,6 +999,7 @@ impl Model {
                 enforcement: spec.enforcement.clone(),
                 interaction: spec.interaction,
                 search_distance: spec.search_distance,
+                two_pass_penalty: spec.two_pass_penalty,
             });
         }
         if let Some(sweep) = &case.sweep {
@@ -1398,13 +1438,52 @@ fn check_cells(mesh: &Mesh, source: &str, at: &str) -> Result<()> {
     Ok(())
 }
 
+/// The nodes of `nodes` that lie outside the box `[lo, hi]` (taken in by the tolerance only),
+/// as a warning naming the set `loc`.
+fn widened_box_warning(
+    mesh: &Mesh,
+    nodes: impl Iterator<Item = usize>,
+    (lo, hi): ([f64; 2], [f64; 2]),
+    loc: &str,
+) -> Option<String> {
+    let outside = |n: &usize| {
+        let p = mesh.nodes[*n];
+        (0..2)
+            .map(|i| (lo[i] - p[i]).max(p[i] - hi[i]))
+            .fold(0.0f64, f64::max)
+    };
+    let mut out: Vec<(usize, f64)> = nodes
+        .map(|n| (n, outside(&n)))
+        .filter(|(_, d)| *d > 0.0)
+        .collect();
+    out.sort_unstable_by_key(|x| x.0);
+    out.dedup_by_key(|x| x.0);
+    let &(n, d) = out.iter().max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let p = mesh.nodes[n];
+    Some(format!(
+        "{loc}: {} node(s) lie outside the box [{}, {}] x [{}, {}] and are in the set only by the \
+         tolerance of 1e-9 x the body size ({:.3e}); the farthest is node {n} at ({}, {}), {d:.3e} \
+         outside. Widen the box to take them in on purpose, or narrow it to leave them out",
+        out.len(),
+        lo[0],
+        hi[0],
+        lo[1],
+        hi[1],
+        mesh.tolerance(),
+        p[0],
+        p[1]
+    ))
+}
+
+/// Add the body's named sets to `mesh`; returns the warnings about them.
 fn add_user_sets(
     mesh: &mut Mesh,
     spec: &crate::io::scene::BodySpec,
     source: &str,
     at: &str,
-) -> Result<()> {
+) -> Result<Vec<String>> {
     let tol = mesh.tolerance();
+    let mut warnings = Vec::new();
     for (name, set) in &spec.node_sets {
         let loc = format!("{at}.node_sets.{name}");
         if mesh.node_sets.contains_key(name) {
@@ -1448,6 +1527,14 @@ fn add_user_sets(
                 "check the box limits against the body's coordinates",
             ));
         }
+        if let NodeSetSpec::Box(b) = set {
+            warnings.extend(widened_box_warning(
+                mesh,
+                nodes.iter().copied(),
+                (b.min, b.max),
+                &loc,
+            ));
+        }
         mesh.node_sets.insert(name.clone(), nodes);
     }
     for (name, set) in &spec.facet_sets {
@@ -1486,9 +1573,22 @@ fn add_user_sets(
                 "a facet enters a box set only when all its nodes lie in the box",
             ));
         }
+        if let FacetSetSpec::Box(b) = set {
+            let edges = mesh.kind.edges();
+            let nodes: Vec<usize> = facets
+                .iter()
+                .flat_map(|f| edges[f.edge].iter().map(|&l| mesh.cell(f.cell)[l]))
+                .collect();
+            warnings.extend(widened_box_warning(
+                mesh,
+                nodes.into_iter(),
+                (b.min, b.max),
+                &loc,
+            ));
+        }
         mesh.facet_sets.insert(name.clone(), facets);
     }
-    Ok(())
+    Ok(warnings)
 }
 
 /// What acts on a facet.

@@ -1672,7 +1672,9 @@ impl Kernel<'_> {
         let row_w: Vec<f64> = rows
             .iter()
             .zip(&row_methods)
-            .map(|(r, m)| m.kappa().unwrap_or(0.0) * r.area)
+            .map(|(r, m)| {
+                m.kappa().unwrap_or(0.0) * self.model.contact[r.pair].penalty_share() * r.area
+            })
             .collect();
         let iterative: Vec<bool> = row_methods
             .iter()

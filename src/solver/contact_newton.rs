@@ -207,17 +207,19 @@ impl<'a> ContactSystem<'a> {
 
     /// How row `r` is enforced.
     fn law(&self, r: &Constraint) -> RowLaw {
-        match method(&self.model.contact[r.pair].enforcement).kernel() {
+        let pair = &self.model.contact[r.pair];
+        let share = pair.penalty_share();
+        match method(&pair.enforcement).kernel() {
             // the model refuses the perturbed Lagrangian's consistent mortar coupling here,
             // so its rows carry the lumped mass: the penalty's law
             Method::Regularized { kappa } | Method::PerturbedLagrange { kappa } => {
                 RowLaw::Penalty {
-                    w: kappa * r.area,
+                    w: kappa * share * r.area,
                     update: None,
                 }
             }
             Method::AugmentedLagrange { kappa, update } => RowLaw::Penalty {
-                w: kappa * r.area,
+                w: kappa * share * r.area,
                 update: Some(update),
             },
             Method::Lagrange => RowLaw::Multiplier,

@@ -1,0 +1,324 @@
+//! Contact results per point and per surface: what a user compares with another code.
+//!
+//! For every node of a pair's contact surfaces (the slave surface, and the master surface when
+//! the master is a body) this gives, from the nodal forces of [`super::forces`]
+//! (`f^k = B_k^T lambda_k`, unique even where the multipliers of dependent rows are not):
+//!
+//! ```text
+//! nodal contact force   f_a = (B_n^T lambda_n + B_t^T lambda_t)_a   (on the node, [x, y])
+//! normal pressure       p_a   = -f_a . n_a / A_a (compression positive)
+//! shear traction        tau_a =  f_a . t_a / A_a,  t_a = (-n_y, n_x)
+//! ```
+//!
+//! (`B_t^T lambda_t`: the tangential rows of Coulomb pairs, [`super::friction`]; zero elsewhere)
+//! with `n_a` the outward unit normal of the surface at the node and `A_a = t int N_a ds` its
+//! tributary area (thickness `t`). For a Lagrange multiplier row `lambda_i / A_i` is the
+//! multiplier, for a penalty row `kappa (-g_i)`: `p_a` is that same force per tributary area,
+//! summed over every row that acts on the node (a master node of a one-pass pair gets the
+//! share the projection weights give it).
+//!
+//! At a node that is the slave node of a row of the pair (first-pass slave nodes, and the
+//! master body's nodes in the second pass of a two-pass pair) the rows also give:
+//!
+//! * **gap**: the row's gap `g(u)` at the solution (`g < 0`: penetration); the smallest one
+//!   if several frictionless rows share the node; for a tie, the normal opening
+//!   `-(u_s - u_m) . n_s` of the jump along the slave normal.
+//! * **status**: `open` (no row of the node carries force), `closed` (frictionless or tied),
+//!   `stick` or `slip` (Coulomb pairs, from the return map of [`super::friction`]).
+//! * **slip**: Coulomb pairs only, the tangential slip measure `g_t = t . (u_s - sum N_m u_m)`
+//!   at the end of the solve and its plastic part `g_t^p`.
+//!
+//! A node without a row of its own (the master surface of a one-pass pair) is `unmeasured`:
+//! it has a force and a pressure but no gap, status or slip.
+//!
+//! Per pair the totals: the forces on both sides (from [`super::forces`]), the normal force
+//! `sum_a p_a A_a` over the first-pass slave side, the closed tributary area (the sum of `A_a`
+//! over its closed nodes), the largest pressure and the counts of each status.
+//!
+//! Positions are reference coordinates (the rows' configuration may be `X + u`: see
+//! [`super::forces`]); the displacement at each node is given beside them.
+
+use super::forces::{pair_forces, PairForces};
+use super::friction::Status as FrictionStatus;
+use super::state::ContactState;
+use crate::fe::EdgeKind;
+use crate::model::{MasterSide, Model};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// What the rows say about a contact point.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PointStatus {
+    /// No row has this node as its slave node (a one-pass master surface).
+    Unmeasured,
+    Open,
+    Closed,
+    Stick,
+    Slip,
+}
+
+impl PointStatus {
+    /// The integer written to `.vtu` files (`contact_status`): 0 unmeasured, 1 open, 2 closed,
+    /// 3 stick, 4 slip.
+    pub fn code(self) -> i32 {
+        match self {
+            PointStatus::Unmeasured => 0,
+            PointStatus::Open => 1,
+            PointStatus::Closed => 2,
+            PointStatus::Stick => 3,
+            PointStatus::Slip => 4,
+        }
+    }
+
+    /// The word written to CSV files.
+    pub fn word(self) -> &'static str {
+        match self {
+            PointStatus::Unmeasured => "unmeasured",
+            PointStatus::Open => "open",
+            PointStatus::Closed => "closed",
+            PointStatus::Stick => "stick",
+            PointStatus::Slip => "slip",
+        }
+    }
+}
+
+/// Which surface of a pair a point lies on.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Side {
+    /// The pair's (first-pass) slave surface.
+    Slave,
+    /// The master body's surface.
+    Master,
+}
+
+/// The results at one node of a contact surface.
+#[derive(Clone, Debug, Serialize)]
+pub struct ContactPoint {
+    pub side: Side,
+    /// Body name and local node number.
+    pub body: String,
+    pub node: usize,
+    /// Reference position and displacement.
+    pub x: [f64; 2],
+    pub u: [f64; 2],
+    /// Outward unit normal of the surface and tributary area `A_a`.
+    pub normal: [f64; 2],
+    pub area: f64,
+    /// Nodal contact force `f_a`.
+    pub force: [f64; 2],
+    /// `-f_a . n_a / A_a`.
+    pub pressure: f64,
+    /// `f_a . t_a / A_a`, `t_a = (-n_y, n_x)`.
+    pub shear: f64,
+    /// The gap of the node's rows (`None`: unmeasured).
+    pub gap: Option<f64>,
+    pub status: PointStatus,
+    /// Coulomb pairs: slip measure `g_t` and plastic slip `g_t^p` (`None` elsewhere).
+    pub slip: Option<f64>,
+    pub plastic_slip: Option<f64>,
+}
+
+/// One surface of a pair: its body and facets, as indices into the pair's points.
+#[derive(Clone, Debug)]
+pub struct SurfaceCells {
+    pub side: Side,
+    pub kind: EdgeKind,
+    /// Each facet's points (indices into [`PairResults::points`]), in edge order
+    /// `[start, end(, mid)]`.
+    pub facets: Vec<Vec<usize>>,
+}
+
+/// The totals of one pair.
+#[derive(Clone, Debug, Serialize)]
+pub struct PairTotals {
+    /// Net force on the slave body and on the master (body or rigid surface).
+    pub force_on_slave: [f64; 2],
+    pub force_on_master: [f64; 2],
+    /// `sum_a p_a A_a` over the slave side.
+    pub normal_force: f64,
+    /// Sum of the tributary areas of the slave side's closed (closed, stick, slip) points.
+    pub closed_area: f64,
+    /// Largest pressure over the points that carry rows (for frictionless pairs the
+    /// `max_pressure` of [`super::forces::PairForces`]).
+    pub max_pressure: f64,
+    /// Points of each status, both sides.
+    pub unmeasured: usize,
+    pub open: usize,
+    pub closed: usize,
+    pub stick: usize,
+    pub slip: usize,
+}
+
+/// Everything a pair's result files hold.
+#[derive(Clone, Debug)]
+pub struct PairResults {
+    pub pair: usize,
+    pub name: String,
+    pub points: Vec<ContactPoint>,
+    pub surfaces: Vec<SurfaceCells>,
+    pub totals: PairTotals,
+}
+
+/// The per-point results of every pair of `model` in the contact solution `state` at `u`.
+pub fn pair_results(model: &Model, state: &ContactState, u: &[f64]) -> Vec<PairResults> {
+    pair_forces(model, state)
+        .iter()
+        .map(|f| one_pair(model, state, u, f))
+        .collect()
+}
+
+/// What the rows of one slave node found.
+#[derive(Default)]
+struct RowFindings {
+    frictionless_gap: Option<f64>,
+    jump: Option<([f64; 2], [f64; 2])>,
+    carries_force: bool,
+    friction: Option<(FrictionStatus, f64, f64)>,
+}
+
+fn one_pair(model: &Model, state: &ContactState, u: &[f64], forces: &PairForces) -> PairResults {
+    let k = forces.pair;
+    let pair = &model.contact[k];
+    let mut findings: BTreeMap<(usize, usize), RowFindings> = BTreeMap::new();
+    for (i, r) in state.rows.iter().enumerate() {
+        if r.pair != k {
+            continue;
+        }
+        let found = findings.entry((r.slave_body, r.slave_node)).or_default();
+        let g = state.gaps[i];
+        if r.bilateral {
+            let e = found.jump.get_or_insert(([0.0; 2], r.slave_normal));
+            e.0[0] += g * r.normal[0];
+            e.0[1] += g * r.normal[1];
+        } else {
+            found.frictionless_gap = Some(found.frictionless_gap.map_or(g, |m: f64| m.min(g)));
+        }
+        found.carries_force |= state.active[i];
+        if let Some(Some(fp)) = state.friction.get(i) {
+            found.friction = Some((fp.status, fp.slip, fp.plastic_slip));
+        }
+    }
+
+    // the tangential forces lambda_t b_t of Coulomb rows (the nodal forces of `forces` are
+    // those of the normal rows)
+    let mut tangential: BTreeMap<(usize, usize), [f64; 2]> = BTreeMap::new();
+    for (r, f) in state.rows.iter().zip(&state.friction) {
+        let (Some(t), Some(f), true) = (&r.tangent, f, r.pair == k) else {
+            continue;
+        };
+        for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
+            if let Some(o) = model.dof_owner(d) {
+                tangential.entry((o.body, o.node)).or_insert([0.0; 2])[o.component] += c * f.force;
+            }
+        }
+    }
+
+    let mut sides = vec![(Side::Slave, pair.slave.0, &pair.slave.1)];
+    if let MasterSide::Body { body, facets } = &pair.master {
+        sides.push((Side::Master, *body, facets));
+    }
+    let mut points = Vec::new();
+    let mut index: BTreeMap<(Side, usize, usize), usize> = BTreeMap::new();
+    let mut surfaces = Vec::new();
+    for &(side, b, facet_set) in &sides {
+        let body = &model.bodies[b];
+        let side_nodes: std::collections::BTreeSet<usize> = facet_set
+            .iter()
+            .flat_map(|&f| body.mesh.facet_nodes(f))
+            .collect();
+        for &node in &side_nodes {
+            let Some(n) = forces.nodes.iter().find(|t| t.body == b && t.node == node) else {
+                continue;
+            };
+            let found = findings.get(&(b, n.node));
+            let (gap, status, slip, plastic_slip) = match found {
+                None => (None, PointStatus::Unmeasured, None, None),
+                Some(f) => {
+                    let gap = match (f.frictionless_gap, f.jump) {
+                        (Some(g), _) => Some(g),
+                        (None, Some((d, ns))) => Some(-(d[0] * ns[0] + d[1] * ns[1])),
+                        (None, None) => None,
+                    };
+                    let status = match (f.friction, f.carries_force) {
+                        (Some((FrictionStatus::Stick, ..)), true) => PointStatus::Stick,
+                        (Some((FrictionStatus::Slip, ..)), true) => PointStatus::Slip,
+                        (_, true) => PointStatus::Closed,
+                        (_, false) => PointStatus::Open,
+                    };
+                    (
+                        gap,
+                        status,
+                        f.friction.map(|x| x.1),
+                        f.friction.map(|x| x.2),
+                    )
+                }
+            };
+            let nn = n.normal;
+            let ft = tangential.get(&(b, node)).copied().unwrap_or([0.0; 2]);
+            let force = [n.force[0] + ft[0], n.force[1] + ft[1]];
+            index.insert((side, b, n.node), points.len());
+            points.push(ContactPoint {
+                side,
+                body: body.name.clone(),
+                node: n.node,
+                x: body.mesh.nodes[n.node],
+                u: [u[body.dof(n.node, 0)], u[body.dof(n.node, 1)]],
+                normal: nn,
+                area: n.area,
+                force,
+                // + 0.0: a node without force has pressure 0, not -0
+                pressure: -(force[0] * nn[0] + force[1] * nn[1]) / n.area + 0.0,
+                shear: (-force[0] * nn[1] + force[1] * nn[0]) / n.area + 0.0,
+                gap,
+                status,
+                slip,
+                plastic_slip,
+            });
+        }
+        let facets = facet_set
+            .iter()
+            .map(|&f| {
+                body.mesh
+                    .facet_nodes(f)
+                    .iter()
+                    .map(|n| index[&(side, b, *n)])
+                    .collect()
+            })
+            .collect();
+        surfaces.push(SurfaceCells {
+            side,
+            kind: body.mesh.kind.edge_kind(),
+            facets,
+        });
+    }
+
+    let count = |s: PointStatus| points.iter().filter(|p| p.status == s).count();
+    let slave_side = points.iter().filter(|p| p.side == Side::Slave);
+    let totals = PairTotals {
+        force_on_slave: forces.on_slave,
+        force_on_master: forces.on_master,
+        normal_force: slave_side.clone().map(|p| p.pressure * p.area).sum(),
+        closed_area: slave_side
+            .filter(|p| p.status > PointStatus::Open)
+            .map(|p| p.area)
+            .sum(),
+        max_pressure: points
+            .iter()
+            .filter(|p| p.status != PointStatus::Unmeasured)
+            .fold(0.0, |m: f64, p| m.max(p.pressure)),
+        unmeasured: count(PointStatus::Unmeasured),
+        open: count(PointStatus::Open),
+        closed: count(PointStatus::Closed),
+        stick: count(PointStatus::Stick),
+        slip: count(PointStatus::Slip),
+    };
+    PairResults {
+        pair: k,
+        name: pair.name.clone(),
+        points,
+        surfaces,
+        totals,
+    }
+}

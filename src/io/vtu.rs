@@ -1,0 +1,160 @@
+//! VTK XML unstructured grids (`.vtu`, version 0.1, ASCII) built from points, cells and named
+//! point-data arrays: the contact-surface files, and the extra point data of the body files.
+//!
+//! Format: *VTK File Formats*, Kitware (VTK User's Guide, "XML File Formats"): `<Points>` with
+//! three components per point, `<Cells>` with `connectivity`, `offsets` and `types`, then
+//! `<PointData>` with one `<DataArray>` per field. Numbers are written in Rust's shortest
+//! round-trip form, so a reader gets back the very `f64` the solver computed. Cell types used:
+//! 3 (`VTK_LINE`) for Line2 facets and 21 (`VTK_QUADRATIC_EDGE`, end, end, middle) for Line3
+//! facets, whose node order is ours.
+
+use crate::error::{Error, Result};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// `x` in the shortest form that reads back as the same `f64`, with an exponent for very small
+/// and very large magnitudes (`1e-18`, not eighteen zeros).
+pub fn number(x: f64) -> String {
+    format!("{x:?}")
+}
+
+/// The values of one point-data array, `components` per point.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Values {
+    Float(Vec<f64>),
+    Int(Vec<i32>),
+}
+
+/// One named point-data array.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointArray {
+    pub name: String,
+    pub components: usize,
+    pub values: Values,
+}
+
+impl PointArray {
+    pub fn float(name: &str, components: usize, values: Vec<f64>) -> PointArray {
+        PointArray {
+            name: name.into(),
+            components,
+            values: Values::Float(values),
+        }
+    }
+
+    pub fn int(name: &str, values: Vec<i32>) -> PointArray {
+        PointArray {
+            name: name.into(),
+            components: 1,
+            values: Values::Int(values),
+        }
+    }
+
+    /// The `<DataArray>` element, one point per line.
+    pub fn xml(&self) -> String {
+        let (kind, text): (&str, Vec<String>) = match &self.values {
+            Values::Float(v) => ("Float64", v.iter().map(|&x| number(x)).collect()),
+            Values::Int(v) => ("Int32", v.iter().map(|x| x.to_string()).collect()),
+        };
+        let mut s = format!(
+            "<DataArray type=\"{kind}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">\n",
+            self.name, self.components
+        );
+        for point in text.chunks(self.components.max(1)) {
+            s += &point.join(" ");
+            s.push('\n');
+        }
+        s += "</DataArray>\n";
+        s
+    }
+}
+
+/// Write an unstructured grid of `points` (2D, z = 0) and `cells` (VTK cell type, point
+/// indices) with `arrays` as point data.
+pub fn write_grid(
+    path: &Path,
+    points: &[[f64; 2]],
+    cells: &[(u8, Vec<usize>)],
+    arrays: &[PointArray],
+) -> Result<()> {
+    let mut text = String::new();
+    let _ = writeln!(text, "<?xml version=\"1.0\"?>");
+    let _ = writeln!(
+        text,
+        "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">"
+    );
+    let _ = writeln!(text, "<UnstructuredGrid>");
+    let _ = writeln!(
+        text,
+        "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
+        points.len(),
+        cells.len()
+    );
+    let _ = writeln!(
+        text,
+        "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
+    );
+    for p in points {
+        let _ = writeln!(text, "{} {} 0", number(p[0]), number(p[1]));
+    }
+    let _ = writeln!(text, "</DataArray></Points>");
+    let _ = writeln!(
+        text,
+        "<Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
+    );
+    for (_, ids) in cells {
+        let ids: Vec<String> = ids.iter().map(|n| n.to_string()).collect();
+        let _ = writeln!(text, "{}", ids.join(" "));
+    }
+    let _ = writeln!(
+        text,
+        "</DataArray><DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
+    );
+    let mut offset = 0;
+    for (_, ids) in cells {
+        offset += ids.len();
+        let _ = writeln!(text, "{offset}");
+    }
+    let _ = writeln!(
+        text,
+        "</DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
+    );
+    for (kind, _) in cells {
+        let _ = writeln!(text, "{kind}");
+    }
+    let _ = writeln!(text, "</DataArray></Cells>");
+    let _ = writeln!(text, "<PointData>");
+    for a in arrays {
+        text += &a.xml();
+    }
+    let _ = writeln!(text, "</PointData>");
+    let _ = writeln!(text, "</Piece></UnstructuredGrid></VTKFile>");
+    std::fs::write(path, text).map_err(|e| Error::io(path.display(), "writing", e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arrays_write_one_point_per_line_in_round_trip_form() {
+        let a = PointArray::float("f", 2, vec![0.1 + 0.2, 1.4000000000000001, -3.0, 5e-324]);
+        let xml = a.xml();
+        let lines: Vec<&str> = xml.lines().collect();
+        assert_eq!(
+            lines[0],
+            "<DataArray type=\"Float64\" Name=\"f\" NumberOfComponents=\"2\" format=\"ascii\">"
+        );
+        assert_eq!(lines[1], "0.30000000000000004 1.4000000000000001");
+        let back: Vec<f64> = lines[2]
+            .split(' ')
+            .map(|t| t.parse().expect("a number"))
+            .collect();
+        assert_eq!(back, vec![-3.0, 5e-324]);
+        assert_eq!(lines[2], "-3.0 5e-324");
+        assert_eq!(
+            PointArray::int("s", vec![0, 4]).xml().lines().nth(2),
+            Some("4")
+        );
+    }
+}
