@@ -201,20 +201,6 @@ fn one_pair(model: &Model, state: &ContactState, u: &[f64], forces: &PairForces)
         }
     }
 
-    // the tangential forces lambda_t b_t of Coulomb rows (the nodal forces of `forces` are
-    // those of the normal rows)
-    let mut tangential: BTreeMap<(usize, usize), [f64; 2]> = BTreeMap::new();
-    for (r, f) in state.rows.iter().zip(&state.friction) {
-        let (Some(t), Some(f), true) = (&r.tangent, f, r.pair == k) else {
-            continue;
-        };
-        for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
-            if let Some(o) = model.dof_owner(d) {
-                tangential.entry((o.body, o.node)).or_insert([0.0; 2])[o.component] += c * f.force;
-            }
-        }
-    }
-
     let mut sides = vec![(Side::Slave, pair.slave.0, &pair.slave.1)];
     if let MasterSide::Body { body, facets } = &pair.master {
         sides.push((Side::Master, *body, facets));
@@ -256,8 +242,9 @@ fn one_pair(model: &Model, state: &ContactState, u: &[f64], forces: &PairForces)
                 }
             };
             let nn = n.normal;
-            let ft = tangential.get(&(b, node)).copied().unwrap_or([0.0; 2]);
-            let force = [n.force[0] + ft[0], n.force[1] + ft[1]];
+            // the nodal force of `forces`: normal rows plus, for Coulomb pairs, the tangential
+            // forces `B_t^T lambda_t` (see `contact::forces`)
+            let force = n.force;
             index.insert((side, b, n.node), points.len());
             points.push(ContactPoint {
                 side,
