@@ -1,4 +1,5 @@
-//! Coulomb friction with penalty regularization: the return map of one contact point.
+//! Coulomb friction at one contact point: the penalty return map, and the open/stick/slip sets
+//! of Lagrange multipliers.
 //!
 //! Reference: P. Wriggers, *Computational Contact Mechanics* (2nd ed., Springer 2006),
 //! section 5.2 (elasto-plastic analogy of friction) and 6.3 (penalty return map); T. A.
