@@ -1,5 +1,6 @@
-//! Coulomb friction with penalty regularization in the Newton scheme (penalty and perturbed
-//! Lagrangian normal laws)
+//! Coulomb friction in the Newton scheme: penalty regularization (penalty and perturbed
+//! Lagrangian normal laws) and Lagrange multipliers (tangential multipliers, semi-smooth Newton
+//! over open/stick/slip sets)
 //! (`src/contact/friction.rs`, `src/solver/contact_newton.rs`), every check against a closed
 //! form:
 //!
@@ -13,7 +14,10 @@
 //!   lambda_n` at every slave node (`mu p` per unit area where the frictionless test passes);
 //! * the sliding limit of a block on an incline, `F/G = (tan a + mu) / (1 - mu tan a)`, with
 //!   Coulomb's inequality and non-negative dissipation in every converged step;
-//! * Newton's residual history with the consistent (unsymmetric) and the symmetrized tangent.
+//! * Newton's residual history with the consistent (unsymmetric) and the symmetrized tangent;
+//! * with Lagrange multipliers: the tangent against central differences in stick and slip, the
+//!   patch test (exact stress and no slip in stick, `|lambda_t| = mu lambda_n` to round-off in
+//!   slip) with its Newton iteration counts, and the incline limit `F/G = 0.412371`.
 
 use contact_patch::contact::friction::Status;
 use contact_patch::model::{parse, Model};
@@ -413,9 +417,9 @@ fn dragged(master: Value, d: f64) -> Value {
 
 /// Largest difference between the tangent's columns and central differences of the residual,
 /// relative to the largest tangent entry.
-fn fd_error(model: &Model, u: &[f64], expect: Status) -> f64 {
+fn fd_error(model: &Model, o: &Outcome, expect: Status) -> f64 {
     let mut probe = Probe::new(model, 0.0).unwrap();
-    let x = probe.unknowns(u);
+    let x = probe.unknowns_at(&o.solution.u, o.solution.contact.as_ref().unwrap());
     let at = probe.evaluate(&x).unwrap();
     // every closed point in the expected status (open points may stay open)
     let same = |st: &[Status]| st.iter().all(|&s| s == expect || s == Status::Open);
@@ -550,7 +554,7 @@ fn the_frictional_tangent_is_the_derivative_of_the_residual_in_stick_and_in_slip
             let o = run(&v);
             assert_eq!(termination(&o), Termination::Converged, "{name} {status:?}");
             let model = build(&v).unwrap();
-            let e = fd_error(&model, &o.solution.u, status);
+            let e = fd_error(&model, &o, status);
             println!("{name}, {status:?}: tangent vs central differences {e:.1e}");
             assert!(e < 1e-6, "{name} {status:?}: {e:e}");
         }
@@ -679,8 +683,18 @@ fn friction_is_refused_where_this_slice_does_not_solve_it_with_the_fix() {
         m.contains("Newton scheme only") && m.contains("\"newton\""),
         "{m}"
     );
-    let m = with(&|v| v["contact"][0]["enforcement"] = json!({"kind": "lagrange"}));
-    assert!(m.contains("penalty-type normal law"), "{m}");
+    // Lagrange multipliers carry friction without a tangential penalty: kappa_t is refused
+    let m = with(&|v| {
+        v["contact"][0]["enforcement"] = json!({"kind": "lagrange"});
+        v["contact"][0]["interaction"]["coulomb"]["kappa_t"] = json!(1e4);
+    });
+    assert!(
+        m.contains("kappa_t has no role with Lagrange multipliers")
+            && m.contains("leave kappa_t out"),
+        "{m}"
+    );
+    let m = with(&|v| v["contact"][0]["enforcement"] = json!({"kind": "elimination"}));
+    assert!(m.contains("Lagrange multipliers as normal law"), "{m}");
     // every discretization carries friction (tests/friction_table.rs)
     for d in [
         json!({"kind": "mortar", "multiplier": "standard"}),
@@ -786,4 +800,217 @@ fn the_perturbed_lagrangian_carries_friction_as_the_penalty_does() {
     v["contact"][0]["enforcement"] = json!({"kind": "augmented_lagrange", "kappa": KAPPA});
     let m = refusal(&v);
     assert!(m.contains("augmented Lagrangian is not solved yet"), "{m}");
+}
+
+/// `v` with Lagrange multipliers as the normal law of its pair (and so for friction).
+fn lagrange(mut v: Value) -> Value {
+    v["contact"][0]["enforcement"] = json!({"kind": "lagrange"});
+    v
+}
+
+/// Newton iterations of every load step of a solve.
+fn iterations_per_step(o: &Outcome) -> Vec<usize> {
+    let state = o.solution.contact.as_ref().unwrap();
+    state.steps.iter().map(|s| s.iterations).collect()
+}
+
+#[test]
+fn lagrange_multipliers_tangent_is_the_derivative_of_the_residual_in_stick_and_in_slip() {
+    let cases = [
+        (
+            "A node-to-node",
+            patch(
+                "A",
+                "0.0",
+                node_to_node(),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+            patch("A", "0.3", node_to_node(), 0.5 * MU * P, Top::Traction, 1),
+        ),
+        (
+            "C node-to-surface",
+            patch(
+                "C",
+                "0.0",
+                node_to_surface(),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+            patch(
+                "C",
+                "0.3",
+                node_to_surface(),
+                0.5 * MU * P,
+                Top::Traction,
+                1,
+            ),
+        ),
+        ("rigid line", dragged(line(), 0.05), dragged(line(), 1e-6)),
+        (
+            "E dual mortar",
+            patch(
+                "E",
+                "0.0",
+                mortar("dual"),
+                MU * P,
+                Top::Displacement(0.05),
+                1,
+            ),
+            patch("E", "0.3", mortar("dual"), 0.5 * MU * P, Top::Traction, 1),
+        ),
+    ];
+    for (name, slip, stick) in cases {
+        for (v, status) in [
+            (lagrange(stick), Status::Stick),
+            (lagrange(slip), Status::Slip),
+        ] {
+            let o = run(&v);
+            assert_eq!(termination(&o), Termination::Converged, "{name} {status:?}");
+            let model = build(&v).unwrap();
+            let e = fd_error(&model, &o, status);
+            println!("Lagrange, {name}, {status:?}: tangent vs central differences {e:.1e}");
+            assert!(e < 1e-6, "{name} {status:?}: {e:e}");
+        }
+    }
+}
+
+#[test]
+fn lagrange_multipliers_pass_the_frictional_patch_test_in_stick_and_in_slip() {
+    for (mesh, disc) in [
+        ("A", node_to_node()),
+        ("D", node_to_node()),
+        ("A", node_to_surface()),
+    ] {
+        // stick: the exact uniform stress, no slip, the tangential load carried
+        let q = 0.5 * MU * P;
+        let o = run(&lagrange(patch(
+            mesh,
+            "0.3",
+            disc.clone(),
+            q,
+            Top::Traction,
+            2,
+        )));
+        assert_eq!(termination(&o), Termination::Converged, "{mesh} {disc}");
+        let pts = points(&o);
+        assert!(pts.iter().all(|p| p.0 == Status::Stick), "{mesh} {disc}");
+        for p in &pts {
+            // no slip in the step (the committed position kept) and inside the cone
+            assert!(p.1.abs() <= MU * p.2 * (1.0 + 1e-12));
+        }
+        let state = o.solution.contact.as_ref().unwrap();
+        for (f, r) in state.friction.iter().zip(&state.rows) {
+            if let Some(f) = f {
+                assert!((f.slip - f.committed).abs() <= 1e-14 * 8.0, "{r:?}");
+                assert_eq!(f.dissipation, 0.0);
+            }
+        }
+        let t = tangential_x(&o);
+        assert!((t + 2.0 * q).abs() <= 1e-10 * 2.0 * q, "{mesh} {disc}: {t}");
+        let e = stress_error(&o, [0.0, -P, q]) / P;
+        let its = iterations_per_step(&o);
+        println!("Lagrange stick, mesh {mesh}, {disc}: stress error {e:.1e} p, Newton iterations per step {its:?}");
+        assert!(e < 1e-8, "{mesh} {disc}: stress error {e:e}");
+        assert!(its.iter().all(|&k| k <= 4), "{its:?}");
+
+        // slip: |lambda_t| = mu lambda_n at every node to round-off, traction mu p
+        let sxy = MU * P;
+        let o = run(&lagrange(patch(
+            mesh,
+            "0.0",
+            disc.clone(),
+            sxy,
+            Top::Displacement(0.05),
+            2,
+        )));
+        assert_eq!(termination(&o), Termination::Converged, "{mesh} {disc}");
+        let pts = points(&o);
+        let mut worst = 0.0f64;
+        for p in &pts {
+            assert_eq!(p.0, Status::Slip, "{mesh} {disc}");
+            worst = worst.max((p.1.abs() - MU * p.2).abs() / (MU * P));
+            assert!(p.1 * p.4[0] < 0.0);
+            assert!(
+                (p.1.abs() / p.3 - MU * P).abs() <= 1e-9 * MU * P,
+                "{mesh} {disc}"
+            );
+        }
+        assert!(worst <= 1e-13, "{mesh} {disc}: {worst:e}");
+        let normal: f64 = pts.iter().map(|p| p.2).sum();
+        assert!((normal - 2.0 * P).abs() <= 1e-10 * P, "{mesh} {disc}");
+        let t = tangential_x(&o);
+        assert!((t + 2.0 * MU * P).abs() <= 1e-10 * P, "{mesh} {disc}: {t}");
+        let e = stress_error(&o, [0.0, -P, sxy]) / P;
+        let s = o.solution.contact.as_ref().unwrap().steps.clone();
+        for step in &s {
+            let f = step.friction.as_ref().unwrap();
+            assert!(f.dissipation >= 0.0 && f.max_cone_ratio <= 1.0 + 1e-12);
+        }
+        assert_eq!(s[0].friction.as_ref().unwrap().slip, 0);
+        assert!(s.last().unwrap().friction.as_ref().unwrap().dissipation > 0.0);
+        let its = iterations_per_step(&o);
+        println!("Lagrange slip, mesh {mesh}, {disc}: | |lambda_t| - mu lambda_n | <= {worst:.1e} mu p, stress error {e:.1e} p, Newton iterations per step {its:?}");
+        assert!(e < 1e-8, "{mesh} {disc}: stress error {e:e}");
+        assert!(its.iter().all(|&k| k <= 5), "{its:?}");
+        // the slip rows are the sets' equations, not a linearization: the symmetrized tangent
+        // keeps them, and the solve is the same
+        let mut v = lagrange(patch(
+            mesh,
+            "0.0",
+            disc.clone(),
+            sxy,
+            Top::Displacement(0.05),
+            2,
+        ));
+        v["solver"]["friction_tangent"] = json!("symmetrized");
+        let s = run(&v);
+        assert_eq!(termination(&s), Termination::Converged, "{mesh} {disc}");
+        assert_eq!(iterations_per_step(&s), its, "{mesh} {disc}");
+        assert!((tangential_x(&s) - t).abs() <= 1e-12 * P, "{mesh} {disc}");
+    }
+}
+
+#[test]
+fn lagrange_multipliers_hold_a_block_on_an_incline_up_to_the_coulomb_limit() {
+    let tan_a: f64 = 0.1;
+    let limit = (tan_a + MU) / (1.0 - MU * tan_a);
+    assert!((limit - 0.412371).abs() < 1e-6);
+    let (s, c) = (
+        tan_a / (1.0 + tan_a * tan_a).sqrt(),
+        1.0 / (1.0 + tan_a * tan_a).sqrt(),
+    );
+    for ratio in [0.5, 0.98, 0.995] {
+        let o = run(&lagrange(incline(ratio * limit, tan_a, 4)));
+        assert_eq!(
+            termination(&o),
+            Termination::Converged,
+            "F/G = {ratio} limit"
+        );
+        let state = o.solution.contact.as_ref().unwrap();
+        for step in &state.steps {
+            let f = step.friction.as_ref().unwrap();
+            assert!(f.max_cone_ratio <= 1.0 + 1e-12, "{f:?}");
+            assert!(f.dissipation >= 0.0, "{f:?}");
+        }
+        let (g, f) = (10.0, ratio * limit * 10.0);
+        let tangential = tangential_x(&o);
+        let normal: f64 = points(&o).iter().map(|p| p.2).sum();
+        assert!(
+            (tangential + (f * c - g * s)).abs() <= 1e-9 * g,
+            "{tangential}"
+        );
+        assert!((normal - (g * c + f * s)).abs() <= 1e-9 * g, "{normal}");
+        assert!(tangential.abs() <= MU * normal * (1.0 + 1e-12));
+        println!(
+            "Lagrange, F/G = {ratio} x limit: |T|/(mu N) = {:.6}, Newton iterations per step {:?}",
+            tangential.abs() / (MU * normal),
+            iterations_per_step(&o)
+        );
+    }
+    // just past the limit no equilibrium exists
+    let o = run(&lagrange(incline(1.01 * limit, tan_a, 4)));
+    assert_ne!(termination(&o), Termination::Converged);
 }

@@ -1,4 +1,5 @@
-//! Coulomb friction with penalty regularization: the return map of one contact point.
+//! Coulomb friction at one contact point: the penalty return map, and the open/stick/slip sets
+//! of Lagrange multipliers.
 //!
 //! Reference: P. Wriggers, *Computational Contact Mechanics* (2nd ed., Springer 2006),
 //! section 5.2 (elasto-plastic analogy of friction) and 6.3 (penalty return map); T. A.
@@ -33,6 +34,23 @@
 //! 1988). The open branch resets the elastic slip, so a point that closes again starts to
 //! stick where it lands. The frictional dissipation of a step is `D = -lambda_t (g_t^p -
 //! g_t^{p,n}) = mu lambda_n (|lambda_t^tr| - mu lambda_n) / w_t >= 0` in slip (zero in stick).
+//!
+//! **Lagrange multipliers** (no tangential penalty, [`multiplier_status`]): the tangential
+//! force `lambda_t` is an unknown, and the sets of the semi-smooth Newton method follow from the
+//! complementarity function of Alart & Curnier (1991, *Comput. Methods Appl. Mech. Engrg.* 92,
+//! 353-375) in the active-set form of Hüeber, Stadler & Wohlmuth (2008, *SIAM J. Sci. Comput.*
+//! 30, 572-596), with the slip increment `dg_t = g_t - g_t^n` from the tangential position
+//! `g_t^n` committed at the start of the load step and a constant `c > 0`:
+//!
+//! ```text
+//! trial:  tau = lambda_t - c dg_t
+//! open:   lambda_n inactive      =>  lambda_t = 0
+//! stick:  |tau| <= mu lambda_n   =>  dg_t = 0
+//! slip:   otherwise, s = sign(tau) =>  lambda_t = s mu lambda_n
+//! ```
+//!
+//! At a solution of the slip branch `tau = s (mu lambda_n + c |dg_t|)`: the slip runs against
+//! the force and the dissipation `-lambda_t dg_t = mu lambda_n |dg_t|` is non-negative.
 
 use serde::Serialize;
 
@@ -99,6 +117,29 @@ pub fn return_map(
         plastic_slip: g_t + force / w_t,
         d_slip: 0.0,
         d_normal: if lambda_n > 0.0 { s * mu } else { 0.0 },
+    }
+}
+
+/// The frictional status of a point with Lagrange multipliers (see the module doc): normal force
+/// `lambda_n` (`active`: the normal row is in the active set), tangential force `lambda_t`, slip
+/// increment `dg_t` of the step and the constant `c` (a stiffness). Returns the status and, in
+/// slip, the sign `s` of the force `lambda_t = s mu lambda_n` (`0.0` otherwise).
+pub fn multiplier_status(
+    mu: f64,
+    lambda_n: f64,
+    active: bool,
+    lambda_t: f64,
+    increment: f64,
+    c: f64,
+) -> (Status, f64) {
+    if !active {
+        return (Status::Open, 0.0);
+    }
+    let trial = lambda_t - c * increment;
+    if trial.abs() <= mu * lambda_n.max(0.0) {
+        (Status::Stick, 0.0)
+    } else {
+        (Status::Slip, trial.signum())
     }
 }
 
@@ -200,6 +241,32 @@ mod tests {
         assert_eq!(
             (open.status, open.force, open.plastic_slip),
             (Status::Open, 0.0, 0.5)
+        );
+    }
+
+    #[test]
+    fn multiplier_sets_follow_the_trial_force() {
+        // inside the cone: stick; outside: slip against the motion; no normal force: open
+        assert_eq!(
+            multiplier_status(0.5, 4.0, true, 1.0, 0.0, 10.0),
+            (Status::Stick, 0.0)
+        );
+        assert_eq!(
+            multiplier_status(0.5, 4.0, true, 2.0, 0.5, 10.0),
+            (Status::Slip, -1.0)
+        );
+        assert_eq!(
+            multiplier_status(0.5, 4.0, true, 3.0, 0.0, 10.0),
+            (Status::Slip, 1.0)
+        );
+        assert_eq!(
+            multiplier_status(0.5, 4.0, false, 3.0, 0.0, 10.0),
+            (Status::Open, 0.0)
+        );
+        // a closed point with no compression yet sticks where it is
+        assert_eq!(
+            multiplier_status(0.5, 0.0, true, 0.0, 0.0, 10.0),
+            (Status::Stick, 0.0)
         );
     }
 }

@@ -1161,7 +1161,7 @@ impl Model {
 }
 
 /// A Coulomb pair: its parameters, and what this slice of friction solves (the Newton scheme,
-/// penalty-type normal laws, node-based rows with master normals, the reference geometry).
+/// penalty-type normal laws or Lagrange multipliers, the reference geometry).
 fn validate_coulomb(
     case: &Case,
     spec: &crate::io::scene::ContactSpec,
@@ -1177,6 +1177,14 @@ fn validate_coulomb(
             format!("{here}.mu"),
             format!("the friction coefficient mu must be a finite number >= 0, got {mu}"),
             "give e.g. \"mu\": 0.3 (mu = 0 is frictionless with tangential rows)",
+        ));
+    }
+    if let (Some(_), EnforcementSpec::Lagrange) = (kappa_t, &spec.enforcement) {
+        return Err(Error::invalid(
+            source,
+            format!("{here}.kappa_t"),
+            "the tangential penalty kappa_t has no role with Lagrange multipliers: their stick is exact",
+            "leave kappa_t out for this pair, or use the penalty as its enforcement",
         ));
     }
     if let Some(k) = kappa_t {
@@ -1228,7 +1236,8 @@ pub struct CoulombObstacle {
     pub fix: String,
 }
 
-/// What this slice of friction solves: the Newton scheme, penalty-type normal laws, the
+/// What this slice of friction solves: the Newton scheme, penalty-type normal laws or Lagrange
+/// multipliers, the
 /// reference geometry; every discretization (node-to-node, node-to-surface one- and two-pass
 /// with master or slave normals, rigid masters, standard and dual mortar with the weighted
 /// tangential slip). `None` when the combination is solved;
@@ -1263,15 +1272,17 @@ pub fn coulomb_obstacle(
     }
     if !matches!(
         enforcement,
-        EnforcementSpec::Penalty { .. } | EnforcementSpec::PerturbedLagrange { .. }
+        EnforcementSpec::Penalty { .. }
+            | EnforcementSpec::PerturbedLagrange { .. }
+            | EnforcementSpec::Lagrange
     ) {
         return obstacle(
             "enforcement",
             &format!(
-                "Coulomb friction is regularized by a tangential penalty and needs a penalty-type normal law, not {}",
+                "Coulomb friction needs the penalty, the perturbed Lagrangian or Lagrange multipliers as normal law, not {}",
                 crate::contact::enforcement::method(enforcement).name()
             ),
-            "use the penalty or the perturbed Lagrangian for this pair",
+            "use the penalty, the perturbed Lagrangian or Lagrange multipliers for this pair",
         );
     }
     if geometry != crate::io::scene::ContactGeometry::Reference {

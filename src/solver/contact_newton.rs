@@ -45,8 +45,8 @@
 //! singular: the step ends `Singular` with the reason, where the active-set scheme picks the
 //! minimum-norm multipliers.
 //!
-//! **Coulomb friction** (pairs with `interaction: {"coulomb": ..}`, the penalty or the
-//! perturbed Lagrangian as normal law):
+//! **Coulomb friction** (pairs with `interaction: {"coulomb": ..}`) with the penalty or the
+//! perturbed Lagrangian as normal law:
 //! every row carries its tangential slip `g_t` with gradient `b_t`, and the return map of
 //! [`crate::contact::friction`] gives the tangential force `lambda_t` from the plastic slip
 //! committed at the end of the last load step (`committed`, carried from step to step by
@@ -56,6 +56,24 @@
 //! that is not the derivative: Newton converges linearly in slip; the coupling's symmetric part
 //! instead makes the matrix indefinite, and the iteration diverged on the patch test). A change of a point's
 //! frictional status (open, stick, slip) counts as a status change of the iteration.
+//!
+//! **Coulomb friction with Lagrange multipliers** (Lagrange rows of a Coulomb pair): each row
+//! with a normal multiplier gains a tangential one, `lambda_t = rho mu_t`, numbered after the
+//! normal ones, and the semi-smooth Newton method of Alart & Curnier (1991) in the active-set
+//! form of Hüeber, Stadler & Wohlmuth (2008) takes each point's set from the last iterate
+//! ([`crate::contact::friction::multiplier_status`], `c = rho`, the slip increment `dg_t = g_t -
+//! g_t^n` from the tangential position committed at the end of the last load step):
+//!
+//! `R_u -= rho mu_t b_t` (closed points), and
+//! `R_t = -rho mu_t` (open), `R_t = -rho dg_t` with `R_u += rho dg_t b_t` (stick, the
+//! augmentation that vanishes at the solution and holds a body only friction holds),
+//! `R_t = -rho (mu_t - s mu mu_n)` (slip).
+//!
+//! The stick rows keep the saddle-point matrix symmetric; a slip row's equation couples `mu_t`
+//! to `mu_n` alone, not to the displacements its column acts on: the tangent is unsymmetric and
+//! factored by LU, also with `friction_tangent: "symmetrized"` (this row is the set's equation,
+//! not a linearization to drop). The multipliers of a step start at zero, so every closed point
+//! sticks in the first iteration of a step; the stick position `g_t^n` is committed per load step.
 //!
 //! A body held by nothing but contact rows that are open at the start has a singular tangent:
 //! in the first evaluation the rows that would hold it are closed, nearest first
@@ -69,7 +87,7 @@ use super::newton::{self, Evaluation, System, Tangent};
 use super::sparse::{GeneralPattern, PatternBuilder, SymmetricPattern};
 use crate::contact::discretization::gap_second_derivative;
 use crate::contact::enforcement::{method, Method};
-use crate::contact::friction::{return_map, FrictionPoint, ReturnMap, Status};
+use crate::contact::friction::{multiplier_status, return_map, FrictionPoint, ReturnMap, Status};
 use crate::contact::state::{ContactState, Departure, Termination};
 use crate::contact::Constraint;
 use crate::error::Result;
@@ -107,6 +125,8 @@ pub(crate) struct ContactSystem<'a> {
     rows: Vec<Constraint>,
     /// The multiplier unknown of each row (Lagrange rows with free equations).
     multiplier: Vec<Option<usize>>,
+    /// The tangential multiplier unknown of each frictional Lagrange row with a normal one.
+    tangential: Vec<Option<usize>>,
     /// The multiplier unknowns of the last pattern, by point (to carry them to a new one).
     carried: HashMap<RowKey, usize>,
     /// Stiffness scale `rho`.
@@ -187,6 +207,7 @@ impl<'a> ContactSystem<'a> {
             version: 0,
             rows,
             multiplier: Vec::new(),
+            tangential: Vec::new(),
             carried: HashMap::new(),
             rho,
             augmentation: HashMap::new(),
@@ -234,19 +255,57 @@ impl<'a> ContactSystem<'a> {
         let Interaction::Coulomb { mu, kappa_t } = pair.interaction else {
             return None;
         };
+        // Lagrange rows have no tangential penalty (the model refuses kappa_t there): w_t = 0
         let kappa_t = kappa_t
             .or_else(|| method(&pair.enforcement).kappa())
-            .expect("the model admits friction with penalty-type methods only");
+            .unwrap_or(0.0);
         Some((mu, kappa_t * r.area))
     }
 
     /// The return map of frictional row `i` at `u`, with its normal force and status.
-    fn friction_at(&self, i: usize, u: &[f64], lambda_n: f64, on: bool) -> Option<ReturnMap> {
+    /// Lagrange rows: the status from [`multiplier_status`] at the unknowns `x`, the force
+    /// `lambda_t = rho x_t` (zero open), the plastic slip `g_t` (the committed one in stick) and,
+    /// in `d_normal`, the sign `s` of a slip.
+    fn friction_at(
+        &self,
+        i: usize,
+        u: &[f64],
+        x: &[f64],
+        lambda_n: f64,
+        on: bool,
+    ) -> Option<ReturnMap> {
         let r = &self.rows[i];
         let (mu, w_t) = self.coulomb(r)?;
         let t = r.tangent.as_ref()?;
         let committed = self.committed.get(&row_key(r)).copied().unwrap_or(0.0);
-        Some(return_map(mu, w_t, lambda_n, on, t.slip(u), committed))
+        let g_t = t.slip(u);
+        if !matches!(self.law(r), RowLaw::Multiplier) {
+            return Some(return_map(mu, w_t, lambda_n, on, g_t, committed));
+        }
+        let j = self.tangential[i]?;
+        let lambda_t = self.rho * x[j];
+        let (status, s) = if on && self.evaluations == 0 {
+            // a step starts with zero multipliers: every closed point sticks in its first
+            // iteration (a bound mu lambda_n = 0 would make any round-off slip a slip)
+            (Status::Stick, 0.0)
+        } else {
+            multiplier_status(mu, lambda_n, on, lambda_t, g_t - committed, self.rho)
+        };
+        Some(ReturnMap {
+            status,
+            force: if status == Status::Open {
+                0.0
+            } else {
+                lambda_t
+            },
+            plastic_slip: if status == Status::Stick {
+                committed
+            } else {
+                g_t
+            },
+            d_slip: 0.0,
+            d_normal: s,
+        })
     }
 
     /// The free equations of a gradient with their coefficients.
@@ -287,6 +346,23 @@ impl<'a> ContactSystem<'a> {
                 })
             })
             .collect();
+        let normal_count = m;
+        self.tangential = self
+            .rows
+            .iter()
+            .zip(&self.multiplier)
+            .map(|(r, mult)| {
+                (mult.is_some() && self.coulomb(r).is_some()).then(|| {
+                    m += 1;
+                    n + m - 1
+                })
+            })
+            .collect();
+        debug_assert!(self
+            .tangential
+            .iter()
+            .flatten()
+            .all(|&j| j >= n + normal_count));
         if m == 0 {
             self.pattern = self.sys.pattern.clone();
             self.k_positions = (0..self.sys.pattern.nnz()).collect();
@@ -299,10 +375,15 @@ impl<'a> ContactSystem<'a> {
                 builder.add_block(&[p.row_idx[k], j]);
             }
         }
-        for (r, mult) in self.rows.iter().zip(&self.multiplier) {
+        for ((r, mult), tangential) in self.rows.iter().zip(&self.multiplier).zip(&self.tangential)
+        {
             if let Some(j) = mult {
                 let mut block: Vec<usize> = self.free_terms(r).iter().map(|&(e, _)| e).collect();
                 block.push(*j);
+                if let (Some(jt), Some(t)) = (tangential, &r.tangent) {
+                    block.extend(self.free_of(&t.dofs, &t.coeffs).iter().map(|&(e, _)| e));
+                    block.push(*jt);
+                }
                 builder.add_block(&block);
             }
         }
@@ -401,7 +482,7 @@ impl<'a> ContactSystem<'a> {
             active.push(a);
             forces.push(if a { f } else { 0.0 });
             let r = &self.rows[i];
-            friction.push(self.friction_at(i, &u, f, a).map(|m| {
+            friction.push(self.friction_at(i, &u, x, f, a).map(|m| {
                 let committed = self.committed.get(&row_key(r)).copied().unwrap_or(0.0);
                 FrictionPoint {
                     status: m.status,
@@ -529,7 +610,16 @@ impl System for ContactSystem<'_> {
                     r.point[0], r.point[1], self.model.contact[r.pair].name, r.pass
                 )
             }
-            None => format!("multiplier {k}"),
+            None => match self.tangential.iter().position(|&m| m == Some(k)) {
+                Some(i) => {
+                    let r = &self.rows[i];
+                    format!(
+                        "the tangential multiplier of the slave node at ({}, {}) of contact '{}' (pass {})",
+                        r.point[0], r.point[1], self.model.contact[r.pair].name, r.pass
+                    )
+                }
+                None => format!("multiplier {k}"),
+            },
         }
     }
 
@@ -591,6 +681,9 @@ impl System for ContactSystem<'_> {
         let symmetrized = self.model.solver.friction_tangent == FrictionTangent::Symmetrized;
         // unsymmetric entries (row equation, column equation, value) of slipping points
         let mut coupling: Vec<(usize, usize, f64)> = Vec::new();
+        // the unsymmetric entries of slipping Lagrange rows (the set's equation itself: kept
+        // with the symmetrized tangent too)
+        let mut slip_rows: Vec<(usize, usize, f64)> = Vec::new();
         let mut status = HashMap::new();
         let mut active = HashMap::with_capacity(self.rows.len());
         let mut forces = HashMap::with_capacity(self.rows.len());
@@ -612,7 +705,7 @@ impl System for ContactSystem<'_> {
             }
             active.insert(key, on);
             forces.insert(key, shown);
-            if let Some(map) = self.friction_at(i, &u, lambda, on) {
+            if let Some(map) = self.friction_at(i, &u, x, lambda, on) {
                 // the branch of the return map: a slip that reverses is a change too
                 let branch = (map.status, map.force > 0.0 && map.status == Status::Slip);
                 if self.evaluations > 0 && self.status.get(&key) != Some(&branch) {
@@ -625,7 +718,46 @@ impl System for ContactSystem<'_> {
                     residual[e] -= map.force * c;
                     eval.force_scale = eval.force_scale.max((map.force * c).abs());
                 }
-                if map.d_slip != 0.0 {
+                if let Some(jt) = self.tangential[i] {
+                    // Lagrange rows: the force -rho x_t b_t, and the row of the set
+                    let jn = self.multiplier[i].expect("a tangential multiplier has a normal one");
+                    match map.status {
+                        Status::Open => {
+                            // R_t = -rho x_t drives the multiplier to zero
+                            residual[jt] = -rho * x[jt];
+                            upper[self.pattern.position(jt, jt).expect("diagonal")] = -rho;
+                        }
+                        Status::Stick => {
+                            // R_t = -rho dg_t, and the augmentation rho dg_t b_t (zero at the
+                            // solution) holds a body that only friction holds
+                            let committed = self.committed.get(&key).copied().unwrap_or(0.0);
+                            let dg = t.slip(&u) - committed;
+                            residual[jt] = -rho * dg;
+                            for (a, &(ea, ca)) in tangential.iter().enumerate() {
+                                residual[ea] += rho * dg * ca;
+                                upper[self.pattern.position(ea, jt).expect("coupling")] -= rho * ca;
+                                for &(eb, cb) in &tangential[a..] {
+                                    upper[self
+                                        .pattern
+                                        .position(ea.min(eb), ea.max(eb))
+                                        .expect("covered")] += rho * ca * cb;
+                                }
+                            }
+                        }
+                        Status::Slip => {
+                            // R_t = -rho (x_t - s mu x_n): the column -rho b_t of the force
+                            // only, not its transpose
+                            let (mu, _) = self.coulomb(r).expect("frictional");
+                            residual[jt] = -rho * (x[jt] - map.d_normal * mu * x[jn]);
+                            upper[self.pattern.position(jt, jt).expect("diagonal")] = -rho;
+                            slip_rows.push((jt, jn, rho * map.d_normal * mu));
+                            for &(e, c) in &tangential {
+                                upper[self.pattern.position(e, jt).expect("coupling")] -= rho * c;
+                                slip_rows.push((jt, e, rho * c));
+                            }
+                        }
+                    }
+                } else if map.d_slip != 0.0 {
                     // stick: -d lambda_t/d g_t b_t b_t^T = w_t b_t b_t^T
                     for (a, &(ea, ca)) in tangential.iter().enumerate() {
                         for &(eb, cb) in &tangential[a..] {
@@ -636,7 +768,7 @@ impl System for ContactSystem<'_> {
                         }
                     }
                 }
-                if map.d_normal != 0.0 {
+                if map.d_normal != 0.0 && self.tangential[i].is_none() {
                     // slip: -b_t (d lambda_t/d lambda_n) (d lambda_n/du)^T, with
                     // d lambda_n/du = -w b_n for the penalty-type normal law
                     let RowLaw::Penalty { w, .. } = self.law(r) else {
@@ -716,11 +848,14 @@ impl System for ContactSystem<'_> {
         tangent.values = general.symmetric_values(&upper);
         // the symmetrized tangent drops the slip coupling (its symmetric part would make the
         // matrix indefinite and Newton diverge)
-        tangent.symmetric = coupling.is_empty() || symmetrized;
+        tangent.symmetric = (coupling.is_empty() || symmetrized) && slip_rows.is_empty();
         if !symmetrized {
             for (a, b, v) in coupling {
                 tangent.values[general.position(a, b).expect("covered")] += v;
             }
+        }
+        for (a, b, v) in slip_rows {
+            tangent.values[general.position(a, b).expect("covered")] += v;
         }
         tangent.multipliers = self.pattern.n - n;
         tangent.scale = rho;
@@ -887,6 +1022,29 @@ impl<'a> Probe<'a> {
             .iter()
             .map(|&d| u[d])
             .collect()
+    }
+
+    /// The unknowns at a solved state with Lagrange multipliers: the free displacements of `u`,
+    /// then the scaled normal and tangential multipliers `lambda / rho` of `state`'s rows; the
+    /// rows active in `state` start active.
+    pub fn unknowns_at(&mut self, u: &[f64], state: &ContactState) -> Vec<f64> {
+        let mut x = self.unknowns(u);
+        x.resize(self.general.n, 0.0);
+        let system = &mut self.system;
+        for (i, r) in state.rows.iter().enumerate() {
+            let key = row_key(r);
+            let Some(k) = system.rows.iter().position(|s| row_key(s) == key) else {
+                continue;
+            };
+            system.active.insert(key, state.active[i]);
+            if let Some(j) = system.multiplier[k] {
+                x[j] = state.forces[i] / system.rho;
+            }
+            if let (Some(j), Some(f)) = (system.tangential[k], &state.friction[i]) {
+                x[j] = f.force / system.rho;
+            }
+        }
+        x
     }
 
     pub fn evaluate(&mut self, x: &[f64]) -> Result<ProbeEvaluation> {
