@@ -3,8 +3,11 @@
 //! warning (stderr and `summary.json`), with the set, the node and its distance; a box that
 //! holds its nodes says nothing; a box that catches nothing is refused naming the set.
 
+mod common;
+use common::run_case;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 /// The Signorini block (x in [0, 3], y in [0, 2]) with the node set `sets` and facet set
 /// `facets` added, run into a scratch folder.
@@ -21,15 +24,7 @@ fn run(node_box: [[f64; 2]; 2], facet_box: [[f64; 2]; 2]) -> (Output, Option<ser
     let case = dir.path().join("case.json");
     std::fs::write(&case, c.to_string()).unwrap();
     let out = dir.path().join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
-        .args([
-            "run",
-            case.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let o = run_case(&case, &out);
     let summary = std::fs::read_to_string(out.join("summary.json"))
         .ok()
         .map(|t| serde_json::from_str(&t).unwrap());

@@ -4,6 +4,9 @@
 //! a rigid cylinder, the uniform pressure of the contact patch test, the penalty law
 //! `p = -kappa g`, and Coulomb's `|tau| = mu p` at slipping points.
 
+mod common;
+use common::run_case;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -14,15 +17,7 @@ fn case(rel: &str) -> PathBuf {
 
 /// Run `case` into `out`; the exit code must be `code`.
 fn run(case: &Path, out: &Path, code: i32) {
-    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
-        .args([
-            "run",
-            case.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let o = run_case(case, out);
     assert_eq!(
         o.status.code(),
         Some(code),

@@ -5,8 +5,10 @@
 //! `g = -p / (2 kappa)` or `g = -p / kappa`: the closed forms judged here, from the gaps of
 //! `<pair>.contact.csv`.
 
+mod common;
+use common::run_case;
+
 use std::path::Path;
-use std::process::Command;
 
 /// Patch A, two-pass penalty at `kappa`, with `scaling` (None: the field left out); returns
 /// the gaps of every point of both surfaces and the summary.
@@ -24,15 +26,7 @@ fn run(dir: &Path, kappa: f64, scaling: Option<&str>) -> (Vec<f64>, serde_json::
     let case = dir.join(format!("{name}.json"));
     std::fs::write(&case, c.to_string()).unwrap();
     let out = dir.join(&name);
-    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
-        .args([
-            "run",
-            case.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let o = run_case(&case, &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = std::fs::read_to_string(out.join("interface.contact.csv")).unwrap();
     let mut lines = csv.lines();
@@ -84,15 +78,7 @@ fn halved_without_a_two_pass_discretization_is_refused() {
     let case = dir.path().join("case.json");
     std::fs::write(&case, c.to_string()).unwrap();
     let out = dir.path().join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
-        .args([
-            "run",
-            case.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let o = run_case(&case, &out);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(

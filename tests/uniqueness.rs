@@ -10,7 +10,7 @@
 //!   refusal.
 
 mod common;
-use common::defect;
+use common::{defect, run_case};
 use contact_patch::model::{parse, Model};
 use contact_patch::run::{run_model, Outcome};
 use contact_patch::solver::active_set::Termination;
@@ -150,19 +150,8 @@ fn a_part_that_floats_free_is_refused_and_located() {
 #[test]
 fn d08_non_finite_results_are_an_error_naming_where() {
     let dir = tempfile::tempdir().unwrap();
-    let run = |case: &Path, out: &Path| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
-            .args([
-                "run",
-                case.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-            ])
-            .output()
-            .unwrap()
-    };
     let out = dir.path().join("out");
-    let result = run(&defect("D08"), &out);
+    let result = run_case(&defect("D08"), &out);
     let stderr = String::from_utf8_lossy(&result.stderr);
     assert_eq!(result.status.code(), Some(2), "{stderr}");
     for needle in [
@@ -181,7 +170,7 @@ fn d08_non_finite_results_are_an_error_naming_where() {
                               {"body": "block", "set": "bottom_left", "x": 0.0}]);
     let path = dir.path().join("static.json");
     std::fs::write(&path, case.to_string()).unwrap();
-    let result = run(&path, &out);
+    let result = run_case(&path, &out);
     let stderr = String::from_utf8_lossy(&result.stderr);
     assert_eq!(result.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("is not finite"), "{stderr}");

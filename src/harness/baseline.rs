@@ -346,34 +346,14 @@ mod tests {
 
     fn cell(verdict: &str, stress_error: Option<f64>) -> Cell {
         Cell {
-            catalogue: Catalogue::Patch,
-            case: "patch-X".into(),
-            mesh: "X".into(),
             nu: 0.3,
             discretization: "mortar".into(),
-            passes: None,
             slave: Some("punch".into()),
             enforcement: "lagrange".into(),
-            kappa: None,
             pressure: 1.0,
             verdict: verdict.into(),
             stress_error,
-            stress_error_stiff: None,
-            penalty_trend: None,
-            pressure_error: None,
-            force_balance: None,
-            load_error: None,
-            max_penetration: None,
-            rank_deficiency: None,
-            stability: "-".into(),
-            newton_iterations: None,
-            termination: None,
-            linear_solver: None,
-            vs_penalty: None,
-            time_ms: 0.0,
-            note: String::new(),
-            friction: None,
-            tol: 1e-10,
+            ..Cell::unmeasured(Catalogue::Patch, "patch-X".into(), "X".into(), 1e-10)
         }
     }
 

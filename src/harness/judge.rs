@@ -561,34 +561,16 @@ pub fn outside_cells(
         return Ok(Vec::new());
     };
     let mut cell = crate::harness::Cell {
-        catalogue: sweep.catalogue,
-        case: model.name.clone(),
-        mesh: sweep.mesh.clone(),
         nu: model.bodies[0].material.nu,
         discretization: "outside".into(),
-        passes: None,
-        slave: None,
         enforcement: code.to_string(),
-        kappa: None,
         pressure: sweep.pressure,
-        verdict: "n/a".into(),
-        stress_error: None,
-        stress_error_stiff: None,
-        penalty_trend: None,
-        pressure_error: None,
-        force_balance: None,
-        load_error: None,
-        max_penetration: None,
-        rank_deficiency: None,
-        stability: "-".into(),
-        newton_iterations: None,
-        termination: None,
-        linear_solver: None,
-        vs_penalty: None,
-        time_ms: 0.0,
-        note: String::new(),
-        tol: sweep.tol,
-        friction: None,
+        ..crate::harness::Cell::unmeasured(
+            sweep.catalogue,
+            model.name.clone(),
+            sweep.mesh.clone(),
+            sweep.tol,
+        )
     };
     let Some(path) = results_in(dir, &model.name)? else {
         cell.note = format!(

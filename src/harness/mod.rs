@@ -110,6 +110,43 @@ pub struct Cell {
     pub tol: f64,
 }
 
+impl Cell {
+    /// A cell of `case` (mesh `mesh`, judged at `tol`) with nothing measured yet: verdict
+    /// `n/a`, every measure absent; the sweep and the outside-results table fill it in.
+    pub fn unmeasured(catalogue: Catalogue, case: String, mesh: String, tol: f64) -> Cell {
+        Cell {
+            catalogue,
+            case,
+            mesh,
+            nu: 0.0,
+            discretization: String::new(),
+            passes: None,
+            slave: None,
+            enforcement: String::new(),
+            kappa: None,
+            pressure: 0.0,
+            verdict: "n/a".into(),
+            stress_error: None,
+            stress_error_stiff: None,
+            penalty_trend: None,
+            pressure_error: None,
+            force_balance: None,
+            load_error: None,
+            max_penetration: None,
+            rank_deficiency: None,
+            stability: "-".into(),
+            newton_iterations: None,
+            termination: None,
+            linear_solver: None,
+            vs_penalty: None,
+            time_ms: 0.0,
+            note: String::new(),
+            friction: None,
+            tol,
+        }
+    }
+}
+
 /// The friction part of a cell of the friction table ([`friction`]).
 #[derive(Clone, Debug, Serialize)]
 pub struct FrictionCell {
@@ -289,9 +326,6 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 method(e).name()
             ));
             let mut cell = Cell {
-                catalogue: sweep.catalogue,
-                case: base.name.clone(),
-                mesh: sweep.mesh.clone(),
                 nu,
                 discretization: disc_name.into(),
                 passes,
@@ -299,22 +333,6 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 enforcement: method(e).name().into(),
                 kappa: method(e).kappa(),
                 pressure: sweep.pressure,
-                verdict: "n/a".into(),
-                stress_error: None,
-                stress_error_stiff: None,
-                penalty_trend: None,
-                pressure_error: None,
-                force_balance: None,
-                load_error: None,
-                max_penetration: None,
-                rank_deficiency: None,
-                stability: "-".into(),
-                newton_iterations: None,
-                termination: None,
-                linear_solver: None,
-                vs_penalty: None,
-                time_ms: 0.0,
-                note: String::new(),
                 friction: sweep.expect.map(|x| FrictionCell {
                     expect: friction::name(x).into(),
                     statuses: None,
@@ -322,7 +340,12 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                     cone_ratio: None,
                     min_dissipation: None,
                 }),
-                tol: sweep.tol,
+                ..Cell::unmeasured(
+                    sweep.catalogue,
+                    base.name.clone(),
+                    sweep.mesh.clone(),
+                    sweep.tol,
+                )
             };
             let mut model = base.clone();
             pair.enforcement = e.clone();

@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 /// The reproducer `tests/defects/NAME-*.json` (NAME as `D12` or `D24a`).
+#[allow(dead_code)] // not every test binary that includes this module replays defects
 pub fn defect(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/defects");
     std::fs::read_dir(&dir)
@@ -15,4 +16,18 @@ pub fn defect(name: &str) -> PathBuf {
                 .starts_with(&format!("{name}-"))
         })
         .unwrap_or_else(|| panic!("no reproducer {name} in {}", dir.display()))
+}
+
+/// `contact-patch run CASE --out OUT`, its output captured.
+#[allow(dead_code)] // not every test binary that includes this module runs cases
+pub fn run_case(case: &Path, out: &Path) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .args([
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap()
 }
