@@ -32,6 +32,12 @@
 //! counts `c_j` of `L` (George & Liu 1981, sec. 2.2; a dense matrix: `n^3 / 3`). Above the
 //! case's [`WorkLimit`] the analysis is refused ([`FactorError::TooLarge`]). An LU is
 //! estimated as twice the Cholesky factor of its (structurally symmetric) pattern under AMD.
+//! An `L D L^T` whose multipliers-last order is above the limit is analysed again with each
+//! multiplier beside its own displacement (see `multipliers_after_their_displacements`): a long
+//! interface against a coarse master couples every multiplier through the master's few
+//! displacements, so multipliers last make their whole block dense; beside their slave
+//! displacements they stay sparse. Below the limit the multipliers-last order is kept, so the
+//! results of every system that fits are unchanged.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError;
@@ -361,7 +367,7 @@ pub const UNLIMITED: WorkLimit = WorkLimit {
 };
 
 /// How to get past [`FactorError::TooLarge`].
-pub const TOO_LARGE_HINT: &str = "raise \"limits\": {\"factor_gigabytes\": G, \"factor_operations\": N} in the case if the machine has the memory and the time, or use a coarser mesh; Lagrange multipliers are eliminated after every displacement, so a long interface makes their block of the factor dense: a penalty-type method (penalty, augmented Lagrangian) or elimination keeps it sparse";
+pub const TOO_LARGE_HINT: &str = "raise \"limits\": {\"factor_gigabytes\": G, \"factor_operations\": N} in the case if the machine has the memory and the time, or use a coarser mesh, or for a Lagrange-multiplier interface a penalty-type method (penalty, augmented Lagrangian) or elimination, which factor no multipliers";
 
 /// The most memory (gigabytes of factor values) and multiply-adds one factorization may take
 /// (the case's `limits.factor_gigabytes` and `limits.factor_operations`).
@@ -491,6 +497,102 @@ impl Factor {
     }
 }
 
+/// The elimination order "every trailing equation (multiplier) right after a leading equation
+/// (displacement) of its own": each multiplier is matched to one of its displacements that as
+/// few other multipliers couple as possible (for dual mortar its slave displacement, coupled to
+/// it alone), the pair is one node of the graph AMD orders (the displacement's adjacency plus
+/// the multiplier's), and the multiplier follows its displacement; unmatched multipliers come
+/// last. A multiplier eliminated after its own displacement has the expected (negative) pivot
+/// as long as the rows eliminated so far are independent on the displacements eliminated so far
+/// (with `K` positive definite, the leading principal blocks `[[K_SS, B_S^T], [B_S, D]]` then
+/// have `B_S` of full row rank); a pivot that fails is reported by [`Ldlt::factor`] as for the
+/// multipliers-last order. Returns `(fwd, inv)`: the original equation of each step and the
+/// step of each equation.
+fn multipliers_after_their_displacements(
+    pattern: &SymmetricPattern,
+    leading: usize,
+) -> Result<(Vec<usize>, Vec<usize>), FactorError> {
+    let n = pattern.n;
+    let column = |j: usize| &pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]];
+    let coupled: Vec<Vec<usize>> = (leading..n)
+        .map(|j| column(j).iter().copied().filter(|&i| i < leading).collect())
+        .collect();
+    // how many multipliers couple each displacement
+    let mut sharing = vec![0usize; leading];
+    for displacements in &coupled {
+        for &e in displacements {
+            sharing[e] += 1;
+        }
+    }
+    // match each multiplier to a free displacement shared by the fewest multipliers
+    let mut matched: Vec<Option<usize>> = vec![None; n - leading];
+    let mut owner: Vec<Option<usize>> = vec![None; leading];
+    for (i, displacements) in coupled.iter().enumerate() {
+        if let Some(&e) = displacements
+            .iter()
+            .filter(|&&e| owner[e].is_none())
+            .min_by_key(|&&e| (sharing[e], e))
+        {
+            owner[e] = Some(i);
+            matched[i] = Some(e);
+        }
+    }
+    // the quotient graph: a matched pair is its displacement's node
+    let mut builder = PatternBuilder::new(leading);
+    for j in 0..leading {
+        for &i in column(j) {
+            builder.add_block(&[i, j]);
+        }
+    }
+    for (i, displacements) in coupled.iter().enumerate() {
+        let Some(own) = matched[i] else { continue };
+        for &e in displacements {
+            builder.add_block(&[own, e]);
+        }
+        // multiplier-multiplier couplings (a perturbation C)
+        for &k in column(leading + i) {
+            if k >= leading {
+                if let Some(other) = matched[k - leading] {
+                    builder.add_block(&[own, other]);
+                }
+            }
+        }
+    }
+    let block = builder.build();
+    let nnz = block.row_idx.len();
+    let mut fwd_leading = vec![0usize; leading];
+    let mut step = vec![0usize; leading];
+    let mut mem = MemBuffer::try_new(faer::sparse::linalg::amd::order_scratch::<usize>(
+        leading, nnz,
+    ))
+    .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+    faer::sparse::linalg::amd::order(
+        &mut fwd_leading,
+        &mut step,
+        block.symbolic(),
+        Default::default(),
+        MemStack::new(&mut mem),
+    )
+    .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+    let mut fwd = Vec::with_capacity(n);
+    for &e in &fwd_leading {
+        fwd.push(e);
+        if let Some(i) = owner[e] {
+            fwd.push(leading + i);
+        }
+    }
+    fwd.extend(
+        (0..n - leading)
+            .filter(|&i| matched[i].is_none())
+            .map(|i| leading + i),
+    );
+    let mut inv = vec![0usize; n];
+    for (k, &e) in fwd.iter().enumerate() {
+        inv[e] = k;
+    }
+    Ok((fwd, inv))
+}
+
 /// Sparse `L D L^T` of a symmetric indefinite matrix with known pivot signs.
 pub struct Ldlt {
     symbolic: Arc<SymbolicCholesky<usize>>,
@@ -549,9 +651,38 @@ impl Ldlt {
             Default::default(),
         )
         .map_err(other)?;
-        FactorWork::of(&symbolic).check(limit)?;
-        Ok(Ldlt {
-            symbolic: Arc::new(symbolic),
+        let last = FactorWork::of(&symbolic);
+        if last.check(limit).is_ok() {
+            return Ok(Ldlt {
+                symbolic: Arc::new(symbolic),
+            });
+        }
+        // multipliers last fill their whole block in when a multiplier couples displacements far
+        // apart (a long interface against a coarse master): eliminate each one right after its
+        // displacements instead
+        let (fwd, inv) = multipliers_after_their_displacements(pattern, leading)?;
+        let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
+        let interleaved = factorize_symbolic_cholesky(
+            pattern.symbolic(),
+            Side::Upper,
+            SymmetricOrdering::Custom(perm),
+            Default::default(),
+        )
+        .map_err(other)?;
+        let work = FactorWork::of(&interleaved);
+        if work.check(limit).is_ok() {
+            return Ok(Ldlt {
+                symbolic: Arc::new(interleaved),
+            });
+        }
+        let smaller = if work.operations < last.operations {
+            work
+        } else {
+            last
+        };
+        Err(FactorError::TooLarge {
+            work: smaller,
+            limit: *limit,
         })
     }
 
@@ -906,6 +1037,91 @@ mod tests {
                 assert_eq!(work.operations, 2.0 * operations);
                 assert_eq!(work.entries, 2 * entries);
             }
+            other => panic!("not refused: {:?}", other.map(|_| ())),
+        }
+    }
+
+    /// A chain of `n` displacements (K tridiagonal, SPD) and `n - 1` multipliers, each tying
+    /// its own displacement `i + 1` to the shared displacement 0 (a long interface against a
+    /// coarse master): `u_{i+1} - u_0 = g_i`.
+    fn hub_saddle(n: usize) -> (SymmetricPattern, Vec<f64>) {
+        let m = n - 1;
+        let mut pb = PatternBuilder::new(n + m);
+        for i in 0..n - 1 {
+            pb.add_block(&[i, i + 1]);
+        }
+        for i in 0..m {
+            pb.add_block(&[0, i + 1, n + i]);
+        }
+        let p = pb.build();
+        let mut v = vec![0.0; p.nnz()];
+        let mut set = |i: usize, j: usize, x: f64| v[p.position(i, j).unwrap()] = x;
+        for i in 0..n {
+            set(i, i, 2.0);
+        }
+        for i in 0..n - 1 {
+            set(i, i + 1, -1.0);
+        }
+        for i in 0..m {
+            set(0, n + i, 1.0);
+            set(i + 1, n + i, -1.0);
+        }
+        (p, v)
+    }
+
+    #[test]
+    fn multipliers_beside_their_own_displacements_keep_the_factor_sparse_and_solve() {
+        let n = 300;
+        let (p, v) = hub_saddle(n);
+        let last = FactorWork::of(&Ldlt::analyse(&p, n, &UNLIMITED).unwrap().symbolic);
+        // multipliers last: the hub couples them all, their block is dense, m^3/3 and more
+        let m = (n - 1) as f64;
+        assert!(last.operations >= m * m * m / 3.0, "{last:?}");
+        let (fwd, inv) = multipliers_after_their_displacements(&p, n).unwrap();
+        // every multiplier right after its own displacement i + 1
+        for i in 0..n - 1 {
+            assert_eq!(inv[n + i], inv[i + 1] + 1, "multiplier {i}");
+        }
+        assert!((0..p.n).all(|k| inv[fwd[k]] == k));
+        let perm = faer::perm::PermRef::new_checked(&fwd, &inv, p.n);
+        let symbolic = factorize_symbolic_cholesky(
+            p.symbolic(),
+            Side::Upper,
+            SymmetricOrdering::Custom(perm),
+            Default::default(),
+        )
+        .unwrap();
+        let interleaved = FactorWork::of(&symbolic);
+        // a chain with one hub: a bounded number of entries per column
+        assert!(
+            interleaved.operations <= 100.0 * p.n as f64,
+            "{interleaved:?}"
+        );
+        // under a limit only the interleaved order meets, the analysis takes it and solves
+        let limit = WorkLimit {
+            gigabytes: 1.0,
+            operations: interleaved.operations,
+        };
+        let ldlt = Ldlt::analyse(&p, n, &limit).unwrap();
+        assert_eq!(FactorWork::of(&ldlt.symbolic), interleaved);
+        let x: Vec<f64> = (0..p.n)
+            .map(|i| ((i * 7919) % 101) as f64 / 50.0 - 1.0)
+            .collect();
+        let mut b = vec![0.0; p.n];
+        p.mul(&v, &x, &mut b);
+        let signs: Vec<i8> = (0..p.n).map(|i| if i < n { 1 } else { -1 }).collect();
+        let f = ldlt.factor(&p, &v, &signs, 1e-14, 1.0).unwrap();
+        f.solve_in_place(&mut b);
+        for i in 0..p.n {
+            assert!((b[i] - x[i]).abs() < 1e-9, "{i}: {} vs {}", b[i], x[i]);
+        }
+        // under a limit neither order meets: refused with the smaller work
+        let below = WorkLimit {
+            gigabytes: 1.0,
+            operations: interleaved.operations - 1.0,
+        };
+        match Ldlt::analyse(&p, n, &below) {
+            Err(FactorError::TooLarge { work, .. }) => assert_eq!(work, interleaved),
             other => panic!("not refused: {:?}", other.map(|_| ())),
         }
     }
