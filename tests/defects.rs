@@ -259,6 +259,60 @@ fn d01_d02_huge_divisions_are_refused_before_allocation() {
     );
 }
 
+/// The fuzz's tied layer with 5000 layer elements against 4 base elements (dual mortar,
+/// Lagrange multipliers) ran for more than 5 minutes in the dense multiplier block of the
+/// saddle-point factor (multipliers eliminated last: 1.16e13 multiply-adds). The symbolic
+/// analysis now sees that before factoring and orders each multiplier beside its own slave
+/// displacement (5.2e7): the run ends within the hang guard, and whatever its outcome it is not
+/// a refusal. Under a limit below both orders it is refused (exit 2), naming the system's
+/// equations, entries, gigabytes and operations and the limits to raise.
+#[test]
+fn a_factorization_beyond_the_work_limit_is_refused_before_it_starts() {
+    let s = Scratch::new();
+    let tied = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/tied-layer/tied-layer-q9.json");
+    let case = s.case(&tied, "case.json", |v| {
+        v["bodies"][1]["mesh"]["block"]["x"]["divisions"] = 5000.into()
+    });
+    let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    assert!(code == 0 || code == 1, "exit {code}:\n{stderr}");
+    assert!(!stderr.contains("factor entries"), "{stderr}");
+    // the displacement Cholesky takes 3.4e7 multiply-adds, the saddle point's 5.2e7 at best
+    let case = s.case(&tied, "case.json", |v| {
+        v["bodies"][1]["mesh"]["block"]["x"]["divisions"] = 5000.into();
+        v["limits"] = serde_json::json!({"factor_operations": 4e7})
+    });
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &[
+            "sparse factorization of 80129 equations",
+            "factor entries",
+            "GB",
+            "multiply-adds",
+            "limits.factor_gigabytes",
+            "limits.factor_operations",
+            "penalty",
+        ],
+    );
+    // the limits are the case's to set: a small one refuses a small case
+    let case = s.case(&good_case(), "case.json", |v| {
+        v["limits"] = serde_json::json!({"factor_operations": 10.0})
+    });
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &["above the limits of 8 GB", "1.0e1 multiply-adds"],
+    );
+    // and must be positive numbers
+    for (field, value) in [("factor_gigabytes", -1.0), ("factor_operations", 0.0)] {
+        let case = s.case(&good_case(), "case.json", |v| {
+            v["limits"] = serde_json::json!({ field: value })
+        });
+        assert_refused(
+            s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+            &[&format!("limits.{field}"), "not a positive number"],
+        );
+    }
+}
+
 #[test]
 fn tied_layer_levels_are_bounded() {
     let s = Scratch::new();

@@ -58,7 +58,11 @@ fn d09_names_the_unconnected_node_on_the_simplicial_path() {
     let case = read(&defect("D09"));
     let m = model(&case, "D09");
     let pattern = assemble(&m, &[]).pattern;
-    assert!(!Cholesky::analyse(&pattern).unwrap().is_supernodal());
+    assert!(
+        !Cholesky::analyse(&pattern, &contact_patch::solver::sparse::UNLIMITED)
+            .unwrap()
+            .is_supernodal()
+    );
     let e = solve(&case, "D09").unwrap_err().to_string();
     assert!(e.contains("body 'beam', node 9 at (6.3, 0.18)"), "{e}");
     assert!(
@@ -113,16 +117,23 @@ fn a_failing_pivot_on_the_supernodal_path_names_its_node() {
     let case = grid_case(60, &[(1900, [20.5, 31.25])], None);
     let m = model(&case, "grid");
     let pattern = assemble(&m, &[]).pattern;
-    assert!(Cholesky::analyse(&pattern).unwrap().is_supernodal());
+    assert!(
+        Cholesky::analyse(&pattern, &contact_patch::solver::sparse::UNLIMITED)
+            .unwrap()
+            .is_supernodal()
+    );
     let e = solve(&case, "grid").unwrap_err().to_string();
     assert!(e.contains("node 1900 at (20.5, 31.25)"), "{e}");
     assert!(e.contains("belongs to no cell"), "{e}");
     // the same on the simplicial path
     let case = grid_case(3, &[(5, [0.5, 1.25])], None);
     let m = model(&case, "small");
-    assert!(!Cholesky::analyse(&assemble(&m, &[]).pattern)
-        .unwrap()
-        .is_supernodal());
+    assert!(!Cholesky::analyse(
+        &assemble(&m, &[]).pattern,
+        &contact_patch::solver::sparse::UNLIMITED
+    )
+    .unwrap()
+    .is_supernodal());
     let e = solve(&case, "small").unwrap_err().to_string();
     assert!(e.contains("node 5 at (0.5, 1.25)"), "{e}");
 }

@@ -147,6 +147,16 @@ pub struct Limits {
     /// minute of stepping on one core).
     #[serde(default = "default_max_step_dofs")]
     pub step_dofs: u64,
+    /// The most memory one sparse factorization's values may take, in gigabytes (8 bytes per
+    /// entry of the factor, known from its symbolic analysis before anything is allocated);
+    /// default 8. An LU is estimated as twice the Cholesky factor of its pattern.
+    #[serde(default = "default_factor_gigabytes")]
+    pub factor_gigabytes: f64,
+    /// The most multiply-adds one sparse factorization may take (`sum_j c_j^2` over the
+    /// factor's column counts, known from the symbolic analysis); default 1e12, about 8 times
+    /// the 1.3e11 of the Cholesky factor of the million-dof square in `cases/large`.
+    #[serde(default = "default_factor_operations")]
+    pub factor_operations: f64,
 }
 
 pub const DEFAULT_MAX_NODES: usize = 2_000_000;
@@ -160,11 +170,24 @@ fn default_max_nodes() -> usize {
     DEFAULT_MAX_NODES
 }
 
+pub const DEFAULT_FACTOR_GIGABYTES: f64 = 8.0;
+pub const DEFAULT_FACTOR_OPERATIONS: f64 = 1e12;
+
+fn default_factor_gigabytes() -> f64 {
+    DEFAULT_FACTOR_GIGABYTES
+}
+
+fn default_factor_operations() -> f64 {
+    DEFAULT_FACTOR_OPERATIONS
+}
+
 impl Default for Limits {
     fn default() -> Self {
         Limits {
             nodes: DEFAULT_MAX_NODES,
             step_dofs: DEFAULT_MAX_STEP_DOFS,
+            factor_gigabytes: DEFAULT_FACTOR_GIGABYTES,
+            factor_operations: DEFAULT_FACTOR_OPERATIONS,
         }
     }
 }

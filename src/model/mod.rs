@@ -178,6 +178,8 @@ pub struct Model {
     /// What building the model found worth saying although nothing is wrong (e.g. a box set
     /// that takes in nodes only by its tolerance); reported with the run's warnings.
     pub warnings: Vec<String>,
+    /// The most memory and operations one sparse factorization may take (`limits`).
+    pub factor_limit: crate::solver::sparse::WorkLimit,
 }
 
 /// Parse case JSON; errors carry line, column and a hint.
@@ -496,6 +498,10 @@ impl Model {
             sweep: case.sweep.clone(),
             solver: case.solver.clone(),
             dynamics: None,
+            factor_limit: crate::solver::sparse::WorkLimit {
+                gigabytes: case.limits.factor_gigabytes,
+                operations: case.limits.factor_operations,
+            },
         };
         model.apply_supports(case)?;
         model.apply_loads(case)?;
@@ -1389,6 +1395,19 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {
 /// The node count of every mesh, from the spec alone (nothing is allocated), against
 /// `limits.nodes`.
 fn check_size(case: &Case, source: &str) -> Result<()> {
+    for (field, value) in [
+        ("factor_gigabytes", case.limits.factor_gigabytes),
+        ("factor_operations", case.limits.factor_operations),
+    ] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(Error::invalid(
+                source,
+                format!("limits.{field}"),
+                format!("{value} is not a positive number"),
+                "give a positive limit, or leave the field out for its default",
+            ));
+        }
+    }
     let limit = case.limits.nodes as u128;
     let mut total: u128 = 0;
     for (bi, spec) in case.bodies.iter().enumerate() {

@@ -506,7 +506,8 @@ fn solve_at(
 
     let t = Instant::now();
     progress("contact iterations");
-    let chol = Cholesky::analyse(&sys.pattern).map_err(|e| sys.factor_error(model, e))?;
+    let chol = Cholesky::analyse(&sys.pattern, &model.factor_limit)
+        .map_err(|e| sys.factor_error(model, e))?;
     let initial_active = previous.map(|previous| {
         rows.iter()
             .map(|r| {
@@ -533,7 +534,8 @@ fn solve_at(
         iteration: 0,
         chol,
         saddle: if method == Method::Lagrange || coupled {
-            Saddle::new(&sys, &eq_rows, &perturbation)
+            Saddle::new(&sys, &eq_rows, &perturbation, &model.factor_limit)
+                .map_err(|e| sys.factor_error(model, e))?
         } else {
             None
         },
@@ -646,6 +648,8 @@ struct Saddle {
             crate::solver::sparse::Lu,
         )>,
     >,
+    /// The case's bound on the work of a factorization (for the LU fallback).
+    limit: crate::solver::sparse::WorkLimit,
 }
 
 impl Saddle {
@@ -656,7 +660,7 @@ impl Saddle {
             .lu
             .get_or_init(|| {
                 let general = crate::solver::sparse::GeneralPattern::from_symmetric(&self.pattern);
-                crate::solver::sparse::Lu::analyse(&general)
+                crate::solver::sparse::Lu::analyse(&general, &self.limit)
                     .ok()
                     .map(|lu| (general, lu))
             })
@@ -673,7 +677,8 @@ impl Saddle {
         sys: &LinearSystem,
         rows: &[EqRow],
         perturbation: &[Vec<(usize, f64)>],
-    ) -> Option<Saddle> {
+        limit: &crate::solver::sparse::WorkLimit,
+    ) -> Result<Option<Saddle>, crate::solver::sparse::FactorError> {
         let (n, m) = (sys.n, rows.len());
         let mut b = PatternBuilder::new(n + m);
         let p = &sys.pattern;
@@ -701,16 +706,26 @@ impl Saddle {
         let mut k_positions = Vec::with_capacity(p.nnz());
         for j in 0..n {
             for k in p.col_ptr[j]..p.col_ptr[j + 1] {
-                k_positions.push(pattern.position(p.row_idx[k], j)?);
+                let Some(position) = pattern.position(p.row_idx[k], j) else {
+                    return Ok(None);
+                };
+                k_positions.push(position);
             }
         }
-        let ldlt = crate::solver::sparse::Ldlt::analyse(&pattern, n).ok()?;
-        Some(Saddle {
+        // a factor above the limit is refused with its size; another failure of the analysis
+        // leaves the saddle-point path out, as before
+        let ldlt = match crate::solver::sparse::Ldlt::analyse(&pattern, n, limit) {
+            Ok(ldlt) => ldlt,
+            Err(e @ crate::solver::sparse::FactorError::TooLarge { .. }) => return Err(e),
+            Err(_) => return Ok(None),
+        };
+        Ok(Some(Saddle {
             pattern,
             k_positions,
             ldlt,
             lu: std::cell::OnceCell::new(),
-        })
+            limit: *limit,
+        }))
     }
 }
 
@@ -1393,7 +1408,8 @@ impl Kernel<'_> {
         let reduction = constraints.reduction(&self.sys.pattern);
         let values = reduction.matrix(&self.k);
         let mut y = reduction.rhs(&self.k, &self.rhs);
-        let chol = Cholesky::analyse(&reduction.pattern).map_err(|e| format!("{e:?}"))?;
+        let chol = Cholesky::analyse(&reduction.pattern, &self.model.factor_limit)
+            .map_err(|e| self.sys.factor_error(self.model, e).to_string())?;
         // a failing pivot is named by its unknown of the reduced system: map it back
         let free = constraints.free_dofs();
         let f = chol.factor(&reduction.pattern, &values).map_err(|e| {

@@ -201,7 +201,10 @@ mod tests {
     }
 
     fn estimate(p: &SymmetricPattern, values: &[f64]) -> f64 {
-        let f = Cholesky::analyse(p).unwrap().factor(p, values).unwrap();
+        let f = Cholesky::analyse(p, &crate::solver::sparse::UNLIMITED)
+            .unwrap()
+            .factor(p, values)
+            .unwrap();
         condition_estimate_symmetric(p, values, |b| f.solve_in_place(b))
     }
 

@@ -754,7 +754,8 @@ mod tests {
         let reduction = c.reduction(pattern);
         let values = reduction.matrix(k);
         let mut y = reduction.rhs(k, f);
-        let chol = Cholesky::analyse(&reduction.pattern).unwrap();
+        let chol =
+            Cholesky::analyse(&reduction.pattern, &crate::solver::sparse::UNLIMITED).unwrap();
         chol.factor(&reduction.pattern, &values)
             .unwrap()
             .solve_in_place(&mut y);

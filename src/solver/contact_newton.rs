@@ -928,6 +928,7 @@ pub(crate) fn solve_step(
         newton::Settings {
             max_iterations: model.solver.max_iterations,
             tolerance: RESIDUAL_TOLERANCE,
+            factor_limit: model.factor_limit,
         },
     )?;
     timings.factorization = outcome.factorization_seconds;

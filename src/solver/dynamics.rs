@@ -235,7 +235,7 @@ impl<'a> Integrator<'a> {
                 }
             }
         }
-        let mass_factor = Cholesky::analyse(&sys.pattern)
+        let mass_factor = Cholesky::analyse(&sys.pattern, &model.factor_limit)
             .and_then(|c| c.factor(&sys.pattern, &mass_ff))
             .map_err(|e| sys.factor_error(model, e))?;
         let rhs0 = sys.rhs.clone();
@@ -259,13 +259,13 @@ impl<'a> Integrator<'a> {
         let projection = if dynamics.impact == ImpactTreatment::ContactStabilized {
             let mut p = ContactSystem::new(model, None, None, Default::default())?;
             p.replace_stiffness(mass_ff.iter().map(|m| c0 * m).collect());
-            let linear = LinearSolver::new(p.pattern());
+            let linear = LinearSolver::new(p.pattern(), model.factor_limit);
             let x = vec![0.0; p.pattern().n];
             Some((p, linear, x))
         } else {
             None
         };
-        let linear = LinearSolver::new(system.pattern());
+        let linear = LinearSolver::new(system.pattern(), model.factor_limit);
         let n_unknowns = system.pattern().n;
         let d = system
             .linear_system()
@@ -806,6 +806,7 @@ fn newton_step(
         newton::Settings {
             max_iterations: model.solver.max_iterations,
             tolerance: super::contact_newton::RESIDUAL_TOLERANCE,
+            factor_limit: model.factor_limit,
         },
         linear,
     )?;

@@ -173,6 +173,11 @@ impl LinearSystem {
                     other => other,
                 }
             }
+            FactorError::TooLarge { work, limit } => Error::Solver {
+                path: model.source.clone(),
+                problem: work.refusal(&limit),
+                hint: crate::solver::sparse::TOO_LARGE_HINT.into(),
+            },
             FactorError::Other(msg) => Error::Solver {
                 path: model.source.clone(),
                 problem: format!("the factorization failed: {msg}"),
@@ -281,7 +286,8 @@ pub fn solve_elastic(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<So
     progress("factorizing");
     let mut x = sys.rhs.clone();
     if sys.n > 0 {
-        let chol = Cholesky::analyse(&sys.pattern).map_err(|e| sys.factor_error(model, e))?;
+        let chol = Cholesky::analyse(&sys.pattern, &model.factor_limit)
+            .map_err(|e| sys.factor_error(model, e))?;
         let factor = chol
             .factor(&sys.pattern, &sys.k)
             .map_err(|e| sys.factor_error(model, e))?;

@@ -18,7 +18,8 @@
 //! term); a factorization is reused when the tangent's values have not changed.
 
 use super::sparse::{
-    Cholesky, Factor, FactorError, GeneralPattern, Ldlt, LdltFactor, Lu, LuFactor, SymmetricPattern,
+    Cholesky, Factor, FactorError, GeneralPattern, Ldlt, LdltFactor, Lu, LuFactor,
+    SymmetricPattern, WorkLimit,
 };
 use crate::contact::state::{IterationRecord, Termination};
 use crate::error::Result;
@@ -94,6 +95,8 @@ pub struct Settings {
     pub max_iterations: usize,
     /// Residual tolerance relative to [`Evaluation::force_scale`].
     pub tolerance: f64,
+    /// The most memory and operations one factorization of the tangent may take.
+    pub factor_limit: WorkLimit,
 }
 
 /// How a Newton solve ended.
@@ -109,7 +112,7 @@ pub struct Outcome {
 
 /// Run Newton's method on `system` from `x` (overwritten with the last iterate).
 pub fn solve(system: &mut dyn System, x: &mut Vec<f64>, settings: Settings) -> Result<Outcome> {
-    let mut linear = LinearSolver::new(system.pattern());
+    let mut linear = LinearSolver::new(system.pattern(), settings.factor_limit);
     solve_with(system, x, settings, &mut linear)
 }
 
@@ -137,7 +140,7 @@ pub fn solve_with(
     let termination = loop {
         if system.pattern_version() != version {
             earlier_seconds += linear.seconds - base_seconds;
-            *linear = LinearSolver::new(system.pattern());
+            *linear = LinearSolver::new(system.pattern(), settings.factor_limit);
             base_seconds = 0.0;
             version = system.pattern_version();
             *x = system.carry(x);
@@ -213,6 +216,11 @@ pub fn solve_with(
                     "a pivot that is not positive at {}",
                     system.describe_unknown(equation)
                 ),
+                FactorError::TooLarge { work, limit } => format!(
+                    "{}; {}",
+                    work.refusal(&limit),
+                    crate::solver::sparse::TOO_LARGE_HINT
+                ),
                 FactorError::Other(why) => why,
             };
             break Termination::Singular(format!(
@@ -253,6 +261,8 @@ impl Factorization {
 /// once per solver kind; the last factorization is reused while the tangent's values do not
 /// change.
 pub struct LinearSolver {
+    /// The most memory and operations one factorization may take.
+    limit: WorkLimit,
     symmetric: SymmetricPattern,
     pub general: GeneralPattern,
     cholesky: Option<Cholesky>,
@@ -271,8 +281,9 @@ pub struct LinearSolver {
 }
 
 impl LinearSolver {
-    pub fn new(pattern: &SymmetricPattern) -> LinearSolver {
+    pub fn new(pattern: &SymmetricPattern, limit: WorkLimit) -> LinearSolver {
         LinearSolver {
+            limit,
             symmetric: pattern.clone(),
             general: GeneralPattern::from_symmetric(pattern),
             cholesky: None,
@@ -315,7 +326,10 @@ impl LinearSolver {
             let n = self.general.n;
             let leading = n - tangent.multipliers;
             if self.ldlt.as_ref().is_none_or(|(l, _)| *l != leading) {
-                self.ldlt = Some((leading, Ldlt::analyse(&self.symmetric, leading)?));
+                self.ldlt = Some((
+                    leading,
+                    Ldlt::analyse(&self.symmetric, leading, &self.limit)?,
+                ));
             }
             let upper = self
                 .general
@@ -339,7 +353,7 @@ impl LinearSolver {
             }
         } else if tangent.symmetric {
             if self.cholesky.is_none() {
-                self.cholesky = Some(Cholesky::analyse(&self.symmetric)?);
+                self.cholesky = Some(Cholesky::analyse(&self.symmetric, &self.limit)?);
             }
             let upper = self
                 .general
@@ -360,7 +374,7 @@ impl LinearSolver {
             }
         }
         if self.lu.is_none() {
-            self.lu = Some(Lu::analyse(&self.general)?);
+            self.lu = Some(Lu::analyse(&self.general, &self.limit)?);
         }
         let f = self
             .lu
@@ -377,6 +391,7 @@ impl LinearSolver {
 mod tests {
     use super::*;
     use crate::solver::sparse::PatternBuilder;
+    use crate::solver::sparse::UNLIMITED;
 
     /// `R(x) = A x + c x^3 - f` on a tridiagonal `A`: Newton converges quadratically from zero.
     struct Cubic {
@@ -444,6 +459,7 @@ mod tests {
                 Settings {
                     max_iterations: 30,
                     tolerance: 1e-14,
+                    factor_limit: UNLIMITED,
                 },
             )
             .unwrap();
@@ -478,11 +494,12 @@ mod tests {
         let settings = Settings {
             max_iterations: 10,
             tolerance: 1e-13,
+            factor_limit: UNLIMITED,
         };
         let out = solve(&mut s, &mut x, settings).unwrap();
         assert_eq!(out.termination, Termination::Converged);
         assert_eq!(out.iterations, 1);
-        let mut linear = LinearSolver::new(&s.pattern);
+        let mut linear = LinearSolver::new(&s.pattern, UNLIMITED);
         let general = linear.general.clone();
         let mut t = Tangent {
             values: vec![0.0; general.nnz()],
@@ -508,6 +525,7 @@ mod tests {
             Settings {
                 max_iterations: 2,
                 tolerance: 1e-14,
+                factor_limit: UNLIMITED,
             },
         )
         .unwrap();

@@ -26,6 +26,18 @@
 //! General matrices on a structurally symmetric pattern (unsymmetric tangents, saddle systems
 //! LDL^T refuses): [`GeneralPattern`] holds both triangles, [`Lu`] is faer's sparse LU with
 //! partial pivoting whose symbolic analysis is made once per pattern and reused.
+//!
+//! Work bound: every symbolic analysis gives the factor's size before any value is allocated,
+//! [`FactorWork`]: its entries (memory) and its multiply-adds `sum_j c_j^2` over the column
+//! counts `c_j` of `L` (George & Liu 1981, sec. 2.2; a dense matrix: `n^3 / 3`). Above the
+//! case's [`WorkLimit`] the analysis is refused ([`FactorError::TooLarge`]). An LU is
+//! estimated as twice the Cholesky factor of its (structurally symmetric) pattern under AMD.
+//! An `L D L^T` whose multipliers-last order is above the limit is analysed again with each
+//! multiplier beside its own displacement (see `multipliers_after_their_displacements`): a long
+//! interface against a coarse master couples every multiplier through the master's few
+//! displacements, so multipliers last make their whole block dense; beside their slave
+//! displacements they stay sparse. Below the limit the multipliers-last order is kept, so the
+//! results of every system that fits are unchanged.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError;
@@ -205,6 +217,9 @@ pub enum FactorError {
         ratio: f64,
         regularized: usize,
     },
+    /// The symbolic analysis shows a factor larger than the case allows (memory or
+    /// operations); nothing was allocated for it.
+    TooLarge { work: FactorWork, limit: WorkLimit },
     /// Out of memory or another non-numerical failure.
     Other(String),
 }
@@ -271,6 +286,97 @@ fn pivots(symbolic: &SymbolicCholesky<usize>, values: &[f64], squared: bool) -> 
     d
 }
 
+/// The size of a factorization, known from its symbolic analysis before any value is
+/// computed: `equations` (the order `n`), `entries` (the stored factor values, `len_val`:
+/// supernodes store their dense `w x (w + r)` blocks) and `operations`, the multiply-adds of the
+/// numeric factorization, `sum_j c_j^2` over the factor's columns with `c_j` the entries of
+/// column `j` on and below the diagonal (George & Liu, *Computer Solution of Large Sparse
+/// Positive Definite Systems*, 1981, sec. 2.2: a dense `n x n` matrix has `n (n + 1) / 2`
+/// entries and about `n^3 / 3` operations).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FactorWork {
+    pub equations: usize,
+    pub entries: usize,
+    pub operations: f64,
+}
+
+impl FactorWork {
+    /// The work of the factorization `symbolic` describes.
+    pub fn of(symbolic: &SymbolicCholesky<usize>) -> FactorWork {
+        let operations = match symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => s
+                .col_ptr()
+                .windows(2)
+                .map(|w| ((w[1] - w[0]) as f64).powi(2))
+                .sum(),
+            SymbolicCholeskyRaw::Supernodal(s) => (0..s.n_supernodes())
+                .map(|sn| {
+                    let width = s.supernode_end()[sn] - s.supernode_begin()[sn];
+                    let below = s.supernode(sn).pattern().len();
+                    // column k of the supernode has width - k + below entries
+                    (1..=width)
+                        .map(|c| ((c + below) as f64).powi(2))
+                        .sum::<f64>()
+                })
+                .sum(),
+        };
+        FactorWork {
+            equations: symbolic.nrows(),
+            entries: symbolic.len_val(),
+            operations,
+        }
+    }
+
+    /// The sentence that refuses this factorization under `limit`: the system's size, its
+    /// factor's entries, memory and operations, and the limits.
+    pub fn refusal(&self, limit: &WorkLimit) -> String {
+        format!(
+            "the sparse factorization of {} equations would hold {} factor entries ({:.2} GB) \
+             and take {:.2e} multiply-adds, above the limits of {} GB \
+             (limits.factor_gigabytes) and {:.1e} multiply-adds (limits.factor_operations)",
+            self.equations,
+            self.entries,
+            self.gigabytes(),
+            self.operations,
+            limit.gigabytes,
+            limit.operations
+        )
+    }
+
+    /// Memory of the factor's values in gigabytes (8 bytes each).
+    pub fn gigabytes(&self) -> f64 {
+        self.entries as f64 * 8.0 / 1e9
+    }
+
+    /// `Err(FactorError::TooLarge)` when the factor's memory or operations exceed `limit`.
+    pub fn check(self, limit: &WorkLimit) -> Result<FactorWork, FactorError> {
+        if self.gigabytes() > limit.gigabytes || self.operations > limit.operations {
+            return Err(FactorError::TooLarge {
+                work: self,
+                limit: *limit,
+            });
+        }
+        Ok(self)
+    }
+}
+
+/// No bound on the work of a factorization (for tests and internal tiny systems).
+pub const UNLIMITED: WorkLimit = WorkLimit {
+    gigabytes: f64::INFINITY,
+    operations: f64::INFINITY,
+};
+
+/// How to get past [`FactorError::TooLarge`].
+pub const TOO_LARGE_HINT: &str = "raise \"limits\": {\"factor_gigabytes\": G, \"factor_operations\": N} in the case if the machine has the memory and the time, or use a coarser mesh, or for a Lagrange-multiplier interface a penalty-type method (penalty, augmented Lagrangian) or elimination, which factor no multipliers";
+
+/// The most memory (gigabytes of factor values) and multiply-adds one factorization may take
+/// (the case's `limits.factor_gigabytes` and `limits.factor_operations`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorkLimit {
+    pub gigabytes: f64,
+    pub operations: f64,
+}
+
 /// Original equation of elimination step `k`.
 fn original(symbolic: &SymbolicCholesky<usize>, k: usize) -> usize {
     symbolic.perm().map_or(k, |p| p.arrays().0[k])
@@ -283,8 +389,9 @@ pub struct Cholesky {
 }
 
 impl Cholesky {
-    /// Analyse the pattern (ordering, elimination tree, supernodes).
-    pub fn analyse(pattern: &SymmetricPattern) -> Result<Self, FactorError> {
+    /// Analyse the pattern (ordering, elimination tree, supernodes); a factor whose work
+    /// exceeds `limit` is [`FactorError::TooLarge`].
+    pub fn analyse(pattern: &SymmetricPattern, limit: &WorkLimit) -> Result<Self, FactorError> {
         let symbolic = factorize_symbolic_cholesky(
             pattern.symbolic(),
             Side::Upper,
@@ -292,6 +399,7 @@ impl Cholesky {
             Default::default(),
         )
         .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+        FactorWork::of(&symbolic).check(limit)?;
         Ok(Cholesky {
             symbolic: Arc::new(symbolic),
         })
@@ -389,6 +497,102 @@ impl Factor {
     }
 }
 
+/// The elimination order "every trailing equation (multiplier) right after a leading equation
+/// (displacement) of its own": each multiplier is matched to one of its displacements that as
+/// few other multipliers couple as possible (for dual mortar its slave displacement, coupled to
+/// it alone), the pair is one node of the graph AMD orders (the displacement's adjacency plus
+/// the multiplier's), and the multiplier follows its displacement; unmatched multipliers come
+/// last. A multiplier eliminated after its own displacement has the expected (negative) pivot
+/// as long as the rows eliminated so far are independent on the displacements eliminated so far
+/// (with `K` positive definite, the leading principal blocks `[[K_SS, B_S^T], [B_S, D]]` then
+/// have `B_S` of full row rank); a pivot that fails is reported by [`Ldlt::factor`] as for the
+/// multipliers-last order. Returns `(fwd, inv)`: the original equation of each step and the
+/// step of each equation.
+fn multipliers_after_their_displacements(
+    pattern: &SymmetricPattern,
+    leading: usize,
+) -> Result<(Vec<usize>, Vec<usize>), FactorError> {
+    let n = pattern.n;
+    let column = |j: usize| &pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]];
+    let coupled: Vec<Vec<usize>> = (leading..n)
+        .map(|j| column(j).iter().copied().filter(|&i| i < leading).collect())
+        .collect();
+    // how many multipliers couple each displacement
+    let mut sharing = vec![0usize; leading];
+    for displacements in &coupled {
+        for &e in displacements {
+            sharing[e] += 1;
+        }
+    }
+    // match each multiplier to a free displacement shared by the fewest multipliers
+    let mut matched: Vec<Option<usize>> = vec![None; n - leading];
+    let mut owner: Vec<Option<usize>> = vec![None; leading];
+    for (i, displacements) in coupled.iter().enumerate() {
+        if let Some(&e) = displacements
+            .iter()
+            .filter(|&&e| owner[e].is_none())
+            .min_by_key(|&&e| (sharing[e], e))
+        {
+            owner[e] = Some(i);
+            matched[i] = Some(e);
+        }
+    }
+    // the quotient graph: a matched pair is its displacement's node
+    let mut builder = PatternBuilder::new(leading);
+    for j in 0..leading {
+        for &i in column(j) {
+            builder.add_block(&[i, j]);
+        }
+    }
+    for (i, displacements) in coupled.iter().enumerate() {
+        let Some(own) = matched[i] else { continue };
+        for &e in displacements {
+            builder.add_block(&[own, e]);
+        }
+        // multiplier-multiplier couplings (a perturbation C)
+        for &k in column(leading + i) {
+            if k >= leading {
+                if let Some(other) = matched[k - leading] {
+                    builder.add_block(&[own, other]);
+                }
+            }
+        }
+    }
+    let block = builder.build();
+    let nnz = block.row_idx.len();
+    let mut fwd_leading = vec![0usize; leading];
+    let mut step = vec![0usize; leading];
+    let mut mem = MemBuffer::try_new(faer::sparse::linalg::amd::order_scratch::<usize>(
+        leading, nnz,
+    ))
+    .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+    faer::sparse::linalg::amd::order(
+        &mut fwd_leading,
+        &mut step,
+        block.symbolic(),
+        Default::default(),
+        MemStack::new(&mut mem),
+    )
+    .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+    let mut fwd = Vec::with_capacity(n);
+    for &e in &fwd_leading {
+        fwd.push(e);
+        if let Some(i) = owner[e] {
+            fwd.push(leading + i);
+        }
+    }
+    fwd.extend(
+        (0..n - leading)
+            .filter(|&i| matched[i].is_none())
+            .map(|i| leading + i),
+    );
+    let mut inv = vec![0usize; n];
+    for (k, &e) in fwd.iter().enumerate() {
+        inv[e] = k;
+    }
+    Ok((fwd, inv))
+}
+
 /// Sparse `L D L^T` of a symmetric indefinite matrix with known pivot signs.
 pub struct Ldlt {
     symbolic: Arc<SymbolicCholesky<usize>>,
@@ -403,8 +607,13 @@ pub struct LdltFactor {
 impl Ldlt {
     /// Symbolic analysis with the ordering "AMD of the leading `leading x leading` block, then
     /// the remaining equations in order", so that multipliers (numbered last) are eliminated
-    /// after their displacements and every pivot has its expected sign exactly.
-    pub fn analyse(pattern: &SymmetricPattern, leading: usize) -> Result<Self, FactorError> {
+    /// after their displacements and every pivot has its expected sign exactly. A factor whose
+    /// work exceeds `limit` is [`FactorError::TooLarge`].
+    pub fn analyse(
+        pattern: &SymmetricPattern,
+        leading: usize,
+        limit: &WorkLimit,
+    ) -> Result<Self, FactorError> {
         let n = pattern.n;
         fn other(e: impl std::fmt::Debug) -> FactorError {
             FactorError::Other(format!("{e:?}"))
@@ -442,8 +651,38 @@ impl Ldlt {
             Default::default(),
         )
         .map_err(other)?;
-        Ok(Ldlt {
-            symbolic: Arc::new(symbolic),
+        let last = FactorWork::of(&symbolic);
+        if last.check(limit).is_ok() {
+            return Ok(Ldlt {
+                symbolic: Arc::new(symbolic),
+            });
+        }
+        // multipliers last fill their whole block in when a multiplier couples displacements far
+        // apart (a long interface against a coarse master): eliminate each one right after its
+        // displacements instead
+        let (fwd, inv) = multipliers_after_their_displacements(pattern, leading)?;
+        let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
+        let interleaved = factorize_symbolic_cholesky(
+            pattern.symbolic(),
+            Side::Upper,
+            SymmetricOrdering::Custom(perm),
+            Default::default(),
+        )
+        .map_err(other)?;
+        let work = FactorWork::of(&interleaved);
+        if work.check(limit).is_ok() {
+            return Ok(Ldlt {
+                symbolic: Arc::new(interleaved),
+            });
+        }
+        let smaller = if work.operations < last.operations {
+            work
+        } else {
+            last
+        };
+        Err(FactorError::TooLarge {
+            work: smaller,
+            limit: *limit,
         })
     }
 
@@ -650,7 +889,35 @@ pub struct LuFactor {
 }
 
 impl Lu {
-    pub fn analyse(pattern: &GeneralPattern) -> Result<Lu, FactorError> {
+    /// Analyse the pattern. The work is estimated before, as `L` and `U` each the size of the
+    /// Cholesky factor of the (structurally symmetric) pattern under AMD: partial pivoting can
+    /// add fill, so this is an estimate from below; above `limit` it is
+    /// [`FactorError::TooLarge`].
+    pub fn analyse(pattern: &GeneralPattern, limit: &WorkLimit) -> Result<Lu, FactorError> {
+        // the upper triangle of the full pattern: its entries with row <= column
+        let mut col_ptr = vec![0usize; pattern.n + 1];
+        let mut row_idx = Vec::with_capacity(pattern.nnz() / 2 + pattern.n);
+        for j in 0..pattern.n {
+            let rows = &pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]];
+            row_idx.extend(rows.iter().copied().filter(|&i| i <= j));
+            col_ptr[j + 1] = row_idx.len();
+        }
+        let upper =
+            SymbolicSparseColMatRef::new_checked(pattern.n, pattern.n, &col_ptr, None, &row_idx);
+        let cholesky = factorize_symbolic_cholesky(
+            upper,
+            Side::Upper,
+            SymmetricOrdering::Amd,
+            Default::default(),
+        )
+        .map_err(|e| FactorError::Other(format!("symbolic LU: {e:?}")))?;
+        let one = FactorWork::of(&cholesky);
+        FactorWork {
+            equations: one.equations,
+            entries: 2 * one.entries,
+            operations: 2.0 * one.operations,
+        }
+        .check(limit)?;
         faer::sparse::linalg::solvers::SymbolicLu::try_new(pattern.symbolic())
             .map(|symbolic| Lu { symbolic })
             .map_err(|e| FactorError::Other(format!("symbolic LU: {e:?}")))
@@ -684,6 +951,181 @@ impl LuFactor {
 mod tests {
     use super::*;
 
+    /// Upper pattern of a dense `n x n` matrix.
+    fn dense_pattern(n: usize) -> SymmetricPattern {
+        let mut b = PatternBuilder::new(n);
+        b.add_block(&(0..n).collect::<Vec<_>>());
+        b.build()
+    }
+
+    #[test]
+    fn the_work_of_a_dense_factor_is_n_cubed_over_three() {
+        for n in [1usize, 7, 40, 200] {
+            let p = dense_pattern(n);
+            let chol = Cholesky::analyse(&p, &UNLIMITED).unwrap();
+            let work = FactorWork::of(&chol.symbolic);
+            // sum_{c=1}^{n} c^2 = n (n + 1) (2n + 1) / 6, n^3/3 to leading order
+            let exact = (n * (n + 1) * (2 * n + 1) / 6) as f64;
+            assert_eq!(work.operations, exact, "n = {n}");
+            let third = (n as f64).powi(3) / 3.0;
+            assert!((work.operations - third).abs() <= (n * n) as f64, "n = {n}");
+            assert_eq!(work.equations, n);
+            // n (n + 1) / 2 entries column by column, n^2 in one dense supernode block
+            let expected = if chol.is_supernodal() {
+                n * n
+            } else {
+                n * (n + 1) / 2
+            };
+            assert_eq!(work.entries, expected, "n = {n}");
+            assert_eq!(work.gigabytes(), expected as f64 * 8.0 / 1e9);
+        }
+    }
+
+    #[test]
+    fn the_work_of_a_chain_has_no_fill() {
+        // tridiagonal: every column of L holds its diagonal and one entry below, the last
+        // only its diagonal, whatever the AMD ordering (a path stays a path)
+        let n = 500;
+        let mut b = PatternBuilder::new(n);
+        for i in 0..n - 1 {
+            b.add_block(&[i, i + 1]);
+        }
+        let p = b.build();
+        let work = FactorWork::of(&Cholesky::analyse(&p, &UNLIMITED).unwrap().symbolic);
+        assert_eq!(work.operations, (4 * (n - 1) + 1) as f64);
+    }
+
+    #[test]
+    fn a_factor_above_either_limit_is_refused_with_its_size() {
+        let n = 40;
+        let p = dense_pattern(n);
+        let operations = (n * (n + 1) * (2 * n + 1) / 6) as f64;
+        let at = |gigabytes: f64, operations: f64| WorkLimit {
+            gigabytes,
+            operations,
+        };
+        // exactly at the limit passes, just below refuses
+        assert!(Cholesky::analyse(&p, &at(1.0, operations)).is_ok());
+        match Cholesky::analyse(&p, &at(1.0, operations - 1.0)) {
+            Err(FactorError::TooLarge { work, limit }) => {
+                assert_eq!(work.operations, operations);
+                assert_eq!(limit.operations, operations - 1.0);
+                let text = work.refusal(&limit);
+                assert!(text.contains("40 equations"), "{text}");
+                assert!(text.contains("limits.factor_operations"), "{text}");
+            }
+            other => panic!("not refused: {:?}", other.map(|_| ())),
+        }
+        let entries = FactorWork::of(&Cholesky::analyse(&p, &UNLIMITED).unwrap().symbolic).entries;
+        let gigabytes = entries as f64 * 8.0 / 1e9;
+        assert!(Cholesky::analyse(&p, &at(gigabytes, f64::INFINITY)).is_ok());
+        assert!(matches!(
+            Cholesky::analyse(&p, &at(gigabytes * 0.999, f64::INFINITY)),
+            Err(FactorError::TooLarge { .. })
+        ));
+        // LDL^T of the same pattern with its last 10 equations ordered last: still dense
+        assert!(matches!(
+            Ldlt::analyse(&p, n - 10, &at(1.0, operations - 1.0)),
+            Err(FactorError::TooLarge { .. })
+        ));
+        assert!(Ldlt::analyse(&p, n - 10, &at(1.0, operations)).is_ok());
+        // LU: L and U each the size of the Cholesky factor
+        let g = GeneralPattern::from_symmetric(&p);
+        assert!(Lu::analyse(&g, &at(1.0, 2.0 * operations)).is_ok());
+        match Lu::analyse(&g, &at(1.0, 2.0 * operations - 1.0)) {
+            Err(FactorError::TooLarge { work, .. }) => {
+                assert_eq!(work.operations, 2.0 * operations);
+                assert_eq!(work.entries, 2 * entries);
+            }
+            other => panic!("not refused: {:?}", other.map(|_| ())),
+        }
+    }
+
+    /// A chain of `n` displacements (K tridiagonal, SPD) and `n - 1` multipliers, each tying
+    /// its own displacement `i + 1` to the shared displacement 0 (a long interface against a
+    /// coarse master): `u_{i+1} - u_0 = g_i`.
+    fn hub_saddle(n: usize) -> (SymmetricPattern, Vec<f64>) {
+        let m = n - 1;
+        let mut pb = PatternBuilder::new(n + m);
+        for i in 0..n - 1 {
+            pb.add_block(&[i, i + 1]);
+        }
+        for i in 0..m {
+            pb.add_block(&[0, i + 1, n + i]);
+        }
+        let p = pb.build();
+        let mut v = vec![0.0; p.nnz()];
+        let mut set = |i: usize, j: usize, x: f64| v[p.position(i, j).unwrap()] = x;
+        for i in 0..n {
+            set(i, i, 2.0);
+        }
+        for i in 0..n - 1 {
+            set(i, i + 1, -1.0);
+        }
+        for i in 0..m {
+            set(0, n + i, 1.0);
+            set(i + 1, n + i, -1.0);
+        }
+        (p, v)
+    }
+
+    #[test]
+    fn multipliers_beside_their_own_displacements_keep_the_factor_sparse_and_solve() {
+        let n = 300;
+        let (p, v) = hub_saddle(n);
+        let last = FactorWork::of(&Ldlt::analyse(&p, n, &UNLIMITED).unwrap().symbolic);
+        // multipliers last: the hub couples them all, their block is dense, m^3/3 and more
+        let m = (n - 1) as f64;
+        assert!(last.operations >= m * m * m / 3.0, "{last:?}");
+        let (fwd, inv) = multipliers_after_their_displacements(&p, n).unwrap();
+        // every multiplier right after its own displacement i + 1
+        for i in 0..n - 1 {
+            assert_eq!(inv[n + i], inv[i + 1] + 1, "multiplier {i}");
+        }
+        assert!((0..p.n).all(|k| inv[fwd[k]] == k));
+        let perm = faer::perm::PermRef::new_checked(&fwd, &inv, p.n);
+        let symbolic = factorize_symbolic_cholesky(
+            p.symbolic(),
+            Side::Upper,
+            SymmetricOrdering::Custom(perm),
+            Default::default(),
+        )
+        .unwrap();
+        let interleaved = FactorWork::of(&symbolic);
+        // a chain with one hub: a bounded number of entries per column
+        assert!(
+            interleaved.operations <= 100.0 * p.n as f64,
+            "{interleaved:?}"
+        );
+        // under a limit only the interleaved order meets, the analysis takes it and solves
+        let limit = WorkLimit {
+            gigabytes: 1.0,
+            operations: interleaved.operations,
+        };
+        let ldlt = Ldlt::analyse(&p, n, &limit).unwrap();
+        assert_eq!(FactorWork::of(&ldlt.symbolic), interleaved);
+        let x: Vec<f64> = (0..p.n)
+            .map(|i| ((i * 7919) % 101) as f64 / 50.0 - 1.0)
+            .collect();
+        let mut b = vec![0.0; p.n];
+        p.mul(&v, &x, &mut b);
+        let signs: Vec<i8> = (0..p.n).map(|i| if i < n { 1 } else { -1 }).collect();
+        let f = ldlt.factor(&p, &v, &signs, 1e-14, 1.0).unwrap();
+        f.solve_in_place(&mut b);
+        for i in 0..p.n {
+            assert!((b[i] - x[i]).abs() < 1e-9, "{i}: {} vs {}", b[i], x[i]);
+        }
+        // under a limit neither order meets: refused with the smaller work
+        let below = WorkLimit {
+            gigabytes: 1.0,
+            operations: interleaved.operations - 1.0,
+        };
+        match Ldlt::analyse(&p, n, &below) {
+            Err(FactorError::TooLarge { work, .. }) => assert_eq!(work, interleaved),
+            other => panic!("not refused: {:?}", other.map(|_| ())),
+        }
+    }
+
     #[test]
     fn lu_solves_unsymmetric_values_and_reuses_its_analysis() {
         // a symmetric structure (blocks of a chain) with unsymmetric values
@@ -693,7 +1135,7 @@ mod tests {
             pb.add_block(&[i, i + 1, i + 2]);
         }
         let general = GeneralPattern::from_symmetric(&pb.build());
-        let lu = Lu::analyse(&general).unwrap();
+        let lu = Lu::analyse(&general, &UNLIMITED).unwrap();
         for trial in 0..2 {
             let mut a = vec![0.0; general.nnz()];
             for j in 0..n {
@@ -761,7 +1203,7 @@ mod tests {
         let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
         let mut b = vec![0.0; n];
         pattern.mul(&values, &x, &mut b);
-        let chol = Cholesky::analyse(&pattern).unwrap();
+        let chol = Cholesky::analyse(&pattern, &UNLIMITED).unwrap();
         let f = chol.factor(&pattern, &values).unwrap();
         f.solve_in_place(&mut b);
         for i in 0..n {
@@ -784,7 +1226,7 @@ mod tests {
         let pattern = pb.build();
         let mut values = vec![0.0; pattern.nnz()];
         pattern.scatter(&[0, 1], &[1.0, -1.0, -1.0, 1.0], &mut values);
-        let chol = Cholesky::analyse(&pattern).unwrap();
+        let chol = Cholesky::analyse(&pattern, &UNLIMITED).unwrap();
         assert!(matches!(
             chol.factor(&pattern, &values),
             Err(FactorError::NotPositiveDefinite { .. })
@@ -811,7 +1253,7 @@ mod tests {
         let x = [0.3, -0.2, -0.2, 1.7];
         let mut b = vec![0.0; 4];
         p.mul(&v, &x, &mut b);
-        let f = Ldlt::analyse(&p, 3)
+        let f = Ldlt::analyse(&p, 3, &UNLIMITED)
             .unwrap()
             .factor(&p, &v, &[1, 1, 1, -1], 1e-14, 1.0)
             .unwrap();
@@ -874,7 +1316,7 @@ mod tests {
             let loose = side * side / 2 + 3;
             for value in [-1.0, 0.0] {
                 let (p, v) = grid_with_loose_equation(side, loose, value);
-                let chol = Cholesky::analyse(&p).unwrap();
+                let chol = Cholesky::analyse(&p, &UNLIMITED).unwrap();
                 assert_eq!(chol.is_supernodal(), supernodal);
                 assert_eq!(
                     chol.factor(&p, &v).err(),
@@ -883,7 +1325,10 @@ mod tests {
                 );
             }
             let (p, v) = grid_with_loose_equation(side, loose, 1.0);
-            assert!(Cholesky::analyse(&p).unwrap().factor(&p, &v).is_ok());
+            assert!(Cholesky::analyse(&p, &UNLIMITED)
+                .unwrap()
+                .factor(&p, &v)
+                .is_ok());
         }
     }
 
@@ -896,7 +1341,7 @@ mod tests {
         let mut v = vec![0.0; p.nnz()];
         p.scatter(&[0, 2], &[1.0, 1.0, 1.0, 1.0 + 1e-14], &mut v);
         v[p.position(1, 1).unwrap()] = 1.0;
-        match Cholesky::analyse(&p).unwrap().factor(&p, &v) {
+        match Cholesky::analyse(&p, &UNLIMITED).unwrap().factor(&p, &v) {
             Err(FactorError::ZeroPivot {
                 equation, ratio, ..
             }) => {
@@ -921,7 +1366,7 @@ mod tests {
         set(0, 1, -1.0);
         set(0, 2, -1.0);
         set(1, 2, 1.0);
-        let err = Ldlt::analyse(&p, 2)
+        let err = Ldlt::analyse(&p, 2, &UNLIMITED)
             .unwrap()
             .factor(&p, &v, &[1, 1, -1], 1e-13, 1.0)
             .err();
