@@ -460,105 +460,66 @@ fn circle() -> Value {
     json!({"kind": "circle", "centre": [1.0, -1000.0], "radius": 1000.0})
 }
 
-#[test]
-fn the_frictional_tangent_is_the_derivative_of_the_residual_in_stick_and_in_slip() {
-    let cases = [
-        (
-            "A node-to-node",
-            patch(
-                "A",
-                "0.0",
-                node_to_node(),
-                MU * P,
-                Top::Displacement(0.05),
-                1,
-            ),
-            patch("A", "0.3", node_to_node(), 0.5 * MU * P, Top::Traction, 1),
+/// The one-step slip (top dragged 0.05, nu = 0) and stick (traction mu p / 2, nu = 0.3) patch
+/// tests of `mesh` with discretization `disc`, as the finite-difference checks use them.
+fn slip_and_stick(mesh: &str, disc: Value) -> (Value, Value) {
+    (
+        patch(
+            mesh,
+            "0.0",
+            disc.clone(),
+            MU * P,
+            Top::Displacement(0.05),
+            1,
         ),
-        (
-            "C node-to-surface",
-            patch(
-                "C",
-                "0.0",
-                node_to_surface(),
-                MU * P,
-                Top::Displacement(0.05),
-                1,
-            ),
-            patch(
-                "C",
-                "0.3",
-                node_to_surface(),
-                0.5 * MU * P,
-                Top::Traction,
-                1,
-            ),
-        ),
-        ("rigid line", dragged(line(), 0.05), dragged(line(), 1e-6)),
-        (
-            "C two-pass node-to-surface",
-            patch("C", "0.0", two_pass(), MU * P, Top::Displacement(0.05), 1),
-            patch("C", "0.3", two_pass(), 0.5 * MU * P, Top::Traction, 1),
-        ),
-        (
-            "C node-to-surface, slave normals",
-            patch(
-                "C",
-                "0.0",
-                slave_normals(),
-                MU * P,
-                Top::Displacement(0.05),
-                1,
-            ),
-            patch("C", "0.3", slave_normals(), 0.5 * MU * P, Top::Traction, 1),
-        ),
-        (
-            "C mortar",
-            patch(
-                "C",
-                "0.0",
-                mortar("standard"),
-                MU * P,
-                Top::Displacement(0.05),
-                1,
-            ),
-            patch(
-                "C",
-                "0.3",
-                mortar("standard"),
-                0.5 * MU * P,
-                Top::Traction,
-                1,
-            ),
-        ),
-        (
-            "E dual mortar",
-            patch(
-                "E",
-                "0.0",
-                mortar("dual"),
-                MU * P,
-                Top::Displacement(0.05),
-                1,
-            ),
-            patch("E", "0.3", mortar("dual"), 0.5 * MU * P, Top::Traction, 1),
-        ),
-        (
-            "rigid circle",
-            dragged(circle(), 0.05),
-            dragged(circle(), 1e-6),
-        ),
-    ];
-    for (name, slip, stick) in cases {
-        for (v, status) in [(stick, Status::Stick), (slip, Status::Slip)] {
+        patch(mesh, "0.3", disc, 0.5 * MU * P, Top::Traction, 1),
+    )
+}
+
+/// Solve every case in stick and in slip with its pair's normal law set by `law`, and check the
+/// frictional tangent against central differences of the residual at the converged state.
+fn assert_tangents_match_differences(
+    label: &str,
+    cases: Vec<(&str, (Value, Value))>,
+    law: fn(Value) -> Value,
+) {
+    for (name, (slip, stick)) in cases {
+        for (v, status) in [(law(stick), Status::Stick), (law(slip), Status::Slip)] {
             let o = run(&v);
             assert_eq!(termination(&o), Termination::Converged, "{name} {status:?}");
             let model = build(&v).unwrap();
             let e = fd_error(&model, &o, status);
-            println!("{name}, {status:?}: tangent vs central differences {e:.1e}");
-            assert!(e < 1e-6, "{name} {status:?}: {e:e}");
+            println!("{label}, {name}, {status:?}: tangent vs central differences {e:.1e}");
+            assert!(e < 1e-6, "{label} {name} {status:?}: {e:e}");
         }
     }
+}
+
+#[test]
+fn the_frictional_tangent_is_the_derivative_of_the_residual_in_stick_and_in_slip() {
+    assert_tangents_match_differences(
+        "penalty",
+        vec![
+            ("A node-to-node", slip_and_stick("A", node_to_node())),
+            ("C node-to-surface", slip_and_stick("C", node_to_surface())),
+            ("rigid line", (dragged(line(), 0.05), dragged(line(), 1e-6))),
+            (
+                "C two-pass node-to-surface",
+                slip_and_stick("C", two_pass()),
+            ),
+            (
+                "C node-to-surface, slave normals",
+                slip_and_stick("C", slave_normals()),
+            ),
+            ("C mortar", slip_and_stick("C", mortar("standard"))),
+            ("E dual mortar", slip_and_stick("E", mortar("dual"))),
+            (
+                "rigid circle",
+                (dragged(circle(), 0.05), dragged(circle(), 1e-6)),
+            ),
+        ],
+        |v| v,
+    );
 }
 
 /// Residual history of the first step of `v` with the given friction tangent.
@@ -816,65 +777,16 @@ fn iterations_per_step(o: &Outcome) -> Vec<usize> {
 
 #[test]
 fn lagrange_multipliers_tangent_is_the_derivative_of_the_residual_in_stick_and_in_slip() {
-    let cases = [
-        (
-            "A node-to-node",
-            patch(
-                "A",
-                "0.0",
-                node_to_node(),
-                MU * P,
-                Top::Displacement(0.05),
-                1,
-            ),
-            patch("A", "0.3", node_to_node(), 0.5 * MU * P, Top::Traction, 1),
-        ),
-        (
-            "C node-to-surface",
-            patch(
-                "C",
-                "0.0",
-                node_to_surface(),
-                MU * P,
-                Top::Displacement(0.05),
-                1,
-            ),
-            patch(
-                "C",
-                "0.3",
-                node_to_surface(),
-                0.5 * MU * P,
-                Top::Traction,
-                1,
-            ),
-        ),
-        ("rigid line", dragged(line(), 0.05), dragged(line(), 1e-6)),
-        (
-            "E dual mortar",
-            patch(
-                "E",
-                "0.0",
-                mortar("dual"),
-                MU * P,
-                Top::Displacement(0.05),
-                1,
-            ),
-            patch("E", "0.3", mortar("dual"), 0.5 * MU * P, Top::Traction, 1),
-        ),
-    ];
-    for (name, slip, stick) in cases {
-        for (v, status) in [
-            (lagrange(stick), Status::Stick),
-            (lagrange(slip), Status::Slip),
-        ] {
-            let o = run(&v);
-            assert_eq!(termination(&o), Termination::Converged, "{name} {status:?}");
-            let model = build(&v).unwrap();
-            let e = fd_error(&model, &o, status);
-            println!("Lagrange, {name}, {status:?}: tangent vs central differences {e:.1e}");
-            assert!(e < 1e-6, "{name} {status:?}: {e:e}");
-        }
-    }
+    assert_tangents_match_differences(
+        "Lagrange",
+        vec![
+            ("A node-to-node", slip_and_stick("A", node_to_node())),
+            ("C node-to-surface", slip_and_stick("C", node_to_surface())),
+            ("rigid line", (dragged(line(), 0.05), dragged(line(), 1e-6))),
+            ("E dual mortar", slip_and_stick("E", mortar("dual"))),
+        ],
+        lagrange,
+    );
 }
 
 #[test]
