@@ -4,7 +4,8 @@
 //! of breaks (the contact patch meshes need uneven, non-nested breaks), optionally moves some
 //! vertices to distort the grid, and derives the higher-order nodes from the (moved) vertices:
 //! mid-side nodes at edge midpoints, the Q9 centre at the mean of its corners, so every element
-//! keeps straight sides. Triangles split each quadrilateral cell along the diagonal from its
+//! keeps straight sides. A move may also start at a mid-side or centre node (where the vertex
+//! moves left it) and then moves that node alone, which curves a side. Triangles split each quadrilateral cell along the diagonal from its
 //! lower-left to its upper-right vertex.
 //!
 //! A facet is `(cell, local edge)`; only boundary facets (edges owned by one cell) enter facet
@@ -208,7 +209,7 @@ pub enum BlockError {
         value: f64,
         previous: f64,
     },
-    NoVertexAt {
+    NoNodeAt {
         from: [f64; 2],
     },
 }
@@ -224,9 +225,9 @@ impl std::fmt::Display for BlockError {
                 f,
                 "the {axis} breaks must increase strictly, but entry {index} ({value}) is not greater than the one before ({previous})"
             ),
-            BlockError::NoVertexAt { from } => write!(
+            BlockError::NoNodeAt { from } => write!(
                 f,
-                "a move starts at ({}, {}), where the block has no vertex; use the coordinates of a grid vertex",
+                "a move starts at ({}, {}), where the block has no node; use the coordinates of a grid vertex, or of a mid-side or centre node as the vertex moves leave it",
                 from[0], from[1]
             ),
         }
@@ -267,14 +268,17 @@ pub fn block(
         }
     }
     let size = (xs[nx] - xs[0]).max(ys[ny] - ys[0]);
+    let at = |p: [f64; 2], from: [f64; 2]| {
+        (p[0] - from[0]).abs() <= 1e-9 * size && (p[1] - from[1]).abs() <= 1e-9 * size
+    };
+    // a move from a vertex of the grid moves the vertex (the higher-order nodes follow it);
+    // any other move is of a mid-side or centre node, applied once they are placed
+    let mut node_moves = Vec::new();
     for &(from, to) in moves {
-        let k = vertex
-            .iter()
-            .position(|v| {
-                (v[0] - from[0]).abs() <= 1e-9 * size && (v[1] - from[1]).abs() <= 1e-9 * size
-            })
-            .ok_or(BlockError::NoVertexAt { from })?;
-        vertex[k] = to;
+        match vertex.iter().position(|&v| at(v, from)) {
+            Some(k) => vertex[k] = to,
+            None => node_moves.push((from, to)),
+        }
     }
     let v = |i: usize, j: usize| vertex[j * (nx + 1) + i];
     let mid = |a: [f64; 2], b: [f64; 2]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
@@ -359,6 +363,15 @@ pub fn block(
             }
         }
     }
+    // moves of single higher-order nodes (curving a side, shifting a centre), from where the
+    // vertex moves left them; vertices were taken above, so only lattice nodes remain
+    for (from, to) in node_moves {
+        let k = nodes
+            .iter()
+            .position(|&p| at(p, from))
+            .ok_or(BlockError::NoNodeAt { from })?;
+        nodes[k] = to;
+    }
     Ok(Mesh::new(kind, nodes, conn))
 }
 
@@ -430,7 +443,50 @@ mod tests {
                 &[0.0, 1.0],
                 &[([0.5, 0.5], [0.4, 0.4])]
             ),
-            Err(BlockError::NoVertexAt { .. })
+            Err(BlockError::NoNodeAt { .. })
+        ));
+    }
+
+    #[test]
+    fn a_move_from_a_mid_side_or_centre_node_moves_that_node_alone() {
+        // Q9 on [0,2]x[0,1]: curve the top side of the first cell (its mid-side node at
+        // (0.5, 1)) and shift the centre of the second ((1.5, 0.5))
+        let plain = block(ElementKind::Q9, &[0.0, 1.0, 2.0], &[0.0, 1.0], &[]).unwrap();
+        let moved = block(
+            ElementKind::Q9,
+            &[0.0, 1.0, 2.0],
+            &[0.0, 1.0],
+            &[([0.5, 1.0], [0.5, 1.1]), ([1.5, 0.5], [1.55, 0.45])],
+        )
+        .unwrap();
+        assert_eq!(plain.nodes.len(), moved.nodes.len());
+        let changed: Vec<usize> = (0..plain.nodes.len())
+            .filter(|&k| plain.nodes[k] != moved.nodes[k])
+            .collect();
+        assert_eq!(changed.len(), 2, "{changed:?}");
+        let top_mid = plain.nearest_node([0.5, 1.0]).unwrap().0;
+        let centre = plain.nearest_node([1.5, 0.5]).unwrap().0;
+        assert_eq!(moved.nodes[top_mid], [0.5, 1.1]);
+        assert_eq!(moved.nodes[centre], [1.55, 0.45]);
+        // after a vertex move, a mid-side node is found where the move left it
+        let both = block(
+            ElementKind::T6,
+            &[0.0, 1.0],
+            &[0.0, 1.0],
+            &[([1.0, 1.0], [1.2, 1.0]), ([0.6, 1.0], [0.6, 1.05])],
+        )
+        .unwrap();
+        assert!(both.nodes.contains(&[0.6, 1.05]));
+        assert!(both.nodes.contains(&[1.2, 1.0]));
+        // a linear element has no such nodes: the move is refused
+        assert!(matches!(
+            block(
+                ElementKind::Q4,
+                &[0.0, 1.0],
+                &[0.0, 1.0],
+                &[([0.5, 1.0], [0.5, 1.1])]
+            ),
+            Err(BlockError::NoNodeAt { .. })
         ));
     }
 }

@@ -579,7 +579,10 @@ pub struct BlockSpec {
     pub element: ElementKind,
     pub x: Breaks,
     pub y: Breaks,
-    /// Vertices moved after generation, to distort the grid.
+    /// Nodes moved after generation, to distort the grid: a move from a grid vertex moves the
+    /// vertex and the mid-side and centre nodes follow it (straight sides); a move from any
+    /// other node of a quadratic block (a mid-side or centre node, where the vertex moves left
+    /// it) moves that node alone, e.g. to curve a side.
     #[serde(default)]
     pub moves: Vec<Move>,
 }
