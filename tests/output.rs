@@ -189,3 +189,45 @@ fn the_summary_lists_only_the_effects_the_scene_asked_for() {
     let shares: f64 = effects.iter().filter_map(|e| e["share"].as_f64()).sum();
     assert!(shares > 0.0 && shares <= 1.0 + 1e-12, "{shares}");
 }
+
+/// Two outputs of one case with the same name: a body called `interface.contact` beside the pair
+/// `interface` would write `interface.contact.vtu` twice. The run is refused naming the file,
+/// and the previous output and a user's file beside it stay as they were.
+#[test]
+fn two_outputs_with_one_name_are_refused_not_written_over_each_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("cases/contact/coulomb-patch-slip.json"),
+    )
+    .unwrap()
+    .replace("\"punch\"", "\"interface.contact\"");
+    let case = dir.path().join("case.json");
+    std::fs::write(&case, text).unwrap();
+    let keep = dir.path().join("mine.txt");
+    std::fs::write(&keep, "the user's").unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .args([
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("would both be named 'interface.contact.vtu'"),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "nothing is moved into place");
+    assert_eq!(std::fs::read_to_string(&keep).unwrap(), "the user's");
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("partial"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}

@@ -18,7 +18,7 @@
 //!   smallest measured gap, the highest status code and the slip of the last pair naming it.
 
 use crate::contact::results::{ContactPoint, PairResults, PointStatus, Side};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::fe::EdgeKind;
 use crate::io::paths::file_name;
 use crate::io::scene::RigidSurface;
@@ -45,11 +45,11 @@ pub fn write_pair_files(dir: &Path, model: &Model, results: &[PairResults]) -> R
         let [vtu, csv, json] = pair_file_names(&r.name)?;
         write_surface_vtu(&dir.join(vtu), r)?;
         let path = dir.join(csv);
-        std::fs::write(&path, csv_text(r)).map_err(|e| Error::io(path.display(), "writing", e))?;
+        crate::io::paths::write_new_file(&path, &csv_text(r))?;
         let path = dir.join(json);
         let text = serde_json::to_string_pretty(&json_value(model, r))
             .expect("the contact results serialize");
-        std::fs::write(&path, text + "\n").map_err(|e| Error::io(path.display(), "writing", e))?;
+        crate::io::paths::write_new_file(&path, &(text + "\n"))?;
     }
     Ok(())
 }

@@ -238,7 +238,7 @@ pub fn export_case(case_file: &Path, out: &ReportFolder) -> Result<(OutputFolder
     folder.write(|tmp| {
         for (name, text) in &files {
             let path = tmp.join(name);
-            fs::write(&path, text).map_err(|e| Error::io(path.display(), "writing", e))?;
+            crate::io::paths::write_new_file(&path, text)?;
         }
         Ok(())
     })?;

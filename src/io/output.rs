@@ -24,7 +24,6 @@ use crate::post::{cell_stresses, nodal_stresses};
 use crate::run::Outcome;
 use crate::solver::linear::Timings;
 use serde::Serialize;
-use std::fs;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
@@ -418,7 +417,7 @@ pub fn write_run(folder: &OutputFolder, outcome: &Outcome) -> Result<()> {
     folder.write(|tmp| {
         let path = tmp.join("summary.json");
         let text = serde_json::to_string_pretty(&summary).expect("the summary serializes");
-        fs::write(&path, text + "\n").map_err(|e| Error::io(path.display(), "writing", e))?;
+        crate::io::paths::write_new_file(&path, &(text + "\n"))?;
         for (k, (b, s)) in outcome.model.bodies.iter().zip(&nodal).enumerate() {
             let path = tmp.join(file_name("body name", &b.name, ".vtu")?);
             let contact = body_point_arrays(&outcome.model, k, &results);
@@ -448,7 +447,7 @@ pub fn write_vtu_with(
     extra: &[PointArray],
 ) -> Result<()> {
     let io = |e| Error::io(path.display(), "writing", e);
-    let file = fs::File::create(path).map_err(io)?;
+    let file = crate::io::paths::create_new_file(path)?;
     let mut w = BufWriter::new(file);
     let mesh = &body.mesh;
     let cells = cell_stresses(body, u);

@@ -178,6 +178,43 @@ struct Manifest {
     files: Vec<String>,
 }
 
+/// Create the file `path` in a folder this process is filling (an [`OutputFolder`]'s staging
+/// folder), refusing to open a file that is already there: two outputs of one case that would
+/// carry the same name (a body called `a.contact` beside a pair `a`, a body called like another
+/// body's frame) are an error naming the file, never one output silently written over another.
+pub fn create_new_file(path: &Path) -> Result<fs::File> {
+    fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(path)
+        .map_err(|e| {
+            if e.kind() == std::io::ErrorKind::AlreadyExists {
+                let name = path
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                Error::invalid(
+                    path.display(),
+                    "the output files",
+                    format!("two outputs of this case would both be named '{name}'"),
+                    "rename a body or a contact pair so that its files (<body>.vtu, \
+                     <body>.frame-NNNN.vtu, <body>.pvd, <pair>.contact.vtu/.csv/.json) differ \
+                     from the others and from summary.json and history.*",
+                )
+            } else {
+                Error::io(path.display(), "creating", e)
+            }
+        })
+}
+
+/// [`create_new_file`], then write `text` into it.
+pub fn write_new_file(path: &Path, text: &str) -> Result<()> {
+    use std::io::Write;
+    create_new_file(path)?
+        .write_all(text.as_bytes())
+        .map_err(|e| Error::io(path.display(), "writing", e))
+}
+
 /// A folder the tool owns as a whole: built aside, then moved into place.
 #[derive(Debug)]
 pub struct OutputFolder {

@@ -5,13 +5,11 @@
 //! `Collection`, one `DataSet` per frame with its `timestep`) of the frames
 //! `<body>.frame-NNNN.vtu`, written like the run's `.vtu` files.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::io::paths::file_name;
 use crate::io::svg::{line_plot, Series};
 use crate::model::{Body, Model};
 use crate::solver::history::DynamicHistory;
-use std::collections::HashSet;
-use std::fs;
 use std::path::Path;
 
 /// Writes one `.vtu` frame: `(path, body, global displacement)`.
@@ -25,22 +23,13 @@ pub fn write_history(
     history: &DynamicHistory,
     write_frame: FrameWriter<'_>,
 ) -> Result<()> {
-    let write = |name: &str, text: &str| {
-        let path = dir.join(name);
-        fs::write(&path, text).map_err(|e| Error::io(path.display(), "writing", e))
-    };
+    // every file is created new: a name taken by another output is refused there
+    let write = |name: &str, text: &str| crate::io::paths::write_new_file(&dir.join(name), text);
     let json = serde_json::to_string_pretty(history).expect("the history serializes") + "\n";
     write("history.json", &json)?;
     write("history.csv", &history.csv())?;
     for (name, svg) in plots(history) {
         write(&name, &svg)?;
-    }
-    let mut names: HashSet<String> = ["history.json", "history.csv", "summary.json"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    for b in &model.bodies {
-        names.insert(file_name("body name", &b.name, ".vtu")?);
     }
     for body in &model.bodies {
         let mut collection = String::from(
@@ -48,14 +37,6 @@ pub fn write_history(
         );
         for (k, (time, u)) in history.frames.iter().enumerate() {
             let name = file_name("body name", &body.name, &format!(".frame-{k:04}.vtu"))?;
-            if !names.insert(name.clone()) {
-                return Err(Error::invalid(
-                    &model.source,
-                    format!("body '{}'", body.name),
-                    format!("its frame file '{name}' has the name of another output file"),
-                    "rename the body so that no body is called like another's frame (<body>.frame-NNNN)",
-                ));
-            }
             write_frame(&dir.join(&name), body, u)?;
             collection.push_str(&format!(
                 "<DataSet timestep=\"{time:e}\" group=\"\" part=\"0\" file=\"{name}\"/>\n"
@@ -63,14 +44,6 @@ pub fn write_history(
         }
         collection.push_str("</Collection>\n</VTKFile>\n");
         let pvd = file_name("body name", &body.name, ".pvd")?;
-        if !names.insert(pvd.clone()) {
-            return Err(Error::invalid(
-                &model.source,
-                format!("body '{}'", body.name),
-                format!("its collection file '{pvd}' has the name of another output file"),
-                "rename the body",
-            ));
-        }
         write(&pvd, &collection)?;
     }
     Ok(())

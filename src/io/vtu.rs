@@ -8,7 +8,7 @@
 //! 3 (`VTK_LINE`) for Line2 facets and 21 (`VTK_QUADRATIC_EDGE`, end, end, middle) for Line3
 //! facets, whose node order is ours.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -129,7 +129,7 @@ pub fn write_grid(
     }
     let _ = writeln!(text, "</PointData>");
     let _ = writeln!(text, "</Piece></UnstructuredGrid></VTKFile>");
-    std::fs::write(path, text).map_err(|e| Error::io(path.display(), "writing", e))
+    crate::io::paths::write_new_file(path, &text)
 }
 
 #[cfg(test)]
