@@ -98,18 +98,25 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
-    /// The impact study: the dynamic cases with every impact treatment and mass against the
-    /// 1D wave solutions; writes reports/impact.md and reports/impact.json.
+    /// The impact studies: `impact` (default), the dynamic cases with every impact treatment
+    /// and mass against the 1D wave solutions (reports/impact.md, .json); `block-drop`, a block
+    /// dropped on a foundation under time-step refinement (reports/block-drop.md, .json, .svg);
+    /// `cost`, errors against the wave solution versus wall time over four refinement levels
+    /// (reports/impact-cost.md, .json, .svg).
     #[command(
         name = "impact-report",
-        after_help = "Example:\n  contact-patch impact-report\n  contact-patch impact-report cases/dynamics/bar-on-rigid-wall.json --out /tmp/reports"
+        after_help = "Example:\n  contact-patch impact-report\n  contact-patch impact-report cases/dynamics/bar-on-rigid-wall.json --out /tmp/reports\n  contact-patch impact-report --study block-drop\n  contact-patch impact-report --study cost"
     )]
     ImpactReport {
-        /// Dynamic case files (default: the three of cases/dynamics).
+        /// Dynamic case files (default: the three bar cases of cases/dynamics for `impact`,
+        /// the three block-drop cases for `block-drop`, the bar on a rigid wall for `cost`).
         paths: Vec<PathBuf>,
         /// Output folder.
         #[arg(long, default_value = "reports")]
         out: PathBuf,
+        /// Which study to run.
+        #[arg(long, value_enum, default_value = "impact")]
+        study: ImpactStudy,
     },
     /// Solve one case and plot a contact pair's pressure profile (against Hertz's closed form
     /// when the master is a rigid circle); writes <case>.<pair>.pressure.svg and .md.
@@ -203,7 +210,7 @@ fn main() -> ExitCode {
         ),
         Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
         Command::Hard { paths, out } => hard(&paths, &out),
-        Command::ImpactReport { paths, out } => impact_report(&paths, &out),
+        Command::ImpactReport { paths, out, study } => impact_report(&paths, &out, study),
         Command::Profile { case, pair, out } => profile(&case, &pair, &out),
         Command::Schema => {
             print!("{}", contact_patch::io::scene::case_schema());
@@ -986,14 +993,34 @@ fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
     }
 }
 
+/// The studies of `contact-patch impact-report`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum ImpactStudy {
+    /// The bar cases with every treatment and mass (reports/impact.md, .json).
+    Impact,
+    /// A block dropped on a foundation under dt refinement (reports/block-drop.*).
+    BlockDrop,
+    /// Errors against the wave solution versus wall time (reports/impact-cost.*).
+    Cost,
+}
+
 /// The cases of `contact-patch impact-report` when none are given.
 const IMPACT_CASES: [&str; 3] = [
     "cases/dynamics/bar-on-rigid-wall.json",
     "cases/dynamics/two-identical-bars.json",
     "cases/dynamics/two-bars-different-impedance.json",
 ];
+/// The cases of `impact-report --study block-drop` when none are given.
+const BLOCK_DROP_CASES: [&str; 3] = [
+    "cases/dynamics/block-drop-node-to-surface.json",
+    "cases/dynamics/block-drop-mortar.json",
+    "cases/dynamics/block-drop-rigid.json",
+];
+/// The case of `impact-report --study cost` when none is given.
+const COST_CASES: [&str; 1] = ["cases/dynamics/bar-on-rigid-wall.json"];
 
-fn impact_report(paths: &[PathBuf], out: &Path) -> ExitCode {
+fn impact_report(paths: &[PathBuf], out: &Path, study: ImpactStudy) -> ExitCode {
+    use contact_patch::harness::{block_drop, impact, impact_cost};
     let folder = match ReportFolder::new(out) {
         Ok(f) => f,
         Err(e) => {
@@ -1001,27 +1028,65 @@ fn impact_report(paths: &[PathBuf], out: &Path) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let defaults: &[&str] = match study {
+        ImpactStudy::Impact => &IMPACT_CASES,
+        ImpactStudy::BlockDrop => &BLOCK_DROP_CASES,
+        ImpactStudy::Cost => &COST_CASES,
+    };
     let paths: Vec<&Path> = if paths.is_empty() {
-        IMPACT_CASES.iter().map(Path::new).collect()
+        defaults.iter().map(Path::new).collect()
     } else {
         paths.iter().map(PathBuf::as_path).collect()
     };
-    let result = (|| -> contact_patch::Result<()> {
-        let measures = contact_patch::harness::impact::study(&paths)?;
-        folder.write_file(
-            "impact.md",
-            &contact_patch::harness::impact::report(&measures),
-        )?;
-        let json = serde_json::to_string_pretty(&measures).expect("measures serialize") + "\n";
-        folder.write_file("impact.json", &json)
+    let result = (|| -> contact_patch::Result<Vec<String>> {
+        let (stem, md, json, plots) = match study {
+            ImpactStudy::Impact => {
+                let m = impact::study(&paths)?;
+                (
+                    "impact",
+                    impact::report(&m),
+                    serde_json::to_string_pretty(&m),
+                    Vec::new(),
+                )
+            }
+            ImpactStudy::BlockDrop => {
+                let m = block_drop::study(&paths)?;
+                let plots = block_drop::plots(&m);
+                (
+                    "block-drop",
+                    block_drop::report(&m),
+                    serde_json::to_string_pretty(&m),
+                    plots,
+                )
+            }
+            ImpactStudy::Cost => {
+                let m = impact_cost::study(&paths)?;
+                let plots = impact_cost::plots(&m);
+                (
+                    "impact-cost",
+                    impact_cost::report(&m),
+                    serde_json::to_string_pretty(&m),
+                    plots,
+                )
+            }
+        };
+        let mut written = vec![format!("{stem}.md"), format!("{stem}.json")];
+        folder.write_file(&written[0], &md)?;
+        folder.write_file(&written[1], &(json.expect("measures serialize") + "\n"))?;
+        for (name, svg) in plots {
+            let file = format!("{name}.svg");
+            folder.write_file(&file, &svg)?;
+            written.push(file);
+        }
+        Ok(written)
     })();
     match result {
-        Ok(()) => {
-            println!(
-                "wrote {} and {}",
-                folder.shown("impact.md").display(),
-                folder.shown("impact.json").display()
-            );
+        Ok(written) => {
+            let shown: Vec<String> = written
+                .iter()
+                .map(|f| folder.shown(f).display().to_string())
+                .collect();
+            println!("wrote {}", shown.join(", "));
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -69,3 +69,53 @@ write(case("two-bars-different-impedance",
              "master": {"body": "target", "set": "left"},
              "discretization": {"kind": "node_to_node"}}],
            [{"body": "striker", "velocity": [0.01, 0.0]}], 0.005, 0.4, lagrange))
+
+# a 2D elastic block dropped on an elastic foundation (benchmarks.md section 6, issue 11): no
+# closed form; judged on no energy gain and the release time under time-step refinement
+# (tests/dynamics.rs). Block [0.5, 1.5] x [1, 2] at v = (0, -0.01) touches the foundation
+# [0, 2] x [0, 1] (bottom clamped) at t = 0; both E = 100, nu = 0.3, rho = 1, plane strain:
+# c_p = sqrt(E (1 - nu) / ((1 + nu)(1 - 2 nu) rho)) = 11.60; the 1D estimate of the contact
+# time of the block alone is 2 H / c_p = 0.172 (the foundation's compliance lengthens it).
+def block_drop(name, discretization, rigid=False):
+    block = {"name": "block", "material": "m",
+             "mesh": {"block": {"element": "Q4", "x": {"from": 0.5, "to": 1.5, "divisions": 8},
+                                "y": {"from": 1.0, "to": 2.0, "divisions": 8}}}}
+    foundation = {"name": "foundation", "material": "m",
+                  "mesh": {"block": {"element": "Q4", "x": {"from": 0.0, "to": 2.0, "divisions": 16},
+                                     "y": {"from": 0.0, "to": 1.0, "divisions": 8}}}}
+    if rigid:
+        bodies, supports = [block], []
+        master = {"rigid": {"kind": "line", "point": [1.0, 1.0], "normal": [0.0, 1.0]}}
+        where = "a rigid foundation (the line y = 1)"
+    else:
+        bodies = [block, foundation]
+        supports = [{"body": "foundation", "set": "bottom", "x": 0.0, "y": 0.0}]
+        master = {"body": "foundation", "set": "top"}
+        where = "an elastic foundation [0, 2] x [0, 1] (Q4 16 x 8, bottom clamped)"
+    return {
+        "$schema": "../case.schema.json",
+        "name": name,
+        "description": f"A block [0.5, 1.5] x [1, 2] (Q4 8 x 8) moving at v = (0, -0.01) touches {where} at t = 0; E = 100, nu = 0.3, rho = 1, plane strain (c_p = 11.60, 2 H / c_p = 0.172). {discretization['kind']} contact, Lagrange multipliers, the seed's post-impact correction, dt = 0.01 (about h / c_p). No closed form: tests/dynamics.rs checks that the energy never grows and that the release time converges as dt is halved; reports/block-drop.md shows the contact force history.",
+        "analysis": {"plane": "strain", "thickness": 1.0},
+        "materials": {"m": {"E": 100.0, "nu": 0.3, "density": 1.0}},
+        "bodies": bodies,
+        "supports": supports,
+        "physics": {"dynamics": {"integrator": "average_acceleration", "dt": 0.01, "end_time": 0.5,
+                                 "mass": "lumped", "impact": "post_impact",
+                                 "initial_velocity": [{"body": "block", "velocity": [0.0, -0.01]}]}},
+        "contact": [{"name": "drop", "slave": {"body": "block", "set": "bottom"},
+                     "master": master, "discretization": discretization,
+                     "enforcement": lagrange}],
+        "solver": {"scheme": "newton"},
+        # at end_time the block has left: no contact force is left, and Lagrange multipliers
+        # let no node penetrate
+        "checks": [
+            {"check": "contact_force", "pair": "drop", "component": "y", "value": 0.0,
+             "tol": 1e-12},
+            {"check": "max_penetration", "share": 1e-12},
+        ],
+    }
+
+write(block_drop("block-drop-node-to-surface", {"kind": "node_to_surface", "passes": 1}))
+write(block_drop("block-drop-mortar", {"kind": "mortar"}))
+write(block_drop("block-drop-rigid", {"kind": "node_to_surface", "passes": 1}, rigid=True))

@@ -30,11 +30,13 @@
 //! * `n/a` cells say why the combination does not apply.
 
 pub mod baseline;
+pub mod block_drop;
 pub mod checks;
 pub(crate) mod exact;
 pub mod friction;
 pub mod hard;
 pub mod impact;
+pub mod impact_cost;
 pub mod judge;
 pub mod junit;
 pub mod layer;
