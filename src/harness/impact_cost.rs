@@ -86,7 +86,7 @@ pub fn refined(case: &Case, refinement: Refinement, level: usize, source: &str) 
                     Breaks::Uniform(u) => u.divisions *= level,
                     Breaks::List(_) => return Err(Error::invalid(
                         source,
-                        &format!("bodies[{k}].mesh.block.x"),
+                        format!("bodies[{k}].mesh.block.x"),
                         "the cost study refines uniform divisions; this axis is a list of breaks",
                         "give the axis as {\"from\": .., \"to\": .., \"divisions\": N}",
                     )),
@@ -94,7 +94,7 @@ pub fn refined(case: &Case, refinement: Refinement, level: usize, source: &str) 
                 MeshSpec::Explicit(_) => {
                     return Err(Error::invalid(
                         source,
-                        &format!("bodies[{k}].mesh"),
+                        format!("bodies[{k}].mesh"),
                         "the cost study refines block meshes; this mesh is explicit",
                         "give the bar as a \"block\" mesh with uniform divisions",
                     ))
@@ -323,4 +323,35 @@ pub fn plots(measures: &[CostMeasure]) -> Vec<(String, String)> {
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::force_l2_error;
+
+    #[test]
+    fn the_force_error_is_the_trapezoidal_l2_norm_of_the_difference() {
+        // the exact history gives 0; a zero history on steps dt = T / 10 over (0, 2 T) gives
+        // sqrt(dt (1/2 (F/2)^2 + 9 F^2 + (F/2)^2) / (F^2 T)) = sqrt(9.375 / 10)
+        let (force, duration) = (3.0, 0.2);
+        let dt = duration / 10.0;
+        let times: Vec<f64> = (0..=20).map(|k| k as f64 * dt).collect();
+        let exact: Vec<(f64, f64)> = times
+            .iter()
+            .map(|&t| {
+                let f = if t == 0.0 || (t - duration).abs() < 1e-12 {
+                    0.5 * force
+                } else if t < duration {
+                    force
+                } else {
+                    0.0
+                };
+                (t, f)
+            })
+            .collect();
+        assert!(force_l2_error(&exact, force, duration, dt) < 1e-15);
+        let zero: Vec<(f64, f64)> = times.iter().map(|&t| (t, 0.0)).collect();
+        let e = force_l2_error(&zero, force, duration, dt);
+        assert!((e - (9.375f64 / 10.0).sqrt()).abs() < 1e-14, "{e}");
+    }
 }
