@@ -139,9 +139,11 @@ def in_box(points, box):
 class Problem:
     """One body of a case, resolved on the body's .vtu mesh. Without `body` the case must have
     exactly one body (and may have rigid contact pairs); with `body` (a name) the supports and
-    loads of that body are taken and the rest of the case is left to the caller (`TiedCase`)."""
+    loads of that body are taken and the rest of the case is left to the caller (`TiedCase`).
+    A case with `physics.dynamics` is refused unless `dynamic` (then `self.dynamics` is that
+    section and `u_ours` the displacement at the last step)."""
 
-    def __init__(self, case_path, out_dir, body=None):
+    def __init__(self, case_path, out_dir, body=None, dynamic=False):
         self.case_path = Path(case_path)
         self.case = json.loads(self.case_path.read_text())
         self.name = self.case["name"]
@@ -154,7 +156,12 @@ class Problem:
             if key not in {"name", "description", "analysis", "materials", "bodies", "exact",
                            "supports", "loads", "checks", "physics", "contact"}:
                 raise Unsupported(f"case section {key!r}")
-        physics = c.get("physics", {}) or {}
+        physics = dict(c.get("physics", {}) or {})
+        # a time history (physics.dynamics) only for the callers that step it (`dynamic`)
+        self.dynamics = physics.pop("dynamics", None)
+        if self.dynamics is not None and not dynamic:
+            raise Unsupported("physics.dynamics (a time history; DOLFINx steps it, "
+                              "ref_dolfinx.solve_wave)")
         if any(k != "kinematics" or v != "small_strain" for k, v in physics.items()):
             raise Unsupported(f"physics {physics}")
         if body is None:

@@ -22,6 +22,18 @@ the active set is then the exact solution of the linear problem on that set, up 
 Two-body tied cases are not solved here (the tied layer's DOLFINx reference is the one-body
 mesh); their reference file says so.
 
+Elastic waves (`physics.dynamics`, no contact; `solve_wave`): the stiffness form above and the
+consistent mass form `int t rho u . v dx` (quadrature of our `mass_rule`: Gauss 3x3 on Q4, 4x4
+on Q9; exact on triangles) assembled by DOLFINx on the same mesh, the lumped mass as the row
+sums of that matrix (our HRZ lumping on parallelogram Q4 cells, whose consistent element mass
+has equal diagonal entries, where HRZ is the row sum), the facet loads integrated as above;
+then Newmark's method with the case's beta, gamma and dt, written here in numpy/scipy
+independently of our solver: `(K + M / (beta dt^2)) d_{n+1} = f + M d~ / (beta dt^2)` on the
+free dofs (SuperLU), `d~ = d_n + dt v_n + dt^2 (1/2 - beta) a_n`,
+`a_{n+1} = (d_{n+1} - d~) / (beta dt^2)`, `v_{n+1} = v_n + dt ((1 - gamma) a_n + gamma a_{n+1})`,
+from `d_0 = 0`, the case's initial velocities and `a_0 = M^-1 (f - K d_0)`. The reference keeps
+the displacement at every step and the kinetic, strain and load energies.
+
 The solution is also written by DOLFINx itself (`dolfinx.io.VTKFile`, ASCII) as
 OUT_ROOT/<case>/dolfinx.pvd + dolfinx_p0_000000.vtu, with the point fields `displacement` and
 `stress` (xx, yy, xy of sigma(u_h) interpolated at the nodes of a Lagrange space of the same
@@ -32,6 +44,7 @@ so that `contact-patch judge` can apply the case's checks to it (crosscheck/run.
 import dolfinx_solver  # noqa: F401  (must come before dolfinx and petsc4py)
 
 import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -205,6 +218,139 @@ def solve(pb: Problem, vtu_path=None):
     return out, extra
 
 
+# Our mass quadrature (src/solid.rs `mass_rule`): Gauss 3x3 (Q4) and 4x4 (Q9), i.e. basix
+# degrees 4 and 7; triangles are affine, where any rule exact for the integrand agrees.
+MASS_DEGREE = {"Q4": 4, "Q9": 7, "T3": 2, "T6": 4}
+NEWMARK = {"average_acceleration": (0.25, 0.5), "central_difference": (0.0, 0.5)}
+
+
+def solve_wave(pb: Problem):
+    """Newmark time stepping of an elastic body without contact (see the module text). Returns
+    the displacement at the last step (in .vtu order) and the history."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    dyn = pb.dynamics
+    if pb.contact:
+        raise Unsupported("dynamics with contact (the wave cross-check has none)")
+    integrator = dyn.get("integrator", "average_acceleration")
+    beta, gamma = (NEWMARK[integrator] if isinstance(integrator, str)
+                   else (integrator["newmark"]["beta"], integrator["newmark"]["gamma"]))
+    if beta <= 0.0:
+        raise Unsupported("the explicit member (beta = 0)")
+    dt, end = float(dyn["dt"]), float(dyn["end_time"])
+    ratio = end / dt
+    steps = max(1, math.ceil(ratio - 1e-9 * ratio))     # as src/model/dynamics.rs
+    mass_kind = dyn.get("mass", "lumped")
+    rho = float(pb.case["materials"][pb.case["bodies"][0]["material"]]["density"])
+
+    cellname, degree = CELL[pb.element]
+    perm = cell_perm_vtk(DCELL[cellname], pb.cells.shape[1])
+    cells = np.ascontiguousarray(pb.cells[:, perm], dtype=np.int64)
+    coord_el = basix.ufl.element("Lagrange", cellname, degree, shape=(2,),
+                                 lagrange_variant=basix.LagrangeVariant.equispaced)
+    msh = dmesh.create_mesh(MPI.COMM_SELF, cells, ufl.Mesh(coord_el), pb.points)
+    V = fem.functionspace(msh, ("Lagrange", degree, (2,)))
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    mat = pb.material
+    th = fem.Constant(msh, pb.thickness)
+
+    def eps(w):
+        return ufl.sym(ufl.grad(w))
+
+    def sigma(w):
+        return mat.lam * ufl.tr(eps(w)) * ufl.Identity(2) + 2.0 * mat.mu * eps(w)
+
+    dxk = ufl.Measure("dx", domain=msh, metadata={"quadrature_degree": STIFFNESS_DEGREE[pb.element]})
+    dxm = ufl.Measure("dx", domain=msh, metadata={"quadrature_degree": MASS_DEGREE[pb.element]})
+    K = fem.assemble_matrix(fem.form(th * ufl.inner(sigma(u), eps(v)) * dxk)).to_scipy().tocsr()
+    M = fem.assemble_matrix(fem.form(th * rho * ufl.inner(u, v) * dxm)).to_scipy().tocsr()
+    if mass_kind == "lumped":
+        M = sp.diags(np.asarray(M.sum(axis=1)).ravel()).tocsr()
+
+    # facet loads (constant in time) and body forces, as in `solve`
+    fdim = msh.topology.dim - 1
+    msh.topology.create_connectivity(fdim, msh.topology.dim)
+    x, n = ufl.SpatialCoordinate(msh), ufl.FacetNormal(msh)
+    f = np.zeros(K.shape[0])
+    for k, ld in enumerate(pb.loads):
+        if ld.box is None:
+            dxb = ufl.Measure("dx", domain=msh, metadata={"quadrature_degree": BODY_FORCE_DEGREE})
+            form = th * ufl.dot(ufl.as_vector(ld.value), v) * dxb
+        else:
+            facets = dmesh.locate_entities_boundary(
+                msh, fdim, lambda X, box=ld.box: in_box(X[:2].T, box))
+            if len(facets) == 0:
+                raise RuntimeError(f"{pb.name}: load {k} selects no boundary facet")
+            mt = dmesh.meshtags(msh, fdim, np.sort(facets).astype(np.int32),
+                                np.ones(len(facets), dtype=np.int32))
+            ds = ufl.Measure("ds", domain=msh, subdomain_data=mt,
+                             metadata={"quadrature_degree": LOAD_DEGREE})
+            form = th * ufl.dot(ufl.as_vector(ld.traction(x[0], x[1], n)), v) * ds(1)
+        f += fem.assemble_vector(fem.form(form)).array
+
+    # dof 2 i + c is component c of the node at V's coordinate i (block size 2)
+    X = V.tabulate_dof_coordinates()[:, :2]
+    ids, dist = pb.match(X)                      # DOLFINx node -> .vtu point
+    inv = np.empty(len(ids), dtype=np.int64)
+    inv[ids] = np.arange(len(ids))               # .vtu point -> DOLFINx node
+    tree = cKDTree(X)
+    fixed = np.zeros(K.shape[0], dtype=bool)
+    for coords, comp, values in pb.supports:
+        d, idx = tree.query(coords)
+        if d.max() > pb.tol:
+            raise RuntimeError(f"{pb.name}: support node not found (distance {d.max():.3e})")
+        if np.any(values != 0.0):
+            raise Unsupported("a non-zero support in a dynamic case")
+        fixed[2 * idx + comp] = True
+    free = np.flatnonzero(~fixed)
+
+    vel = np.zeros(K.shape[0])
+    for iv in dyn.get("initial_velocity", []):
+        if iv["body"] != pb.body:
+            raise Unsupported(f"initial velocity of body {iv['body']!r}")
+        nodes = pb.node_set(iv["set"]) if iv.get("set") else np.arange(len(pb.points))
+        for comp in (0, 1):
+            vel[2 * inv[nodes] + comp] = float(iv["velocity"][comp])
+    vel[fixed] = 0.0
+
+    Kff, Mff = K[free][:, free], M[free][:, free]
+    c0 = 1.0 / (beta * dt * dt)
+    effective = spla.splu((Kff + c0 * Mff).tocsc())
+    mass_lu = spla.splu(Mff.tocsc())
+    d = np.zeros(K.shape[0])
+    a = np.zeros(K.shape[0])
+    a[free] = mass_lu.solve(f[free] - Kff @ d[free])
+
+    def on_vtu(w):
+        return w.reshape(-1, 2)[inv]             # DOLFINx nodes -> .vtu order
+
+    def energies():
+        return {"kinetic": 0.5 * vel @ (M @ vel), "strain": 0.5 * d @ (K @ d),
+                "load": -f @ d}
+
+    history = {"time": [0.0], "u": [on_vtu(d).tolist()]}
+    energy = {k: [e] for k, e in energies().items()}
+    for step in range(1, steps + 1):
+        predictor = d + dt * vel + dt * dt * (0.5 - beta) * a
+        d_new = np.zeros_like(d)
+        d_new[free] = effective.solve(f[free] + c0 * (Mff @ predictor[free]))
+        a_new = np.zeros_like(a)
+        a_new[free] = c0 * (d_new[free] - predictor[free])
+        vel = vel + dt * ((1.0 - gamma) * a + gamma * a_new)
+        d, a = d_new, a_new
+        history["time"].append(step * dt)
+        history["u"].append(on_vtu(d).tolist())
+        for k, e in energies().items():
+            energy[k].append(float(e))
+    extra = {"match_distance": dist, "dofs": int(K.shape[0]),
+             "stiffness_quadrature_degree": STIFFNESS_DEGREE[pb.element],
+             "mass_quadrature_degree": MASS_DEGREE[pb.element], "mass": mass_kind,
+             "newmark": {"beta": beta, "gamma": gamma, "dt": dt, "steps": steps},
+             "history": history, "energy": energy}
+    return on_vtu(d), extra
+
+
 def newton_penalty(pb, msh, V, a, L, bcs_values, bcs0, mt, contact_terms, th, ids):
     """Newton's method for K u = f + penalty contact forces (see the module text), from u = 0
     plus the supports' values. `bcs0` are the supports with zero values (for the increments).
@@ -340,8 +486,12 @@ def main(argv):
                     "reference is the one-body mesh")}))
                 print(f"dolfinx {name}: not applicable (two bodies)", flush=True)
                 continue
-            pb = Problem(case, root / name)
-            u, extra = solve(pb, root / name / "dolfinx.pvd")
+            if (json.loads(Path(case).read_text()).get("physics") or {}).get("dynamics"):
+                pb = Problem(case, root / name, dynamic=True)
+                u, extra = solve_wave(pb)
+            else:
+                pb = Problem(case, root / name)
+                u, extra = solve(pb, root / name / "dolfinx.pvd")
             extra.update({"seconds": time.perf_counter() - t0,
                           "versions": {"dolfinx": dolfinx.__version__,
                                        "basix": basix.__version__}})

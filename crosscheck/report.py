@@ -22,6 +22,10 @@ contact results or the tie solutions; see ref_dolfinx.py and ref_skfem.py). Quan
   s. 3): peak pressure within 3% of p0, half-width within one node spacing of a.
 * two bodies tied by a mortar pair: scikit-fem's mortar tie with the same multipliers; the
   field over both bodies (and per body), tolerance 1e-10. DOLFINx: not applicable (n/a).
+* elastic waves (physics.dynamics, no contact): DOLFINx only (ref_dolfinx.solve_wave, the
+  same Newmark steps on DOLFINx's stiffness and mass); the last step's field, the displacement
+  history at every frame and node and at two nodes, and the kinetic, strain and load energy
+  histories, tolerance TOL. scikit-fem: not applicable.
 * studies (OUT_ROOT/studies.json, written by studies.py), sampled with common.Sampler:
   - tied layer: du of src/harness/layer.rs (our dual mortar tie against the one-body solution of our
     tool, DOLFINx and scikit-fem at the same level); the three must agree to 1e-8 (absolute)
@@ -244,6 +248,9 @@ def case_entry(case_path, root, repo):
         if len(case.get("bodies", [])) > 1:
             tc = TiedCase(case_path, out)
             kind = "tie"
+        elif (case.get("physics") or {}).get("dynamics") is not None:
+            pb = Problem(case_path, out, dynamic=True)
+            kind = "wave"
         else:
             pb = Problem(case_path, out)
             kind = "contact" if pb.contact else "elasticity"
@@ -273,6 +280,11 @@ def case_entry(case_path, root, repo):
     try:
         if kind == "tie":
             rows = tie_rows(entry, tc, datas, errors, na)
+        elif kind == "wave":
+            if "dolfinx" in na:   # DOLFINx must step every wave case
+                errors["dolfinx"] = f"not applicable to a wave case: {na.pop('dolfinx')}"
+                entry["errors"] = errors
+            rows = wave_rows(entry, pb, out, datas, errors, na)
         else:
             if na:   # a one-body case must be solved by both references
                 for s, why in na.items():
@@ -375,6 +387,73 @@ def body_rows(entry, pb, summary, kind, datas, errors):
                       "bound_text": f"node spacing {spacing:.3g}",
                       "verdict": verdict(herr, spacing)}]}
     return rows, hertz
+
+
+def our_frames(out, body):
+    """(times, displacements (frames, points, 2)) of our .pvd series of `body`."""
+    pvd = ET.parse(out / f"{body}.pvd").getroot()
+    times, frames = [], []
+    for ds in pvd.iter("DataSet"):
+        times.append(float(ds.get("timestep")))
+        frames.append(read_vtu(out / ds.get("file"))[3])
+    return np.asarray(times), np.asarray(frames)
+
+
+def wave_rows(entry, pb, out, datas, errors, na):
+    """An elastic wave without contact (ref_dolfinx.solve_wave): the displacement at the last
+    step; the displacement history over every frame our tool wrote (each frame matched to the
+    reference's step at the same time) at all nodes, at the top-right node and at the top node
+    nearest mid-length; the kinetic, strain and load energy histories of every step
+    (history.json). Relative differences: max over time (and nodes) of |ref - ours| over max
+    |ours| of the same quantity. Tolerance TOL (round-off): the same discrete problem."""
+    entry.update({"element": pb.element, "plane": pb.material.plane, "nodes": len(pb.points),
+                  "cells": len(pb.cells), "mass": pb.dynamics.get("mass", "lumped"),
+                  "tolerance_rule": "round-off, 1e-10"})
+    refs = {s: np.asarray(d["u"], dtype=float) for s, d in datas.items()}
+    rows = Rows(refs, errors, na)
+    tol, txt = TOL, tol_text(TOL)
+    corner = pb.node_set("top_right")
+    corner = int(corner[0]) if len(corner) == 1 else None
+    field_rows(rows, pb.u_ours, refs, tol, txt, corner, label="u at the last step, all nodes")
+    times, ours = our_frames(out, pb.body)
+    dt = float(pb.dynamics["dt"])
+    hist = {}
+    for s, d in datas.items():
+        h = d["history"]
+        steps = np.rint(times / dt).astype(int)
+        if steps.max() >= len(h["time"]) or np.abs(np.asarray(h["time"])[steps] - times).max() \
+                > 1e-9 * dt:
+            raise RuntimeError(f"{NAMES[s]}'s steps do not meet our frame times")
+        hist[s] = np.asarray(h["u"], dtype=float)[steps]
+    scale = float(np.abs(ours).max()) or 1.0
+    rows.add(f"u history, {len(times)} frames x all nodes", scale,
+             {s: float(np.abs(r).max()) for s, r in hist.items()},
+             {s: float(np.abs(r - ours).max() / scale) for s, r in hist.items()}, tol, txt)
+    top = np.flatnonzero(np.abs(pb.points[:, 1] - pb.hi[1]) <= pb.tol)
+    mid = int(top[np.argmin(np.abs(pb.points[top, 0] - 0.5 * (pb.lo[0] + pb.hi[0])))])
+    for node, where in ((corner, "top_right"), (mid, "top, mid-length")):
+        if node is None:
+            continue
+        h_ours = ours[:, node, 0]
+        sc = float(np.abs(h_ours).max()) or 1.0
+        rows.add(f"u_x history at {where}", sc,
+                 {s: float(np.abs(r[:, node, 0]).max()) for s, r in hist.items()},
+                 {s: float(np.abs(r[:, node, 0] - h_ours).max() / sc) for s, r in hist.items()},
+                 tol, txt)
+    steps = json.loads((out / "history.json").read_text())["steps"]
+    for ours_key, ref_key, what in (("kinetic", "kinetic", "kinetic"),
+                                    ("strain", "strain", "strain"),
+                                    ("load_potential", "load", "load potential")):
+        e = np.asarray([st[ours_key] for st in steps], dtype=float)
+        sc = float(np.abs(e).max()) or 1.0
+        refs_e = {s: np.asarray(d["energy"][ref_key], dtype=float) for s, d in datas.items()}
+        for s, r in refs_e.items():
+            if len(r) != len(e):
+                raise RuntimeError(f"{NAMES[s]} has {len(r)} steps, ours {len(e)}")
+        rows.add(f"{what} energy history, {len(e)} steps", sc,
+                 {s: float(np.abs(r).max()) for s, r in refs_e.items()},
+                 {s: float(np.abs(r - e).max() / sc) for s, r in refs_e.items()}, tol, txt)
+    return rows
 
 
 def tie_rows(entry, tc, datas, errors, na):
@@ -676,7 +755,12 @@ def write_md(path, report):
         "stiffness' 1-norm condition number makes that larger (*k1 eps*); 1e-8 for penalty "
         "contact (both references stop Newton's method at a relative residual below 1e-9). "
         "Two-body ties are compared with scikit-fem's mortar tie (the same multiplier rows); "
-        "DOLFINx does not solve them (n/a, not judged).",
+        "DOLFINx does not solve them (n/a, not judged). Elastic waves (`wave-bar-*`, "
+        "physics.dynamics without contact): DOLFINx assembles the stiffness and mass on our "
+        "mesh and ref_dolfinx.py steps Newmark's method with the case's beta, gamma and dt "
+        "(consistent mass, or its row sums for the lumped case); the displacement history at "
+        "every frame and node, at two nodes, and the energy histories are compared, tolerance "
+        "1e-10 (the same discrete problem); scikit-fem: n/a.",
         "",
         "| case | element | plane | nodes | quantity | ours | DOLFINx | scikit-fem "
         "| rel. diff DOLFINx | rel. diff scikit-fem | tol | verdict |",
