@@ -24,12 +24,11 @@
 use crate::error::{Error, Result};
 use crate::io::scene::{Case, ImpactTreatment, Integrator, MassKind};
 use crate::io::svg::{line_plot, Series};
-use crate::model::parse;
 use crate::solver::history::DynamicHistory;
 use serde::Serialize;
 use std::path::Path;
 
-use super::impact::{run, variant, MASSES, TREATMENTS};
+use super::impact::{each_case, run, variant, MASSES, TREATMENTS};
 
 /// The time-step divisors of the study.
 pub const DT_DIVISORS: [usize; 4] = [1, 2, 4, 8];
@@ -144,14 +143,7 @@ pub fn study_case(case: &Case, source: &str) -> Result<Vec<DropMeasure>> {
 
 /// The study on each case file of `paths`.
 pub fn study(paths: &[&Path]) -> Result<Vec<DropMeasure>> {
-    let mut out = Vec::new();
-    for path in paths {
-        let source = path.display().to_string();
-        let text =
-            std::fs::read_to_string(path).map_err(|e| Error::io(&source, "reading the case", e))?;
-        out.extend(study_case(&parse(&text, &source)?, &source)?);
-    }
-    Ok(out)
+    each_case(paths, study_case)
 }
 
 fn opt(t: Option<f64>) -> String {

@@ -249,24 +249,35 @@ pub const TREATMENTS: [ImpactTreatment; 3] = [
 ];
 pub const MASSES: [MassKind; 2] = [MassKind::Lumped, MassKind::Consistent];
 
-/// Every treatment and mass (average acceleration) on each case file of `paths`.
-pub fn study(paths: &[&Path]) -> Result<Vec<ImpactMeasure>> {
+/// The study `study_case` on each case file of `paths` (read and parsed), concatenated.
+pub fn each_case<T>(
+    paths: &[&Path],
+    mut study_case: impl FnMut(&Case, &str) -> Result<Vec<T>>,
+) -> Result<Vec<T>> {
     let mut out = Vec::new();
     for path in paths {
         let source = path.display().to_string();
         let text =
             std::fs::read_to_string(path).map_err(|e| Error::io(&source, "reading the case", e))?;
-        let case = parse(&text, &source)?;
+        out.extend(study_case(&parse(&text, &source)?, &source)?);
+    }
+    Ok(out)
+}
+
+/// Every treatment and mass (average acceleration) on each case file of `paths`.
+pub fn study(paths: &[&Path]) -> Result<Vec<ImpactMeasure>> {
+    each_case(paths, |case, source| {
+        let mut out = Vec::new();
         for impact in TREATMENTS {
             for mass in MASSES {
-                let c = variant(&case, impact, mass, Integrator::AverageAcceleration);
-                let (model, history, seconds) = run(&c, &source)?;
+                let c = variant(case, impact, mass, Integrator::AverageAcceleration);
+                let (model, history, seconds) = run(&c, source)?;
                 let exact = wave_solution(&model)?;
                 out.push(measure(&case.name, &history, &exact, seconds));
             }
         }
-    }
-    Ok(out)
+        Ok(out)
+    })
 }
 
 fn opt(t: Option<f64>) -> String {

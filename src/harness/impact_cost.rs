@@ -25,11 +25,10 @@
 use crate::error::{Error, Result};
 use crate::io::scene::{Breaks, Case, Integrator, MeshSpec};
 use crate::io::svg::{line_plot, Series};
-use crate::model::parse;
 use serde::Serialize;
 use std::path::Path;
 
-use super::impact::{measure, run, variant, wave_solution, MASSES, TREATMENTS};
+use super::impact::{each_case, measure, run, variant, wave_solution, MASSES, TREATMENTS};
 
 /// Refinement levels (divisors of `h` and `dt`).
 pub const LEVELS: [usize; 4] = [1, 2, 4, 8];
@@ -188,14 +187,7 @@ pub fn study_case(case: &Case, source: &str) -> Result<Vec<CostMeasure>> {
 
 /// The study on each case file of `paths`.
 pub fn study(paths: &[&Path]) -> Result<Vec<CostMeasure>> {
-    let mut out = Vec::new();
-    for path in paths {
-        let source = path.display().to_string();
-        let text =
-            std::fs::read_to_string(path).map_err(|e| Error::io(&source, "reading the case", e))?;
-        out.extend(study_case(&parse(&text, &source)?, &source)?);
-    }
-    Ok(out)
+    each_case(paths, study_case)
 }
 
 /// The observed order `log2(e_first / e_last) / log2(level_last / level_first)` of a sequence.
