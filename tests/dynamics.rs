@@ -585,3 +585,25 @@ fn the_cost_study_refuses_a_mesh_it_cannot_refine() {
     let c = refined(&case, Refinement::StepOnly, 2, "listed").unwrap();
     assert_eq!(c.physics.dynamics.unwrap().dt, 0.0025);
 }
+
+#[test]
+fn the_impact_studies_refuse_cases_they_cannot_measure() {
+    // the block-drop study needs a contact pair; the wave measures need a striker bar
+    let mut v = read("cases/dynamics/block-drop-rigid.json");
+    v["contact"] = json!([]);
+    v["checks"] = json!([]);
+    let case = parse(&v.to_string(), "no-contact").unwrap();
+    let e = contact_patch::harness::block_drop::study_case(&case, "no-contact")
+        .expect_err("a case without contact is refused")
+        .to_string();
+    assert!(
+        e.contains("contact") && e.contains("no contact pair"),
+        "{e}"
+    );
+    let v = read("cases/dynamics/block-drop-node-to-surface.json");
+    let case = parse(&v.to_string(), "block").unwrap();
+    let e = contact_patch::harness::impact_cost::study_case(&case, "block")
+        .expect_err("two blocks are no striker bar against a wall")
+        .to_string();
+    assert!(e.contains("striker bar"), "{e}");
+}
