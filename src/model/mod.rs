@@ -28,9 +28,9 @@ use crate::fe::{point_values, ElementKind};
 use crate::harness::exact::ExactField;
 use crate::io::paths::{name_problem, NAME_RULE};
 use crate::io::scene::{
-    Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, Interaction,
-    MeshSpec, MultiplierSpace, NodeSetSpec, Physics, Plane, Prescribed, RigidSurface, SolverSpec,
-    SweepSpec, TractionSpec, MAX_SOLVER_COUNT,
+    Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, GmshMeshSpec,
+    Interaction, MeshSpec, MultiplierSpace, NodeSetSpec, Physics, Plane, Prescribed, RigidSurface,
+    SolverSpec, SweepSpec, TractionSpec, MAX_SOLVER_COUNT,
 };
 use crate::mesh::{block, Facet, Mesh};
 use crate::solid::{check_geometry, Elasticity};
@@ -435,7 +435,8 @@ impl Model {
                     &format!("define it under \"materials\" or use one of {known:?}"),
                 ));
             };
-            let mut mesh = build_mesh(&spec.mesh, source, &at)?;
+            let mut mesh = build_mesh(&spec.mesh, source, &at, &mut set_warnings)?;
+            check_read_size(case, &bodies, &mesh, source, &at)?;
             check_cells(&mesh, source, &at)?;
             set_warnings.extend(add_user_sets(&mut mesh, spec, source, &at)?);
             let body = Body {
@@ -1315,8 +1316,18 @@ fn validate_enforcement(e: &EnforcementSpec, source: &str, at: &str) -> Result<(
     Ok(())
 }
 
-fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {
+fn build_mesh(spec: &MeshSpec, source: &str, at: &str, notes: &mut Vec<String>) -> Result<Mesh> {
     match spec {
+        MeshSpec::Gmsh(g) => {
+            let (mesh, mirrored) = read_gmsh_mesh(g, source, at)?;
+            if mirrored > 0 {
+                notes.push(format!(
+                    "{at}.mesh.gmsh: {mirrored} cell(s) of '{}' ran clockwise and were renumbered counter-clockwise",
+                    g.file
+                ));
+            }
+            Ok(mesh)
+        }
         MeshSpec::Block(b) => {
             let xs = b.x.values();
             let ys = b.y.values();
@@ -1392,6 +1403,52 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {
     }
 }
 
+/// The mesh of a body from a Gmsh file, the file named relative to the case file's folder
+/// (`source`), and the number of cells renumbered from clockwise.
+fn read_gmsh_mesh(g: &GmshMeshSpec, source: &str, at: &str) -> Result<(Mesh, usize)> {
+    let folder = std::path::Path::new(source)
+        .parent()
+        .unwrap_or(std::path::Path::new(""));
+    let path = folder.join(&g.file);
+    let shown = path.display().to_string();
+    let bytes = std::fs::read(&path).map_err(|e| {
+        Error::invalid(
+            source,
+            format!("{at}.mesh.gmsh.file"),
+            format!("cannot read '{shown}': {e}"),
+            "name a .msh file that exists, relative to the case file's folder",
+        )
+    })?;
+    crate::io::gmsh_read::read_msh(&bytes)
+        .and_then(|content| crate::io::gmsh_read::body_mesh(&content, g.physical.as_deref()))
+        .map_err(|e| {
+            Error::invalid(
+                source,
+                format!("{at}.mesh.gmsh ({shown}, {})", e.place),
+                e.problem,
+                e.hint,
+            )
+        })
+}
+
+/// The nodes read from Gmsh files count against `limits.nodes` once read (a block's or an
+/// explicit mesh's count is checked from the spec by [`check_size`]).
+fn check_read_size(case: &Case, built: &[Body], mesh: &Mesh, source: &str, at: &str) -> Result<()> {
+    let total: usize = built.iter().map(|b| b.mesh.nodes.len()).sum::<usize>() + mesh.nodes.len();
+    if total > case.limits.nodes {
+        return Err(Error::invalid(
+            source,
+            format!("{at}.mesh"),
+            format!(
+                "the meshes have {total} nodes, above the limit of {}",
+                case.limits.nodes
+            ),
+            "use a coarser mesh, or raise \"limits\": {\"nodes\": N} if the machine has the memory",
+        ));
+    }
+    Ok(())
+}
+
 /// The node count of every mesh, from the spec alone (nothing is allocated), against
 /// `limits.nodes`.
 fn check_size(case: &Case, source: &str) -> Result<()> {
@@ -1418,6 +1475,8 @@ fn check_size(case: &Case, source: &str) -> Result<()> {
                 along(b.x.intervals()) * along(b.y.intervals())
             }
             MeshSpec::Explicit(e) => e.nodes.len() as u128,
+            // counted once read (check_read_size)
+            MeshSpec::Gmsh(_) => 0,
         };
         total = total.saturating_add(nodes);
         if total > limit {
