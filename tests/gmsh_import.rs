@@ -247,3 +247,29 @@ fn an_unknown_element_type_and_a_truncated_file_are_refused() {
     assert!(e.contains("patch-q4.msh"), "{e}");
     assert!(e.contains("could not be read"), "{e}");
 }
+
+/// Every prefix of the committed files (MSH 4.1 ASCII and binary, MSH 2.2 ASCII), cut at every
+/// 7th byte, is read to a mesh or refused with a message; none panics.
+#[test]
+fn truncated_files_are_refused_without_a_panic() {
+    use contact_patch::io::gmsh_read::{body_mesh, read_msh};
+    for file in ["patch-q4.msh", "patch-t6.msh", "patch-q9.msh"] {
+        let bytes = std::fs::read(case("cases/gmsh").join(file)).unwrap();
+        let mut refused = 0;
+        for cut in (0..bytes.len()).step_by(7) {
+            match read_msh(&bytes[..cut]).and_then(|c| body_mesh(&c, Some("patch"))) {
+                Ok(_) => {}
+                Err(e) => {
+                    assert!(
+                        !e.problem.is_empty() && !e.hint.is_empty(),
+                        "{file} at {cut}"
+                    );
+                    assert!(!e.problem.contains("Hex dump"), "{}", e.problem);
+                    refused += 1;
+                }
+            }
+        }
+        // a cut before $EndElements cannot give the whole mesh
+        assert!(refused * 7 >= bytes.len() * 9 / 10, "{file}: {refused}");
+    }
+}

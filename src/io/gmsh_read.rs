@@ -235,7 +235,10 @@ fn read_v41(bytes: &[u8]) -> Read<MshContent> {
     let file = mshio::parse_msh_bytes(bytes).map_err(|e| {
         MshError::new(
             "MSH 4.1 sections",
-            format!("the file could not be read: {e}"),
+            format!(
+                "the file could not be read: {}",
+                mshio_message(&e.to_string())
+            ),
             "check that the file is complete (not truncated) and written by Gmsh",
         )
     })?;
@@ -317,6 +320,16 @@ fn read_v41(bytes: &[u8]) -> Read<MshContent> {
         }
     }
     Ok(content)
+}
+
+/// `mshio`'s message without the hex dump it appends, its context lines joined into one.
+fn mshio_message(full: &str) -> String {
+    let text = full.split("Hex dump").next().unwrap_or(full);
+    text.lines()
+        .map(|l| l.trim().trim_end_matches(','))
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 /// Lines of a section, numbered from 1, between `$Name` and `$EndName`.
