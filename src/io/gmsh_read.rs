@@ -1,4 +1,4 @@
-//! Reading Gmsh `.msh` meshes into a body's [`Mesh`], with physical groups as named sets.
+//! Reading Gmsh `.msh` meshes into a body's mesh (`crate::mesh::Mesh`), with physical groups as named sets.
 //!
 //! Formats (Gmsh reference manual, C. Geuzaine, J.-F. Remacle, gmsh.info/doc/texinfo, sec. 10.1
 //! "MSH file format" and 10.2 "Legacy formats"):
