@@ -3,11 +3,12 @@
 //! writes ([`output`]: `summary.json` and `.vtu` files) and its plots (`svg`); [`contact_output`]
 //! writes the per-pair contact results through [`vtu`]; [`timeline`] the histories and frames
 //! of a time integration; [`export`] and [`gmsh`] write a case for other codes, and
-//! [`vtu_read`] reads their results back.
+//! [`vtu_read`] reads their results back; [`gmsh_read`] reads a body's mesh from a Gmsh file.
 
 pub mod contact_output;
 pub mod export;
 pub mod gmsh;
+pub mod gmsh_read;
 pub mod output;
 pub mod paths;
 pub mod scene;

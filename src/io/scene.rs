@@ -571,6 +571,20 @@ pub enum MeshSpec {
     Block(BlockSpec),
     /// Nodes and cells given one by one (element node order as in `fe`).
     Explicit(ExplicitMeshSpec),
+    /// A Gmsh `.msh` file (MSH 4.1 ASCII or binary, MSH 2.2 ASCII): the 2D elements of one
+    /// physical surface; the file's other physical groups become node and facet sets.
+    Gmsh(GmshMeshSpec),
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GmshMeshSpec {
+    /// The `.msh` file, relative to the case file's folder.
+    pub file: String,
+    /// The physical surface (2D physical group) whose elements are the body's cells; may be
+    /// left out when the file's 2D elements are all the body's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub physical: Option<String>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]

@@ -28,9 +28,9 @@ use crate::fe::{point_values, ElementKind};
 use crate::harness::exact::ExactField;
 use crate::io::paths::{name_problem, NAME_RULE};
 use crate::io::scene::{
-    Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, Interaction,
-    MeshSpec, MultiplierSpace, NodeSetSpec, Physics, Plane, Prescribed, RigidSurface, SolverSpec,
-    SweepSpec, TractionSpec, MAX_SOLVER_COUNT,
+    Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, GmshMeshSpec,
+    Interaction, MeshSpec, MultiplierSpace, NodeSetSpec, Physics, Plane, Prescribed, RigidSurface,
+    SolverSpec, SweepSpec, TractionSpec, MAX_SOLVER_COUNT,
 };
 use crate::mesh::{block, Facet, Mesh};
 use crate::solid::{check_geometry, Elasticity};
@@ -435,7 +435,8 @@ impl Model {
                     &format!("define it under \"materials\" or use one of {known:?}"),
                 ));
             };
-            let mut mesh = build_mesh(&spec.mesh, source, &at)?;
+            let mut mesh = build_mesh(&spec.mesh, source, &at, &mut set_warnings)?;
+            check_read_size(case, &bodies, &mesh, source, &at)?;
             check_cells(&mesh, source, &at)?;
             set_warnings.extend(add_user_sets(&mut mesh, spec, source, &at)?);
             let body = Body {
@@ -1315,8 +1316,18 @@ fn validate_enforcement(e: &EnforcementSpec, source: &str, at: &str) -> Result<(
     Ok(())
 }
 
-fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {
+fn build_mesh(spec: &MeshSpec, source: &str, at: &str, notes: &mut Vec<String>) -> Result<Mesh> {
     match spec {
+        MeshSpec::Gmsh(g) => {
+            let (mesh, mirrored) = read_gmsh_mesh(g, source, at)?;
+            if mirrored > 0 {
+                notes.push(format!(
+                    "{at}.mesh.gmsh: {mirrored} cell(s) of '{}' ran clockwise and were renumbered counter-clockwise",
+                    g.file
+                ));
+            }
+            Ok(mesh)
+        }
         MeshSpec::Block(b) => {
             let xs = b.x.values();
             let ys = b.y.values();
@@ -1392,6 +1403,52 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str) -> Result<Mesh> {
     }
 }
 
+/// The mesh of a body from a Gmsh file, the file named relative to the case file's folder
+/// (`source`), and the number of cells renumbered from clockwise.
+fn read_gmsh_mesh(g: &GmshMeshSpec, source: &str, at: &str) -> Result<(Mesh, usize)> {
+    let folder = std::path::Path::new(source)
+        .parent()
+        .unwrap_or(std::path::Path::new(""));
+    let path = folder.join(&g.file);
+    let shown = path.display().to_string();
+    let bytes = std::fs::read(&path).map_err(|e| {
+        Error::invalid(
+            source,
+            format!("{at}.mesh.gmsh.file"),
+            format!("cannot read '{shown}': {e}"),
+            "name a .msh file that exists, relative to the case file's folder",
+        )
+    })?;
+    crate::io::gmsh_read::read_msh(&bytes)
+        .and_then(|content| crate::io::gmsh_read::body_mesh(&content, g.physical.as_deref()))
+        .map_err(|e| {
+            Error::invalid(
+                source,
+                format!("{at}.mesh.gmsh ({shown}, {})", e.place),
+                e.problem,
+                e.hint,
+            )
+        })
+}
+
+/// The nodes read from Gmsh files count against `limits.nodes` once read (a block's or an
+/// explicit mesh's count is checked from the spec by [`check_size`]).
+fn check_read_size(case: &Case, built: &[Body], mesh: &Mesh, source: &str, at: &str) -> Result<()> {
+    let total: usize = built.iter().map(|b| b.mesh.nodes.len()).sum::<usize>() + mesh.nodes.len();
+    if total > case.limits.nodes {
+        return Err(Error::invalid(
+            source,
+            format!("{at}.mesh"),
+            format!(
+                "the meshes have {total} nodes, above the limit of {}",
+                case.limits.nodes
+            ),
+            "use a coarser mesh, or raise \"limits\": {\"nodes\": N} if the machine has the memory",
+        ));
+    }
+    Ok(())
+}
+
 /// The node count of every mesh, from the spec alone (nothing is allocated), against
 /// `limits.nodes`.
 fn check_size(case: &Case, source: &str) -> Result<()> {
@@ -1418,6 +1475,8 @@ fn check_size(case: &Case, source: &str) -> Result<()> {
                 along(b.x.intervals()) * along(b.y.intervals())
             }
             MeshSpec::Explicit(e) => e.nodes.len() as u128,
+            // counted once read (check_read_size)
+            MeshSpec::Gmsh(_) => 0,
         };
         total = total.saturating_add(nodes);
         if total > limit {
@@ -1615,10 +1674,116 @@ fn add_user_sets(
                 (b.min, b.max),
                 &loc,
             ));
+            warnings.extend(separate_pieces_warning(mesh, &facets, &loc));
         }
         mesh.facet_sets.insert(name.clone(), facets);
     }
     Ok(warnings)
+}
+
+/// A box facet set whose facets do not form one connected piece of boundary (two facets are
+/// connected when they share an end node) has caught facets away from the edge or arc it was
+/// drawn around, e.g. the end of another side that reaches into the box: a warning naming the
+/// set, the number of pieces and each piece's facets and extent. `None` for one piece.
+fn separate_pieces_warning(mesh: &Mesh, facets: &[Facet], loc: &str) -> Option<String> {
+    let ends: Vec<[usize; 2]> = facets
+        .iter()
+        .map(|&f| {
+            let n = mesh.facet_nodes(f);
+            [n[0], n[1]]
+        })
+        .collect();
+    // union-find over the facets, joined through shared end nodes
+    let mut parent: Vec<usize> = (0..facets.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut first_at: std::collections::HashMap<usize, usize> = Default::default();
+    for (i, e) in ends.iter().enumerate() {
+        for &n in e {
+            match first_at.get(&n) {
+                Some(&j) => {
+                    let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                    parent[a] = b;
+                }
+                None => {
+                    first_at.insert(n, i);
+                }
+            }
+        }
+    }
+    let mut pieces: std::collections::BTreeMap<usize, (usize, [f64; 2], [f64; 2])> =
+        Default::default();
+    for (i, e) in ends.iter().enumerate() {
+        let r = root(&mut parent, i);
+        let piece = pieces
+            .entry(r)
+            .or_insert((0, [f64::INFINITY; 2], [f64::NEG_INFINITY; 2]));
+        piece.0 += 1;
+        for &n in e {
+            for k in 0..2 {
+                piece.1[k] = piece.1[k].min(mesh.nodes[n][k]);
+                piece.2[k] = piece.2[k].max(mesh.nodes[n][k]);
+            }
+        }
+    }
+    if pieces.len() < 2 {
+        return sharp_turn_warning(mesh, &ends, loc);
+    }
+    let listed: Vec<String> = pieces
+        .values()
+        .map(|(count, lo, hi)| {
+            format!(
+                "{count} facet(s) in [{}, {}] x [{}, {}]",
+                lo[0], hi[0], lo[1], hi[1]
+            )
+        })
+        .collect();
+    Some(format!(
+        "{loc}: the box takes in {} separate pieces of boundary ({}); a box drawn around one edge \
+         or arc has caught facets of another. Shrink the box to the piece meant, or list the \
+         facets, or make one set per piece",
+        pieces.len(),
+        listed.join("; ")
+    ))
+}
+
+/// A box facet set that turns a corner sharper than 45 degrees where two of its facets meet
+/// (the angle between the chords of consecutive facets) has caught the end of another side:
+/// a warning naming the set and the corners. `None` if it turns no such corner (an arc meshed
+/// finely turns by a few degrees per facet).
+fn sharp_turn_warning(mesh: &Mesh, ends: &[[usize; 2]], loc: &str) -> Option<String> {
+    let chord = |e: &[usize; 2]| {
+        let (a, b) = (mesh.nodes[e[0]], mesh.nodes[e[1]]);
+        [b[0] - a[0], b[1] - a[1]]
+    };
+    let mut corners = Vec::new();
+    for into in ends {
+        // boundary facets run counter-clockwise, so the next facet starts where this one ends
+        for out in ends.iter().filter(|o| o[0] == into[1]) {
+            let (u, v) = (chord(into), chord(out));
+            let cos = (u[0] * v[0] + u[1] * v[1]) / (u[0].hypot(u[1]) * v[0].hypot(v[1]));
+            let angle = cos.clamp(-1.0, 1.0).acos().to_degrees();
+            if angle > 45.0 {
+                let p = mesh.nodes[into[1]];
+                corners.push(format!("{angle:.0} degrees at ({}, {})", p[0], p[1]));
+            }
+        }
+    }
+    if corners.is_empty() {
+        return None;
+    }
+    Some(format!(
+        "{loc}: the box's facets turn {} corner(s) sharper than 45 degrees ({}); a box drawn \
+         around one edge or arc has caught facets of another side. Shrink the box to the side \
+         meant, or list the facets, or make one set per side",
+        corners.len(),
+        corners.join("; ")
+    ))
 }
 
 /// What acts on a facet.
