@@ -24,8 +24,12 @@
 //! `max_qp max_i |sigma_i(u) - sigma_exact,i| / p <= tol` (the contact patch test's uniform
 //! stress), the other columns of a cell being contact quantities that results do not carry.
 
+use crate::contact::forces::PairForces;
 use crate::error::{Error, Result};
-use crate::harness::checks::{evaluate, CheckResult, Magnitudes};
+use crate::harness::checks::{
+    evaluate_with, force_balance_of, pressure_error_of, CheckResult, Magnitudes,
+};
+use crate::harness::outside_contact::{self, OutsideContact, Source};
 use crate::io::paths::file_name;
 use crate::io::scene::Check;
 use crate::io::vtu_read::{read_vtu, PointField, PointGrid};
@@ -41,6 +45,9 @@ pub const DEFAULT_MATCH_SHARE: f64 = 1e-8;
 pub const DISPLACEMENT_FIELD: &str = "displacement";
 pub const STRESS_FIELD: &str = "stress";
 pub const CONTACT_PRESSURE_FIELD: &str = "contact_pressure";
+pub const CONTACT_FORCE_FIELD: &str = "contact_force";
+pub const CONTACT_GAP_FIELD: &str = "contact_gap";
+pub const CONTACT_STATUS_FIELD: &str = "contact_status";
 
 /// One results file.
 #[derive(Clone, Debug)]
@@ -58,14 +65,14 @@ pub enum Results {
 }
 
 impl Results {
-    fn of_body(&self, b: usize) -> &ResultsFile {
+    pub(crate) fn of_body(&self, b: usize) -> &ResultsFile {
         match self {
             Results::Shared(f) => f,
             Results::PerBody(files) => &files[b],
         }
     }
 
-    fn files(&self) -> Vec<&ResultsFile> {
+    pub(crate) fn files(&self) -> Vec<&ResultsFile> {
         match self {
             Results::Shared(f) => vec![f],
             Results::PerBody(files) => files.iter().collect(),
@@ -137,8 +144,10 @@ pub struct Judgement {
     pub nodes: usize,
     pub largest_distance: f64,
     pub match_distance: f64,
-    /// The solution the results define (`u`, `K u - f`).
+    /// The solution the results define (`u`, `K u - f - f_c`).
     pub solution: Solution,
+    /// The contact fields read (empty without contact pairs).
+    pub contact: OutsideContact,
 }
 
 impl Judgement {
@@ -154,14 +163,12 @@ fn unjudgeable(check: &Check) -> Option<&'static str> {
         | Check::ExactDisplacement { .. }
         | Check::Reaction { .. }
         | Check::Displacement { .. } => None,
+        // judged from the results' contact fields (crate::harness::outside_contact)
         Check::ContactPressure { .. }
         | Check::ContactForce { .. }
         | Check::MaxContactPressure { .. }
         | Check::MaxPenetration { .. }
-        | Check::ForceBalance { .. } => Some(
-            "it is judged from the contact forces and gaps of the solve's contact rows, which \
-             point results do not carry (a 'contact_pressure' field is not read for it yet)",
-        ),
+        | Check::ForceBalance { .. } => None,
         Check::TerminatesWith { .. }
         | Check::Equilibrium { .. }
         | Check::StatusChanges { .. }
@@ -224,7 +231,7 @@ impl<'a> PointIndex<'a> {
 }
 
 /// A named point field with at least `min_components` components, or `None` when absent.
-fn field<'a>(
+pub(crate) fn field<'a>(
     file: &'a ResultsFile,
     name: &str,
     min_components: usize,
@@ -240,7 +247,8 @@ fn field<'a>(
                 "{} components per point (at least {min_components} expected)",
                 f.components
             ),
-            "write displacement as a 2- or 3-component vector (x, y[, 0])",
+            "write displacement and contact_force as 2- or 3-component vectors (x, y[, 0]), \
+             contact_pressure, contact_gap and contact_status as scalars",
         ));
     }
     if let Some(k) = f.values.iter().position(|v| !v.is_finite()) {
@@ -381,22 +389,41 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
         }
         matched.push(points);
     }
-    let solution = solution_of(model, u);
-    let (judgeable, skipped): (Vec<Check>, Vec<Check>) = model
-        .checks
-        .iter()
-        .cloned()
-        .partition(|c| unjudgeable(c).is_none());
-    let mut judged_model = model.clone();
-    judged_model.checks = judgeable;
-    let mut checks = evaluate(&judged_model, &solution);
-    let not_judged = skipped
-        .iter()
-        .map(|c| NotJudged {
-            check: serde_json::to_string(c).expect("checks serialize"),
-            why: unjudgeable(c).unwrap_or_default().to_string(),
-        })
-        .collect();
+    let contact = if model.contact.is_empty() {
+        OutsideContact::default()
+    } else {
+        outside_contact::read(model, results, &matched)?
+    };
+    let solution = solution_of(model, u, contact.nodal_force.as_deref());
+    let mut checks = Vec::new();
+    let mut not_judged = Vec::new();
+    for check in &model.checks {
+        let stated = || serde_json::to_string(check).expect("checks serialize");
+        if let Some(why) = unjudgeable(check) {
+            not_judged.push(NotJudged {
+                check: stated(),
+                why: why.to_string(),
+            });
+            continue;
+        }
+        let mut one = model.clone();
+        one.checks = vec![check.clone()];
+        match contact.source(model, check) {
+            Source::NoContact => checks.extend(evaluate_with(&one, &solution, None)),
+            Source::NotJudged(why) => not_judged.push(NotJudged {
+                check: stated(),
+                why,
+            }),
+            Source::Forces(forces, from) => checks.extend(
+                evaluate_with(&one, &solution, Some(&forces))
+                    .into_iter()
+                    .map(|mut c| {
+                        c.check += &format!(" [from the results' '{from}']");
+                        c
+                    }),
+            ),
+        }
+    }
     // the results' own stress field
     let files = results.files();
     let mut stress_found = !files.is_empty();
@@ -456,9 +483,15 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
             });
         }
     }
-    let pressure_found = files
-        .iter()
-        .all(|f| f.grid.fields.contains_key(CONTACT_PRESSURE_FIELD));
+    let contact_use = |found: bool, what: &str| {
+        if model.contact.is_empty() {
+            "not read: the case has no contact pairs".to_string()
+        } else if found {
+            what.to_string()
+        } else {
+            format!("missing: {what} are not judged from it")
+        }
+    };
     let fields = vec![
         FieldUse {
             field: DISPLACEMENT_FIELD.into(),
@@ -476,8 +509,24 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
         },
         FieldUse {
             field: CONTACT_PRESSURE_FIELD.into(),
-            found: pressure_found,
-            use_: "not read: the contact checks are not judged".into(),
+            found: contact.pressure_field,
+            use_: contact_use(
+                contact.pressure_field,
+                "the contact pressure checks (and the forces -p A n of frictionless pairs)",
+            ),
+        },
+        FieldUse {
+            field: CONTACT_FORCE_FIELD.into(),
+            found: contact.force_field,
+            use_: contact_use(
+                contact.force_field,
+                "the contact force and force balance checks (and the tractions of ties)",
+            ),
+        },
+        FieldUse {
+            field: CONTACT_GAP_FIELD.into(),
+            found: contact.gap_field,
+            use_: contact_use(contact.gap_field, "the penetration checks"),
         },
     ];
     Ok(Judgement {
@@ -488,13 +537,19 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
         largest_distance,
         match_distance: delta,
         solution,
+        contact,
     })
 }
 
 /// The solution `u` defines: `K u - f` at every dof (reactions at the prescribed ones), and the
 /// largest free-dof residual relative to the largest external force or reaction.
-fn solution_of(model: &Model, u: Vec<f64>) -> Solution {
+fn solution_of(model: &Model, u: Vec<f64>, contact_force: Option<&[f64]>) -> Solution {
     let mut r: Vec<f64> = model.external_force.iter().map(|f| -f).collect();
+    if let Some(fc) = contact_force {
+        for (r, f) in r.iter_mut().zip(fc) {
+            *r -= f;
+        }
+    }
     for_each_element_stiffness(model, |dofs, ke| {
         let n = dofs.len();
         for i in 0..n {
@@ -584,10 +639,70 @@ pub fn outside_cells(
     let judged = judge(&model, &results, match_share)?;
     let e = crate::harness::stress_error(&model, &judged.solution.u, sweep.pressure);
     cell.stress_error = Some(e);
-    cell.verdict = if e <= sweep.tol { "pass" } else { "fail" }.into();
+    let mut pass = e <= sweep.tol;
+    let mut judged_on = vec!["the stress of its displacement"];
+    let mut missing = Vec::new();
+    let pairs = &judged.contact.pairs;
+    let pressures: Option<Vec<PairForces>> = pairs
+        .iter()
+        .map(|p| p.pressures().map(|(f, _)| f.clone()))
+        .collect();
+    match (pressures, model.exact.as_ref()) {
+        (Some(p), Some(exact)) if !pairs.is_empty() => {
+            let error = pressure_error_of(
+                &model,
+                &judged.solution,
+                &p,
+                exact,
+                None,
+                Some(sweep.pressure.abs()),
+            );
+            cell.pressure_error = Some(error);
+            pass &= error <= sweep.tol;
+            judged_on.push("the contact pressure");
+        }
+        _ => missing.push("pressure"),
+    }
+    let forces: Option<Vec<PairForces>> = pairs
+        .iter()
+        .map(|p| p.forces().map(|(f, _)| f.clone()))
+        .collect();
+    match forces {
+        Some(f) if !pairs.is_empty() => {
+            let first_pass: std::collections::HashSet<(usize, usize, usize)> = f
+                .iter()
+                .flat_map(|pf| {
+                    let slave = model.contact[pf.pair].slave.0;
+                    pf.nodes
+                        .iter()
+                        .filter(move |n| n.carries_rows && n.body == slave)
+                        .map(move |n| (pf.pair, n.body, n.node))
+                })
+                .collect();
+            let load = crate::harness::load_error(&model, &f, sweep.pressure, &|k, b, n| {
+                first_pass.contains(&(k, b, n))
+            });
+            let balance = force_balance_of(&model, &judged.solution, &f);
+            cell.load_error = Some(load);
+            cell.force_balance = Some(balance);
+            pass &= load <= sweep.tol && balance <= crate::harness::balance_tol(&model);
+            judged_on.push("the total contact force and the force balance");
+        }
+        _ => missing.push("contact forces"),
+    }
+    cell.verdict = if pass { "pass" } else { "fail" }.into();
+    let missing = if missing.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; not in the results: {} (fields '{CONTACT_PRESSURE_FIELD}', '{CONTACT_FORCE_FIELD}')",
+            missing.join(", ")
+        )
+    };
     cell.note = format!(
-        "{}: judged on the stress of its displacement; contact forces are not in the results",
-        path.display()
+        "{}: judged on {}{missing}",
+        path.display(),
+        judged_on.join(", ")
     );
     Ok(vec![cell])
 }
