@@ -443,6 +443,30 @@ fn table_of_outside_results_matches_the_direct_cells_of_the_same_method() {
             (got - want).abs() <= 1e-12 * want.max(1e-3),
             "{case}: {got:e} vs {want:e}"
         );
+        // the contact measures from the body files' contact_pressure and contact_force
+        for (key, want) in [
+            ("pressure_error", same.pressure_error.unwrap()),
+            ("load_error", same.load_error.unwrap()),
+        ] {
+            let got = cell[key].as_f64().unwrap();
+            assert!(
+                (got - want).abs() <= 1e-12 * want.max(1e-3),
+                "{case}: {key} {got:e} vs {want:e}"
+            );
+        }
+        let balance = cell["force_balance"].as_f64().unwrap();
+        assert!(
+            (balance - same.force_balance.unwrap()).abs() <= 1e-12,
+            "{case}: force balance {balance:e}"
+        );
+        assert!(
+            cell["note"]
+                .as_str()
+                .unwrap()
+                .contains("the contact pressure, the total contact force and the force balance"),
+            "{}",
+            cell["note"]
+        );
         assert_eq!(cell["verdict"], same.verdict.as_str(), "{case}");
         verdicts.push(same.verdict.clone());
     }

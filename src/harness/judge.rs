@@ -16,13 +16,17 @@
 //! * a results `stress` field (`xx, yy, xy`; or a 2x2 or 3x3 tensor, row by row) adds, for each
 //!   `uniform_stress` check, `max_nodes max_i |s_i - sigma_i| / scale` with the check's scale;
 //! * the contact checks (`contact_pressure`, `contact_force`, `max_contact_pressure`,
-//!   `max_penetration`, `force_balance`) need the contact forces of the solve and are listed as
-//!   not judged, with that reason.
+//!   `max_penetration`, `force_balance`): from the results' point fields `contact_force`,
+//!   `contact_pressure` (compression positive) and `contact_gap` on the pairs' surfaces, as
+//!   [`crate::harness::outside_contact`] states; a check whose field is missing is listed as not
+//!   judged, naming the field. With contact forces `f_c`, `K u - f - f_c` is the residual.
 //!
 //! `table --results DIR` makes one table cell per swept case from the results in `DIR`
-//! ([`outside_cells`]): its verdict is the sweep's stress criterion,
+//! ([`outside_cells`]), judged as the sweep judges an exact method: the stress criterion
 //! `max_qp max_i |sigma_i(u) - sigma_exact,i| / p <= tol` (the contact patch test's uniform
-//! stress), the other columns of a cell being contact quantities that results do not carry.
+//! stress) and, where the results carry them, the pressure error, the total contact force
+//! (load error) within `tol` and the force balance within the case's `force_balance` tolerance;
+//! the note names what was judged and what the results lack.
 
 use crate::contact::forces::PairForces;
 use crate::error::{Error, Result};
@@ -30,9 +34,14 @@ use crate::harness::checks::{
     evaluate_with, force_balance_of, pressure_error_of, CheckResult, Magnitudes,
 };
 use crate::harness::outside_contact::{self, OutsideContact, Source};
+use crate::harness::outside_results::field;
+pub use crate::harness::outside_results::{
+    load_results, Results, ResultsFile, CONTACT_FORCE_FIELD, CONTACT_GAP_FIELD,
+    CONTACT_PRESSURE_FIELD, CONTACT_STATUS_FIELD, DISPLACEMENT_FIELD, STRESS_FIELD,
+};
 use crate::io::paths::file_name;
 use crate::io::scene::Check;
-use crate::io::vtu_read::{read_vtu, PointField, PointGrid};
+use crate::io::vtu_read::PointGrid;
 use crate::model::Model;
 use crate::solver::linear::{for_each_element_stiffness, Solution, Timings};
 use std::collections::HashMap;
@@ -40,82 +49,6 @@ use std::path::Path;
 
 /// Default node-matching distance, relative to the model size.
 pub const DEFAULT_MATCH_SHARE: f64 = 1e-8;
-
-/// The point field names read.
-pub const DISPLACEMENT_FIELD: &str = "displacement";
-pub const STRESS_FIELD: &str = "stress";
-pub const CONTACT_PRESSURE_FIELD: &str = "contact_pressure";
-pub const CONTACT_FORCE_FIELD: &str = "contact_force";
-pub const CONTACT_GAP_FIELD: &str = "contact_gap";
-pub const CONTACT_STATUS_FIELD: &str = "contact_status";
-
-/// One results file.
-#[derive(Clone, Debug)]
-pub struct ResultsFile {
-    pub shown: String,
-    pub grid: PointGrid,
-}
-
-/// Another code's results: one file for every body, or one file per body.
-#[derive(Clone, Debug)]
-pub enum Results {
-    Shared(ResultsFile),
-    /// In the order of the model's bodies.
-    PerBody(Vec<ResultsFile>),
-}
-
-impl Results {
-    pub(crate) fn of_body(&self, b: usize) -> &ResultsFile {
-        match self {
-            Results::Shared(f) => f,
-            Results::PerBody(files) => &files[b],
-        }
-    }
-
-    pub(crate) fn files(&self) -> Vec<&ResultsFile> {
-        match self {
-            Results::Shared(f) => vec![f],
-            Results::PerBody(files) => files.iter().collect(),
-        }
-    }
-}
-
-/// Read the results at `path`: a `.vtu` file (for every body), or a folder with `<body>.vtu`
-/// for each body of `model` (the layout `contact-patch run` writes).
-pub fn load_results(model: &Model, path: &Path) -> Result<Results> {
-    if path.is_dir() {
-        let mut files = Vec::new();
-        for body in &model.bodies {
-            let file = path.join(file_name("body name", &body.name, ".vtu")?);
-            if !file.is_file() {
-                return Err(Error::invalid(
-                    path.display(),
-                    format!("body '{}'", body.name),
-                    format!("the folder holds no {}", file.display()),
-                    "a results folder holds one <body name>.vtu per body of the case; or give \
-                     one .vtu file that holds every body",
-                ));
-            }
-            files.push(ResultsFile {
-                shown: file.display().to_string(),
-                grid: read_vtu(&file)?,
-            });
-        }
-        Ok(Results::PerBody(files))
-    } else if path.is_file() {
-        Ok(Results::Shared(ResultsFile {
-            shown: path.display().to_string(),
-            grid: read_vtu(path)?,
-        }))
-    } else {
-        Err(Error::invalid(
-            path.display(),
-            "results",
-            "no such file or folder",
-            "give a .vtu file, or a folder with one <body name>.vtu per body",
-        ))
-    }
-}
 
 /// A check that could not be judged, and why.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -228,43 +161,6 @@ impl<'a> PointIndex<'a> {
             .map(|(k, p)| (k, (p[0] - x[0]).hypot(p[1] - x[1])))
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
-}
-
-/// A named point field with at least `min_components` components, or `None` when absent.
-pub(crate) fn field<'a>(
-    file: &'a ResultsFile,
-    name: &str,
-    min_components: usize,
-) -> Result<Option<&'a PointField>> {
-    let Some(f) = file.grid.fields.get(name) else {
-        return Ok(None);
-    };
-    if f.components < min_components {
-        return Err(Error::invalid(
-            &file.shown,
-            format!("point field '{name}'"),
-            format!(
-                "{} components per point (at least {min_components} expected)",
-                f.components
-            ),
-            "write displacement and contact_force as 2- or 3-component vectors (x, y[, 0]), \
-             contact_pressure, contact_gap and contact_status as scalars",
-        ));
-    }
-    if let Some(k) = f.values.iter().position(|v| !v.is_finite()) {
-        return Err(Error::invalid(
-            &file.shown,
-            format!("point field '{name}'"),
-            format!(
-                "value {} of point {} is {}",
-                k % f.components + 1,
-                k / f.components,
-                f.values[k]
-            ),
-            "the results hold a non-finite number; the other code's solve failed",
-        ));
-    }
-    Ok(Some(f))
 }
 
 /// `xx, yy, xy` of a stress field value: 3 components as they are, 4 as a 2x2 and 9 as a 3x3
@@ -484,15 +380,13 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
         }
     }
     let contact_use = |found: bool, what: &str| {
-        if model.contact.is_empty() {
-            "not read: the case has no contact pairs".to_string()
-        } else if found {
+        if found {
             what.to_string()
         } else {
-            format!("missing: {what} are not judged from it")
+            format!("missing: not used for {what}")
         }
     };
-    let fields = vec![
+    let mut fields = vec![
         FieldUse {
             field: DISPLACEMENT_FIELD.into(),
             found: true,
@@ -507,28 +401,32 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
                 "missing: stresses are judged from the displacement only".into()
             },
         },
-        FieldUse {
-            field: CONTACT_PRESSURE_FIELD.into(),
-            found: contact.pressure_field,
-            use_: contact_use(
-                contact.pressure_field,
-                "the contact pressure checks (and the forces -p A n of frictionless pairs)",
-            ),
-        },
-        FieldUse {
-            field: CONTACT_FORCE_FIELD.into(),
-            found: contact.force_field,
-            use_: contact_use(
-                contact.force_field,
-                "the contact force and force balance checks (and the tractions of ties)",
-            ),
-        },
-        FieldUse {
-            field: CONTACT_GAP_FIELD.into(),
-            found: contact.gap_field,
-            use_: contact_use(contact.gap_field, "the penetration checks"),
-        },
     ];
+    if !model.contact.is_empty() {
+        fields.extend([
+            FieldUse {
+                field: CONTACT_PRESSURE_FIELD.into(),
+                found: contact.pressure_field,
+                use_: contact_use(
+                    contact.pressure_field,
+                    "the contact pressure checks; the forces -p A n of frictionless pairs",
+                ),
+            },
+            FieldUse {
+                field: CONTACT_FORCE_FIELD.into(),
+                found: contact.force_field,
+                use_: contact_use(
+                    contact.force_field,
+                    "the contact force and force balance checks; the tractions of ties",
+                ),
+            },
+            FieldUse {
+                field: CONTACT_GAP_FIELD.into(),
+                found: contact.gap_field,
+                use_: contact_use(contact.gap_field, "the penetration checks"),
+            },
+        ]);
+    }
     Ok(Judgement {
         checks,
         not_judged,

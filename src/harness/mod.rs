@@ -39,6 +39,7 @@ pub mod judge;
 pub mod junit;
 pub mod layer;
 pub mod outside_contact;
+pub mod outside_results;
 pub mod profile;
 pub mod report;
 pub mod stability;

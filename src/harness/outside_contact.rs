@@ -38,7 +38,7 @@
 use crate::contact::discretization::geometry::Surface;
 use crate::contact::forces::{element_sizes, NodalTraction, PairForces, Penetration};
 use crate::error::Result;
-use crate::harness::judge::{
+use crate::harness::outside_results::{
     field, Results, ResultsFile, CONTACT_FORCE_FIELD, CONTACT_GAP_FIELD, CONTACT_PRESSURE_FIELD,
     CONTACT_STATUS_FIELD,
 };
