@@ -35,6 +35,7 @@ pub(crate) mod exact;
 pub mod friction;
 pub mod hard;
 pub mod impact;
+pub mod index_page;
 pub mod judge;
 pub mod junit;
 pub mod layer;
