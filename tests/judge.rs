@@ -169,6 +169,28 @@ fn exported_gmsh_file_reads_back_with_mshio() {
         let model = contact_patch::model::admit::load(&root().join(case)).unwrap();
         let msh_path = folder.path().join(format!("{}.msh", model.name));
         assert!(files.contains(&format!("{}.msh", model.name)));
+        // the sidecar names every point field judge reads
+        let sidecar: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(folder.path().join(format!("{}.json", model.name))).unwrap(),
+        )
+        .unwrap();
+        let fields: Vec<&str> = sidecar["results"]["fields"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f["name"].as_str().unwrap())
+            .collect();
+        assert_eq!(
+            fields,
+            [
+                "displacement",
+                "stress",
+                "contact_force",
+                "contact_pressure",
+                "contact_gap",
+                "contact_status"
+            ]
+        );
         let bytes = std::fs::read(&msh_path).unwrap();
         let msh = mshio::parse_msh_bytes(bytes.as_slice()).unwrap();
         assert_eq!(msh.header.version, 4.1);
@@ -261,21 +283,7 @@ fn a_wrong_displacement_fails_with_its_error_and_a_junit_failure() {
     let tmp = tempfile::tempdir().unwrap();
     // the displacement array: scale every x by 1.01 (a 1% error in e_xx)
     let results = edited_results(tmp.path(), |t| {
-        let (head, rest) = t.split_once("Name=\"displacement\"").unwrap();
-        let (data, tail) = rest.split_once("</DataArray>").unwrap();
-        let (attrs, values) = data.split_once('>').unwrap();
-        let scaled: Vec<String> = values
-            .trim()
-            .lines()
-            .map(|l| {
-                let v: Vec<f64> = l.split(' ').map(|w| w.parse().unwrap()).collect();
-                format!("{} {} {}", v[0] * 1.01, v[1], v[2])
-            })
-            .collect();
-        format!(
-            "{head}Name=\"displacement\"{attrs}>\n{}\n</DataArray>{tail}",
-            scaled.join("\n")
-        )
+        edit_array(t, "displacement", |v| vec![v[0] * 1.01, v[1], v[2]])
     });
     let junit = tmp.path().join("judge.xml");
     let o = run(&[
