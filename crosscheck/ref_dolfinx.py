@@ -38,7 +38,10 @@ The solution is also written by DOLFINx itself (`dolfinx.io.VTKFile`, ASCII) as
 OUT_ROOT/<case>/dolfinx.pvd + dolfinx_p0_000000.vtu, with the point fields `displacement` and
 `stress` (xx, yy, xy of sigma(u_h) interpolated at the nodes of a Lagrange space of the same
 degree),
-so that `contact-patch judge` can apply the case's checks to it (crosscheck/run.sh does).
+so that `contact-patch judge` can apply the case's checks to it (crosscheck/run.sh does); with
+contact also `contact_force` (the assembled nodal penalty force on the body), `contact_pressure`
+(kappa (-g)_+ at the slave nodes, compression positive) and `contact_gap` (see
+`contact_point_fields`), from which `judge` applies the contact checks.
 """
 
 import dolfinx_solver  # noqa: F401  (must come before dolfinx and petsc4py)
@@ -73,8 +76,9 @@ CELL = {"Q4": ("quadrilateral", 1), "Q9": ("quadrilateral", 2),
 DCELL = {"quadrilateral": dmesh.CellType.quadrilateral, "triangle": dmesh.CellType.triangle}
 
 
-def write_vtu(path, msh, degree, uh, sigma):
-    """DOLFINx's own VTK output of u_h and sigma(u_h) (see the module text)."""
+def write_vtu(path, msh, degree, uh, sigma, contact_fields=()):
+    """DOLFINx's own VTK output of u_h and sigma(u_h) (see the module text), and the contact
+    fields of `contact_point_fields` when the case has contact."""
     uh.name = "displacement"
     # xx, yy, xy as a 3-vector: DOLFINx pads a 2x2 tensor to 9 values as xx, xy, yx, yy, 0..
     # (not the 3x3 row-by-row layout VTK readers expect)
@@ -85,7 +89,36 @@ def write_vtu(path, msh, degree, uh, sigma):
     s.interpolate(fem.Expression(ufl.as_vector([S[0, 0], S[1, 1], S[0, 1]]),
                                  W.element.interpolation_points))
     with dolfinx.io.VTKFile(MPI.COMM_SELF, str(path), "w") as f:
-        f.write_function([uh, s])
+        f.write_function([uh, s, *contact_fields])
+
+
+def contact_point_fields(msh, degree, V, uh, pb, contact):
+    """The point fields `contact-patch judge` reads for the contact checks: `contact_force`,
+    the assembled nodal force of every pair's penalty term on the body (the vector
+    t kappa int (g)_- (n . v) ds, the residual's contact part); `contact_pressure`,
+    kappa (-g_a)_+ at each slave node (compression positive; with the Gauss-Lobatto rule at the
+    facet nodes it equals f_a . n_a / A_a, as in our tool); `contact_gap`, g_a at the slave
+    nodes (g < 0: penetration). Zero away from the slave nodes."""
+    fc = fem.Function(V)
+    fc.name = "contact_force"
+    fc.x.array[:] = 0.0
+    Q = fem.functionspace(msh, ("Lagrange", degree))
+    pc, gc = fem.Function(Q), fem.Function(Q)
+    pc.name, gc.name = "contact_pressure", "contact_gap"
+    pc.x.array[:] = 0.0
+    gc.x.array[:] = 0.0
+    # V's dof nodes -> Q's dofs, by coordinates (the same nodes of the same mesh)
+    tree = cKDTree(Q.tabulate_dof_coordinates()[:, :2])
+    d, to_q = tree.query(V.tabulate_dof_coordinates()[:, :2])
+    if d.max() > pb.tol:
+        raise RuntimeError(f"{pb.name}: scalar and vector dof nodes differ by {d.max():.3e}")
+    for pair, entry in zip(pb.contact, contact["pairs"]):
+        fc.x.array[:] += entry["nodal_force"]
+        dn = np.asarray(entry["dofs"], dtype=np.int64)
+        g = np.asarray(entry["gap"])
+        pc.x.array[to_q[dn]] = pair.kappa * np.maximum(-g, 0.0)
+        gc.x.array[to_q[dn]] = g
+    return [fc, pc, gc]
 
 
 def solve(pb: Problem, vtu_path=None):
@@ -211,7 +244,12 @@ def solve(pb: Problem, vtu_path=None):
             raise RuntimeError(f"{pb.name}: PETSc solve did not converge (reason {reason})")
 
     if vtu_path is not None:
-        write_vtu(vtu_path, msh, degree, uh, sigma)
+        fields = contact_point_fields(msh, degree, V, uh, pb, extra["contact"]) \
+            if pb.contact else ()
+        write_vtu(vtu_path, msh, degree, uh, sigma, fields)
+    for entry in extra.get("contact", {}).get("pairs", []):   # not for the reference file
+        for key in ("nodal_force", "dofs", "gap"):
+            entry.pop(key)
     U = uh.x.array.reshape(-1, 2)
     out = np.empty_like(pb.u_ours)
     out[ids] = U
@@ -462,10 +500,14 @@ def newton_penalty(pb, msh, V, a, L, bcs_values, bcs0, mt, contact_terms, th, id
         nx, ny = np.broadcast_to(nx, dn.shape), np.broadcast_to(ny, dn.shape)
         normal_force = f[dn, 0] * nx + f[dn, 1] * ny
         pressure = normal_force / area[dn]
+        gap, _, _ = pair.gap(X[:, 0], X[:, 1], U[dn, 0], U[dn, 1], np.sqrt)
         contact.append({"name": pair.name, "total_force": f.sum(axis=0).tolist(),
                         "nodes": vn.tolist(), "area": area[dn].tolist(),
                         "pressure": pressure.tolist(),
-                        "active": [bool(t) for t in current[k]]})
+                        "active": [bool(t) for t in current[k]],
+                        # for the .vtu point fields (contact_point_fields), then dropped
+                        "nodal_force": f.reshape(-1).copy(), "dofs": dn.tolist(),
+                        "gap": np.broadcast_to(gap, dn.shape).tolist()})
     return uh, {"pairs": contact, "newton": history, "iterations": len(history),
                 "relative_residual": res,
                 "contact_quadrature": f"GLL degree {CONTACT_RULE[pb.element]}"}

@@ -671,8 +671,9 @@ JUDGE_LINE = re.compile(r"^  (pass|FAIL) (.*) \(error ([^,]+), tol ([^)]+)\)$")
 
 
 def check_words(text):
-    """A check's words without its measured value (`reaction ... = 1.2e-15 (...)`)."""
-    return text.split(" = ")[0]
+    """A check's words without its measured value (`reaction ... = 1.2e-15 (...)`) and without
+    the results field `judge` read it from (` [from the results' 'contact_force']`)."""
+    return text.split(" [from the results' ")[0].split(" = ")[0]
 
 
 def judged_entry(case_path, root):
@@ -704,7 +705,7 @@ def judged_entry(case_path, root):
     uniform = next((c for c in summary["checks"] if c["check"].startswith("uniform stress")),
                    None)
     lines = [m for m in (JUDGE_LINE.match(ln) for ln in text.splitlines()) if m]
-    agree = len(lines) == len(statuses)     # a case with contact checks only judges none
+    agree = len(lines) == len(statuses)
     for m, status in zip(lines, statuses):
         verdict, check, error, tol = m.groups()
         mine = ours.get(check_words(check))
@@ -909,7 +910,10 @@ def write_md(path, report):
     if judged:
         lines += [
             "DOLFINx writes its solution of each single-body case itself (`dolfinx.io.VTKFile`: "
-            "point fields `displacement` and `stress`, sigma(u_h) interpolated at the nodes); "
+            "point fields `displacement` and `stress`, sigma(u_h) interpolated at the nodes; "
+            "with rigid-obstacle contact also `contact_force`, its assembled nodal penalty "
+            "force, `contact_pressure`, kappa (-g)_+ at the slave nodes, and `contact_gap`, "
+            "from which the contact checks are judged); "
             "`contact-patch judge CASE dolfinx_p0_000000.vtu --junit ...` applies the case's "
             "checks to it, as for an outside code. *ours*: the same check on our own run. "
             f"**{report['judged_passed']} of {len(judged)} cases agree** (every judged verdict "
@@ -930,8 +934,8 @@ def write_md(path, report):
                              f"{sci(r['error'])} | {tol_text(r['tol'])} | {verdict} | {ours} | "
                              f"{r['ours_verdict'] or '-'} |")
             if e["not_judged"]:
-                lines.append(f"| | not judged (contact checks need the solve's contact "
-                             f"forces): {len(e['not_judged'])} | | | | | |")
+                lines.append(f"| | not judged (see judge-dolfinx.txt for why): "
+                             f"{len(e['not_judged'])} | | | | | |")
     else:
         lines.append("No DOLFINx .vtu was judged in this run.")
     lines += [

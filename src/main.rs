@@ -133,6 +133,16 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// Write reports/index.html: one self-contained page with every table, plot and study of
+    /// the reports folder (a report not generated yet is listed with its command).
+    #[command(
+        after_help = "Example:\n  contact-patch report\n  contact-patch report --reports /tmp/reports"
+    )]
+    Report {
+        /// The reports folder (read, and where index.html is written).
+        #[arg(long, default_value = "reports")]
+        reports: PathBuf,
+    },
     /// Print the JSON Schema of the case format (committed as cases/case.schema.json; a case
     /// file may name it in "$schema" so that editors validate and complete it).
     #[command(after_help = "Example:\n  contact-patch schema > cases/case.schema.json")]
@@ -212,6 +222,7 @@ fn main() -> ExitCode {
         Command::Hard { paths, out } => hard(&paths, &out),
         Command::ImpactReport { paths, out, study } => impact_report(&paths, &out, study),
         Command::Profile { case, pair, out } => profile(&case, &pair, &out),
+        Command::Report { reports } => report_page(&reports),
         Command::Schema => {
             print!("{}", contact_patch::io::scene::case_schema());
             ExitCode::SUCCESS
@@ -1087,6 +1098,42 @@ fn impact_report(paths: &[PathBuf], out: &Path, study: ImpactStudy) -> ExitCode 
                 .map(|f| folder.shown(f).display().to_string())
                 .collect();
             println!("wrote {}", shown.join(", "));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn report_page(reports: &Path) -> ExitCode {
+    let result = ReportFolder::new(reports).and_then(|f| {
+        let page = contact_patch::harness::index_page::write(&f)?;
+        Ok((f, page))
+    });
+    match result {
+        Ok((folder, page)) => {
+            println!(
+                "wrote {}: {} tables, {} images, {} links; {} reports not generated yet{}",
+                folder
+                    .shown(contact_patch::harness::index_page::INDEX_FILE)
+                    .display(),
+                page.tables,
+                page.images,
+                page.targets.len(),
+                page.missing.len(),
+                if page.missing.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", page.missing.join(", "))
+                }
+            );
+            for link in &page.unlinked {
+                println!(
+                    "  a report links to {link}, which is not a file of the folder: shown as text"
+                );
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {

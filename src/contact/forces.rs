@@ -112,7 +112,7 @@ fn placed<'a>(body: &'a Body, u: Option<&[f64]>) -> std::borrow::Cow<'a, Body> {
 }
 
 /// Longest facet (chord) at each node of `surface`.
-fn element_sizes(surface: &Surface) -> BTreeMap<usize, f64> {
+pub(crate) fn element_sizes(surface: &Surface) -> BTreeMap<usize, f64> {
     let mut h = BTreeMap::new();
     for (nodes, coords) in surface.facets.iter().zip(&surface.coords) {
         let len =

@@ -109,6 +109,19 @@ pub fn pressure_error(
     if solution.contact.is_none() {
         return f64::INFINITY;
     }
+    pressure_error_of(model, solution, forces, exact, pair, scale)
+}
+
+/// [`pressure_error`] of the given nodal forces, whatever produced them (our solve, or another
+/// code's results read by [`crate::harness::outside_contact`]).
+pub fn pressure_error_of(
+    model: &Model,
+    solution: &Solution,
+    forces: &[PairForces],
+    exact: &crate::harness::exact::ExactField,
+    pair: Option<usize>,
+    scale: Option<f64>,
+) -> f64 {
     let fallback = Magnitudes::of(model, solution).stress;
     let mut error = 0.0f64;
     for pf in forces {
@@ -153,6 +166,12 @@ pub fn force_balance(model: &Model, solution: &Solution, forces: &[PairForces]) 
     if solution.contact.is_none() {
         return f64::INFINITY;
     }
+    force_balance_of(model, solution, forces)
+}
+
+/// [`force_balance`] of the given nodal forces; `solution.reactions` must already hold
+/// `K u - f - f_contact` (the out-of-balance force at the free dofs).
+pub fn force_balance_of(model: &Model, solution: &Solution, forces: &[PairForces]) -> f64 {
     let size = model.size();
     let load = Magnitudes::of(model, solution).force.max(f64::MIN_POSITIVE);
     let out_of_balance: f64 = model
@@ -243,13 +262,25 @@ fn pair_of<'a>(forces: &'a [PairForces], model: &Model, name: &str) -> Option<&'
 /// solve that did not converge adds a failing check of its own, so that no declared check can
 /// pass on an unconverged solution.
 pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
-    let u = &solution.u;
-    let magnitudes = Magnitudes::of(model, solution);
-    let forces: Vec<PairForces> = solution
+    let forces: Option<Vec<PairForces>> = solution
         .contact
         .as_ref()
-        .map(|state| pair_forces(model, state))
-        .unwrap_or_default();
+        .map(|state| pair_forces(model, state));
+    evaluate_with(model, solution, forces.as_deref())
+}
+
+/// [`evaluate`] with the contact forces given: those of our solve (`solution.contact`), or,
+/// for another code's results, the ones [`crate::harness::outside_contact`] read (then
+/// `solution.contact` is `None`). `None`: no contact forces, every contact check fails.
+pub fn evaluate_with(
+    model: &Model,
+    solution: &Solution,
+    contact_forces: Option<&[PairForces]>,
+) -> Vec<CheckResult> {
+    let u = &solution.u;
+    let magnitudes = Magnitudes::of(model, solution);
+    let has_forces = contact_forces.is_some();
+    let forces: &[PairForces] = contact_forces.unwrap_or(&[]);
     // a case that names its expected termination judges it itself
     let expects_termination = model
         .checks
@@ -310,15 +341,16 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
                 Check::ContactPressure { pair, tol } => {
                     let exact = model.exact.as_ref().expect("resolved when the model was built");
                     let k = model.contact.iter().position(|p| p.name == *pair).expect("resolved when the model was built");
-                    (format!("contact pressure of '{pair}' against the exact stress"), pressure_error(model, solution, &forces, exact, Some(k), None), *tol)
+                    let error = if has_forces { pressure_error_of(model, solution, forces, exact, Some(k), None) } else { f64::INFINITY };
+                    (format!("contact pressure of '{pair}' against the exact stress"), error, *tol)
                 }
                 Check::ContactForce { pair, component, value, tol } => {
-                    let got = pair_of(&forces, model, pair).map(|f| f.on_slave[component.index()]).unwrap_or(f64::NAN);
+                    let got = pair_of(forces, model, pair).map(|f| f.on_slave[component.index()]).unwrap_or(f64::NAN);
                     let (error, expected) = judged(got, *value, magnitudes.force, "the applied load");
                     (format!("total contact force {component:?} of '{pair}' on its slave body = {got:.6e} ({expected})"), error, *tol)
                 }
                 Check::MaxContactPressure { pair, value, tol } => {
-                    let got = pair_of(&forces, model, pair).map(|f| f.max_pressure()).unwrap_or(f64::NAN);
+                    let got = pair_of(forces, model, pair).map(|f| f.max_pressure()).unwrap_or(f64::NAN);
                     let (error, expected) = judged(got, *value, magnitudes.stress, "the load's stress");
                     (format!("max contact pressure of '{pair}' = {got:.6e} ({expected})"), error, *tol)
                 }
@@ -326,7 +358,7 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
                     let got = forces
                         .iter()
                         .filter(|f| pair.as_ref().is_none_or(|p| model.contact[f.pair].name == *p))
-                        .fold(if solution.contact.is_some() { 0.0 } else { f64::NAN }, |m, f| worst(m, f.penetration.share_of_element));
+                        .fold(if has_forces { 0.0 } else { f64::NAN }, |m, f| worst(m, f.penetration.share_of_element));
                     let of = pair.as_ref().map(|p| format!(" of '{p}'")).unwrap_or_default();
                     (format!("largest penetration{of} relative to the contact element size"), got, *share)
                 }
@@ -380,7 +412,7 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
                         model.size(),
                         magnitudes.force
                     ),
-                    force_balance(model, solution, &forces),
+                    if has_forces { force_balance_of(model, solution, forces) } else { f64::INFINITY },
                     *tol,
                 ),
                 Check::Displacement { body, point, component, value, tol } => {

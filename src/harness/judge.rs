@@ -16,19 +16,32 @@
 //! * a results `stress` field (`xx, yy, xy`; or a 2x2 or 3x3 tensor, row by row) adds, for each
 //!   `uniform_stress` check, `max_nodes max_i |s_i - sigma_i| / scale` with the check's scale;
 //! * the contact checks (`contact_pressure`, `contact_force`, `max_contact_pressure`,
-//!   `max_penetration`, `force_balance`) need the contact forces of the solve and are listed as
-//!   not judged, with that reason.
+//!   `max_penetration`, `force_balance`): from the results' point fields `contact_force`,
+//!   `contact_pressure` (compression positive) and `contact_gap` on the pairs' surfaces, as
+//!   [`crate::harness::outside_contact`] states; a check whose field is missing is listed as not
+//!   judged, naming the field. With contact forces `f_c`, `K u - f - f_c` is the residual.
 //!
 //! `table --results DIR` makes one table cell per swept case from the results in `DIR`
-//! ([`outside_cells`]): its verdict is the sweep's stress criterion,
+//! ([`outside_cells`]), judged as the sweep judges an exact method: the stress criterion
 //! `max_qp max_i |sigma_i(u) - sigma_exact,i| / p <= tol` (the contact patch test's uniform
-//! stress), the other columns of a cell being contact quantities that results do not carry.
+//! stress) and, where the results carry them, the pressure error, the total contact force
+//! (load error) within `tol` and the force balance within the case's `force_balance` tolerance;
+//! the note names what was judged and what the results lack.
 
+use crate::contact::forces::PairForces;
 use crate::error::{Error, Result};
-use crate::harness::checks::{evaluate, CheckResult, Magnitudes};
+use crate::harness::checks::{
+    evaluate_with, force_balance_of, pressure_error_of, CheckResult, Magnitudes,
+};
+use crate::harness::outside_contact::{self, OutsideContact, Source};
+use crate::harness::outside_results::field;
+pub use crate::harness::outside_results::{
+    load_results, Results, ResultsFile, CONTACT_FORCE_FIELD, CONTACT_GAP_FIELD,
+    CONTACT_PRESSURE_FIELD, CONTACT_STATUS_FIELD, DISPLACEMENT_FIELD, STRESS_FIELD,
+};
 use crate::io::paths::file_name;
 use crate::io::scene::Check;
-use crate::io::vtu_read::{read_vtu, PointField, PointGrid};
+use crate::io::vtu_read::PointGrid;
 use crate::model::Model;
 use crate::solver::linear::{for_each_element_stiffness, Solution, Timings};
 use std::collections::HashMap;
@@ -36,79 +49,6 @@ use std::path::Path;
 
 /// Default node-matching distance, relative to the model size.
 pub const DEFAULT_MATCH_SHARE: f64 = 1e-8;
-
-/// The point field names read.
-pub const DISPLACEMENT_FIELD: &str = "displacement";
-pub const STRESS_FIELD: &str = "stress";
-pub const CONTACT_PRESSURE_FIELD: &str = "contact_pressure";
-
-/// One results file.
-#[derive(Clone, Debug)]
-pub struct ResultsFile {
-    pub shown: String,
-    pub grid: PointGrid,
-}
-
-/// Another code's results: one file for every body, or one file per body.
-#[derive(Clone, Debug)]
-pub enum Results {
-    Shared(ResultsFile),
-    /// In the order of the model's bodies.
-    PerBody(Vec<ResultsFile>),
-}
-
-impl Results {
-    fn of_body(&self, b: usize) -> &ResultsFile {
-        match self {
-            Results::Shared(f) => f,
-            Results::PerBody(files) => &files[b],
-        }
-    }
-
-    fn files(&self) -> Vec<&ResultsFile> {
-        match self {
-            Results::Shared(f) => vec![f],
-            Results::PerBody(files) => files.iter().collect(),
-        }
-    }
-}
-
-/// Read the results at `path`: a `.vtu` file (for every body), or a folder with `<body>.vtu`
-/// for each body of `model` (the layout `contact-patch run` writes).
-pub fn load_results(model: &Model, path: &Path) -> Result<Results> {
-    if path.is_dir() {
-        let mut files = Vec::new();
-        for body in &model.bodies {
-            let file = path.join(file_name("body name", &body.name, ".vtu")?);
-            if !file.is_file() {
-                return Err(Error::invalid(
-                    path.display(),
-                    format!("body '{}'", body.name),
-                    format!("the folder holds no {}", file.display()),
-                    "a results folder holds one <body name>.vtu per body of the case; or give \
-                     one .vtu file that holds every body",
-                ));
-            }
-            files.push(ResultsFile {
-                shown: file.display().to_string(),
-                grid: read_vtu(&file)?,
-            });
-        }
-        Ok(Results::PerBody(files))
-    } else if path.is_file() {
-        Ok(Results::Shared(ResultsFile {
-            shown: path.display().to_string(),
-            grid: read_vtu(path)?,
-        }))
-    } else {
-        Err(Error::invalid(
-            path.display(),
-            "results",
-            "no such file or folder",
-            "give a .vtu file, or a folder with one <body name>.vtu per body",
-        ))
-    }
-}
 
 /// A check that could not be judged, and why.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -137,8 +77,10 @@ pub struct Judgement {
     pub nodes: usize,
     pub largest_distance: f64,
     pub match_distance: f64,
-    /// The solution the results define (`u`, `K u - f`).
+    /// The solution the results define (`u`, `K u - f - f_c`).
     pub solution: Solution,
+    /// The contact fields read (empty without contact pairs).
+    pub contact: OutsideContact,
 }
 
 impl Judgement {
@@ -154,14 +96,12 @@ fn unjudgeable(check: &Check) -> Option<&'static str> {
         | Check::ExactDisplacement { .. }
         | Check::Reaction { .. }
         | Check::Displacement { .. } => None,
+        // judged from the results' contact fields (crate::harness::outside_contact)
         Check::ContactPressure { .. }
         | Check::ContactForce { .. }
         | Check::MaxContactPressure { .. }
         | Check::MaxPenetration { .. }
-        | Check::ForceBalance { .. } => Some(
-            "it is judged from the contact forces and gaps of the solve's contact rows, which \
-             point results do not carry (a 'contact_pressure' field is not read for it yet)",
-        ),
+        | Check::ForceBalance { .. } => None,
         Check::TerminatesWith { .. }
         | Check::Equilibrium { .. }
         | Check::StatusChanges { .. }
@@ -221,42 +161,6 @@ impl<'a> PointIndex<'a> {
             .map(|(k, p)| (k, (p[0] - x[0]).hypot(p[1] - x[1])))
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
-}
-
-/// A named point field with at least `min_components` components, or `None` when absent.
-fn field<'a>(
-    file: &'a ResultsFile,
-    name: &str,
-    min_components: usize,
-) -> Result<Option<&'a PointField>> {
-    let Some(f) = file.grid.fields.get(name) else {
-        return Ok(None);
-    };
-    if f.components < min_components {
-        return Err(Error::invalid(
-            &file.shown,
-            format!("point field '{name}'"),
-            format!(
-                "{} components per point (at least {min_components} expected)",
-                f.components
-            ),
-            "write displacement as a 2- or 3-component vector (x, y[, 0])",
-        ));
-    }
-    if let Some(k) = f.values.iter().position(|v| !v.is_finite()) {
-        return Err(Error::invalid(
-            &file.shown,
-            format!("point field '{name}'"),
-            format!(
-                "value {} of point {} is {}",
-                k % f.components + 1,
-                k / f.components,
-                f.values[k]
-            ),
-            "the results hold a non-finite number; the other code's solve failed",
-        ));
-    }
-    Ok(Some(f))
 }
 
 /// `xx, yy, xy` of a stress field value: 3 components as they are, 4 as a 2x2 and 9 as a 3x3
@@ -381,22 +285,41 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
         }
         matched.push(points);
     }
-    let solution = solution_of(model, u);
-    let (judgeable, skipped): (Vec<Check>, Vec<Check>) = model
-        .checks
-        .iter()
-        .cloned()
-        .partition(|c| unjudgeable(c).is_none());
-    let mut judged_model = model.clone();
-    judged_model.checks = judgeable;
-    let mut checks = evaluate(&judged_model, &solution);
-    let not_judged = skipped
-        .iter()
-        .map(|c| NotJudged {
-            check: serde_json::to_string(c).expect("checks serialize"),
-            why: unjudgeable(c).unwrap_or_default().to_string(),
-        })
-        .collect();
+    let contact = if model.contact.is_empty() {
+        OutsideContact::default()
+    } else {
+        outside_contact::read(model, results, &matched)?
+    };
+    let solution = solution_of(model, u, contact.nodal_force.as_deref());
+    let mut checks = Vec::new();
+    let mut not_judged = Vec::new();
+    for check in &model.checks {
+        let stated = || serde_json::to_string(check).expect("checks serialize");
+        if let Some(why) = unjudgeable(check) {
+            not_judged.push(NotJudged {
+                check: stated(),
+                why: why.to_string(),
+            });
+            continue;
+        }
+        let mut one = model.clone();
+        one.checks = vec![check.clone()];
+        match contact.source(model, check) {
+            Source::NoContact => checks.extend(evaluate_with(&one, &solution, None)),
+            Source::NotJudged(why) => not_judged.push(NotJudged {
+                check: stated(),
+                why,
+            }),
+            Source::Forces(forces, from) => checks.extend(
+                evaluate_with(&one, &solution, Some(&forces))
+                    .into_iter()
+                    .map(|mut c| {
+                        c.check += &format!(" [from the results' '{from}']");
+                        c
+                    }),
+            ),
+        }
+    }
     // the results' own stress field
     let files = results.files();
     let mut stress_found = !files.is_empty();
@@ -456,10 +379,14 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
             });
         }
     }
-    let pressure_found = files
-        .iter()
-        .all(|f| f.grid.fields.contains_key(CONTACT_PRESSURE_FIELD));
-    let fields = vec![
+    let contact_use = |found: bool, what: &str| {
+        if found {
+            what.to_string()
+        } else {
+            format!("missing: not used for {what}")
+        }
+    };
+    let mut fields = vec![
         FieldUse {
             field: DISPLACEMENT_FIELD.into(),
             found: true,
@@ -474,12 +401,32 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
                 "missing: stresses are judged from the displacement only".into()
             },
         },
-        FieldUse {
-            field: CONTACT_PRESSURE_FIELD.into(),
-            found: pressure_found,
-            use_: "not read: the contact checks are not judged".into(),
-        },
     ];
+    if !model.contact.is_empty() {
+        fields.extend([
+            FieldUse {
+                field: CONTACT_PRESSURE_FIELD.into(),
+                found: contact.pressure_field,
+                use_: contact_use(
+                    contact.pressure_field,
+                    "the contact pressure checks; the forces -p A n of frictionless pairs",
+                ),
+            },
+            FieldUse {
+                field: CONTACT_FORCE_FIELD.into(),
+                found: contact.force_field,
+                use_: contact_use(
+                    contact.force_field,
+                    "the contact force and force balance checks; the tractions of ties",
+                ),
+            },
+            FieldUse {
+                field: CONTACT_GAP_FIELD.into(),
+                found: contact.gap_field,
+                use_: contact_use(contact.gap_field, "the penetration checks"),
+            },
+        ]);
+    }
     Ok(Judgement {
         checks,
         not_judged,
@@ -488,13 +435,19 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
         largest_distance,
         match_distance: delta,
         solution,
+        contact,
     })
 }
 
 /// The solution `u` defines: `K u - f` at every dof (reactions at the prescribed ones), and the
 /// largest free-dof residual relative to the largest external force or reaction.
-fn solution_of(model: &Model, u: Vec<f64>) -> Solution {
+fn solution_of(model: &Model, u: Vec<f64>, contact_force: Option<&[f64]>) -> Solution {
     let mut r: Vec<f64> = model.external_force.iter().map(|f| -f).collect();
+    if let Some(fc) = contact_force {
+        for (r, f) in r.iter_mut().zip(fc) {
+            *r -= f;
+        }
+    }
     for_each_element_stiffness(model, |dofs, ke| {
         let n = dofs.len();
         for i in 0..n {
@@ -584,10 +537,70 @@ pub fn outside_cells(
     let judged = judge(&model, &results, match_share)?;
     let e = crate::harness::stress_error(&model, &judged.solution.u, sweep.pressure);
     cell.stress_error = Some(e);
-    cell.verdict = if e <= sweep.tol { "pass" } else { "fail" }.into();
+    let mut pass = e <= sweep.tol;
+    let mut judged_on = vec!["the stress of its displacement"];
+    let mut missing = Vec::new();
+    let pairs = &judged.contact.pairs;
+    let pressures: Option<Vec<PairForces>> = pairs
+        .iter()
+        .map(|p| p.pressures().map(|(f, _)| f.clone()))
+        .collect();
+    match (pressures, model.exact.as_ref()) {
+        (Some(p), Some(exact)) if !pairs.is_empty() => {
+            let error = pressure_error_of(
+                &model,
+                &judged.solution,
+                &p,
+                exact,
+                None,
+                Some(sweep.pressure.abs()),
+            );
+            cell.pressure_error = Some(error);
+            pass &= error <= sweep.tol;
+            judged_on.push("the contact pressure");
+        }
+        _ => missing.push("pressure"),
+    }
+    let forces: Option<Vec<PairForces>> = pairs
+        .iter()
+        .map(|p| p.forces().map(|(f, _)| f.clone()))
+        .collect();
+    match forces {
+        Some(f) if !pairs.is_empty() => {
+            let first_pass: std::collections::HashSet<(usize, usize, usize)> = f
+                .iter()
+                .flat_map(|pf| {
+                    let slave = model.contact[pf.pair].slave.0;
+                    pf.nodes
+                        .iter()
+                        .filter(move |n| n.carries_rows && n.body == slave)
+                        .map(move |n| (pf.pair, n.body, n.node))
+                })
+                .collect();
+            let load = crate::harness::load_error(&model, &f, sweep.pressure, &|k, b, n| {
+                first_pass.contains(&(k, b, n))
+            });
+            let balance = force_balance_of(&model, &judged.solution, &f);
+            cell.load_error = Some(load);
+            cell.force_balance = Some(balance);
+            pass &= load <= sweep.tol && balance <= crate::harness::balance_tol(&model);
+            judged_on.push("the total contact force and the force balance");
+        }
+        _ => missing.push("contact forces"),
+    }
+    cell.verdict = if pass { "pass" } else { "fail" }.into();
+    let missing = if missing.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; not in the results: {} (fields '{CONTACT_PRESSURE_FIELD}', '{CONTACT_FORCE_FIELD}')",
+            missing.join(", ")
+        )
+    };
     cell.note = format!(
-        "{}: judged on the stress of its displacement; contact forces are not in the results",
-        path.display()
+        "{}: judged on {}{missing}",
+        path.display(),
+        judged_on.join(", ")
     );
     Ok(vec![cell])
 }

@@ -37,16 +37,19 @@ pub mod friction;
 pub mod hard;
 pub mod impact;
 pub mod impact_cost;
+pub mod index_page;
 pub mod judge;
 pub mod junit;
 pub mod layer;
+pub mod outside_contact;
+pub mod outside_results;
 pub mod profile;
 pub mod report;
 pub mod stability;
 
 use crate::contact::discretization::constraints;
 use crate::contact::enforcement::method;
-use crate::contact::forces::pair_forces;
+use crate::contact::forces::{pair_forces, PairForces};
 use crate::error::Result;
 use crate::io::scene::{
     Catalogue, DiscretizationSpec, EnforcementSpec, MultiplierSpace, TwoPassPenalty,
@@ -199,6 +202,50 @@ pub(crate) fn stress_error(model: &Model, u: &[f64], pressure: f64) -> f64 {
     stress_error
 }
 
+/// The case's own force-balance tolerance (its `force_balance` check), 1e-12 if it declares
+/// none.
+pub(crate) fn balance_tol(model: &Model) -> f64 {
+    model
+        .checks
+        .iter()
+        .find_map(|c| match c {
+            crate::io::scene::Check::ForceBalance { tol } => Some(*tol),
+            _ => None,
+        })
+        .unwrap_or(1e-12)
+}
+
+/// The total interaction force on the pass-1 slave bodies against the exact traction
+/// integrated over the slave nodes that carry first-pass rows (`first_pass(pair, body, node)`),
+/// relative to the load scale `|p|` x (that interface area): a zero exact force (parallel
+/// stress across a tie) is judged too.
+pub(crate) fn load_error(
+    model: &Model,
+    forces: &[PairForces],
+    pressure: f64,
+    first_pass: &dyn Fn(usize, usize, usize) -> bool,
+) -> f64 {
+    let exact = model.exact.as_ref();
+    let (mut f, mut f_exact, mut length) = ([0.0f64; 2], [0.0f64; 2], 0.0f64);
+    for pf in forces {
+        f[0] += pf.on_slave[0];
+        f[1] += pf.on_slave[1];
+        for n in &pf.nodes {
+            if !first_pass(pf.pair, n.body, n.node) {
+                continue;
+            }
+            length += n.area;
+            if let Some(e) = exact {
+                let s = e.stress(model.bodies[n.body].mesh.nodes[n.node]);
+                let nn = n.normal;
+                f_exact[0] += n.area * (s[0] * nn[0] + s[2] * nn[1]);
+                f_exact[1] += n.area * (s[2] * nn[0] + s[1] * nn[1]);
+            }
+        }
+    }
+    (f[0] - f_exact[0]).hypot(f[1] - f_exact[1]) / (pressure.abs() * length)
+}
+
 fn measure(model: &Model, solution: &Solution, pressure: f64) -> Measured {
     let exact = model.exact.as_ref();
     let stress_error = stress_error(model, &solution.u, pressure);
@@ -216,32 +263,13 @@ fn measure(model: &Model, solution: &Solution, pressure: f64) -> Measured {
             )
         })
         .unwrap_or(f64::NAN);
-    // total interaction force on the pass-1 slave body, against the exact traction integrated
-    // over the slave nodes that carry first-pass rows
-    let (mut f, mut f_exact, mut length) = ([0.0f64; 2], [0.0f64; 2], 0.0f64);
     let mut first_pass = std::collections::HashSet::new();
     for r in state.rows.iter().filter(|r| r.pass == 1) {
         first_pass.insert((r.pair, r.slave_body, r.slave_node));
     }
-    for pf in &forces {
-        f[0] += pf.on_slave[0];
-        f[1] += pf.on_slave[1];
-        for n in &pf.nodes {
-            if !first_pass.contains(&(pf.pair, n.body, n.node)) {
-                continue;
-            }
-            length += n.area;
-            if let Some(e) = exact {
-                let s = e.stress(model.bodies[n.body].mesh.nodes[n.node]);
-                let nn = n.normal;
-                f_exact[0] += n.area * (s[0] * nn[0] + s[2] * nn[1]);
-                f_exact[1] += n.area * (s[2] * nn[0] + s[1] * nn[1]);
-            }
-        }
-    }
-    // relative to the load scale p x (interface area): a zero exact force (parallel stress
-    // across a tie) is judged too
-    let load_error = (f[0] - f_exact[0]).hypot(f[1] - f_exact[1]) / (pressure.abs() * length);
+    let load_error = load_error(model, &forces, pressure, &|pair, body, node| {
+        first_pass.contains(&(pair, body, node))
+    });
     let max_penetration = forces
         .iter()
         .fold(0.0f64, |m, p| m.max(p.penetration.depth));
@@ -450,14 +478,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             }
             // the case's own force-balance tolerance (its `force_balance` check), 1e-12 if it
             // declares none
-            let balance_tol = model
-                .checks
-                .iter()
-                .find_map(|c| match c {
-                    crate::io::scene::Check::ForceBalance { tol } => Some(*tol),
-                    _ => None,
-                })
-                .unwrap_or(1e-12);
+            let balance_tol = balance_tol(&model);
             let balanced = m.force_balance <= balance_tol;
             if !balanced {
                 notes.push(format!("force balance {:.1e}", m.force_balance));

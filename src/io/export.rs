@@ -168,9 +168,33 @@ pub fn sidecar(case: &Case, model: &Model, case_file: &Path) -> Value {
         },
         "results": {
             "judge": format!("contact-patch judge {} RESULTS", case_file.display()),
-            "expected": "a .vtu with point data 'displacement' (2 or 3 components) at the mesh's nodes, optionally 'stress' (xx, yy, xy, or a 2x2 / 3x3 tensor); or a folder with <body>.vtu per body when bodies touch",
+            "expected": "a .vtu with point data 'displacement' (2 or 3 components) at the mesh's nodes, optionally 'stress' (xx, yy, xy, or a 2x2 / 3x3 tensor) and the contact fields below; or a folder with <body>.vtu per body when bodies touch",
+            "fields": judged_fields(),
         },
     })
+}
+
+/// The point fields `judge` reads, with their components, meaning and use
+/// ([`crate::harness::judge`], [`crate::harness::outside_contact`]).
+fn judged_fields() -> Value {
+    use crate::harness::outside_results::{
+        CONTACT_FORCE_FIELD, CONTACT_GAP_FIELD, CONTACT_PRESSURE_FIELD, CONTACT_STATUS_FIELD,
+        DISPLACEMENT_FIELD, STRESS_FIELD,
+    };
+    json!([
+        {"name": DISPLACEMENT_FIELD, "components": "2 or 3 (x, y[, 0])", "required": true,
+         "meaning": "nodal displacement", "judges": "uniform_stress, exact_displacement, displacement, reaction (K u - f with our K and f)"},
+        {"name": STRESS_FIELD, "components": "3 (xx, yy, xy), or a symmetric 2x2 / 3x3 tensor row by row", "required": false,
+         "meaning": "nodal stress", "judges": "an extra uniform-stress check of the results' own stress"},
+        {"name": CONTACT_FORCE_FIELD, "components": "2 or 3 (x, y[, 0])", "required": false,
+         "meaning": "nodal contact force the interface puts on the node's body (the assembled contact part of the residual), zero away from contact surfaces", "judges": "contact_force, force_balance (out-of-balance sum |K u - f - f_c| over the free dofs), a tie's contact_pressure (whole traction f_a / A_a)"},
+        {"name": CONTACT_PRESSURE_FIELD, "components": 1, "required": false,
+         "meaning": "normal contact pressure, positive in compression: -f_a . n_a / A_a (n_a outward normal, A_a = t int N_a ds), for a penalty code kappa (-g)_+", "judges": "contact_pressure, max_contact_pressure; and contact_force, force_balance of frictionless pairs when contact_force is absent (f_a = -p_a A_a n_a)"},
+        {"name": CONTACT_GAP_FIELD, "components": 1, "required": false,
+         "meaning": "normal gap at the slave nodes (negative: penetration)", "judges": "max_penetration ((-g)_+ over the longest slave facet at the node)"},
+        {"name": CONTACT_STATUS_FIELD, "components": 1, "required": false,
+         "meaning": "0 at a contact-surface node that carries no contact constraint (ours: no row); other values: a contact point", "judges": "which surface nodes the pressure and penetration checks visit (all slave-surface nodes without it)"},
+    ])
 }
 
 /// One body's mesh as VTK XML with the point field `node` (our node number).
