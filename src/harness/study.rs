@@ -27,6 +27,9 @@
 //! condition estimate (Hager-Higham, [`crate::solver::conditioning`]), the phase times of
 //! `summary.json` and the peak resident memory of the run (Linux: `VmHWM` of
 //! `/proc/self/status` after resetting it through `/proc/self/clear_refs`; absent elsewhere).
+//! The reset sets the peak to the resident size at the cell's start, which includes what the
+//! allocator kept from earlier cells, so a small cell after a large one shows the large one's
+//! leftover: the figure bounds the cell's peak from above.
 //!
 //! Derived (from the cells, never written by hand):
 //! * the Pareto front of every error metric against total time: the cells that no other cell
