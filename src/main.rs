@@ -68,6 +68,39 @@ enum Command {
             requires = "results"
         )]
         code: String,
+        /// Run only shard K of N (every N-th case, from the K-th) and write
+        /// table.shard-K-of-N.json into --out; `contact-patch merge` combines the parts.
+        #[arg(long, value_name = "K/N", conflicts_with_all = ["baseline", "junit"])]
+        shard: Option<contact_patch::harness::shard::Shard>,
+    },
+    /// Run a study: a base case over the cartesian grid of the study's axes; writes
+    /// <study>.md, <study>.json and one error-versus-time SVG per metric.
+    #[command(
+        after_help = "Example:\n  contact-patch study cases/studies/hertz-cylinder.study.json\n  contact-patch study cases/studies/penalty-window.study.json --shard 1/4 --out parts\n  contact-patch merge parts/penalty-window.shard-*-of-4.json --out reports\n\nThe study format's JSON Schema: contact-patch schema --study. Exit 2 on a bad study file."
+    )]
+    Study {
+        /// The study file (JSON).
+        study: PathBuf,
+        /// Folder for the reports.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Run only shard K of N (every N-th cell, from the K-th) and write
+        /// <study>.shard-K-of-N.json; `contact-patch merge` combines the parts.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<contact_patch::harness::shard::Shard>,
+    },
+    /// Merge the partial files of `table --shard` or `study --shard` into the tables and
+    /// reports one unsharded run writes.
+    #[command(
+        after_help = "Example:\n  contact-patch merge parts/table.shard-1-of-3.json parts/table.shard-2-of-3.json parts/table.shard-3-of-3.json --out reports\n\nA shard given twice, a missing shard or parts of different runs are refused (exit 2)."
+    )]
+    Merge {
+        /// The partial files (*.shard-K-of-N.json), every shard of one run once.
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Folder for the merged reports.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
     },
     /// The seed's tied layer: node-to-surface and mortar ties against one body, under refinement;
     /// writes reports/tied-layer.md, SVG plots and .vtu files.
@@ -145,8 +178,14 @@ enum Command {
     },
     /// Print the JSON Schema of the case format (committed as cases/case.schema.json; a case
     /// file may name it in "$schema" so that editors validate and complete it).
-    #[command(after_help = "Example:\n  contact-patch schema > cases/case.schema.json")]
-    Schema,
+    #[command(
+        after_help = "Example:\n  contact-patch schema > cases/case.schema.json\n  contact-patch schema --study > cases/studies/study.schema.json"
+    )]
+    Schema {
+        /// Print the JSON Schema of the study format instead.
+        #[arg(long)]
+        study: bool,
+    },
     /// Run the checks declared in cases; exit 0 only when every check of every case passes.
     #[command(
         after_help = "Example:\n  contact-patch check cases/patch-single cases/convergence/cantilever-q4.json\n\nFolders are searched recursively for *.json case files."
@@ -210,6 +249,7 @@ fn main() -> ExitCode {
             baseline_factor,
             results,
             code,
+            shard,
         } => table(
             &paths,
             &out,
@@ -217,14 +257,21 @@ fn main() -> ExitCode {
             &baseline,
             baseline_factor,
             results.as_deref().map(|dir| (dir, code.as_str())),
+            shard,
         ),
+        Command::Study { study, out, shard } => run_study(&study, &out, shard),
+        Command::Merge { parts, out } => merge(&parts, &out),
         Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
         Command::Hard { paths, out } => hard(&paths, &out),
         Command::ImpactReport { paths, out, study } => impact_report(&paths, &out, study),
         Command::Profile { case, pair, out } => profile(&case, &pair, &out),
         Command::Report { reports } => report_page(&reports),
-        Command::Schema => {
-            print!("{}", contact_patch::io::scene::case_schema());
+        Command::Schema { study } => {
+            if study {
+                print!("{}", contact_patch::harness::study::study_schema());
+            } else {
+                print!("{}", contact_patch::io::scene::case_schema());
+            }
             ExitCode::SUCCESS
         }
     }
@@ -323,7 +370,7 @@ fn print_outcome(o: &Outcome) {
 }
 
 /// Case files named by `paths` (folders searched recursively), sorted. In folders, a
-/// `*.schema.json` file (the case format's schema) is not a case.
+/// `*.schema.json` file (a format's schema) and a `*.study.json` file (a study) are not cases.
 fn collect_cases(paths: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
     fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), String> {
         let entries = std::fs::read_dir(dir)
@@ -335,6 +382,7 @@ fn collect_cases(paths: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
                 walk(&p, out)?;
             } else if p.extension().is_some_and(|x| x == "json")
                 && !p.to_string_lossy().ends_with(".schema.json")
+                && !p.to_string_lossy().ends_with(".study.json")
             {
                 out.push(p);
             }
@@ -615,6 +663,7 @@ fn table(
     baseline_paths: &[PathBuf],
     baseline_factor: f64,
     outside: Option<(&Path, &str)>,
+    shard: Option<contact_patch::harness::shard::Shard>,
 ) -> ExitCode {
     let paths = if paths.is_empty() {
         vec![
@@ -664,7 +713,12 @@ fn table(
     let start = std::time::Instant::now();
     let mut cells = Vec::new();
     let mut errors = Vec::new();
-    for case in &cases {
+    let mut units = Vec::new();
+    let mut unit_errors = Vec::new();
+    for (unit, case) in cases.iter().enumerate() {
+        if shard.is_some_and(|s| !s.owns(unit)) {
+            continue;
+        }
         let mut progress = |m: &str| {
             if let Some(b) = &bar {
                 b.set_message(m.to_string());
@@ -679,12 +733,16 @@ fn table(
             ),
             None => contact_patch::harness::run_sweep(case, &mut progress),
         }) {
-            Ok(c) => cells.extend(c),
+            Ok(c) => {
+                units.push((unit, c.clone()));
+                cells.extend(c)
+            }
             Err(e) => {
                 match &bar {
                     Some(b) => b.println(format!("error: {e}")),
                     None => eprintln!("error: {e}"),
                 }
+                unit_errors.push((unit, e.clone()));
                 errors.push((case.display().to_string(), e));
             }
         }
@@ -696,51 +754,64 @@ fn table(
         b.finish_and_clear();
     }
     let seconds = start.elapsed().as_secs_f64();
-    let mut catalogues: Vec<Catalogue> = cells.iter().map(|c| c.catalogue).collect();
-    catalogues.sort();
-    catalogues.dedup();
-    let mut suites = Vec::new();
-    for &catalogue in &catalogues {
-        let part: Vec<_> = cells
-            .iter()
-            .filter(|c| c.catalogue == catalogue)
-            .cloned()
-            .collect();
-        let report = match catalogue {
-            Catalogue::Tied => contact_patch::harness::report::tied_report(&part),
-            Catalogue::Patch => contact_patch::harness::report::patch_report(&part, seconds),
-            Catalogue::Friction => contact_patch::harness::report::friction_report(&part, seconds),
+    if let Some(shard) = shard {
+        use contact_patch::harness::shard::{write_part, Part};
+        let part = Part::Table {
+            shard,
+            cases: cases.iter().map(|c| c.display().to_string()).collect(),
+            ran: units,
+            errors: unit_errors,
+            seconds,
         };
-        let json = serde_json::to_string_pretty(&part).expect("cells serialize") + "\n";
-        let (md, js) = (
-            format!("{}-table.md", catalogue.name()),
-            format!("{}-table.json", catalogue.name()),
-        );
-        if let Err(e) = folder
-            .write_file(&js, &json)
-            .and_then(|_| folder.write_file(&md, &report))
-        {
+        return match write_part(&folder, "table", shard, &part) {
+            Ok(file) => {
+                println!(
+                    "shard {}/{}: {} cells of {} cases in {seconds:.2}s; wrote {}",
+                    shard.index,
+                    shard.count,
+                    cells.len(),
+                    cases
+                        .iter()
+                        .enumerate()
+                        .filter(|(i, _)| shard.owns(*i))
+                        .count(),
+                    folder.shown(&file).display()
+                );
+                if errors.is_empty() {
+                    ExitCode::SUCCESS
+                } else {
+                    eprintln!(
+                        "error: {} cases of this shard could not be run",
+                        errors.len()
+                    );
+                    ExitCode::from(2)
+                }
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::from(2)
+            }
+        };
+    }
+    let written = match contact_patch::harness::shard::write_tables(&folder, &cells, seconds) {
+        Ok(w) => w,
+        Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(2);
         }
-        if catalogue == Catalogue::Patch {
-            println!("{}", contact_patch::harness::report::seed_summary(&part));
+    };
+    let mut suites = Vec::new();
+    for w in &written {
+        let part = &w.cells;
+        if w.catalogue == Catalogue::Patch {
+            println!("{}", contact_patch::harness::report::seed_summary(part));
         }
         suites.push(junit::TestSuite {
-            name: catalogue.name().to_string(),
+            name: w.catalogue.name().to_string(),
             seconds: part.iter().map(|c| c.time_ms / 1e3).sum(),
             cases: part.iter().map(junit::cell_case).collect(),
         });
-        println!(
-            "{}: {} cells ({} pass, {} fail, {} n/a); wrote {} and {}",
-            catalogue.name(),
-            part.len(),
-            part.iter().filter(|c| c.verdict == "pass").count(),
-            part.iter().filter(|c| c.verdict == "fail").count(),
-            part.iter().filter(|c| c.verdict == "n/a").count(),
-            folder.shown(&md).display(),
-            folder.shown(&js).display()
-        );
+        print_catalogue(&folder, w);
     }
     println!("{} cells in {seconds:.2}s", cells.len());
     if !errors.is_empty() {
@@ -1136,6 +1207,142 @@ fn report_page(reports: &Path) -> ExitCode {
             }
             ExitCode::SUCCESS
         }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn print_catalogue(folder: &ReportFolder, w: &contact_patch::harness::shard::Written) {
+    let part = &w.cells;
+    println!(
+        "{}: {} cells ({} pass, {} fail, {} n/a); wrote {} and {}",
+        w.catalogue.name(),
+        part.len(),
+        part.iter().filter(|c| c.verdict == "pass").count(),
+        part.iter().filter(|c| c.verdict == "fail").count(),
+        part.iter().filter(|c| c.verdict == "n/a").count(),
+        folder.shown(&w.md).display(),
+        folder.shown(&w.json).display()
+    );
+}
+
+fn run_study(
+    path: &Path,
+    out: &Path,
+    shard: Option<contact_patch::harness::shard::Shard>,
+) -> ExitCode {
+    use contact_patch::harness::{shard as shards, study};
+    let result = (|| -> contact_patch::Result<()> {
+        let folder = ReportFolder::new(out)?;
+        let s = study::load_study(path)?;
+        let total = s.cell_count();
+        let todo: Vec<usize> = (0..total)
+            .filter(|&i| shard.is_none_or(|k| k.owns(i)))
+            .collect();
+        let bar = progress_bar(todo.len());
+        let mut cells = Vec::new();
+        for &i in &todo {
+            if let Some(b) = &bar {
+                b.set_message(s.cell_labels(i).join(" "));
+            }
+            let cell = s.run_cell(i);
+            if let Some(e) = &cell.error {
+                let line = format!("cell {i} ({}): {e}", cell.labels.join(", "));
+                match &bar {
+                    Some(b) => b.println(line),
+                    None => eprintln!("{line}"),
+                }
+            }
+            cells.push(cell);
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+        }
+        if let Some(b) = bar {
+            b.finish_and_clear();
+        }
+        let failed = cells.iter().filter(|c| c.error.is_some()).count();
+        match shard {
+            Some(k) => {
+                let part = shards::Part::Study {
+                    shard: k,
+                    source: s.source.clone(),
+                    study: s.spec.clone(),
+                    total,
+                    cells,
+                };
+                let file = shards::write_part(&folder, &s.spec.name, k, &part)?;
+                println!(
+                    "shard {}/{}: {} of {total} cells ({failed} could not run); wrote {}",
+                    k.index,
+                    k.count,
+                    todo.len(),
+                    folder.shown(&file).display()
+                );
+            }
+            None => {
+                let command = format!("contact-patch study {}", path.display());
+                let files = study::write_reports(&folder, &s, &cells, &command)?;
+                println!("{total} cells ({failed} could not run)");
+                for f in files {
+                    println!("wrote {}", folder.shown(&f).display());
+                }
+            }
+        }
+        Ok(())
+    })();
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn merge(parts: &[PathBuf], out: &Path) -> ExitCode {
+    use contact_patch::harness::{shard as shards, study};
+    let result = (|| -> contact_patch::Result<()> {
+        let folder = ReportFolder::new(out)?;
+        match shards::merge(shards::read_parts(parts)?)? {
+            shards::Merged::Study {
+                source,
+                study: spec,
+                cells,
+            } => {
+                let s = study::from_parts(*spec, source)?;
+                let command = format!("contact-patch merge ({} shards)", parts.len());
+                for f in study::write_reports(&folder, &s, &cells, &command)? {
+                    println!("wrote {}", folder.shown(&f).display());
+                }
+            }
+            shards::Merged::Table {
+                cells,
+                seconds,
+                errors,
+            } => {
+                for w in shards::write_tables(&folder, &cells, seconds)? {
+                    print_catalogue(&folder, &w);
+                }
+                for (case, e) in &errors {
+                    eprintln!("error: {case}: {e}");
+                }
+                if !errors.is_empty() {
+                    return Err(contact_patch::error::Error::invalid(
+                        "merge",
+                        "PARTS",
+                        format!("{} cases could not be run in their shards (their cells are missing from the tables)", errors.len()),
+                        "fix the cases named above and rerun their shards",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    })();
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(2)

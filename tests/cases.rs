@@ -22,6 +22,7 @@ fn case_files(dir: &Path, out: &mut Vec<PathBuf>) {
             case_files(&p, out);
         } else if p.extension().is_some_and(|x| x == "json")
             && !p.to_string_lossy().ends_with(".schema.json")
+            && !p.to_string_lossy().ends_with(".study.json")
         {
             out.push(p);
         }

@@ -15,7 +15,8 @@ fn json_files(dir: &Path, out: &mut Vec<PathBuf>) {
         if path.is_dir() {
             json_files(&path, out);
         } else if path.extension().is_some_and(|e| e == "json")
-            && path.file_name().unwrap() != "case.schema.json"
+            && !path.to_string_lossy().ends_with(".schema.json")
+            && !path.to_string_lossy().ends_with(".study.json")
         {
             out.push(path);
         }

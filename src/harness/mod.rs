@@ -45,7 +45,9 @@ pub mod outside_contact;
 pub mod outside_results;
 pub mod profile;
 pub mod report;
+pub mod shard;
 pub mod stability;
+pub mod study;
 
 use crate::contact::discretization::constraints;
 use crate::contact::enforcement::method;
@@ -60,12 +62,12 @@ use crate::post::for_each_quadrature_stress;
 use crate::solver::active_set::Termination;
 use crate::solver::linear::Solution;
 use crate::solver::solve_static;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
 
 /// One cell of the patch table.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Cell {
     /// `patch` or `tied` (the sweep's catalogue).
     pub catalogue: Catalogue,
@@ -153,7 +155,7 @@ impl Cell {
 }
 
 /// The friction part of a cell of the friction table ([`friction`]).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct FrictionCell {
     /// `stick` or `slip`: the status every point must end in.
     pub expect: String,
