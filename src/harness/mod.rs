@@ -30,6 +30,7 @@
 //! * `n/a` cells say why the combination does not apply.
 
 pub mod baseline;
+pub mod cattaneo;
 pub mod checks;
 pub(crate) mod exact;
 pub mod friction;
