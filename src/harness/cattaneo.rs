@@ -34,7 +34,10 @@
 //!   outermost closed (stick) point and the next point outward, averaged over the two sides
 //!   (the boundary lies between two nodes, so `|c_h - c| <= h/2` plus the solution error);
 //! * errors against the closed forms over `|s| <= a`: `||q_h - q|| / ||q||` and
-//!   `||p_h - p|| / ||p||` (discrete L2, weights `A'_a`), the part of `q_h` odd in `s`
+//!   `||p_h - p|| / ||p||` (discrete L2, weights `A'_a`); the same for `p` over `|s| <= 0.8 a`
+//!   (the edge nodes depend on where `a` falls between two nodes) and for `q` away from the
+//!   stick/slip boundary (`||s| - c| > 2 h`: `q` has a cusp at `c`, and the nodes next to it
+//!   depend on where `c` falls); the part of `q_h` odd in `s`
 //!   (`||(q_h(s) - q_h(-s))/2|| / ||q||` over the points with a point within `h/20` of `-s`:
 //!   zero in the closed form),
 //!   and the largest Coulomb ratio `|q_a| / (mu p_a)`.
@@ -157,6 +160,11 @@ pub struct CattaneoLevel {
     pub stick_ends: [f64; 2],
     pub traction_error: f64,
     pub pressure_error: f64,
+    /// `||p_h - p|| / ||p||` over `|s| <= 0.8 a` (away from the edges of the contact zone).
+    pub pressure_error_interior: f64,
+    /// `||q_h - q|| / ||q||` over the points of `|s| <= a` farther than `2 h` from `|s| = c`
+    /// (away from the cusp of `q` at the stick/slip boundary).
+    pub traction_error_off_boundary: f64,
     pub odd_traction: f64,
     pub max_cone_ratio: f64,
     pub points: Vec<InterfacePoint>,
@@ -345,18 +353,30 @@ pub fn measure(outcome: &Outcome, pair: &str) -> Result<CattaneoLevel> {
     let (_, measured_half_width) = zone(&closed);
     let (stick_ends, measured_stick_half_width) =
         zone(&|p: &InterfacePoint| p.status == PointStatus::Stick);
-    let norm = |f: &dyn Fn(&InterfacePoint) -> f64| {
+    let norm_over = |keep: &dyn Fn(f64) -> bool, f: &dyn Fn(&InterfacePoint) -> f64| {
         points
             .iter()
-            .filter(|p| p.s.abs() <= a)
+            .filter(|p| keep(p.s))
             .map(|p| f(p).powi(2) * p.area)
             .sum::<f64>()
             .sqrt()
     };
-    let traction_error =
-        norm(&|p| p.traction - closed_form.traction(p.s)) / norm(&|p| closed_form.traction(p.s));
-    let pressure_error =
-        norm(&|p| p.pressure - closed_form.pressure(p.s)) / norm(&|p| closed_form.pressure(p.s));
+    let relative = |keep: &dyn Fn(f64) -> bool, exact: &dyn Fn(f64) -> f64, pressure: bool| {
+        let value = |p: &InterfacePoint| if pressure { p.pressure } else { p.traction };
+        norm_over(keep, &|p| value(p) - exact(p.s)) / norm_over(keep, &|p| exact(p.s))
+    };
+    let traction = |s: f64| closed_form.traction(s);
+    let pressure = |s: f64| closed_form.pressure(s);
+    let in_zone = |s: f64| s.abs() <= a;
+    let traction_error = relative(&in_zone, &traction, false);
+    let pressure_error = relative(&in_zone, &pressure, true);
+    let pressure_error_interior = relative(&|s: f64| s.abs() <= 0.8 * a, &pressure, true);
+    let traction_error_off_boundary = relative(
+        &|s: f64| s.abs() <= a && (s.abs() - c).abs() > 2.0 * spacing,
+        &traction,
+        false,
+    );
+    let norm = |f: &dyn Fn(&InterfacePoint) -> f64| norm_over(&in_zone, f);
     // the odd part of q where a point faces a point about s = 0 (within h / 20: s0 moves a
     // little under the shear)
     let mirror = |p: &InterfacePoint| {
@@ -397,6 +417,8 @@ pub fn measure(outcome: &Outcome, pair: &str) -> Result<CattaneoLevel> {
         stick_ends,
         traction_error,
         pressure_error,
+        pressure_error_interior,
+        traction_error_off_boundary,
         odd_traction,
         max_cone_ratio,
         points,
@@ -469,15 +491,15 @@ fn markdown(levels: &[CattaneoLevel]) -> String {
          supports), the fitted radius R, Hertz's a and the stick half-width \
          c = a sqrt(1 - Q/(mu P)) with the measured a_h and c_h (midpoints between the last \
          closed/stick point and the next one), the discrete L2 errors of q and p against the \
-         closed forms over |s| <= a, the odd part of q (zero in the closed form), and the \
-         largest |q|/(mu p).\n\n\
-         | case | h | beta | P | Q | Q_s | R | a | a_h | c | c_h | stick ends | (c_h - c)/h | q error | p error | odd q | max |q|/(mu p) |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         closed forms over |s| <= a (and of p over |s| <= 0.8 a, of q farther than 2 h from \
+         |s| = c), the odd part of q (zero in the closed form), and the largest |q|/(mu p).\n\n\
+         | case | h | beta | P | Q | Q_s | R | a | a_h | c | c_h | stick ends | (c_h - c)/h | q error | q error off c | p error | p error 0.8 a | odd q | max |q|/(mu p) |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for l in levels {
         let cf = l.closed_form;
         s += &format!(
-            "| {} | {:.4} | {:.1e} | {:.6} | {:.6} | {:.6} | {:.4} | {:.5} | {:.5} | {:.5} | {:.5} | [{:.4}, {:.4}] | {:+.2} | {:.3e} | {:.3e} | {:.3e} | {:.12} |\n",
+            "| {} | {:.4} | {:.1e} | {:.6} | {:.6} | {:.6} | {:.4} | {:.5} | {:.5} | {:.5} | {:.5} | [{:.4}, {:.4}] | {:+.2} | {:.3e} | {:.3e} | {:.3e} | {:.3e} | {:.3e} | {:.12} |\n",
             l.case,
             l.spacing,
             l.dundurs_beta,
@@ -493,7 +515,9 @@ fn markdown(levels: &[CattaneoLevel]) -> String {
             l.stick_ends[1],
             (l.measured_stick_half_width - l.stick_half_width) / l.spacing,
             l.traction_error,
+            l.traction_error_off_boundary,
             l.pressure_error,
+            l.pressure_error_interior,
             l.odd_traction,
             l.max_cone_ratio,
         );
