@@ -493,7 +493,7 @@ fn markdown(levels: &[CattaneoLevel]) -> String {
          closed/stick point and the next one), the discrete L2 errors of q and p against the \
          closed forms over |s| <= a (and of p over |s| <= 0.8 a, of q farther than 2 h from \
          |s| = c), the odd part of q (zero in the closed form), and the largest |q|/(mu p).\n\n\
-         | case | h | beta | P | Q | Q_s | R | a | a_h | c | c_h | stick ends | (c_h - c)/h | q error | q error off c | p error | p error 0.8 a | odd q | max |q|/(mu p) |\n\
+         | case | h | beta | P | Q | Q_s | R | a | a_h | c | c_h | stick ends | (c_h - c)/h | q error | q error off c | p error | p error 0.8 a | odd q | max \\|q\\|/(mu p) |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for l in levels {
