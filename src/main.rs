@@ -175,6 +175,21 @@ enum Command {
         /// The reports folder (read, and where index.html is written).
         #[arg(long, default_value = "reports")]
         reports: PathBuf,
+    /// Solve Cattaneo-Mindlin cases (a cylinder pressed, then sheared, with Coulomb friction)
+    /// and measure the stick zone and the shear traction against the closed forms; writes
+    /// cattaneo-mindlin.md, .json and .svg (the plot of the last case).
+    #[command(
+        after_help = "Example:\n  contact-patch cattaneo\n  contact-patch cattaneo cases/friction-bench/cattaneo-mindlin-L1.json --out /tmp/reports\n\nGive the cases from coarse to fine."
+    )]
+    Cattaneo {
+        /// Case files (default: cases/friction-bench/cattaneo-mindlin-L1 .. L4).
+        paths: Vec<PathBuf>,
+        /// The frictional contact pair.
+        #[arg(long, default_value = "interface")]
+        pair: String,
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
     },
     /// Print the JSON Schema of the case format (committed as cases/case.schema.json; a case
     /// file may name it in "$schema" so that editors validate and complete it).
@@ -266,6 +281,7 @@ fn main() -> ExitCode {
         Command::ImpactReport { paths, out, study } => impact_report(&paths, &out, study),
         Command::Profile { case, pair, out } => profile(&case, &pair, &out),
         Command::Report { reports } => report_page(&reports),
+        Command::Cattaneo { paths, pair, out } => cattaneo(&paths, &pair, &out),
         Command::Schema { study } => {
             if study {
                 print!("{}", contact_patch::harness::study::study_schema());
@@ -1084,6 +1100,55 @@ enum ImpactStudy {
     BlockDrop,
     /// Errors against the wave solution versus wall time (reports/impact-cost.*).
     Cost,
+/// The cases of `contact-patch cattaneo` when none are given, coarse to fine.
+const CATTANEO_CASES: [&str; 4] = [
+    "cases/friction-bench/cattaneo-mindlin-L1.json",
+    "cases/friction-bench/cattaneo-mindlin-L2.json",
+    "cases/friction-bench/cattaneo-mindlin-L3.json",
+    "cases/friction-bench/cattaneo-mindlin-L4.json",
+];
+
+fn cattaneo(paths: &[PathBuf], pair: &str, out: &Path) -> ExitCode {
+    use contact_patch::harness::cattaneo::{measure, write_report, REPORT_FILES};
+    let paths: Vec<&Path> = if paths.is_empty() {
+        CATTANEO_CASES.iter().map(Path::new).collect()
+    } else {
+        paths.iter().map(PathBuf::as_path).collect()
+    };
+    let result = (|| -> contact_patch::Result<()> {
+        let folder = ReportFolder::new(out)?;
+        let mut levels = Vec::new();
+        for path in paths {
+            let outcome = run_case(path, &mut |_| {})?;
+            let level = measure(&outcome, pair)?;
+            println!(
+                "{}: h = {:.4}, P = {:.6}, Q = {:.6}, a = {:.5} (a_h {:.5}), c = {:.5} (c_h {:.5}), q error {:.3e}, p error {:.3e}",
+                level.case,
+                level.spacing,
+                level.closed_form.load,
+                level.closed_form.shear,
+                level.half_width,
+                level.measured_half_width,
+                level.stick_half_width,
+                level.measured_stick_half_width,
+                level.traction_error,
+                level.pressure_error
+            );
+            levels.push(level);
+        }
+        write_report(&folder, &levels)?;
+        for f in REPORT_FILES {
+            println!("wrote {}", folder.shown(f).display());
+        }
+        Ok(())
+    })();
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
 }
 
 /// The cases of `contact-patch impact-report` when none are given.

@@ -1,7 +1,9 @@
 //! Every case under `cases/` runs and passes the checks it declares, except the size
 //! benchmarks in `cases/large/` and the patch-test catalogues `cases/patch/` and
 //! `cases/friction/`, whose cases fail by design for some methods and are judged cell by cell in
-//! the snapshot-tested tables (`tests/patch_table.rs`, `tests/friction_table.rs`). A case without checks is itself a failure: it could not fail.
+//! the snapshot-tested tables (`tests/patch_table.rs`, `tests/friction_table.rs`), and the
+//! refinement study `cases/friction-bench/` (its finer levels take minutes), judged against the
+//! closed forms by `tests/cattaneo.rs`. A case without checks is itself a failure: it could not fail.
 
 use contact_patch::run::run_case;
 use std::path::{Path, PathBuf};
@@ -14,9 +16,9 @@ fn case_files(dir: &Path, out: &mut Vec<PathBuf>) {
     entries.sort();
     for p in entries {
         if p.is_dir() {
-            if p.file_name()
-                .is_some_and(|n| n == "large" || n == "patch" || n == "friction")
-            {
+            if p.file_name().is_some_and(|n| {
+                n == "large" || n == "patch" || n == "friction" || n == "friction-bench"
+            }) {
                 continue;
             }
             case_files(&p, out);

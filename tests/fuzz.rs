@@ -1,8 +1,8 @@
 //! Fuzz test of the `contact-patch` binary on mutated case files, and replays of the known
 //! defect reproducers in `tests/defects/`.
 //!
-//! `mutated_cases_keep_the_invariants` takes every case under `cases/` (except `cases/large/`,
-//! too slow) and two reproducers with explicit meshes (which `cases/` lacks) and mutates them
+//! `mutated_cases_keep_the_invariants` takes every case under `cases/` (except `cases/large/`
+//! and the refinement study `cases/friction-bench/`, too slow) and two reproducers with explicit meshes (which `cases/` lacks) and mutates them
 //! with a fixed seed: keys deleted, values replaced by a wrong type, huge, tiny and shifted
 //! numbers, NaN and infinity tokens, names replaced by path-like, empty or odd strings (renamed
 //! everywhere they are referenced), keys inserted or duplicated, the text truncated or damaged,
@@ -762,7 +762,9 @@ fn bases() -> Vec<Base> {
         entries.sort();
         for p in entries {
             if p.is_dir() {
-                if p.file_name().is_some_and(|n| n != "large") {
+                if p.file_name()
+                    .is_some_and(|n| n != "large" && n != "friction-bench")
+                {
                     walk(&p, out);
                 }
             } else if p.extension().is_some_and(|x| x == "json") {

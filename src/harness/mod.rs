@@ -31,6 +31,7 @@
 
 pub mod baseline;
 pub mod block_drop;
+pub mod cattaneo;
 pub mod checks;
 pub(crate) mod exact;
 pub mod friction;
