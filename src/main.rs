@@ -175,6 +175,7 @@ enum Command {
         /// The reports folder (read, and where index.html is written).
         #[arg(long, default_value = "reports")]
         reports: PathBuf,
+    },
     /// Solve Cattaneo-Mindlin cases (a cylinder pressed, then sheared, with Coulomb friction)
     /// and measure the stick zone and the shear traction against the closed forms; writes
     /// cattaneo-mindlin.md, .json and .svg (the plot of the last case).
@@ -1100,6 +1101,8 @@ enum ImpactStudy {
     BlockDrop,
     /// Errors against the wave solution versus wall time (reports/impact-cost.*).
     Cost,
+}
+
 /// The cases of `contact-patch cattaneo` when none are given, coarse to fine.
 const CATTANEO_CASES: [&str; 4] = [
     "cases/friction-bench/cattaneo-mindlin-L1.json",
