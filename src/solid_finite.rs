@@ -5,7 +5,9 @@
 //! gradient is `F = I + H`, `H = du/dX = sum_a u_a (dN_a/dX)^T`, extended to plane strain by
 //! `F_33 = 1` (`F_13 = F_31 = F_23 = F_32 = 0`). The right Cauchy-Green tensor is `C = F^T F`
 //! (in-plane block, `C_33 = 1`), the Green-Lagrange strain `E = (C - I) / 2` (`E_33 = 0`) and
-//! `J = det F` (the in-plane determinant, since `F_33 = 1`).
+//! `J = det F` (the in-plane determinant, since `F_33 = 1`). Both are computed from `H`
+//! (`E = (H + H^T + H^T H) / 2`, `ln J = ln_1p(tr H + det H)`), not from `F`, so that a lightly
+//! loaded body keeps the round-off of small strain.
 //!
 //! **Materials** (Lamé constants from `E, nu`: `lambda = E nu / ((1 + nu)(1 - 2 nu))`,
 //! `mu = E / (2 (1 + nu))`), energy per reference volume:
@@ -83,29 +85,31 @@ impl Hyperelastic {
         Hyperelastic::SaintVenantKirchhoff { lambda, mu }
     }
 
-    /// Energy per reference volume at the in-plane deformation gradient `f` (`det f > 0`).
-    pub fn energy(&self, f: &Matrix2<f64>) -> f64 {
-        let c = f.transpose() * f;
+    /// Energy per reference volume at the in-plane displacement gradient `h = F - I`
+    /// (`det F > 0`).
+    pub fn energy(&self, h: &Matrix2<f64>) -> f64 {
+        let (e, ln_j) = green_lagrange(h);
         match *self {
+            // I_1 - 3 = tr C - 2 = 2 tr E
             Hyperelastic::NeoHookean { lambda, mu } => {
-                let ln_j = det2(f).ln();
-                0.5 * mu * (c.trace() + 1.0 - 3.0 - 2.0 * ln_j) + 0.5 * lambda * ln_j * ln_j
+                mu * (e.trace() - ln_j) + 0.5 * lambda * ln_j * ln_j
             }
             Hyperelastic::SaintVenantKirchhoff { lambda, mu } => {
-                let e = (c - Matrix2::identity()) * 0.5;
                 0.5 * lambda * e.trace().powi(2) + mu * e.component_mul(&e).sum()
             }
         }
     }
 
-    /// `S`, `S_33` and `D` at the in-plane deformation gradient `f` (`det f > 0`).
-    pub fn material_point(&self, f: &Matrix2<f64>) -> MaterialPoint {
-        let c = f.transpose() * f;
+    /// `S`, `S_33` and `D` at the in-plane displacement gradient `h = F - I` (`det F > 0`).
+    pub fn material_point(&self, h: &Matrix2<f64>) -> MaterialPoint {
+        let (e, ln_j) = green_lagrange(h);
         match *self {
             Hyperelastic::NeoHookean { lambda, mu } => {
-                let ln_j = det2(f).ln();
-                let ci = inverse2(&c);
-                let s = (Matrix2::identity() - ci) * mu + ci * (lambda * ln_j);
+                let ci = inverse2(&(Matrix2::identity() + e * 2.0));
+                // mu (I - C^-1) + lambda ln J C^-1 = C^-1 (2 mu E + lambda ln J I), free of the
+                // cancellation of I - C^-1 at small strain
+                let s = ci * (e * (2.0 * mu) + Matrix2::identity() * (lambda * ln_j));
+                let s = (s + s.transpose()) * 0.5;
                 let m = mu - lambda * ln_j;
                 // CC_ijkl = lambda ci_ij ci_kl + m (ci_ik ci_jl + ci_il ci_jk), Voigt 11, 22, 12
                 let index = [(0, 0), (1, 1), (0, 1)];
@@ -122,7 +126,6 @@ impl Hyperelastic {
                 }
             }
             Hyperelastic::SaintVenantKirchhoff { lambda, mu } => {
-                let e = (c - Matrix2::identity()) * 0.5;
                 let s = Matrix2::identity() * (lambda * e.trace()) + e * (2.0 * mu);
                 #[rustfmt::skip]
                 let d = Matrix3::new(
@@ -140,13 +143,29 @@ impl Hyperelastic {
     }
 
     /// Cauchy stress `[sigma_xx, sigma_yy, sigma_xy]` and `sigma_zz` at the in-plane
-    /// deformation gradient `f`: `sigma = F S F^T / J`, `sigma_33 = S_33 / J`.
-    pub fn cauchy(&self, f: &Matrix2<f64>) -> ([f64; 3], f64) {
-        let j = det2(f);
-        let p = self.material_point(f);
+    /// displacement gradient `h = F - I`: `sigma = F S F^T / J`, `sigma_33 = S_33 / J`.
+    pub fn cauchy(&self, h: &Matrix2<f64>) -> ([f64; 3], f64) {
+        let f = Matrix2::identity() + h;
+        let j = jacobian(h);
+        let p = self.material_point(h);
         let sigma = f * p.s * f.transpose() / j;
         ([sigma[(0, 0)], sigma[(1, 1)], sigma[(0, 1)]], p.s33 / j)
     }
+}
+
+/// The Green-Lagrange strain `E = (H + H^T + H^T H) / 2` and `ln J` (`J = 1 + tr H + det H`,
+/// through `ln_1p`) from the displacement gradient `H`, without the cancellation of
+/// `(F^T F - I) / 2` and `ln det F` at small strain (which would put a round-off floor of
+/// `E eps` under the residual of a lightly loaded body).
+fn green_lagrange(h: &Matrix2<f64>) -> (Matrix2<f64>, f64) {
+    let e = (h + h.transpose() + h.transpose() * h) * 0.5;
+    (e, (h.trace() + det2(h)).ln_1p())
+}
+
+/// `J = det F = 1 + tr H + det H`.
+#[inline(always)]
+pub fn jacobian(h: &Matrix2<f64>) -> f64 {
+    1.0 + h.trace() + det2(h)
 }
 
 /// `det m` of a 2x2 matrix.
@@ -181,10 +200,10 @@ impl std::fmt::Display for Inverted {
     }
 }
 
-/// The deformation gradient `F = I + sum_a u_a (grad_0 N_a)^T` from the reference gradients
-/// `dndx` of `n` nodes and the element displacements `u_e` (`[u_x0, u_y0, u_x1, ...]`).
-fn deformation_gradient(dndx: &[[f64; 2]], u_e: &[f64]) -> Matrix2<f64> {
-    let mut f = Matrix2::identity();
+/// The displacement gradient `H = F - I = sum_a u_a (grad_0 N_a)^T` from the reference
+/// gradients `dndx` of `n` nodes and the element displacements `u_e` (`[u_x0, u_y0, ...]`).
+fn displacement_gradient(dndx: &[[f64; 2]], u_e: &[f64]) -> Matrix2<f64> {
+    let mut f = Matrix2::zeros();
     for (a, g) in dndx.iter().enumerate() {
         for i in 0..2 {
             for k in 0..2 {
@@ -203,12 +222,24 @@ pub fn deformation_gradient_at(
     u_e: &[f64],
     xi: [f64; 2],
 ) -> (Matrix2<f64>, [f64; 2]) {
-    let pv = point_values(kind, coords, xi);
-    let n = kind.node_count();
-    (deformation_gradient(&pv.dndx[..n], u_e), pv.x)
+    let (h, x) = displacement_gradient_at(kind, coords, u_e, xi);
+    (Matrix2::identity() + h, x)
 }
 
-/// The reference gradients and weights `w = w_q det J_0 t` of the rule's points, and `F` there;
+/// The displacement gradient `H = F - I` at natural point `xi` (see
+/// [`deformation_gradient_at`]), with the reference position of the point.
+pub fn displacement_gradient_at(
+    kind: ElementKind,
+    coords: &[[f64; 2]],
+    u_e: &[f64],
+    xi: [f64; 2],
+) -> (Matrix2<f64>, [f64; 2]) {
+    let pv = point_values(kind, coords, xi);
+    let n = kind.node_count();
+    (displacement_gradient(&pv.dndx[..n], u_e), pv.x)
+}
+
+/// The reference gradients and weights `w = w_q det J_0 t` of the rule's points, and `H` there;
 /// `Err` at the first point with `det F <= 0`.
 fn points(
     kind: ElementKind,
@@ -224,8 +255,8 @@ fn points(
         if pv.det_j == 0.0 {
             continue;
         }
-        let f = deformation_gradient(&pv.dndx[..n], u_e);
-        let det_f = det2(&f);
+        let h = displacement_gradient(&pv.dndx[..n], u_e);
+        let det_f = jacobian(&h);
         if det_f.is_nan() || det_f <= 0.0 {
             return Err(Inverted {
                 point: q,
@@ -233,7 +264,7 @@ fn points(
                 det_f,
             });
         }
-        visit(&pv.dndx[..n], point.weight * pv.det_j * thickness, &f);
+        visit(&pv.dndx[..n], point.weight * pv.det_j * thickness, &h);
     }
     Ok(())
 }
@@ -248,8 +279,8 @@ pub fn element_energy(
     rule: &[QuadPoint],
 ) -> Result<f64, Inverted> {
     let mut energy = 0.0;
-    points(kind, coords, u_e, thickness, rule, |_, w, f| {
-        energy += w * law.energy(f)
+    points(kind, coords, u_e, thickness, rule, |_, w, h| {
+        energy += w * law.energy(h)
     })?;
     Ok(energy)
 }
@@ -284,8 +315,9 @@ pub fn element_residual_and_tangent(
     let mut k = ElementMatrix::zeros();
     let n = kind.node_count();
     debug_assert!(n <= MAX_NODES);
-    points(kind, coords, u_e, thickness, rule, |dndx, w, f| {
-        let mp = law.material_point(f);
+    points(kind, coords, u_e, thickness, rule, |dndx, w, h| {
+        let mp = law.material_point(h);
+        let f = &(Matrix2::identity() + h);
         let p = f * mp.s;
         for (a, g) in dndx.iter().enumerate() {
             let fa = p * Vector2::new(g[0], g[1]) * w;
@@ -473,7 +505,7 @@ mod tests {
                     let (f, _) = deformation_gradient_at(kind, &coords, &u, q.xi);
                     assert!((f - target).abs().max() < 1e-13, "{kind:?}: {f}");
                 }
-                let p = target * law.material_point(&target).s;
+                let p = target * law.material_point(&(target - Matrix2::identity())).s;
                 let expected = boundary_force(kind, &coords, &p);
                 let got = force(kind, &coords, &u, &law);
                 let scale = largest(expected.iter().copied());
@@ -497,7 +529,7 @@ mod tests {
         let f = Matrix2::new(a, 0.0, 0.0, b);
         let j: f64 = a * b;
         let (lambda, mu) = lame(E, NU);
-        let (nh, nh33) = Hyperelastic::neo_hookean(E, NU).cauchy(&f);
+        let (nh, nh33) = Hyperelastic::neo_hookean(E, NU).cauchy(&(f - Matrix2::identity()));
         let expected = [
             (mu * (a * a - 1.0) + lambda * j.ln()) / j,
             (mu * (b * b - 1.0) + lambda * j.ln()) / j,
@@ -511,7 +543,8 @@ mod tests {
         }
         assert!((nh33 - lambda * j.ln() / j).abs() < 1e-12 * E);
         let (e1, e2) = (0.5 * (a * a - 1.0), 0.5 * (b * b - 1.0));
-        let (sv, sv33) = Hyperelastic::saint_venant_kirchhoff(E, NU).cauchy(&f);
+        let (sv, sv33) =
+            Hyperelastic::saint_venant_kirchhoff(E, NU).cauchy(&(f - Matrix2::identity()));
         let expected = [
             a * a * (lambda * (e1 + e2) + 2.0 * mu * e1) / j,
             b * b * (lambda * (e1 + e2) + 2.0 * mu * e2) / j,
@@ -551,14 +584,14 @@ mod tests {
                         "{kind:?} {angle}: {f}"
                     );
                     let (fg, _) = deformation_gradient_at(kind, &coords, &u, [0.1, 0.2]);
-                    let (sigma, zz) = law.cauchy(&fg);
+                    let (sigma, zz) = law.cauchy(&(fg - Matrix2::identity()));
                     assert!(largest(sigma) < 1e-12 * E && zz.abs() < 1e-12 * E);
                 }
             }
             let f = Matrix2::new(1.2, 0.15, -0.1, 0.8);
             let r = Matrix2::new(0.0, -1.0, 1.0, 0.0);
-            let (s0, z0) = law.cauchy(&f);
-            let (s1, z1) = law.cauchy(&(r * f));
+            let (s0, z0) = law.cauchy(&(f - Matrix2::identity()));
+            let (s1, z1) = law.cauchy(&(r * f - Matrix2::identity()));
             let m0 = Matrix2::new(s0[0], s0[2], s0[2], s0[1]);
             let rotated = r * m0 * r.transpose();
             assert!((rotated[(0, 0)] - s1[0]).abs() < 1e-12 * E);

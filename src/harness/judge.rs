@@ -530,6 +530,7 @@ fn solution_of(model: &Model, u: Vec<f64>) -> Solution {
         timings: Timings::default(),
         contact: None,
         dynamics: None,
+        finite: None,
     }
 }
 
