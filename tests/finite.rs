@@ -371,3 +371,149 @@ fn combinations_not_built_are_refused_with_the_reason() {
     d["supports"] = json!([{"body": "base", "set": "bottom", "x": 0.0, "y": 0.0}]);
     expect(&d, "master", "only rigid masters");
 }
+
+/// A block between a rigid plane `y = 0` (frictionless contact of its bottom, node-to-surface
+/// against the rigid master, in the current configuration) and a top pushed down by 20 % of
+/// its height, pinned in x at one corner: the homogeneous uniaxial state is exact. With
+/// Lagrange multipliers `F = diag(a, 0.8)` (`a` from `sigma_xx = 0`, neo-Hookean) at every
+/// quadrature point to 1e-10; with the penalty the bottom penetrates uniformly, so `F` is
+/// still uniform and diagonal (to 1e-10) and `sigma_xx = 0` (1e-10 of `sigma_yy`). Q4, Q9, T3,
+/// T6 on the distorted mesh; the contact force balances the top's reaction.
+#[test]
+fn a_block_compressed_by_twenty_percent_on_a_rigid_plane_deforms_homogeneously() {
+    let (lambda, mu) = lame();
+    let (mut lo, mut hi) = (1.0, 3.0);
+    for _ in 0..200 {
+        let m = 0.5 * (lo + hi);
+        if mu * (m * m - 1.0) + lambda * (0.8 * m).ln() > 0.0 {
+            hi = m;
+        } else {
+            lo = m;
+        }
+    }
+    let a = 0.5 * (lo + hi);
+    for enforcement in [
+        json!({"kind": "lagrange"}),
+        json!({"kind": "penalty", "kappa": 1e6}),
+    ] {
+        for element in ["Q4", "Q9", "T3", "T6"] {
+            let mut case = scene("neo_hookean", distorted_block(element), 2);
+            case["physics"]["contact_geometry"] = json!("current");
+            case["solver"]["scheme"] = json!("newton");
+            case["supports"] = json!([
+                {"body": "block", "set": "bottom_left", "x": 0.0},
+                {"body": "block", "set": "top", "y": -0.4}
+            ]);
+            case["contact"] = json!([{
+                "name": "ground", "slave": {"body": "block", "set": "bottom"},
+                "master": {"rigid": {"kind": "line", "point": [0, 0], "normal": [0, 1]}},
+                "discretization": {"kind": "node_to_surface", "passes": 1},
+                "enforcement": enforcement
+            }]);
+            case["checks"] = json!([{"check": "force_balance", "tol": 1e-10}]);
+            let o = run(&case).unwrap();
+            assert!(o.passed(), "{element}: {:?}", o.checks);
+            let mut points = Vec::new();
+            let body = &o.model.bodies[0];
+            let mut ue = Vec::new();
+            for c in 0..body.mesh.cell_count() {
+                cell_displacements(body, &o.solution.u, c, &mut ue);
+                for q in body.mesh.kind.stiffness_rule() {
+                    let (f, _) = deformation_gradient_at(
+                        body.mesh.kind,
+                        &body.mesh.cell_coords(c),
+                        &ue,
+                        q.xi,
+                    );
+                    points.push([f[(0, 0)], f[(0, 1)], f[(1, 0)], f[(1, 1)]]);
+                }
+            }
+            let first = points[0];
+            let spread = points.iter().fold(0.0f64, |m, p| {
+                (0..4).fold(m, |m, i| m.max((p[i] - first[i]).abs()))
+            });
+            let off_diagonal = first[1].abs().max(first[2].abs());
+            let mut worst_xx = 0.0f64;
+            let mut largest_yy = 0.0f64;
+            for_each_quadrature_stress(body, &o.solution.u, |_, _, s| {
+                worst_xx = worst_xx.max(s[0].abs());
+                largest_yy = largest_yy.max(s[1].abs());
+            });
+            let exact = if enforcement["kind"] == "lagrange" {
+                worst_gradient(&o, [[a, 0.0], [0.0, 0.8]])
+            } else {
+                0.0
+            };
+            let history = o.solution.finite.as_ref().unwrap();
+            println!(
+                "{element} {}: F spread {spread:.1e}, |F - F_exact| {exact:.1e}, F = {first:?}, sigma_xx / sigma_yy {:.1e}, residuals {:?}",
+                enforcement["kind"],
+                worst_xx / largest_yy,
+                history.history.iter().map(|h| format!("{}:{:.1e}", h.step, h.residual)).collect::<Vec<_>>()
+            );
+            assert!(
+                spread < 1e-10 && off_diagonal < 1e-10,
+                "{element}: {spread:e}"
+            );
+            assert!(exact < 1e-10, "{element}: {exact:e}");
+            assert!(worst_xx < 1e-10 * largest_yy, "{element}: {worst_xx:e}");
+            assert!(largest_yy > 10.0, "{element}: the block is compressed");
+        }
+    }
+}
+
+/// The tangent of the whole Newton system (hyperelastic solid plus penalty rows against a
+/// rigid circle, with the second derivative of the circle's gap) is the central difference of
+/// its residual at a deformed, penetrating state off equilibrium, to 1e-6 of its largest
+/// entry.
+#[test]
+fn the_newton_tangent_with_a_rigid_circle_is_the_difference_of_the_residual() {
+    use contact_patch::solver::contact_newton::Probe;
+    let mut case = scene("neo_hookean", distorted_block("Q4"), 1);
+    case["physics"]["contact_geometry"] = json!("current");
+    case["solver"]["scheme"] = json!("newton");
+    case["supports"] = json!([{"body": "block", "set": "top", "x": 0.1, "y": -0.3}]);
+    case["contact"] = json!([{
+        "name": "roller", "slave": {"body": "block", "set": "bottom"},
+        "master": {"rigid": {"kind": "circle", "centre": [1.0, -3.0], "radius": 3.0}},
+        "discretization": {"kind": "node_to_surface", "passes": 1},
+        "enforcement": {"kind": "penalty", "kappa": 1e4}
+    }]);
+    case["checks"] = json!([{"check": "force_balance", "tol": 1e-8}]);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&case).unwrap()).unwrap();
+    let o = run_case(&path, &mut |_| {}).unwrap();
+    assert!(o.passed(), "{:?}", o.checks);
+    let model = contact_patch::model::admit::load(&path).unwrap();
+    let mut probe = Probe::new(&model, 0.0).unwrap();
+    // off equilibrium: the solution pushed further down by a nonuniform amount
+    let mut x = probe.unknowns(&o.solution.u);
+    for (i, v) in x.iter_mut().enumerate() {
+        *v += 1e-3 * (0.7 * i as f64).sin() - 5e-3 * (i % 2) as f64;
+    }
+    let at = probe.evaluate(&x).unwrap();
+    let n = x.len();
+    let scale = at
+        .tangent
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let h = 1e-7;
+    let mut worst = 0.0f64;
+    for j in 0..n {
+        let (mut xp, mut xm) = (x.clone(), x.clone());
+        xp[j] += h;
+        xm[j] -= h;
+        let (rp, rm) = (
+            probe.evaluate(&xp).unwrap().residual,
+            probe.evaluate(&xm).unwrap().residual,
+        );
+        for i in 0..n {
+            let fd = (rp[i] - rm[i]) / (2.0 * h);
+            worst = worst.max((fd - at.tangent[i][j]).abs() / scale);
+        }
+    }
+    println!("Newton tangent vs central difference: {worst:.1e} of {scale:.3e}");
+    assert!(worst < 1e-6, "{worst:e}");
+}
