@@ -52,6 +52,7 @@ pub mod model;
 pub mod post;
 pub mod run;
 pub mod solid;
+pub mod solid_finite;
 pub mod solver;
 
 pub use error::{Error, Result};

@@ -1,6 +1,12 @@
 //! Post-processing: stresses and error norms from a displacement solution.
 //!
-//! * Stress at a point of a cell: `sigma = D B(xi) u_e` (constant per T3 cell, varying otherwise).
+//! * Stress at a point of a cell: `sigma = D B(xi) u_e` (constant per T3 cell, varying otherwise);
+//!   under finite kinematics the Cauchy stress `sigma = F S F^T / J`
+//!   ([`crate::solid_finite`]) at the point, a stress of the deformed configuration reported
+//!   at the point's reference position (the `.vtu` holds the reference mesh and the
+//!   displacement: warped by the displacement it is the deformed mesh the stress lives on).
+//!   Every check that compares stresses (`uniform_stress`, `contact_pressure`, the exact
+//!   fields) then compares the Cauchy stress.
 //! * Cell stress: at the cell centre. Nodal stress: the average over the cells sharing a node of
 //!   each cell's stress evaluated at that node (no smoothing beyond averaging).
 //! * Relative L2 displacement error: `sqrt(int |u_h - u|^2 dA / int |u|^2 dA)`, with a Gauss rule
@@ -10,6 +16,7 @@ use crate::fe::point_values;
 use crate::harness::exact::ExactField;
 use crate::model::{Body, Model};
 use crate::solid::{strain_at, MAX_DOFS};
+use crate::solid_finite::{displacement_gradient_at, jacobian};
 
 /// Element displacements of cell `c` of `body`.
 pub fn cell_displacements(body: &Body, u: &[f64], c: usize, out: &mut Vec<f64>) {
@@ -25,6 +32,14 @@ pub fn stress_at(body: &Body, u: &[f64], c: usize, xi: [f64; 2]) -> ([f64; 3], [
     let mut ue = Vec::with_capacity(MAX_DOFS);
     cell_displacements(body, u, c, &mut ue);
     let coords = body.mesh.cell_coords(c);
+    if let Some(law) = &body.hyperelastic {
+        // finite kinematics: the Cauchy stress sigma = F S F^T / J of the deformed body
+        let (h, x) = displacement_gradient_at(body.mesh.kind, &coords, &ue, xi);
+        if jacobian(&h) <= 0.0 {
+            return ([f64::NAN; 3], x);
+        }
+        return (law.cauchy(&h).0, x);
+    }
     let (eps, x) = strain_at(body.mesh.kind, &coords, &ue, xi);
     (body.material.stress(eps), x)
 }

@@ -24,7 +24,8 @@
 //! (row sums are zero or negative at the corners of T6 and Q9 would be wrong for T6).
 //!
 //! **Kinematics seam.** [`Kinematics`] says how strain follows from displacement. With small
-//! strain (the only kind today) `sigma = D eps` is linear in `u_e`, so
+//! strain (this module; finite deformation has its own kernels in [`crate::solid_finite`],
+//! assembled by [`crate::solver::finite_assembly`]) `sigma = D eps` is linear in `u_e`, so
 //! `f_int = K_e u_e` and `K_T = K_e = int B^T D B t dA`, the element stiffness; the kernel still
 //! integrates `f_int` from the stresses, which is the form that finite strain keeps (there `B`
 //! depends on `F = I + H` and `K_T` gains a geometric part). The kernels therefore take the
@@ -165,11 +166,11 @@ pub fn check_geometry(kind: ElementKind, coords: &[[f64; 2]]) -> Result<(), BadG
     Ok(())
 }
 
-/// How strains follow from displacements. Only small strain today; finite strain (total
-/// Lagrangian: `F = I + H`, Green-Lagrange `E = (F^T F - I) / 2`, `f_int = int B(F)^T S t dA`,
-/// `K_T` = material + geometric part) is a second variant with its own kernel behind
-/// [`element_residual_and_tangent`], whose arguments (reference coordinates and displacements)
-/// already carry what it needs.
+/// How strains follow from displacements in this module's kernels: small strain. Finite
+/// strain (total Lagrangian: `F = I + H`, Green-Lagrange `E = (F^T F - I) / 2`,
+/// `f_int = int B(F)^T S t dA`, `K_T` = material + geometric part) takes a hyperelastic law
+/// instead of [`Elasticity`], so it has its own kernels, [`crate::solid_finite`], chosen by
+/// `physics.kinematics: "finite"`.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum Kinematics {
     /// `eps = sym grad u`, `f_int = K_e u_e`, `K_T = K_e`.

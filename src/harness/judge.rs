@@ -483,6 +483,7 @@ fn solution_of(model: &Model, u: Vec<f64>, contact_force: Option<&[f64]>) -> Sol
         timings: Timings::default(),
         contact: None,
         dynamics: None,
+        finite: None,
     }
 }
 

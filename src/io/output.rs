@@ -50,6 +50,10 @@ pub struct Summary {
     /// [`crate::harness::stability`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub conditioning: Option<crate::harness::stability::Conditioning>,
+    /// The load stepping of a finite-kinematics solve (every attempt, the cut ones with their
+    /// reasons, and the Newton residuals); absent with small strain.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finite: Option<crate::solver::history::FiniteHistory>,
     pub timings: Timings,
     /// The effects the scene asked for and simulated, with the time each took.
     pub effects: Vec<EffectSummary>,
@@ -91,7 +95,15 @@ fn effects(outcome: &Outcome) -> Vec<EffectSummary> {
     let mut out = vec![EffectSummary {
         effect: "elasticity".into(),
         detail: format!(
-            "small strain, plane {:?}, {} bodies ({})",
+            "{}, plane {:?}, {} bodies ({})",
+            match &outcome.solution.finite {
+                None => "small strain".to_string(),
+                Some(h) => format!(
+                    "finite deformation (total Lagrangian, hyperelastic), {} load steps, {} cut",
+                    h.steps.len() - h.cuts,
+                    h.cuts
+                ),
+            },
             model.plane,
             model.bodies.len(),
             kinds.into_iter().collect::<Vec<_>>().join(", ")
@@ -383,6 +395,7 @@ fn summary_with(outcome: &Outcome, nodal: &[Vec<[f64; 3]>], results: &[PairResul
     });
     Summary {
         contact,
+        finite: solution.finite.as_deref().cloned(),
         case: model.name.clone(),
         source: model.source.clone(),
         description: model.description.clone(),

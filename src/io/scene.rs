@@ -550,6 +550,30 @@ pub struct MaterialSpec {
     /// read by nothing else.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub density: Option<f64>,
+    /// The constitutive law: linear elasticity (small strain), or a hyperelastic energy for
+    /// `physics.kinematics: "finite"` (Lamé constants from `E` and `nu`).
+    #[serde(default, skip_serializing_if = "MaterialModel::is_linear")]
+    pub model: MaterialModel,
+}
+
+/// The constitutive law of a material.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum MaterialModel {
+    /// `sigma = D eps` (small strain).
+    #[default]
+    LinearElastic,
+    /// Compressible neo-Hookean, `W = mu/2 (I_1 - 3 - 2 ln J) + lambda/2 (ln J)^2` (finite
+    /// kinematics only).
+    NeoHookean,
+    /// St. Venant-Kirchhoff, `W = lambda/2 (tr E)^2 + mu E:E` (finite kinematics only).
+    SaintVenantKirchhoff,
+}
+
+impl MaterialModel {
+    pub fn is_linear(&self) -> bool {
+        *self == MaterialModel::LinearElastic
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
@@ -925,8 +949,13 @@ pub enum ContactGeometry {
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Kinematics {
+    /// Small strain: `eps = sym grad u`, linear elasticity.
     #[default]
     SmallStrain,
+    /// Finite deformation, total Lagrangian, plane strain, hyperelastic materials
+    /// (`neo_hookean`, `saint_venant_kirchhoff`); loads in load steps, each cut in half when
+    /// Newton fails; contact against rigid masters only, in the current geometry.
+    Finite,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]

@@ -29,11 +29,12 @@ use crate::harness::exact::ExactField;
 use crate::io::paths::{name_problem, NAME_RULE};
 use crate::io::scene::{
     Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, GmshMeshSpec,
-    Interaction, MeshSpec, MultiplierSpace, NodeSetSpec, Physics, Plane, Prescribed, RigidSurface,
-    SolverSpec, SweepSpec, TractionSpec, MAX_SOLVER_COUNT,
+    Interaction, Kinematics, MaterialModel, MeshSpec, MultiplierSpace, NodeSetSpec, Physics, Plane,
+    Prescribed, RigidSurface, SolverSpec, SweepSpec, TractionSpec, MAX_SOLVER_COUNT,
 };
 use crate::mesh::{block, Facet, Mesh};
 use crate::solid::{check_geometry, Elasticity};
+use crate::solid_finite::Hyperelastic;
 
 /// One elastic body: its mesh (with named sets), material and first global dof.
 #[derive(Clone, Debug)]
@@ -41,6 +42,8 @@ pub struct Body {
     pub name: String,
     pub material_name: String,
     pub material: Elasticity,
+    /// The hyperelastic energy under `physics.kinematics: "finite"` (`None` with small strain).
+    pub hyperelastic: Option<Hyperelastic>,
     pub mesh: Mesh,
     pub dof_offset: usize,
 }
@@ -275,15 +278,33 @@ impl Model {
     /// The model at load step `k` of `n`: the proportional loads and supports at the factor
     /// `k / n`, those on a load path at their own factor for step `k`.
     pub fn at_step(&self, k: usize, n: usize) -> Model {
-        let t = k as f64 / n as f64;
+        self.at_load(k as f64, n)
+    }
+
+    /// The model at the (possibly fractional) load step `s` of `n`, `0 < s <= n`: the
+    /// proportional loads and supports at `s / n`; those on a load path at their factor
+    /// interpolated linearly between the steps `floor(s)` and `ceil(s)` (zero before step 1).
+    /// At a whole `s = k` this is [`Model::at_step`]`(k, n)` exactly.
+    pub fn at_load(&self, s: f64, n: usize) -> Model {
+        let t = s / n as f64;
         if self.load_path.is_empty() {
             return self.with_load_factor(t);
         }
+        let k = (s.ceil() as usize).clamp(1, n);
+        let path_factor = |factors: &[f64]| {
+            let upper = factors[k - 1];
+            if s == k as f64 {
+                return upper;
+            }
+            let lower = if k >= 2 { factors[k - 2] } else { 0.0 };
+            let w = s - (k - 1) as f64;
+            lower + w * (upper - lower)
+        };
         let mut m = self.clone();
         let mut path_dof = vec![None; self.dof_count];
         for part in &self.load_path {
             for &d in &part.dofs {
-                path_dof[d] = Some(part.factors[k - 1]);
+                path_dof[d] = Some(path_factor(&part.factors));
             }
         }
         // proportional forces: the total minus the parts (round-off where both act on a dof)
@@ -297,7 +318,7 @@ impl Model {
             *f = proportional[i] * t;
         }
         for part in &self.load_path {
-            let factor = part.factors[k - 1];
+            let factor = path_factor(&part.factors);
             for (f, p) in m.external_force.iter_mut().zip(&part.force) {
                 *f += factor * p;
             }
@@ -443,6 +464,15 @@ impl Model {
                 name: spec.name.clone(),
                 material_name: spec.material.clone(),
                 material: Elasticity::new(mat.youngs_modulus, mat.nu, plane),
+                hyperelastic: match (case.physics.kinematics, mat.model) {
+                    (Kinematics::Finite, MaterialModel::NeoHookean) => {
+                        Some(Hyperelastic::neo_hookean(mat.youngs_modulus, mat.nu))
+                    }
+                    (Kinematics::Finite, MaterialModel::SaintVenantKirchhoff) => Some(
+                        Hyperelastic::saint_venant_kirchhoff(mat.youngs_modulus, mat.nu),
+                    ),
+                    _ => None,
+                },
                 mesh,
                 dof_offset: offset,
             };
@@ -509,7 +539,108 @@ impl Model {
         model.resolve_contact(case)?;
         model.resolve_checks(case)?;
         model.dynamics = dynamics::resolve(case, &model)?;
+        model.check_kinematics(case)?;
         Ok(model)
+    }
+
+    /// What finite kinematics solves so far, refused otherwise with the reason: hyperelastic
+    /// materials exactly when `physics.kinematics` is `"finite"`, plane strain, static, and
+    /// frictionless contact against rigid masters in the current geometry (Newton scheme).
+    fn check_kinematics(&self, case: &Case) -> Result<()> {
+        let invalid = |location: String, problem: String, hint: &str| {
+            Err(Error::invalid(&self.source, location, problem, hint))
+        };
+        let finite = case.physics.kinematics == Kinematics::Finite;
+        if !finite {
+            for (name, m) in &case.materials {
+                if !m.model.is_linear() {
+                    return invalid(
+                        format!("materials.{name}.model"),
+                        format!("the hyperelastic material '{name}' needs finite kinematics"),
+                        "set \"physics\": {\"kinematics\": \"finite\"}, or use \"model\": \"linear_elastic\" for small strain",
+                    );
+                }
+            }
+            return Ok(());
+        }
+        for (bi, (spec, body)) in case.bodies.iter().zip(&self.bodies).enumerate() {
+            if body.hyperelastic.is_none() {
+                return invalid(
+                    format!("bodies[{bi}] '{}'.material", spec.name),
+                    format!(
+                        "finite kinematics needs a hyperelastic material, but '{}' is linear elastic",
+                        spec.material
+                    ),
+                    &format!(
+                        "give materials.{} \"model\": \"neo_hookean\" or \"saint_venant_kirchhoff\"",
+                        spec.material
+                    ),
+                );
+            }
+        }
+        if self.plane != Plane::Strain {
+            return invalid(
+                "analysis.plane".into(),
+                "finite kinematics is built for plane strain only".into(),
+                "set \"analysis\": {\"plane\": \"strain\"}",
+            );
+        }
+        if case.physics.dynamics.is_some() {
+            return invalid(
+                "physics.dynamics".into(),
+                "finite kinematics with dynamics is not built yet (the static solve only)".into(),
+                "remove physics.dynamics, or use small-strain kinematics",
+            );
+        }
+        if case.sweep.is_some() {
+            return invalid(
+                "sweep".into(),
+                "finite kinematics is not built into the sweeps of the harness yet".into(),
+                "remove the sweep and run the case as it is",
+            );
+        }
+        for (k, pair) in self.contact.iter().enumerate() {
+            let at = format!("contact[{k}] '{}'", pair.name);
+            if matches!(pair.interaction, Interaction::Coulomb { .. }) {
+                return invalid(
+                    format!("{at}.interaction"),
+                    "finite kinematics with friction is not built yet".into(),
+                    "use a frictionless pair, or small-strain kinematics",
+                );
+            }
+            if let MasterSide::Body { .. } = pair.master {
+                return invalid(
+                    format!("{at}.master"),
+                    "finite kinematics with contact between deformable bodies (node-to-node, node-to-surface, mortar) is not built yet: only rigid masters".into(),
+                    "use a rigid master surface (plane or circle), or small-strain kinematics",
+                );
+            }
+        }
+        if !self.contact.is_empty() {
+            if case.solver.scheme != crate::io::scene::Scheme::Newton {
+                return invalid(
+                    "solver.scheme".into(),
+                    "finite kinematics with contact is solved by the Newton scheme only".into(),
+                    "set \"solver\": {\"scheme\": \"newton\"}",
+                );
+            }
+            if case.physics.contact_geometry != crate::io::scene::ContactGeometry::Current {
+                return invalid(
+                    "physics.contact_geometry".into(),
+                    "finite kinematics needs the contact geometry of the current configuration"
+                        .into(),
+                    "set \"physics\": {\"contact_geometry\": \"current\"}",
+                );
+            }
+            if !case.solver.geometric_stiffness {
+                return invalid(
+                    "solver.geometric_stiffness".into(),
+                    "finite kinematics needs the full tangent of the contact rows".into(),
+                    "remove \"geometric_stiffness\": false",
+                );
+            }
+        }
+        Ok(())
     }
 
     fn find_body(&self, name: &str, location: &str) -> Result<&Body> {

@@ -82,6 +82,7 @@
 //! from the gaps.
 
 use super::active_set::{reference_areas, row_key, rows_at, ReferenceAreas, RowKey};
+use super::finite_assembly::tangent_and_residual;
 use super::linear::{assemble, finish, max_abs, LinearSystem, Solution, Timings, NO_EQUATION};
 use super::newton::{self, Evaluation, System, Tangent};
 use super::sparse::{GeneralPattern, PatternBuilder, SymmetricPattern};
@@ -91,7 +92,9 @@ use crate::contact::friction::{multiplier_status, return_map, FrictionPoint, Ret
 use crate::contact::state::{ContactState, Departure, Termination};
 use crate::contact::Constraint;
 use crate::error::Result;
-use crate::io::scene::{ContactGeometry, FrictionTangent, Interaction, MultiplierUpdate};
+use crate::io::scene::{
+    ContactGeometry, FrictionTangent, Interaction, Kinematics, MultiplierUpdate,
+};
 use crate::model::rigid::RigidModes;
 use crate::model::Model;
 use std::collections::{HashMap, HashSet};
@@ -99,6 +102,11 @@ use std::time::Instant;
 
 /// Residual tolerance of the Newton solve, relative to the largest applied or contact force.
 pub const RESIDUAL_TOLERANCE: f64 = 1e-10;
+
+/// The same under finite kinematics: the consistent tangent converges quadratically, so the
+/// last step from `1e-10` costs one solve and brings the answer to round-off (the finite-strain
+/// patch test asks for 1e-10 in the stress, which a residual of `1e-10` does not give).
+pub const FINITE_RESIDUAL_TOLERANCE: f64 = 1e-12;
 
 /// How a row is enforced in the Newton scheme.
 #[derive(Copy, Clone, Debug)]
@@ -151,6 +159,9 @@ pub(crate) struct ContactSystem<'a> {
     /// and the frictional status of the last evaluation (with the direction of a slip).
     committed: HashMap<RowKey, f64>,
     status: HashMap<RowKey, (Status, bool)>,
+    /// Finite kinematics: the element found inverted at the last evaluation (its residual is
+    /// then NaN, which ends the Newton solve; the load step is cut).
+    inverted: Option<String>,
 }
 
 impl<'a> ContactSystem<'a> {
@@ -221,6 +232,7 @@ impl<'a> ContactSystem<'a> {
             reference_areas: areas,
             committed,
             status: HashMap::new(),
+            inverted: None,
         };
         system.number_unknowns();
         Ok(system)
@@ -660,19 +672,41 @@ impl System for ContactSystem<'_> {
                 return Ok(Evaluation::default());
             }
         }
+        // finite kinematics: the solids' tangent K_T(u) and residual f_int(u) - f_ext
+        let mut solid_residual = None;
+        if self.model.physics.kinematics == Kinematics::Finite {
+            match tangent_and_residual(self.model, &self.sys.constraints, &self.sys.pattern, &u) {
+                Ok((k, r)) => {
+                    self.sys.k = k;
+                    solid_residual = Some(r);
+                }
+                Err(inverted) => {
+                    self.inverted = Some(inverted.to_string());
+                    residual.iter_mut().for_each(|v| *v = f64::NAN);
+                    return Ok(Evaluation {
+                        force_scale: 1.0,
+                        ..Evaluation::default()
+                    });
+                }
+            }
+        }
         let rho = self.rho;
         let mut upper = vec![0.0; self.pattern.nnz()];
         for (k, &p) in self.k_positions.iter().enumerate() {
             upper[p] = self.sys.k[k];
         }
         residual.iter_mut().for_each(|v| *v = 0.0);
-        self.sys
-            .pattern
-            .mul(&self.sys.k, &x[..n], &mut residual[..n]);
-        residual[..n]
-            .iter_mut()
-            .zip(&self.sys.rhs)
-            .for_each(|(r, f)| *r -= f);
+        if let Some(r) = solid_residual {
+            residual[..n].copy_from_slice(&r);
+        } else {
+            self.sys
+                .pattern
+                .mul(&self.sys.k, &x[..n], &mut residual[..n]);
+            residual[..n]
+                .iter_mut()
+                .zip(&self.sys.rhs)
+                .for_each(|(r, f)| *r -= f);
+        }
         let mut eval = Evaluation {
             force_scale: max_abs(&self.sys.rhs),
             ..Evaluation::default()
@@ -920,17 +954,38 @@ pub(crate) fn solve_step(
             x[e] = u[d];
         }
     }
+    let first = x.clone();
+    let mut inverted = false;
+    let mut cut = false;
     let t = Instant::now();
     progress("newton iterations");
-    let outcome = newton::solve(
+    let mut outcome = newton::solve(
         &mut system,
         &mut x,
         newton::Settings {
             max_iterations: model.solver.max_iterations,
-            tolerance: RESIDUAL_TOLERANCE,
+            tolerance: if model.physics.kinematics == Kinematics::Finite {
+                FINITE_RESIDUAL_TOLERANCE
+            } else {
+                RESIDUAL_TOLERANCE
+            },
             factor_limit: model.factor_limit,
         },
     )?;
+    if model.physics.kinematics == Kinematics::Finite
+        && outcome.termination != Termination::Converged
+    {
+        // the step is cut (crate::solver::finite): report the reason, and the state it
+        // started from (an iterate may be inverted, with no internal force)
+        if let Some(why) = system.inverted.take() {
+            outcome.termination = Termination::Singular(why);
+            inverted = true;
+        }
+        let n = system.sys.n;
+        x.iter_mut().for_each(|v| *v = 0.0);
+        x[..n].copy_from_slice(&first[..n]);
+        cut = true;
+    }
     timings.factorization = outcome.factorization_seconds;
     timings.contact_search = system.search_seconds;
     timings.solve =
@@ -950,7 +1005,24 @@ pub(crate) fn solve_step(
         }
     }
     let current = model.physics.contact_geometry == ContactGeometry::Current;
-    let mut solution = finish(model, &system.sys, u.clone(), &contact_force, timings)?;
+    let mut solution = if cut {
+        // a failed step under finite kinematics: its prescribed values and the state it
+        // started from need not fit together, and the driver keeps only its termination and
+        // history
+        Solution {
+            reactions: vec![0.0; u.len()],
+            u: u.clone(),
+            equations: system.sys.n,
+            matrix_nonzeros: system.sys.pattern.nnz(),
+            relative_residual: f64::NAN,
+            timings,
+            contact: None,
+            dynamics: None,
+            finite: None,
+        }
+    } else {
+        finish(model, &system.sys, u.clone(), &contact_force, timings)?
+    };
     let iterations = outcome.iterations;
     solution.contact = Some(ContactState {
         rows: std::mem::take(&mut system.rows),
@@ -958,6 +1030,7 @@ pub(crate) fn solve_step(
         forces,
         gaps,
         termination: match outcome.termination {
+            Termination::Singular(why) if inverted => Termination::Singular(why),
             Termination::Singular(why) => Termination::Singular(format!(
                 "{why}; the active rows may depend on each other (a node constrained twice, as in a two-pass discretization with Lagrange multipliers), or a body may be held only by rows that opened"
             )),

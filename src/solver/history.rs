@@ -7,6 +7,10 @@
 //! and the potential of the (constant) loads `-f^T u`; `total = T + U + Phi - f^T u` is constant
 //! for the exact solution of an elastic, frictionless problem. Momentum is `p = sum_d M v` per
 //! component (over every body, and per body).
+//!
+//! A finite-kinematics solve ([`crate::solver::finite`]) records every attempted load step
+//! ([`FiniteStep`]: load factors, termination, iterations, and why a cut step was cut) and the
+//! Newton residual of every iteration ([`FiniteHistory`]).
 
 use serde::Serialize;
 
@@ -102,4 +106,29 @@ impl DynamicHistory {
         }
         out
     }
+}
+
+/// One attempted load step.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FiniteStep {
+    /// Attempt number (1-based), and the load factors it went from and to.
+    pub attempt: usize,
+    pub from: f64,
+    pub to: f64,
+    pub termination: crate::contact::state::Termination,
+    pub iterations: usize,
+    pub accepted: bool,
+    /// Why the step was cut (absent for an accepted step).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut_because: Option<String>,
+}
+
+/// The load stepping of a finite-kinematics solve: every attempt, and the Newton residual
+/// history of every attempt (`step` is the attempt number).
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct FiniteHistory {
+    pub steps: Vec<FiniteStep>,
+    pub history: Vec<crate::contact::state::IterationRecord>,
+    /// How many attempts were cut.
+    pub cuts: usize,
 }

@@ -67,6 +67,9 @@ pub struct Solution {
     pub contact: Option<crate::contact::state::ContactState>,
     /// The record of a time integration (`physics.dynamics`); `None` for a static run.
     pub dynamics: Option<Box<crate::solver::history::DynamicHistory>>,
+    /// The load stepping of a finite-kinematics solve (every attempt, cuts with their
+    /// reasons); `None` with small strain.
+    pub finite: Option<Box<crate::solver::history::FiniteHistory>>,
 }
 
 /// Calls `visit(dofs, ke)` for every cell of every body.
@@ -414,12 +417,18 @@ pub fn finish(
         timings,
         contact: None,
         dynamics: None,
+        finite: None,
     })
 }
 
 /// The internal force `f_int(u)` of every body at the global displacement `u`, element by
-/// element (small strain: `K u`).
+/// element (small strain: `K u`; finite kinematics: [`crate::solver::finite_assembly::internal_force`]).
 pub fn internal_force(model: &Model, u: &[f64]) -> Vec<f64> {
+    if model.physics.kinematics == crate::io::scene::Kinematics::Finite {
+        // an inverted element has no internal force: NaN, which every caller refuses by name
+        return crate::solver::finite_assembly::internal_force(model, u)
+            .unwrap_or_else(|_| vec![f64::NAN; u.len()]);
+    }
     let mut f = vec![0.0; u.len()];
     let mut dofs = Vec::with_capacity(MAX_DOFS);
     let mut ue = [0.0; MAX_DOFS];

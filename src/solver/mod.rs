@@ -2,7 +2,8 @@
 //! ([`crate::solver::linear`]), or with the contact pairs it declares ([`crate::solver::active_set`]: load
 //! steps, active sets, geometry updates). A scene without contact builds no contact row. A
 //! scene with `physics.dynamics` is time-stepped instead ([`crate::solver::dynamics`]); a static
-//! scene builds no mass matrix.
+//! scene builds no mass matrix. A scene with `physics.kinematics: "finite"` is solved by
+//! [`crate::solver::finite`] (Newton in load steps with cuts), with or without contact.
 
 pub mod active_set;
 pub mod conditioning;
@@ -10,6 +11,8 @@ pub mod constraints;
 pub mod contact_newton;
 pub(crate) mod dense;
 pub mod dynamics;
+pub mod finite;
+pub mod finite_assembly;
 pub mod history;
 pub mod linear;
 pub mod newton;
@@ -21,7 +24,9 @@ use crate::solver::linear::Solution;
 
 /// Solve `model`; `progress` is told the name of each stage as it starts.
 pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
-    if model.dynamics.is_some() {
+    if model.physics.kinematics == crate::io::scene::Kinematics::Finite {
+        crate::solver::finite::solve(model, progress)
+    } else if model.dynamics.is_some() {
         crate::solver::dynamics::solve(model, progress)
     } else if model.contact.is_empty() {
         crate::solver::linear::solve_elastic(model, progress)
