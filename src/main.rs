@@ -98,6 +98,18 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// Newton's residual histories with the consistent, symmetrized and Laursen-Simo friction
+    /// tangents on the slip patch and the incline; writes reports/friction-convergence.md and
+    /// reports/friction-convergence.json (run from the repository's root).
+    #[command(
+        name = "friction-convergence",
+        after_help = "Example:\n  contact-patch friction-convergence\n  contact-patch friction-convergence --out /tmp/reports"
+    )]
+    FrictionConvergence {
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
     /// The impact study: the dynamic cases with every impact treatment and mass against the
     /// 1D wave solutions; writes reports/impact.md and reports/impact.json.
     #[command(
@@ -204,6 +216,7 @@ fn main() -> ExitCode {
         Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
         Command::Hard { paths, out } => hard(&paths, &out),
         Command::ImpactReport { paths, out } => impact_report(&paths, &out),
+        Command::FrictionConvergence { out } => friction_convergence(&out),
         Command::Profile { case, pair, out } => profile(&case, &pair, &out),
         Command::Schema => {
             print!("{}", contact_patch::io::scene::case_schema());
@@ -977,6 +990,40 @@ fn tied_layer(cases: &Path, levels: &[usize], out: &Path) -> ExitCode {
                 }
             }
             println!("wrote {}", folder.shown("tied-layer.md").display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// `contact-patch friction-convergence`: the residual histories of the friction tangents.
+fn friction_convergence(out: &Path) -> ExitCode {
+    let folder = match ReportFolder::new(out) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let result = (|| -> contact_patch::Result<()> {
+        let runs = contact_patch::harness::friction_convergence::study(Path::new("."))?;
+        folder.write_file(
+            "friction-convergence.md",
+            &contact_patch::harness::friction_convergence::report(&runs),
+        )?;
+        let json = serde_json::to_string_pretty(&runs).expect("runs serialize") + "\n";
+        folder.write_file("friction-convergence.json", &json)
+    })();
+    match result {
+        Ok(()) => {
+            println!(
+                "wrote {} and {}",
+                folder.shown("friction-convergence.md").display(),
+                folder.shown("friction-convergence.json").display()
+            );
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -33,6 +33,7 @@ pub mod baseline;
 pub mod checks;
 pub(crate) mod exact;
 pub mod friction;
+pub mod friction_convergence;
 pub mod hard;
 pub mod impact;
 pub mod judge;

@@ -1288,6 +1288,22 @@ pub fn coulomb_obstacle(
             "set \"solver\": {\"scheme\": \"newton\"}",
         );
     }
+    if matches!(enforcement, EnforcementSpec::Elimination) {
+        // a slipping point has no constraint on its tangential motion to eliminate, only a
+        // dependent force mu lambda_n t whose lambda_n is itself an eliminated reaction
+        return obstacle(
+            "enforcement",
+            "Coulomb friction with constraint elimination is not solved: stick rows could be eliminated as ties, but a slipping point constrains no tangential motion (its force mu lambda_n acts along the tangent, with lambda_n a reaction recovered only after the reduced solve), so the slip set needs the reactions inside the elimination's own Newton loop, which it does not have",
+            "use Lagrange multipliers (the same exact stick and slip) or the augmented Lagrangian for this pair",
+        );
+    }
+    if matches!(enforcement, EnforcementSpec::PerturbedTangent { .. }) {
+        return obstacle(
+            "enforcement",
+            "Coulomb friction with the perturbed tangent is not built yet (its multiplier update from the residual has no tangential counterpart here)",
+            "use the augmented Lagrangian (the same exact limit with a penalty-stiffened tangent) or Lagrange multipliers for this pair",
+        );
+    }
     if !matches!(
         enforcement,
         EnforcementSpec::Penalty { .. }
