@@ -1087,7 +1087,8 @@ fn augmented_lagrangian_holds_a_block_on_an_incline_up_to_the_coulomb_limit() {
         tan_a / (1.0 + tan_a * tan_a).sqrt(),
         1.0 / (1.0 + tan_a * tan_a).sqrt(),
     );
-    let variants: [(&str, fn(Value) -> Value); 3] = [
+    type Law = fn(Value) -> Value;
+    let variants: [(&str, Law); 3] = [
         ("per iteration", |v| augmented(v, "per_iteration")),
         ("outer loop", |v| augmented(v, "outer_loop")),
         ("Laursen-Simo", laursen_simo),

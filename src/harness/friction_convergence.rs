@@ -126,7 +126,7 @@ pub fn study(root: &Path) -> Result<Vec<ConvergenceRun>> {
     let path = root.join("cases/friction/friction-A-slip.json");
     let text = std::fs::read_to_string(&path).map_err(|e| {
         crate::error::Error::invalid(
-            &path.display().to_string(),
+            path.display(),
             "file",
             format!("cannot read the slip patch case: {e}"),
             "run the command from the repository's root folder",
@@ -134,7 +134,7 @@ pub fn study(root: &Path) -> Result<Vec<ConvergenceRun>> {
     })?;
     let mut patch: Value = serde_json::from_str(&text).map_err(|e| {
         crate::error::Error::invalid(
-            &path.display().to_string(),
+            path.display(),
             "file",
             format!("not JSON: {e}"),
             "regenerate it with python3 cases/friction/make_cases.py",
