@@ -131,6 +131,18 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// Newton's residual histories with the consistent, symmetrized and Laursen-Simo friction
+    /// tangents on the slip patch and the incline; writes reports/friction-convergence.md and
+    /// reports/friction-convergence.json (run from the repository's root).
+    #[command(
+        name = "friction-convergence",
+        after_help = "Example:\n  contact-patch friction-convergence\n  contact-patch friction-convergence --out /tmp/reports"
+    )]
+    FrictionConvergence {
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
     /// The impact studies: `impact` (default), the dynamic cases with every impact treatment
     /// and mass against the 1D wave solutions (reports/impact.md, .json); `block-drop`, a block
     /// dropped on a foundation under time-step refinement (reports/block-drop.md, .json, .svg);
@@ -280,6 +292,7 @@ fn main() -> ExitCode {
         Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
         Command::Hard { paths, out } => hard(&paths, &out),
         Command::ImpactReport { paths, out, study } => impact_report(&paths, &out, study),
+        Command::FrictionConvergence { out } => friction_convergence(&out),
         Command::Profile { case, pair, out } => profile(&case, &pair, &out),
         Command::Report { reports } => report_page(&reports),
         Command::Cattaneo { paths, pair, out } => cattaneo(&paths, &pair, &out),
@@ -1147,6 +1160,40 @@ fn cattaneo(paths: &[PathBuf], pair: &str, out: &Path) -> ExitCode {
     })();
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// `contact-patch friction-convergence`: the residual histories of the friction tangents.
+fn friction_convergence(out: &Path) -> ExitCode {
+    let folder = match ReportFolder::new(out) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let result = (|| -> contact_patch::Result<()> {
+        let runs = contact_patch::harness::friction_convergence::study(Path::new("."))?;
+        folder.write_file(
+            "friction-convergence.md",
+            &contact_patch::harness::friction_convergence::report(&runs),
+        )?;
+        let json = serde_json::to_string_pretty(&runs).expect("runs serialize") + "\n";
+        folder.write_file("friction-convergence.json", &json)
+    })();
+    match result {
+        Ok(()) => {
+            println!(
+                "wrote {} and {}",
+                folder.shown("friction-convergence.md").display(),
+                folder.shown("friction-convergence.json").display()
+            );
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(2)

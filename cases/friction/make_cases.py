@@ -64,6 +64,8 @@ def case(mesh, status):
     sweep = dict(base["sweep"])
     sweep["catalogue"] = "friction"
     sweep["expect"] = status
+    # the augmented Lagrangian again with Laursen & Simo's symmetric form (a column of its own)
+    sweep["friction_tangents"] = ["laursen_simo"]
     name = f"friction-{mesh}-{status}"
     return {
         "name": name,

@@ -51,6 +51,33 @@
 //!
 //! At a solution of the slip branch `tau = s (mu lambda_n + c |dg_t|)`: the slip runs against
 //! the force and the dissipation `-lambda_t dg_t = mu lambda_n |dg_t|` is non-negative.
+//!
+//! **Augmented Lagrangian** ([`augmented_return_map`]; Simo & Laursen 1992, *Comput. Struct.*
+//! 42, 97-116; Laursen & Simo 1993, *Int. J. Numer. Meth. Engng.* 36, 3451-3485): the normal
+//! force `lambda_n = max(0, lambda_bar_n - w_n g_n)` and the tangential trial force are
+//! augmented by Uzawa multipliers `lambda_bar_n`, `lambda_bar_t`, the slip measured from the
+//! stick point `g_t^n` committed at the end of the last load step (not from a plastic slip:
+//! the multiplier, not a spring, carries the force):
+//!
+//! ```text
+//! trial:  lambda_t^tr = lambda_bar_t - w_t (g_t - g_t^n)
+//! stick:  |lambda_t^tr| <= mu lambda_n^b  =>  lambda_t = lambda_t^tr     (stick point kept)
+//! slip:   otherwise                       =>  lambda_t = s mu lambda_n^b (stick point g_t)
+//! Uzawa:  lambda_bar_n <- lambda_n,  lambda_bar_t <- lambda_t = proj_{|.| <= mu lambda_n^b}(lambda_t^tr)
+//! ```
+//!
+//! with the bound `lambda_n^b = lambda_n` (the consistent form: `d lambda_t / du = s mu w_n
+//! b_n` in slip, unsymmetric) or `lambda_n^b = lambda_bar_n`, the multiplier held fixed during
+//! Newton (`friction_tangent: "laursen_simo"`): the slip force is then constant in a Newton
+//! solve and the tangent symmetric; at a converged Uzawa iteration `lambda_bar_n = lambda_n`
+//! and both forms have the same solution. At that solution a stick point does not move
+//! (`lambda_bar_t = lambda_t` needs `g_t = g_t^n`) and a slip point carries exactly `mu
+//! lambda_n`: the Lagrange answer, for any `w_t`. The multipliers are carried from one load
+//! step to the next with the stick point ([`Committed`]): restarting `lambda_bar_n` from zero
+//! drops the bound `mu lambda_n` of a closed point to its penalty part, about zero once the
+//! gap has closed, and the next step's first iterations then released every point into slip
+//! while its slip history was committed against a stick point (the cycling of the first
+//! attempt).
 
 use serde::Serialize;
 
@@ -118,6 +145,78 @@ pub fn return_map(
         d_slip: 0.0,
         d_normal: if lambda_n > 0.0 { s * mu } else { 0.0 },
     }
+}
+
+/// The return map of the augmented Lagrangian (see the module doc) at a point with Uzawa
+/// multiplier `lambda_bar_t`, stick point `stick_point` (committed at the end of the last load
+/// step), slip `g_t`, and the bound's normal force `bound_force` (`lambda_n`, or
+/// `lambda_bar_n` for Laursen & Simo's form). `bound_varies`: the bound is the current normal
+/// force `lambda_n = lambda_bar_n - w_n g_n` (a slip then couples `d_normal = s mu`); with the
+/// multiplier held fixed it does not (`d_normal = 0`). The returned `plastic_slip` is the
+/// point's stick point after the map: `stick_point` in stick, `g_t` otherwise.
+///
+/// `held`: the branch to take regardless of the trial force (stick, or slip with its sign `s`),
+/// as in the Newton iteration right after a Uzawa update (see [`crate::solver::contact_newton`]);
+/// `None` (or open) decides from the trial force.
+#[allow(clippy::too_many_arguments)]
+pub fn augmented_return_map(
+    mu: f64,
+    w_t: f64,
+    bound_force: f64,
+    bound_varies: bool,
+    active: bool,
+    g_t: f64,
+    stick_point: f64,
+    lambda_bar_t: f64,
+    held: Option<(Status, f64)>,
+) -> ReturnMap {
+    if !active {
+        return ReturnMap {
+            status: Status::Open,
+            force: 0.0,
+            plastic_slip: g_t,
+            d_slip: 0.0,
+            d_normal: 0.0,
+        };
+    }
+    let trial = lambda_bar_t - w_t * (g_t - stick_point);
+    let bound = mu * bound_force.max(0.0);
+    let (stick, s) = match held {
+        Some((Status::Stick, _)) => (true, 0.0),
+        Some((Status::Slip, s)) => (false, s),
+        _ => (trial.abs() <= bound, trial.signum()),
+    };
+    if stick {
+        return ReturnMap {
+            status: Status::Stick,
+            force: trial,
+            plastic_slip: stick_point,
+            d_slip: -w_t,
+            d_normal: 0.0,
+        };
+    }
+    ReturnMap {
+        status: Status::Slip,
+        force: s * bound,
+        plastic_slip: g_t,
+        d_slip: 0.0,
+        d_normal: if bound_varies && bound_force > 0.0 {
+            s * mu
+        } else {
+            0.0
+        },
+    }
+}
+
+/// What a frictional point carries from one load step to the next: its committed slip (the
+/// plastic slip of the penalty map, the stick point of the multiplier methods) and its forces
+/// at the end of the step (the Uzawa multipliers the augmented Lagrangian starts the next step
+/// from; unused by the other methods).
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct Committed {
+    pub slip: f64,
+    pub normal_force: f64,
+    pub tangential_force: f64,
 }
 
 /// The frictional status of a point with Lagrange multipliers (see the module doc): normal force
@@ -242,6 +341,40 @@ mod tests {
             (open.status, open.force, open.plastic_slip),
             (Status::Open, 0.0, 0.5)
         );
+    }
+
+    #[test]
+    fn the_augmented_map_projects_the_trial_force_onto_the_cone() {
+        // trial 1.0 - 10 (0.05 - 0.0) = 0.5 inside mu lambda_n = 2: stick, the point kept
+        let stick = augmented_return_map(0.5, 10.0, 4.0, true, true, 0.05, 0.0, 1.0, None);
+        assert_eq!(
+            (stick.status, stick.force, stick.plastic_slip, stick.d_slip),
+            (Status::Stick, 0.5, 0.0, -10.0)
+        );
+        // trial 1.0 - 10 (0.5) = -4 outside: slip at -mu lambda_n, the point moves to g_t
+        let slip = augmented_return_map(0.5, 10.0, 4.0, true, true, 0.5, 0.0, 1.0, None);
+        assert_eq!(
+            (slip.status, slip.force, slip.plastic_slip, slip.d_normal),
+            (Status::Slip, -2.0, 0.5, -0.5)
+        );
+        // Laursen & Simo: the bound held fixed, no coupling to the normal force
+        let fixed = augmented_return_map(0.5, 10.0, 4.0, false, true, 0.5, 0.0, 1.0, None);
+        assert_eq!((fixed.force, fixed.d_normal), (-2.0, 0.0));
+        // held in stick the force is the trial's, even outside the cone
+        let held = augmented_return_map(
+            0.5,
+            10.0,
+            4.0,
+            true,
+            true,
+            0.5,
+            0.0,
+            1.0,
+            Some((Status::Stick, 0.0)),
+        );
+        assert_eq!((held.status, held.force), (Status::Stick, -4.0));
+        let open = augmented_return_map(0.5, 10.0, 4.0, true, false, 0.5, 0.2, 1.0, None);
+        assert_eq!((open.status, open.force), (Status::Open, 0.0));
     }
 
     #[test]

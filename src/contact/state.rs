@@ -55,15 +55,27 @@ pub struct ContactState {
 }
 
 impl ContactState {
-    /// The plastic slip of every frictional point at the end of this state's step: the history
-    /// the next load step starts from.
+    /// The committed slip and the forces of every frictional point at the end of this state's
+    /// step: the history the next load step starts from.
     pub(crate) fn friction_history(
         &self,
-    ) -> std::collections::HashMap<crate::contact::RowKey, f64> {
+    ) -> std::collections::HashMap<crate::contact::RowKey, crate::contact::friction::Committed>
+    {
         self.rows
             .iter()
             .zip(&self.friction)
-            .filter_map(|(r, f)| f.map(|f| (crate::contact::row_key(r), f.plastic_slip)))
+            .filter_map(|(r, f)| {
+                f.map(|f| {
+                    (
+                        crate::contact::row_key(r),
+                        crate::contact::friction::Committed {
+                            slip: f.plastic_slip,
+                            normal_force: f.normal_force,
+                            tangential_force: f.force,
+                        },
+                    )
+                })
+            })
             .collect()
     }
 }

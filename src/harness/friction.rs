@@ -77,8 +77,8 @@ impl FrictionMeasured {
         }
         if self.cone_ratio > 1.0 + 1e-12 {
             notes.push(format!(
-                "Coulomb's inequality violated: |lambda_t| / (mu lambda_n) = {:.3e}",
-                self.cone_ratio
+                "Coulomb's inequality violated: |lambda_t| / (mu lambda_n) = 1 + {:.1e}",
+                self.cone_ratio - 1.0
             ));
         }
         if self.min_dissipation < 0.0 {

@@ -35,6 +35,7 @@ pub mod cattaneo;
 pub mod checks;
 pub(crate) mod exact;
 pub mod friction;
+pub mod friction_convergence;
 pub mod hard;
 pub mod impact;
 pub mod impact_cost;
@@ -55,7 +56,8 @@ use crate::contact::enforcement::method;
 use crate::contact::forces::{pair_forces, PairForces};
 use crate::error::Result;
 use crate::io::scene::{
-    Catalogue, DiscretizationSpec, EnforcementSpec, MultiplierSpace, TwoPassPenalty,
+    Catalogue, DiscretizationSpec, EnforcementSpec, FrictionTangent, MultiplierSpace,
+    TwoPassPenalty,
 };
 use crate::model::admit::load;
 use crate::model::Model;
@@ -351,19 +353,38 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 Some(base.bodies[pair.slave.0].name.clone()),
             ),
         };
-        for e in &sweep.enforcements {
+        // each enforcement with the case's friction tangent, and the augmented Lagrangian again
+        // with each further tangent of the sweep (a column of its own)
+        let variants: Vec<(&EnforcementSpec, Option<FrictionTangent>)> = sweep
+            .enforcements
+            .iter()
+            .flat_map(|e| {
+                let augmented = matches!(e, EnforcementSpec::AugmentedLagrange { .. });
+                std::iter::once((e, None)).chain(
+                    sweep
+                        .friction_tangents
+                        .iter()
+                        .filter(move |_| augmented)
+                        .map(move |&t| (e, Some(t))),
+                )
+            })
+            .collect();
+        for &(e, tangent) in &variants {
+            let enforcement_name = match tangent {
+                Some(t) => format!("{}+{}", method(e).name(), t.name()),
+                None => method(e).name().to_string(),
+            };
             progress(&format!(
-                "{} {disc_name} {} {}",
+                "{} {disc_name} {} {enforcement_name}",
                 sweep.mesh,
                 passes.map(|p| format!("{p}p")).unwrap_or_default(),
-                method(e).name()
             ));
             let mut cell = Cell {
                 nu,
                 discretization: disc_name.into(),
                 passes,
                 slave: slave.clone(),
-                enforcement: method(e).name().into(),
+                enforcement: enforcement_name,
                 kappa: method(e).kappa(),
                 pressure: sweep.pressure,
                 friction: sweep.expect.map(|x| FrictionCell {
@@ -381,6 +402,9 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 )
             };
             let mut model = base.clone();
+            if let Some(t) = tangent {
+                model.solver.friction_tangent = t;
+            }
             pair.enforcement = e.clone();
             model.contact = vec![pair.clone()];
             if let Some(why) = friction::obstacle(&model, &pair) {

@@ -341,6 +341,17 @@ impl Interaction {
     }
 }
 
+impl FrictionTangent {
+    /// The name in a case file: `consistent`, `symmetrized`, `laursen_simo`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FrictionTangent::Consistent => "consistent",
+            FrictionTangent::Symmetrized => "symmetrized",
+            FrictionTangent::LaursenSimo => "laursen_simo",
+        }
+    }
+}
+
 /// The tangent of the frictional rows in a slip state.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
@@ -351,6 +362,11 @@ pub enum FrictionTangent {
     /// The consistent tangent without the slip coupling `s mu w b_t b_n^T` (symmetric, Cholesky;
     /// Newton then converges linearly in slip).
     Symmetrized,
+    /// The symmetric augmented form of Laursen & Simo (1993), augmented-Lagrangian pairs only:
+    /// the slip force bounded by `mu` times the normal Uzawa multiplier, held fixed during
+    /// Newton, so the exact tangent of each Newton solve is symmetric; the Uzawa updates bring
+    /// the bound to `mu lambda_n`.
+    LaursenSimo,
 }
 
 /// The multiplier space of a mortar discretization.
@@ -468,6 +484,11 @@ pub struct SweepSpec {
     /// punch dragged past it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub expect: Option<ExpectedFriction>,
+    /// Friction sweeps: further friction tangents to run the augmented-Lagrangian enforcements
+    /// with, each a column of its own (`augmented_lagrange+laursen_simo`); the other
+    /// enforcements run with the case's own `solver.friction_tangent` only.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub friction_tangents: Vec<FrictionTangent>,
 }
 
 /// The frictional status a friction sweep expects at every contact point of its last step.

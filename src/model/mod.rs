@@ -1199,6 +1199,14 @@ impl Model {
                     "with a Coulomb pair give \"catalogue\": \"friction\" and \"expect\": \"stick\" or \"slip\"; otherwise leave \"expect\" out",
                 ));
             }
+            if !friction && !sweep.friction_tangents.is_empty() {
+                return Err(Error::invalid(
+                    &self.source,
+                    "sweep.friction_tangents",
+                    "friction tangents vary only in a friction sweep (\"catalogue\": \"friction\")",
+                    "leave \"friction_tangents\" out of this sweep",
+                ));
+            }
         }
         Ok(())
     }
@@ -1335,6 +1343,19 @@ fn validate_coulomb(
             ));
         }
     }
+    if case.solver.friction_tangent == crate::io::scene::FrictionTangent::LaursenSimo
+        && !matches!(spec.enforcement, EnforcementSpec::AugmentedLagrange { .. })
+    {
+        return Err(Error::invalid(
+            source,
+            format!("{at}.enforcement"),
+            format!(
+                "solver.friction_tangent \"laursen_simo\" bounds the slip force by the normal Uzawa multiplier of the augmented Lagrangian; this pair uses {}",
+                crate::contact::enforcement::method(&spec.enforcement).name()
+            ),
+            "give this pair {\"kind\": \"augmented_lagrange\", ..} as enforcement, or use \"friction_tangent\": \"consistent\" or \"symmetrized\"",
+        ));
+    }
     if let Some(o) = coulomb_obstacle(
         case.solver.scheme,
         case.physics.contact_geometry,
@@ -1399,28 +1420,36 @@ pub fn coulomb_obstacle(
             "set \"solver\": {\"scheme\": \"newton\"}",
         );
     }
-    if matches!(enforcement, EnforcementSpec::AugmentedLagrange { .. }) {
-        // the Uzawa multipliers restart from zero in every load step; with friction the
-        // second step of the slip patch test cycled between branches (both update rules)
+    if matches!(enforcement, EnforcementSpec::Elimination) {
+        // a slipping point has no constraint on its tangential motion to eliminate, only a
+        // dependent force mu lambda_n t whose lambda_n is itself an eliminated reaction
         return obstacle(
             "enforcement",
-            "Coulomb friction with the augmented Lagrangian is not solved yet (its Newton iteration cycled between stick/slip and open/closed branches after the first load step)",
-            "use the penalty or the perturbed Lagrangian for this pair",
+            "Coulomb friction with constraint elimination is not solved: stick rows could be eliminated as ties, but a slipping point constrains no tangential motion (its force mu lambda_n acts along the tangent, with lambda_n a reaction recovered only after the reduced solve), so the slip set needs the reactions inside the elimination's own Newton loop, which it does not have",
+            "use Lagrange multipliers (the same exact stick and slip) or the augmented Lagrangian for this pair",
+        );
+    }
+    if matches!(enforcement, EnforcementSpec::PerturbedTangent { .. }) {
+        return obstacle(
+            "enforcement",
+            "Coulomb friction with the perturbed tangent is not built yet (its multiplier update from the residual has no tangential counterpart here)",
+            "use the augmented Lagrangian (the same exact limit with a penalty-stiffened tangent) or Lagrange multipliers for this pair",
         );
     }
     if !matches!(
         enforcement,
         EnforcementSpec::Penalty { .. }
             | EnforcementSpec::PerturbedLagrange { .. }
+            | EnforcementSpec::AugmentedLagrange { .. }
             | EnforcementSpec::Lagrange
     ) {
         return obstacle(
             "enforcement",
             &format!(
-                "Coulomb friction needs the penalty, the perturbed Lagrangian or Lagrange multipliers as normal law, not {}",
+                "Coulomb friction needs the penalty, the perturbed Lagrangian, the augmented Lagrangian or Lagrange multipliers as normal law, not {}",
                 crate::contact::enforcement::method(enforcement).name()
             ),
-            "use the penalty, the perturbed Lagrangian or Lagrange multipliers for this pair",
+            "use the penalty, the perturbed Lagrangian, the augmented Lagrangian or Lagrange multipliers for this pair",
         );
     }
     if geometry != crate::io::scene::ContactGeometry::Reference {

@@ -99,7 +99,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
     let mut records: Vec<StepRecord> = Vec::new();
     let mut start: Option<Vec<f64>> = None;
     // the committed plastic slip of every frictional point (Coulomb pairs)
-    let mut friction: HashMap<RowKey, f64> = HashMap::new();
+    let mut friction: HashMap<RowKey, crate::contact::friction::Committed> = HashMap::new();
     let mut departures: Vec<Departure> = Vec::new();
     let mut history: Vec<IterationRecord> = Vec::new();
     let mut timings = crate::solver::linear::Timings::default();
@@ -168,7 +168,7 @@ fn solve_step(
     model: &Model,
     mut previous: Option<HashSet<RowKey>>,
     start: Option<Vec<f64>>,
-    friction: HashMap<RowKey, f64>,
+    friction: HashMap<RowKey, crate::contact::friction::Committed>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Solution> {
     if model.solver.scheme == crate::io::scene::Scheme::Newton {

@@ -88,7 +88,10 @@ use super::newton::{self, Evaluation, System, Tangent};
 use super::sparse::{GeneralPattern, PatternBuilder, SymmetricPattern};
 use crate::contact::discretization::gap_second_derivative;
 use crate::contact::enforcement::{method, Method};
-use crate::contact::friction::{multiplier_status, return_map, FrictionPoint, ReturnMap, Status};
+use crate::contact::friction::{
+    augmented_return_map, multiplier_status, return_map, Committed, FrictionPoint, ReturnMap,
+    Status,
+};
 use crate::contact::state::{ContactState, Departure, Termination};
 use crate::contact::Constraint;
 use crate::error::Result;
@@ -157,11 +160,23 @@ pub(crate) struct ContactSystem<'a> {
     reference_areas: ReferenceAreas,
     /// Coulomb pairs: the plastic slip committed at the end of the last load step, by point,
     /// and the frictional status of the last evaluation (with the direction of a slip).
-    committed: HashMap<RowKey, f64>,
+    committed: HashMap<RowKey, Committed>,
     status: HashMap<RowKey, (Status, bool)>,
     /// Finite kinematics: the element found inverted at the last evaluation (its residual is
     /// then NaN, which ends the Newton solve; the load step is cut).
     inverted: Option<String>,
+    /// Augmented-Lagrangian Coulomb pairs: the tangential Uzawa multiplier `lambda_bar_t` by
+    /// point (carried from the last load step, updated with the normal one).
+    tangential_augmentation: HashMap<RowKey, f64>,
+    /// Whether the last evaluation changed no point's status (open, stick, slip).
+    sets_settled: bool,
+    /// A Uzawa update moved a frictional multiplier: the next evaluation keeps the frictional
+    /// branches of the last one (`holding` while it runs).
+    hold_next: bool,
+    holding: bool,
+    /// Whether the Uzawa multipliers of the frictional points have been updated in this load
+    /// step (Laursen & Simo's bound is held only from then on).
+    multipliers_current: bool,
 }
 
 impl<'a> ContactSystem<'a> {
@@ -171,7 +186,7 @@ impl<'a> ContactSystem<'a> {
         model: &'a Model,
         u: Option<&[f64]>,
         previous: Option<&HashSet<RowKey>>,
-        committed: HashMap<RowKey, f64>,
+        committed: HashMap<RowKey, Committed>,
     ) -> Result<Self> {
         let current = model.physics.contact_geometry == ContactGeometry::Current;
         let t = Instant::now();
@@ -233,9 +248,42 @@ impl<'a> ContactSystem<'a> {
             committed,
             status: HashMap::new(),
             inverted: None,
+            tangential_augmentation: HashMap::new(),
+            sets_settled: false,
+            hold_next: false,
+            holding: false,
+            multipliers_current: false,
         };
         system.number_unknowns();
+        system.carry_uzawa_multipliers();
         Ok(system)
+    }
+
+    /// Augmented-Lagrangian Coulomb rows start a load step from the forces of the last one as
+    /// their Uzawa multipliers (see [`crate::contact::friction`]; frictionless rows restart
+    /// from zero, as before).
+    fn carry_uzawa_multipliers(&mut self) {
+        for r in &self.rows {
+            let key = row_key(r);
+            let (
+                RowLaw::Penalty {
+                    update: Some(_), ..
+                },
+                Some(c),
+            ) = (self.law(r), self.committed.get(&key))
+            else {
+                continue;
+            };
+            if c.normal_force > 0.0 {
+                self.augmentation.insert(key, c.normal_force);
+                self.tangential_augmentation.insert(key, c.tangential_force);
+            }
+        }
+    }
+
+    /// The committed slip of point `key` (zero for a point the last step did not have).
+    fn committed_slip(&self, key: &RowKey) -> f64 {
+        self.committed.get(key).map_or(0.0, |c| c.slip)
     }
 
     /// How row `r` is enforced.
@@ -289,10 +337,51 @@ impl<'a> ContactSystem<'a> {
         let r = &self.rows[i];
         let (mu, w_t) = self.coulomb(r)?;
         let t = r.tangent.as_ref()?;
-        let committed = self.committed.get(&row_key(r)).copied().unwrap_or(0.0);
+        let key = row_key(r);
+        let committed = self.committed_slip(&key);
         let g_t = t.slip(u);
-        if !matches!(self.law(r), RowLaw::Multiplier) {
-            return Some(return_map(mu, w_t, lambda_n, on, g_t, committed));
+        match self.law(r) {
+            RowLaw::Penalty {
+                update: Some(_), ..
+            } => {
+                // the augmented Lagrangian: the trial force from the Uzawa multiplier and the
+                // stick point; Laursen & Simo bound it by the normal multiplier held fixed
+                let lambda_bar_n = self.augmentation.get(&key).copied().unwrap_or(0.0);
+                // Laursen & Simo hold the bound at mu lambda_bar_n once the step has updated
+                // the multipliers; before (the step's first Newton pass) the bound is the
+                // current normal force, the consistent form: the multiplier of the last step
+                // (or none, zero) bounds the friction of the last load, and a body held by
+                // friction alone may have no equilibrium under the new load with it (it slid
+                // away on the incline). A point without a normal multiplier takes the
+                // consistent form too (at a converged Uzawa iteration every compressed point
+                // has one).
+                let fixed = self.model.solver.friction_tangent == FrictionTangent::LaursenSimo
+                    && self.multipliers_current
+                    && lambda_bar_n > 0.0;
+                let held = self
+                    .holding
+                    .then(|| self.status.get(&key))
+                    .flatten()
+                    .map(|&(status, positive)| (status, if positive { 1.0 } else { -1.0 }));
+                return Some(augmented_return_map(
+                    mu,
+                    w_t,
+                    if fixed { lambda_bar_n } else { lambda_n },
+                    !fixed,
+                    on,
+                    g_t,
+                    committed,
+                    self.tangential_augmentation
+                        .get(&key)
+                        .copied()
+                        .unwrap_or(0.0),
+                    held,
+                ));
+            }
+            RowLaw::Penalty { .. } => {
+                return Some(return_map(mu, w_t, lambda_n, on, g_t, committed));
+            }
+            RowLaw::Multiplier => {}
         }
         let j = self.tangential[i]?;
         let lambda_t = self.rho * x[j];
@@ -495,7 +584,7 @@ impl<'a> ContactSystem<'a> {
             forces.push(if a { f } else { 0.0 });
             let r = &self.rows[i];
             friction.push(self.friction_at(i, &u, x, f, a).map(|m| {
-                let committed = self.committed.get(&row_key(r)).copied().unwrap_or(0.0);
+                let committed = self.committed_slip(&row_key(r));
                 FrictionPoint {
                     status: m.status,
                     force: m.force,
@@ -659,6 +748,7 @@ impl System for ContactSystem<'_> {
         if self.evaluations == 0 {
             self.remember_multipliers();
         }
+        self.holding = std::mem::take(&mut self.hold_next);
         let u = self.sys.expand(&x[..n]);
         let current = self.model.physics.contact_geometry == ContactGeometry::Current;
         if current && self.evaluations > 0 {
@@ -764,7 +854,7 @@ impl System for ContactSystem<'_> {
                         Status::Stick => {
                             // R_t = -rho dg_t, and the augmentation rho dg_t b_t (zero at the
                             // solution) holds a body that only friction holds
-                            let committed = self.committed.get(&key).copied().unwrap_or(0.0);
+                            let committed = self.committed_slip(&key);
                             let dg = t.slip(&u) - committed;
                             residual[jt] = -rho * dg;
                             for (a, &(ea, ca)) in tangential.iter().enumerate() {
@@ -898,6 +988,8 @@ impl System for ContactSystem<'_> {
         self.forces = forces;
         self.status = status;
         self.evaluations += 1;
+        self.sets_settled = eval.status_changes == 0;
+        self.holding = false;
         Ok(eval)
     }
 
@@ -906,7 +998,9 @@ impl System for ContactSystem<'_> {
         let size = self.model.size();
         let fmax = self.forces.values().fold(0.0f64, |m, f| m.max(f.abs()));
         let mut updates = Vec::new();
-        for r in &self.rows {
+        let mut tangential_updates = Vec::new();
+        let mut frictional_update = false;
+        for (i, r) in self.rows.iter().enumerate() {
             let RowLaw::Penalty {
                 w,
                 update: Some(rule),
@@ -914,11 +1008,42 @@ impl System for ContactSystem<'_> {
             else {
                 continue;
             };
-            let key = row_key(r);
-            if !self.active.get(&key).copied().unwrap_or(false) {
+            if rule == MultiplierUpdate::OuterLoop && !converged {
                 continue;
             }
-            if rule == MultiplierUpdate::OuterLoop && !converged {
+            if self.coulomb(r).is_some() && !self.sets_settled {
+                // per iteration, a frictional point's multipliers move once the iteration has
+                // settled the open/stick/slip sets: a Uzawa step from an iterate whose branches
+                // still change mixes trial states of different sets (it diverged on the slip
+                // patch test)
+                continue;
+            }
+            if self.coulomb(r).is_some() {
+                frictional_update = true;
+            }
+            let key = row_key(r);
+            let on = self.active.get(&key).copied().unwrap_or(false);
+            if self.coulomb(r).is_some() {
+                // lambda_bar_t <- proj(lambda_bar_t - w_t (g_t - g_t^n)): the map's force, from
+                // the multipliers before this update (zero at an open point)
+                let (lambda_n, active) = self.force(i, &u, x);
+                let map = self
+                    .friction_at(i, &u, x, lambda_n, active)
+                    .expect("a frictional row");
+                let old = self
+                    .tangential_augmentation
+                    .get(&key)
+                    .copied()
+                    .unwrap_or(0.0);
+                let fscale = fmax.max(map.force.abs());
+                let t = r.tangent.as_ref().expect("frictional");
+                let at_floor = map.status == Status::Stick
+                    && (t.slip(&u) - self.committed_slip(&key)).abs() <= 1e-15 * size;
+                if (map.force - old).abs() > 1e-12 * fscale && !at_floor {
+                    tangential_updates.push((key, map.force));
+                }
+            }
+            if !on {
                 continue;
             }
             let g = r.gap(&u);
@@ -928,8 +1053,15 @@ impl System for ContactSystem<'_> {
             let next = self.augmentation.get(&key).copied().unwrap_or(0.0) - w * g;
             updates.push((key, if r.bilateral { next } else { next.max(0.0) }));
         }
-        let moved = !updates.is_empty();
+        let moved = !updates.is_empty() || !tangential_updates.is_empty();
+        // the Newton step right after the update keeps the frictional branches: at the
+        // unchanged displacement the new multiplier adds to the spring's force (a stick point
+        // at half the cone bound would be pushed onto it), and the step is the predictor of
+        // the updated problem from the converged branches
+        self.hold_next = !tangential_updates.is_empty();
+        self.multipliers_current |= frictional_update;
         self.augmentation.extend(updates);
+        self.tangential_augmentation.extend(tangential_updates);
         moved
     }
 }
@@ -940,7 +1072,7 @@ pub(crate) fn solve_step(
     model: &Model,
     previous: Option<HashSet<RowKey>>,
     start: Option<Vec<f64>>,
-    committed: HashMap<RowKey, f64>,
+    committed: HashMap<RowKey, Committed>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Solution> {
     let mut timings = Timings::default();
@@ -1079,7 +1211,15 @@ impl<'a> Probe<'a> {
             .rows
             .iter()
             .filter(|r| r.tangent.is_some())
-            .map(|r| (row_key(r), committed))
+            .map(|r| {
+                (
+                    row_key(r),
+                    Committed {
+                        slip: committed,
+                        ..Committed::default()
+                    },
+                )
+            })
             .collect();
         // past the first evaluation, which closes rows to hold free bodies
         system.evaluations = 1;
@@ -1100,7 +1240,8 @@ impl<'a> Probe<'a> {
 
     /// The unknowns at a solved state with Lagrange multipliers: the free displacements of `u`,
     /// then the scaled normal and tangential multipliers `lambda / rho` of `state`'s rows; the
-    /// rows active in `state` start active.
+    /// rows active in `state` start active. Augmented-Lagrangian rows take the state's forces
+    /// as their Uzawa multipliers and its committed stick points.
     pub fn unknowns_at(&mut self, u: &[f64], state: &ContactState) -> Vec<f64> {
         let mut x = self.unknowns(u);
         x.resize(self.general.n, 0.0);
@@ -1111,6 +1252,24 @@ impl<'a> Probe<'a> {
                 continue;
             };
             system.active.insert(key, state.active[i]);
+            if let RowLaw::Penalty {
+                update: Some(_), ..
+            } = system.law(r)
+            {
+                // the augmented Lagrangian at its converged Uzawa multipliers
+                system.augmentation.insert(key, state.forces[i]);
+                system.multipliers_current = true;
+                if let Some(f) = &state.friction[i] {
+                    system.tangential_augmentation.insert(key, f.force);
+                    system.committed.insert(
+                        key,
+                        Committed {
+                            slip: f.committed,
+                            ..Committed::default()
+                        },
+                    );
+                }
+            }
             if let Some(j) = system.multiplier[k] {
                 x[j] = state.forces[i] / system.rho;
             }
