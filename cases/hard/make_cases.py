@@ -415,6 +415,30 @@ case(
     [stops("iteration_limit", "the residual stagnated")],
 )
 
+# 18. active-set cycling: the shifted punch of case 16 with a penalty (kappa = 1e5 = 100 E / h)
+for remedy in ["hold", "off"]:
+    c = patch("A")
+    c["bodies"][1]["mesh"]["block"]["x"] = [4.5, 5.5, 6.5]
+    c.pop("exact")
+    c["physics"] = {"contact_geometry": "current"}
+    c["contact"][0]["enforcement"] = enforcement("penalty", 1e5)
+    c["solver"] = {"cycling_remedy": remedy}
+    why = "The punch of slave-past-master-end (its right node 0.5 past the master's end) with a penalty kappa = 1e5 = 100 E / h: the first solve leaves the slave node at (4.5, 5) at zero gap and zero force; a penalty row whose trial force is not compressive opens, the punch, held by one point, tips, and that node penetrates: the next set is the first one again, a cycle."
+    if remedy == "hold":
+        case(
+            "active-set-cycling-remedy",
+            why + " With the default remedy (solver.cycling_remedy 'hold') the node stays closed while its force is not tensile and the loop converges: the contact carries the punch's load and the forces balance.",
+            c,
+            [converged(), load_carried("interface", PUNCH_LOAD, 1e-10), {"check": "force_balance", "tol": 1e-12}],
+        )
+    else:
+        case(
+            "active-set-cycling-remedy-off",
+            why + " With solver.cycling_remedy 'off' the loop stops at the repeated set with active_set_cycling, naming the node and the remedy.",
+            c,
+            [stops("active_set_cycling", "the slave points at (4.500000, 5.000000) of contact 'interface' switch between open and closed")],
+        )
+
 
 def main():
     for name, c in CASES.items():

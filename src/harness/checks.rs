@@ -334,7 +334,7 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
                     let (got, text) = match solution.contact.as_ref().map(|c| &c.termination) {
                         Some(Termination::Converged) => (Some(TerminationReason::Converged), String::new()),
                         Some(Termination::IterationLimit) => (Some(TerminationReason::IterationLimit), String::new()),
-                        Some(Termination::ActiveSetCycling) => (Some(TerminationReason::ActiveSetCycling), String::new()),
+                        Some(Termination::ActiveSetCycling(m)) => (Some(TerminationReason::ActiveSetCycling), m.clone()),
                         Some(Termination::Singular(m)) => (Some(TerminationReason::Singular), m.clone()),
                         None => (None, String::new()),
                     };

@@ -13,7 +13,9 @@
 //!   `max_i kappa_i A_i |b_i| eps max|u| / F` (`F` the largest applied or contact force), which names the penalty as the cause when it
 //!   is above round-off and says how far to lower it.
 //! * Chattering: the number of contact points that change status after an iteration, per
-//!   iteration and summed over a load step (the history's `status_changes`).
+//!   iteration and summed over a load step (the history's `status_changes`), and the
+//!   iterations whose active set repeated an earlier one (cycling, see
+//!   [`crate::solver::active_set`]) or ran under the cycling remedy.
 //! * A stalled Uzawa iteration (augmented Lagrangian) or perturbed-tangent iteration: each
 //!   iteration reduces the penetration by about `1 / (1 + kappa A c)` with `c` the
 //!   compliance of the bodies at the point (Bertsekas, *Constrained Optimization and Lagrange
@@ -45,6 +47,17 @@ pub struct Conditioning {
     /// The most status changes after one iteration and in one load step (chattering).
     pub status_changes_per_iteration: usize,
     pub status_changes_per_step: usize,
+    /// Iterations whose active set repeated an earlier one of their loop (cycling, active-set
+    /// scheme), and iterations under the cycling remedy (`solver.cycling_remedy`); absent when
+    /// zero.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub repeated_active_sets: usize,
+    #[serde(skip_serializing_if = "is_zero")]
+    pub cycling_remedy_iterations: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// The most status changes after one iteration, and summed over one load step.
@@ -113,6 +126,13 @@ pub fn conditioning(model: &Model, solution: &Solution) -> Conditioning {
         .map(status_changes)
         .unwrap_or((0, 0));
     let residual = solution.relative_residual;
+    let count = |f: fn(&crate::contact::state::IterationRecord) -> bool| {
+        solution
+            .contact
+            .as_ref()
+            .map(|c| c.history.iter().filter(|r| f(r)).count())
+            .unwrap_or(0)
+    };
     Conditioning {
         condition_estimate,
         lost_digits: condition_estimate.map(lost_digits),
@@ -121,6 +141,8 @@ pub fn conditioning(model: &Model, solution: &Solution) -> Conditioning {
         penalty_floor: penalty_floor(model, solution),
         status_changes_per_iteration: per_iteration,
         status_changes_per_step: per_step,
+        repeated_active_sets: count(|r| r.repeated_set),
+        cycling_remedy_iterations: count(|r| r.cycling_remedy),
     }
 }
 

@@ -453,11 +453,23 @@ impl<'a> ContactSystem<'a> {
             .collect();
         let same_multipliers = multipliers.len() == self.carried.len()
             && multipliers.iter().all(|k| self.carried.contains_key(k));
+        // a multiplier couples the equations its row acts on now: a row whose gradient gained
+        // a component (a normal on a rigid circle that turned away from an axis) needs new
+        // entries in the multiplier's column
+        let coupled = same_multipliers
+            && self.rows.iter().all(|r| {
+                let Some(&j) = self.carried.get(&row_key(r)) else {
+                    return true;
+                };
+                self.free_terms(r)
+                    .iter()
+                    .all(|&(e, _)| self.pattern.position(e.min(j), e.max(j)).is_some())
+            });
         if !covered {
             let blocks: Vec<Vec<usize>> = self.rows.iter().map(|r| r.all_dofs()).collect();
             self.sys = assemble(self.model, &blocks);
         }
-        if !covered || !same_multipliers {
+        if !covered || !coupled {
             self.number_unknowns();
             self.version += 1;
         } else {

@@ -179,6 +179,8 @@ pub fn solve_with(
                 linear_solver: last_solver,
                 condition_estimate: linear.last_condition,
                 seconds: start.elapsed().as_secs_f64(),
+                repeated_set: false,
+                cycling_remedy: false,
             });
             start = Instant::now();
         }
