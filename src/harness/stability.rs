@@ -16,6 +16,8 @@
 //!   iteration and summed over a load step (the history's `status_changes`), and the
 //!   iterations whose active set repeated an earlier one (cycling, see
 //!   [`crate::solver::active_set`]) or ran under the cycling remedy.
+//! * Energy of a time integration: a warning when the total energy grew (the trapezoidal rule
+//!   conserves it without contact; Hughes 1987, 9.1; contact only removes energy).
 //! * A stalled Uzawa iteration (augmented Lagrangian) or perturbed-tangent iteration: each
 //!   iteration reduces the penetration by about `1 / (1 + kappa A c)` with `c` the
 //!   compliance of the bodies at the point (Bertsekas, *Constrained Optimization and Lagrange
@@ -288,5 +290,38 @@ pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
     equilibrium_warning(model, solution)
         .into_iter()
         .chain(stall)
+        .chain(energy_growth(solution))
         .collect()
+}
+
+/// Share of the largest energy of a time integration by which the total energy may grow
+/// before the run warns (see [`energy_growth`]).
+pub const ENERGY_GROWTH_SHARE: f64 = 0.1;
+
+/// A warning when the total energy of a time integration (kinetic + strain + penalty
+/// contact + load potential, conserved by the trapezoidal rule without contact) grew by more
+/// than [`ENERGY_GROWTH_SHARE`] of the largest energy of the run: the integration added
+/// energy (a stiff penalty struck with a penetration per step the step cannot resolve, or an
+/// explicit step near its limit). Contact and numerical damping only remove energy.
+pub fn energy_growth(solution: &Solution) -> Option<String> {
+    let h = solution.dynamics.as_ref()?;
+    let first = h.steps.first()?;
+    let scale = h
+        .steps
+        .iter()
+        .map(|s| {
+            s.kinetic
+                .abs()
+                .max(s.strain.abs())
+                .max(s.contact_energy.abs())
+                .max(s.load_potential.abs())
+        })
+        .fold(0.0f64, f64::max);
+    let most = h.steps.iter().max_by(|a, b| a.total.total_cmp(&b.total))?;
+    (most.total - first.total > ENERGY_GROWTH_SHARE * scale).then(|| {
+        format!(
+            "the total energy grew from {:.4e} to {:.4e} (step {}, t = {:.4e}), more than {ENERGY_GROWTH_SHARE} of the largest energy of the run: the integration added energy (a penalty much stiffer than the bodies struck with a penetration per step that the step cannot resolve, or an explicit step near its stability limit); use \"impact\": \"contact_stabilized\", a smaller dt or a softer penalty",
+            first.total, most.total, most.step, most.time
+        )
+    })
 }

@@ -21,6 +21,7 @@
 pub mod admit;
 pub mod dynamics;
 pub(crate) mod rigid;
+pub mod stable_step;
 
 use crate::contact::enforcement::Family;
 use crate::error::{Error, Result};

@@ -591,6 +591,14 @@ impl ContactSystem<'_> {
         &self.rows
     }
 
+    /// The penalty weight `w = kappa A` of row `r` (`None` for a multiplier row).
+    pub(crate) fn penalty_weight(&self, r: &Constraint) -> Option<f64> {
+        match self.law(r) {
+            RowLaw::Penalty { w, .. } => Some(w),
+            RowLaw::Multiplier => None,
+        }
+    }
+
     /// Active flags, forces (compression positive) and gaps of the rows at the unknowns `x`.
     pub(crate) fn row_state(&self, x: &[f64]) -> (Vec<bool>, Vec<f64>, Vec<f64>) {
         let (active, forces, gaps, _) = self.state(x);
