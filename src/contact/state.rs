@@ -122,7 +122,8 @@ pub struct IterationRecord {
     pub multiplier_change: f64,
     pub linear_solver: &'static str,
     /// Estimated 1-norm condition number of the last system factored for this iteration
-    /// ([`crate::solver::conditioning`]); `None` when the solver has no estimate (LU).
+    /// ([`crate::solver::conditioning`]); `None` when the solver has no estimate (the active-set
+    /// scheme's LU fallback and pseudo-inverse).
     pub condition_estimate: Option<f64>,
     pub seconds: f64,
     /// The active set this iteration chose had been chosen before in the same loop (a cycle;

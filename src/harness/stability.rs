@@ -36,7 +36,7 @@ use serde::Serialize;
 #[derive(Clone, Debug, Serialize)]
 pub struct Conditioning {
     /// Estimated 1-norm condition number of the last factored system (`None` without an
-    /// estimate: no contact, or an LU solve).
+    /// estimate: no contact, or the active-set scheme's LU fallback).
     pub condition_estimate: Option<f64>,
     /// `log10` of the estimate.
     pub lost_digits: Option<f64>,
