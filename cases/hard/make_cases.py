@@ -145,6 +145,15 @@ for mesh, disc, label in [
         c,
         [converged(), stress(P, 1e-9), {"check": "equilibrium", "tol": 1e-12, "per_condition": 1.0}],
     )
+c = patch("A")
+c["materials"]["m"]["nu"] = 0.4999
+c["contact"][0]["discretization"] = {"kind": "node_to_node"}
+case(
+    "nu-0.4999-stress-per-condition",
+    "Mesh A, node-to-node, Lagrange multipliers, nu = 0.4999: the stress judged to 1e-12 relative to the condition estimate (about 1e6, so the tolerance is eps kappa = 2.4e-10): the solve leaves a stress error of about 2e-11, which a plain 1e-12 would call a failure although it is what a backward-stable solve of this system can give.",
+    c,
+    [converged(), {"check": "uniform_stress", "stress": [0.0, -P, 0.0], "tol": 1e-12, "per_condition": 1.0}],
+)
 
 # 4. E from 1e-3 to 1e12 in the units of the case (load scaled alike), mesh B one-pass Lagrange
 for e in [1e-3, 1e12]:

@@ -957,11 +957,16 @@ impl Component {
 pub enum Check {
     /// Max over quadrature points (all bodies, or `body`) of |sigma - stress| / max|stress|
     /// over the components xx, yy, xy.
+    /// With `per_condition = c` the tolerance is `max(tol, c eps kappa)`, `kappa` the condition
+    /// estimate of the last factored system (as for `equilibrium`): a stress from a solve that
+    /// lost digits to conditioning (nu near 1/2) is judged by what the solve can give.
     UniformStress {
         #[serde(default)]
         body: Option<String>,
         stress: [f64; 3],
         tol: f64,
+        #[serde(default)]
+        per_condition: Option<f64>,
     },
     /// Relative L2 error of the displacement against the case's exact solution.
     ExactDisplacement { tol: f64 },
