@@ -28,6 +28,7 @@ fn patch_b_passes_at_every_scale() {
                 body: None,
                 stress,
                 tol: 1e-10,
+                per_condition: None,
             },
             Check::ContactPressure {
                 pair: "interface".into(),

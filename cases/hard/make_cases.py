@@ -145,6 +145,15 @@ for mesh, disc, label in [
         c,
         [converged(), stress(P, 1e-9), {"check": "equilibrium", "tol": 1e-12, "per_condition": 1.0}],
     )
+c = patch("A")
+c["materials"]["m"]["nu"] = 0.4999
+c["contact"][0]["discretization"] = {"kind": "node_to_node"}
+case(
+    "nu-0.4999-stress-per-condition",
+    "Mesh A, node-to-node, Lagrange multipliers, nu = 0.4999: the stress judged to 1e-12 relative to the condition estimate (about 1e6, so the tolerance is eps kappa = 2.4e-10): the solve leaves a stress error of about 2e-11, which a plain 1e-12 would call a failure although it is what a backward-stable solve of this system can give.",
+    c,
+    [converged(), {"check": "uniform_stress", "stress": [0.0, -P, 0.0], "tol": 1e-12, "per_condition": 1.0}],
+)
 
 # 4. E from 1e-3 to 1e12 in the units of the case (load scaled alike), mesh B one-pass Lagrange
 for e in [1e-3, 1e12]:
@@ -414,6 +423,117 @@ case(
     c,
     [stops("iteration_limit", "the residual stagnated")],
 )
+
+# 18. active-set cycling: the shifted punch of case 16 with a penalty (kappa = 1e5 = 100 E / h)
+for remedy in ["hold", "off"]:
+    c = patch("A")
+    c["bodies"][1]["mesh"]["block"]["x"] = [4.5, 5.5, 6.5]
+    c.pop("exact")
+    c["physics"] = {"contact_geometry": "current"}
+    c["contact"][0]["enforcement"] = enforcement("penalty", 1e5)
+    c["solver"] = {"cycling_remedy": remedy}
+    why = "The punch of slave-past-master-end (its right node 0.5 past the master's end) with a penalty kappa = 1e5 = 100 E / h: the first solve leaves the slave node at (4.5, 5) at zero gap and zero force; a penalty row whose trial force is not compressive opens, the punch, held by one point, tips, and that node penetrates: the next set is the first one again, a cycle."
+    if remedy == "hold":
+        case(
+            "active-set-cycling-remedy",
+            why + " With the default remedy (solver.cycling_remedy 'hold') the node stays closed while its force is not tensile and the loop converges: the contact carries the punch's load and the forces balance.",
+            c,
+            [converged(), load_carried("interface", PUNCH_LOAD, 1e-10), {"check": "force_balance", "tol": 1e-12}],
+        )
+    else:
+        case(
+            "active-set-cycling-remedy-off",
+            why + " With solver.cycling_remedy 'off' the loop stops at the repeated set with active_set_cycling, naming the node and the remedy.",
+            c,
+            [stops("active_set_cycling", "the slave points at (4.500000, 5.000000) of contact 'interface' switch between open and closed")],
+        )
+
+
+# 19. friction (Coulomb, Newton scheme): the slip patch test of cases/friction, mesh A, p = 10
+def shear_stress(q, tol):
+    """The frictional patch test's uniform stress [0, -p, q] with p = 10."""
+    return {"check": "uniform_stress", "stress": [0.0, -10.0, q], "tol": tol}
+
+
+def friction_slip(mu, reverse=False, kappa_t=None):
+    """The slip case with friction coefficient mu (every point slips at traction q = mu p),
+    the punch top dragged by 0.1 in step 2 and, with `reverse`, back to -0.1 in step 3."""
+    c = load("cases/friction/friction-A-slip.json")
+    c.pop("sweep", None)
+    q = mu * 10.0
+    path = [0.0, 1.0, -1.0] if reverse else [0.0, 1.0]
+    c["solver"]["load_steps"] = len(path)
+    for s in c["supports"]:
+        if "path" in s:
+            s["path"] = path
+    for ld in c["loads"]:
+        if "traction" in ld:
+            ld["traction"] = [v / 3.0 * q for v in ld["traction"]]
+            ld["path"] = path
+        else:
+            ld["path"] = [1.0] * len(path)
+    c["contact"][0]["interaction"]["coulomb"]["mu"] = mu
+    if kappa_t is not None:
+        c["contact"][0]["interaction"]["coulomb"]["kappa_t"] = kappa_t
+    sign = -1.0 if reverse else 1.0
+    c["exact"] = {"kind": "uniform_stress", "stress": [0.0, -10.0, sign * q]}
+    return c, sign * q
+
+
+c, q = friction_slip(0.3, reverse=True)
+case(
+    "friction-stick-slip-reversal",
+    "Coulomb friction (mu = 0.3, penalty 1e4), mesh A: step 1 presses the punch (p = 10), step 2 drags its top by +0.1 (every point slips forward at q = mu p = 3), step 3 drags it back to -0.1: every point sticks, then slips backward, and the exact stress is [0, -10, -3]. Chattering bound: at most 6 status changes after one iteration (each of the 3 slave points changing its normal and its frictional status once) and 18 in a step (that, over 3 iterations); a point that flip-flops every iteration would exceed it.",
+    c,
+    [converged(), shear_stress(q, 1e-10), {"check": "force_balance", "tol": 1e-12}, {"check": "status_changes", "per_iteration": 6, "per_step": 18}],
+)
+c = load("cases/friction/friction-A-stick.json")
+c.pop("sweep", None)
+c["contact"][0]["interaction"]["coulomb"]["mu"] = 1e3
+case(
+    "friction-mu-1e3",
+    "Coulomb friction with mu = 1e3 (penalty 1e4), mesh A: the stick patch test (p = 10, then a tangential traction q = 1.5 on the punch top); with so large a bound every point sticks and the exact stress is [0, -10, 1.5].",
+    c,
+    [converged(), shear_stress(1.5, 1e-10), {"check": "force_balance", "tol": 1e-12}],
+)
+for mu, label in [(1e-6, "1e-6")]:
+    c, q = friction_slip(mu)
+    case(
+        f"friction-mu-{label}",
+        f"Coulomb friction with mu = {label} (penalty 1e4), mesh A: the slip patch test with the tractions of q = mu p = {q:g}; the punch dragged by 0.1 slips at that traction, and the exact stress is [0, -10, {q:g}].",
+        c,
+        [converged(), shear_stress(q, 1e-9), {"check": "force_balance", "tol": 1e-12}],
+    )
+for kt, label in [(1e2, "1e2"), (1e9, "1e9")]:
+    c, q = friction_slip(0.3, kappa_t=kt)
+    case(
+        f"friction-kappa-t-{label}",
+        f"Coulomb friction mu = 0.3 with the tangential penalty kappa_t = {label} (normal penalty 1e4, E / h = 1000), mesh A: slip does not depend on kappa_t once the drag 0.1 exceeds the elastic slip mu p / kappa_t (0.03 at kappa_t = 1e2 = E / (10 h)); kappa_t = 1e9 = 1e6 E / h enters only the stick tangent of the first iterations, the slip tangent holds mu and the normal penalty, so the last condition estimate does not grow with it; the slip patch test's stress [0, -10, 3] holds.",
+        c,
+        [converged(), shear_stress(q, 1e-9), {"check": "force_balance", "tol": 1e-12}],
+    )
+
+
+# 20. impact at high speed: a bar (E = 100, rho = 1, wave speed c = 10, elements h = 0.05) hits
+# a rigid wall at v = 1 (strain v / c = 0.1), average acceleration, dt = 0.005: a penetration
+# per step v dt = 0.005 = h / 10 with a penalty
+BAR = load("cases/dynamics/bar-on-rigid-wall.json")
+for kappa, label in [(1e4, "1e4"), (1e6, "1e6")]:
+    c = copy.deepcopy(BAR)
+    c["physics"]["dynamics"]["initial_velocity"][0]["velocity"] = [1.0, 0.0]
+    c["contact"][0]["enforcement"] = enforcement("penalty", kappa)
+    if kappa < 1e5:
+        checks = [converged(), {"check": "contact_force", "pair": "wall", "component": "x", "value": 0.0, "tol": 1e-12}]
+        what = "converges and the bar has left the wall at the end (t = 0.4, after the contact time 2 L / c = 0.2): no contact force; the total energy stays within a tenth of the initial kinetic energy (no warning)"
+    else:
+        checks = [converged(), {"check": "warns", "contains": "the total energy grew"}]
+        what = "converges, but the stiff penalty struck at h / 10 per step adds energy (the total grows about tenfold): the run warns, naming the remedies"
+    case(
+        f"impact-high-speed-penalty-{label}",
+        f"A bar at v = 1 (ten times the catalogue's impact, strain 0.1) on a rigid wall, average acceleration, dt = 0.005, penalty kappa = {label}: {what}.",
+        c,
+        checks,
+    )
 
 
 def main():

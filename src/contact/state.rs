@@ -11,7 +11,9 @@ use super::Constraint;
 pub enum Termination {
     Converged,
     IterationLimit,
-    ActiveSetCycling,
+    /// The active set repeated (a cycle) and the remedy was off or did not help: the points
+    /// that flip-flopped and what to change.
+    ActiveSetCycling(String),
     /// The linear system could not be solved (the message says why).
     Singular(String),
 }
@@ -132,7 +134,15 @@ pub struct IterationRecord {
     pub multiplier_change: f64,
     pub linear_solver: &'static str,
     /// Estimated 1-norm condition number of the last system factored for this iteration
-    /// ([`crate::solver::conditioning`]); `None` when the solver has no estimate (LU).
+    /// ([`crate::solver::conditioning`]); `None` when the solver has no estimate (the active-set
+    /// scheme's LU fallback and pseudo-inverse).
     pub condition_estimate: Option<f64>,
     pub seconds: f64,
+    /// The active set this iteration chose had been chosen before in the same loop (a cycle;
+    /// active-set scheme).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub repeated_set: bool,
+    /// The cycling remedy (`solver.cycling_remedy`) was in force in this iteration.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub cycling_remedy: bool,
 }

@@ -304,7 +304,8 @@ pub fn evaluate_with(
         .iter()
         .map(|check| {
             let (check_name, error, tol) = match check {
-                Check::UniformStress { body, stress, tol } => {
+                Check::UniformStress { body, stress, tol, per_condition } => {
+                    let (tol, stated) = conditioned_tolerance(model, solution, *tol, *per_condition);
                     let largest = stress.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                     let (scale, against) = if largest > 0.0 {
                         (largest, String::new())
@@ -321,7 +322,7 @@ pub fn evaluate_with(
                         });
                     }
                     let on = body.as_deref().map(|b| format!(" in body '{b}'")).unwrap_or_default();
-                    (format!("uniform stress {stress:?}{on}{against}"), error, *tol)
+                    (format!("uniform stress {stress:?}{on}{against}{stated}"), error, tol)
                 }
                 Check::ExactDisplacement { tol } => {
                     let exact = model.exact.as_ref().expect("resolved when the model was built");
@@ -366,7 +367,7 @@ pub fn evaluate_with(
                     let (got, text) = match solution.contact.as_ref().map(|c| &c.termination) {
                         Some(Termination::Converged) => (Some(TerminationReason::Converged), String::new()),
                         Some(Termination::IterationLimit) => (Some(TerminationReason::IterationLimit), String::new()),
-                        Some(Termination::ActiveSetCycling) => (Some(TerminationReason::ActiveSetCycling), String::new()),
+                        Some(Termination::ActiveSetCycling(m)) => (Some(TerminationReason::ActiveSetCycling), m.clone()),
                         Some(Termination::Singular(m)) => (Some(TerminationReason::Singular), m.clone()),
                         None => (None, String::new()),
                     };
@@ -381,15 +382,7 @@ pub fn evaluate_with(
                     )
                 }
                 Check::Equilibrium { tol, per_condition } => {
-                    let kappa = crate::harness::stability::conditioning(model, solution).condition_estimate;
-                    let (tol, stated) = match (per_condition, kappa) {
-                        (Some(c), Some(k)) => {
-                            let t = tol.max(c * f64::EPSILON * k);
-                            (t, format!(", tol max({tol:.1e}, {c} eps kappa) with kappa {k:.2e}"))
-                        }
-                        (Some(_), None) => (*tol, ", no condition estimate".to_string()),
-                        _ => (*tol, String::new()),
-                    };
+                    let (tol, stated) = conditioned_tolerance(model, solution, *tol, *per_condition);
                     (format!("relative equilibrium residual{stated}"), solution.relative_residual, tol)
                 }
                 Check::StatusChanges { per_iteration, per_step } => {
@@ -431,4 +424,28 @@ pub fn evaluate_with(
         })
         .collect();
     convergence.into_iter().chain(declared).collect()
+}
+
+/// A check's tolerance stated relative to the conditioning: with `per_condition = c`,
+/// `max(tol, c eps kappa)` with `kappa` the condition estimate of the last factored system
+/// ([`crate::harness::stability::conditioning`]): a backward-stable solve loses up to
+/// `eps kappa` relative accuracy (Higham 2002, ch. 7). Also the words that say so.
+fn conditioned_tolerance(
+    model: &Model,
+    solution: &Solution,
+    tol: f64,
+    per_condition: Option<f64>,
+) -> (f64, String) {
+    let kappa = crate::harness::stability::conditioning(model, solution).condition_estimate;
+    match (per_condition, kappa) {
+        (Some(c), Some(k)) => {
+            let t = tol.max(c * f64::EPSILON * k);
+            (
+                t,
+                format!(", tol max({tol:.1e}, {c} eps kappa) with kappa {k:.2e}"),
+            )
+        }
+        (Some(_), None) => (tol, ", no condition estimate".to_string()),
+        _ => (tol, String::new()),
+    }
 }

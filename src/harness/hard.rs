@@ -44,7 +44,7 @@ fn termination_name(t: &Termination) -> &'static str {
     match t {
         Termination::Converged => "converged",
         Termination::IterationLimit => "iteration_limit",
-        Termination::ActiveSetCycling => "active_set_cycling",
+        Termination::ActiveSetCycling(_) => "active_set_cycling",
         Termination::Singular(_) => "singular",
     }
 }

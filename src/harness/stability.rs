@@ -13,7 +13,11 @@
 //!   `max_i kappa_i A_i |b_i| eps max|u| / F` (`F` the largest applied or contact force), which names the penalty as the cause when it
 //!   is above round-off and says how far to lower it.
 //! * Chattering: the number of contact points that change status after an iteration, per
-//!   iteration and summed over a load step (the history's `status_changes`).
+//!   iteration and summed over a load step (the history's `status_changes`), and the
+//!   iterations whose active set repeated an earlier one (cycling, see
+//!   [`crate::solver::active_set`]) or ran under the cycling remedy.
+//! * Energy of a time integration: a warning when the total energy grew (the trapezoidal rule
+//!   conserves it without contact; Hughes 1987, 9.1; contact only removes energy).
 //! * A stalled Uzawa iteration (augmented Lagrangian) or perturbed-tangent iteration: each
 //!   iteration reduces the penetration by about `1 / (1 + kappa A c)` with `c` the
 //!   compliance of the bodies at the point (Bertsekas, *Constrained Optimization and Lagrange
@@ -32,7 +36,7 @@ use serde::Serialize;
 #[derive(Clone, Debug, Serialize)]
 pub struct Conditioning {
     /// Estimated 1-norm condition number of the last factored system (`None` without an
-    /// estimate: no contact, or an LU solve).
+    /// estimate: no contact, or the active-set scheme's LU fallback).
     pub condition_estimate: Option<f64>,
     /// `log10` of the estimate.
     pub lost_digits: Option<f64>,
@@ -45,6 +49,17 @@ pub struct Conditioning {
     /// The most status changes after one iteration and in one load step (chattering).
     pub status_changes_per_iteration: usize,
     pub status_changes_per_step: usize,
+    /// Iterations whose active set repeated an earlier one of their loop (cycling, active-set
+    /// scheme), and iterations under the cycling remedy (`solver.cycling_remedy`); absent when
+    /// zero.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub repeated_active_sets: usize,
+    #[serde(skip_serializing_if = "is_zero")]
+    pub cycling_remedy_iterations: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// The most status changes after one iteration, and summed over one load step.
@@ -113,6 +128,13 @@ pub fn conditioning(model: &Model, solution: &Solution) -> Conditioning {
         .map(status_changes)
         .unwrap_or((0, 0));
     let residual = solution.relative_residual;
+    let count = |f: fn(&crate::contact::state::IterationRecord) -> bool| {
+        solution
+            .contact
+            .as_ref()
+            .map(|c| c.history.iter().filter(|r| f(r)).count())
+            .unwrap_or(0)
+    };
     Conditioning {
         condition_estimate,
         lost_digits: condition_estimate.map(lost_digits),
@@ -121,6 +143,8 @@ pub fn conditioning(model: &Model, solution: &Solution) -> Conditioning {
         penalty_floor: penalty_floor(model, solution),
         status_changes_per_iteration: per_iteration,
         status_changes_per_step: per_step,
+        repeated_active_sets: count(|r| r.repeated_set),
+        cycling_remedy_iterations: count(|r| r.cycling_remedy),
     }
 }
 
@@ -266,5 +290,38 @@ pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
     equilibrium_warning(model, solution)
         .into_iter()
         .chain(stall)
+        .chain(energy_growth(solution))
         .collect()
+}
+
+/// Share of the largest energy of a time integration by which the total energy may grow
+/// before the run warns (see [`energy_growth`]).
+pub const ENERGY_GROWTH_SHARE: f64 = 0.1;
+
+/// A warning when the total energy of a time integration (kinetic + strain + penalty
+/// contact + load potential, conserved by the trapezoidal rule without contact) grew by more
+/// than [`ENERGY_GROWTH_SHARE`] of the largest energy of the run: the integration added
+/// energy (a stiff penalty struck with a penetration per step the step cannot resolve, or an
+/// explicit step near its limit). Contact and numerical damping only remove energy.
+pub fn energy_growth(solution: &Solution) -> Option<String> {
+    let h = solution.dynamics.as_ref()?;
+    let first = h.steps.first()?;
+    let scale = h
+        .steps
+        .iter()
+        .map(|s| {
+            s.kinetic
+                .abs()
+                .max(s.strain.abs())
+                .max(s.contact_energy.abs())
+                .max(s.load_potential.abs())
+        })
+        .fold(0.0f64, f64::max);
+    let most = h.steps.iter().max_by(|a, b| a.total.total_cmp(&b.total))?;
+    (most.total - first.total > ENERGY_GROWTH_SHARE * scale).then(|| {
+        format!(
+            "the total energy grew from {:.4e} to {:.4e} (step {}, t = {:.4e}), more than {ENERGY_GROWTH_SHARE} of the largest energy of the run: the integration added energy (a penalty much stiffer than the bodies struck with a penetration per step that the step cannot resolve, or an explicit step near its stability limit); use \"impact\": \"contact_stabilized\", a smaller dt or a softer penalty",
+            first.total, most.total, most.step, most.time
+        )
+    })
 }

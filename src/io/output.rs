@@ -367,6 +367,9 @@ fn summary_with(outcome: &Outcome, nodal: &[Vec<[f64; 3]>], results: &[PairResul
         ContactSummary {
             termination: match &c.termination {
                 crate::solver::active_set::Termination::Singular(m) => format!("singular: {m}"),
+                crate::solver::active_set::Termination::ActiveSetCycling(m) => {
+                    format!("ActiveSetCycling: {m}")
+                }
                 t => format!("{t:?}"),
             },
             iterations: c.iterations,

@@ -21,6 +21,7 @@
 pub mod admit;
 pub mod dynamics;
 pub(crate) mod rigid;
+pub mod stable_step;
 
 use crate::contact::enforcement::Family;
 use crate::error::{Error, Result};
@@ -1215,9 +1216,22 @@ impl Model {
         for (k, check) in case.checks.iter().enumerate() {
             let at = format!("checks[{k}]");
             let tol = match check {
-                Check::UniformStress { body, tol, .. } => {
+                Check::UniformStress {
+                    body,
+                    tol,
+                    per_condition,
+                    ..
+                } => {
                     if let Some(b) = body {
                         self.find_body(b, &at)?;
+                    }
+                    if per_condition.is_some_and(|c| !(c.is_finite() && c >= 0.0)) {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            format!("per_condition must be a non-negative number, got {per_condition:?}"),
+                            "give e.g. 10 (the tolerance becomes max(tol, 10 eps times the condition estimate))",
+                        ));
                     }
                     *tol
                 }

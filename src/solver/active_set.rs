@@ -10,6 +10,18 @@
 //! multiplier mass, which keep their multipliers, an active row stays while `lambda >= 0` and
 //! an inactive one closes when `g + C lambda < 0`). The loop ends with a [`Termination`] reason.
 //!
+//! Cycling: for the methods without a multiplier iteration of their own (Lagrange,
+//! elimination, penalty, perturbed Lagrangian) the set alone determines the iterate, so a set
+//! chosen a second time in one loop (the sets are kept in a hash set) repeats its iterate and
+//! the loop would cycle (Murty, *Linear Complementarity*, 1988, ch. 4: pivoting schemes cycle
+//! on degenerate problems, here a point with zero force at zero gap). The iteration is marked
+//! in the history (`repeated_set`). The remedy (`solver.cycling_remedy: "hold"`, the default)
+//! holds the rows that changed status at least twice closed while their force (multiplier or
+//! a penalty row's trial force) is not tensile beyond the force tolerance: the rule a Lagrange
+//! row already follows, a hysteresis band for penalty rows, whose rule opens a row whose trial
+//! force is not compressive. A set that repeats under the remedy, or with it `"off"`, ends the
+//! loop with [`Termination::ActiveSetCycling`] naming the points and what to change.
+//!
 //! Linear algebra: `M = K + sum_i w_i b_i b_i^T` over the active rows, factored by sparse
 //! Cholesky; the pattern includes every candidate row, so its symbolic analysis is done once.
 //! Lagrange multipliers come from the Schur complement `S = B M^-1 B^T` (dense, one column per
@@ -41,7 +53,7 @@ pub use crate::contact::state::{
 };
 use crate::contact::Constraint;
 use crate::error::{Error, Result};
-use crate::io::scene::{ContactGeometry, MultiplierUpdate};
+use crate::io::scene::{ContactGeometry, CyclingRemedy, MultiplierUpdate};
 use crate::model::rigid::{FreeMode, RigidModes};
 use crate::model::Model;
 use crate::solver::conditioning::{condition_estimate_symmetric, EQUILIBRIUM_ROUND_OFF};
@@ -1670,6 +1682,47 @@ impl Kernel<'_> {
         Ok(())
     }
 
+    /// Why the active set cycled, naming the rows in `flipping` (those that changed status at
+    /// least twice), and what to change.
+    fn cycling_diagnosis(
+        &self,
+        rows: &[Constraint],
+        flipping: &[usize],
+        it: usize,
+        remedy: CyclingRemedy,
+        remedied: bool,
+    ) -> String {
+        let mut points: Vec<String> = flipping
+            .iter()
+            .take(5)
+            .map(|&i| {
+                let r = &rows[i];
+                format!(
+                    "({:.6}, {:.6}) of contact '{}'",
+                    r.point[0], r.point[1], self.model.contact[r.pair].name
+                )
+            })
+            .collect();
+        if flipping.len() > 5 {
+            points.push(format!("and {} more", flipping.len() - 5));
+        }
+        let which = if points.is_empty() {
+            "several points".to_string()
+        } else {
+            format!("the slave points at {}", points.join(", "))
+        };
+        let cause = format!(
+            "the active set of iteration {it} repeats an earlier one (the loop would cycle): {which} switch between open and closed, their force and gap both near zero (a point at the edge of the contact zone, or a body held by a point that carries no force)"
+        );
+        if remedy == CyclingRemedy::Off {
+            format!("{cause}; the remedy is off (solver.cycling_remedy \"off\"): remove that setting to hold such points closed while their force is not tensile")
+        } else if remedied {
+            format!("{cause}, and it still cycles with those points held closed while their force is not tensile: apply the load in more load steps (solver.load_steps), use Lagrange multipliers, or refine the slave surface near those points")
+        } else {
+            format!("{cause}; apply the load in more load steps (solver.load_steps) or use Lagrange multipliers")
+        }
+    }
+
     /// The active-set loop. Before each solve the rigid modes are tested with the active rows
     /// ([`Kernel::prepare`]); a set that leaves one free is solved stabilized and never counts
     /// as converged: if the loop settles on it, it ends with [`Termination::Singular`] saying
@@ -1707,8 +1760,13 @@ impl Kernel<'_> {
         let mut lambda_k = vec![0.0; nrows];
         let mut x = vec![0.0; self.sys.n];
         let mut forces = vec![0.0; nrows];
+        // cycling: the sets chosen so far (hashed), how often each row changed status, and the
+        // rows the remedy holds closed once a set repeated
         let mut seen: HashSet<Vec<bool>> = HashSet::new();
         seen.insert(active.clone());
+        let mut flips = vec![0usize; nrows];
+        let mut held: Vec<usize> = Vec::new();
+        let remedy = self.model.solver.cycling_remedy;
         let max_iterations = self.model.solver.max_iterations;
         for it in 1..=max_iterations {
             let iteration_start = Instant::now();
@@ -1843,7 +1901,30 @@ impl Kernel<'_> {
             for i in closing {
                 new_active[i] = true;
             }
+            // the cycling remedy: a held row stays closed while its force (the multiplier, or
+            // a penalty row's trial force) is not tensile beyond the tolerance
+            for &i in &held {
+                if active[i] && !new_active[i] && forces[i] >= -force_tol {
+                    new_active[i] = true;
+                }
+            }
+            for i in 0..nrows {
+                if new_active[i] != active[i] {
+                    flips[i] += 1;
+                }
+            }
             let stable = new_active == active;
+            // the loops without a multiplier iteration of their own determine the iterate by
+            // the set alone: a set chosen before repeats its iterate (the residual cannot have
+            // decreased), a cycle
+            let cycles = matches!(
+                method,
+                Method::Lagrange
+                    | Method::Elimination
+                    | Method::Regularized { .. }
+                    | Method::PerturbedLagrange { .. }
+            ) && !iterative.iter().any(|&it| it);
+            let repeated = cycles && !stable && seen.contains(&new_active);
             self.history.push(IterationRecord {
                 step: 0,
                 geometry_update: 0,
@@ -1865,6 +1946,8 @@ impl Kernel<'_> {
                 linear_solver: self.linear_solver,
                 condition_estimate: self.condition,
                 seconds: iteration_start.elapsed().as_secs_f64(),
+                repeated_set: repeated,
+                cycling_remedy: !held.is_empty(),
             });
             let converged = match method {
                 Method::Lagrange | Method::Elimination => stable,
@@ -1901,17 +1984,22 @@ impl Kernel<'_> {
                 }
                 return Ok((x, forces, active, Termination::Converged, it));
             }
-            // the loops without a multiplier iteration of their own can only cycle
-            let cycles = matches!(
-                method,
-                Method::Lagrange
-                    | Method::Elimination
-                    | Method::Regularized { .. }
-                    | Method::PerturbedLagrange { .. }
-            ) && !iterative.iter().any(|&it| it);
-            if cycles && !stable && !seen.insert(new_active.clone()) {
-                return Ok((x, forces, active, Termination::ActiveSetCycling, it));
+            if repeated {
+                let flipping: Vec<usize> = (0..nrows).filter(|&i| flips[i] >= 2).collect();
+                if remedy == CyclingRemedy::Off || !held.is_empty() || flipping.is_empty() {
+                    let msg = self.cycling_diagnosis(rows, &flipping, it, remedy, !held.is_empty());
+                    return Ok((x, forces, active, Termination::ActiveSetCycling(msg), it));
+                }
+                // hold the flip-flopping rows from now on; the sets of the new rule start afresh
+                held = flipping;
+                seen.clear();
+                for &i in &held {
+                    if active[i] && forces[i] >= -force_tol {
+                        new_active[i] = true;
+                    }
+                }
             }
+            seen.insert(new_active.clone());
             active = new_active;
         }
         Ok((

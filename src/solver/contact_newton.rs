@@ -554,11 +554,23 @@ impl<'a> ContactSystem<'a> {
             .collect();
         let same_multipliers = multipliers.len() == self.carried.len()
             && multipliers.iter().all(|k| self.carried.contains_key(k));
+        // a multiplier couples the equations its row acts on now: a row whose gradient gained
+        // a component (a normal on a rigid circle that turned away from an axis) needs new
+        // entries in the multiplier's column
+        let coupled = same_multipliers
+            && self.rows.iter().all(|r| {
+                let Some(&j) = self.carried.get(&row_key(r)) else {
+                    return true;
+                };
+                self.free_terms(r)
+                    .iter()
+                    .all(|&(e, _)| self.pattern.position(e.min(j), e.max(j)).is_some())
+            });
         if !covered {
             let blocks: Vec<Vec<usize>> = self.rows.iter().map(|r| r.all_dofs()).collect();
             self.sys = assemble(self.model, &blocks);
         }
-        if !covered || !same_multipliers {
+        if !covered || !coupled {
             self.number_unknowns();
             self.version += 1;
         } else {
@@ -678,6 +690,14 @@ impl ContactSystem<'_> {
 
     pub(crate) fn rows(&self) -> &[Constraint] {
         &self.rows
+    }
+
+    /// The penalty weight `w = kappa A` of row `r` (`None` for a multiplier row).
+    pub(crate) fn penalty_weight(&self, r: &Constraint) -> Option<f64> {
+        match self.law(r) {
+            RowLaw::Penalty { w, .. } => Some(w),
+            RowLaw::Multiplier => None,
+        }
     }
 
     /// Active flags, forces (compression positive) and gaps of the rows at the unknowns `x`.

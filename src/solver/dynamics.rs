@@ -58,6 +58,9 @@ use crate::contact::state::{ContactState, Termination};
 use crate::error::{Error, Result};
 use crate::io::scene::{ImpactTreatment, MassKind};
 use crate::model::dynamics::Dynamics;
+use crate::model::stable_step::{
+    critical_omega_dt, largest_frequency_bound, penalty_frequency_bound,
+};
 use crate::model::Model;
 use crate::solid::{element_mass, lumped_mass};
 use std::time::Instant;
@@ -182,6 +185,67 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
     Integrator::new(model, dynamics, progress)?.run(progress)
 }
 
+/// Refuse a conditionally stable member (central difference) whose `dt` is above its
+/// stability limit: the element bound of the bodies' largest frequency plus the bound of the
+/// candidate penalty rows ([`crate::model::stable_step`]).
+fn check_stable_step(
+    model: &Model,
+    dynamics: &Dynamics,
+    system: &ContactSystem,
+    mass: &MassMatrix,
+) -> Result<()> {
+    let (beta, gamma, dt) = (dynamics.beta, dynamics.gamma, dynamics.dt);
+    let Some(omega_dt) = critical_omega_dt(beta, gamma) else {
+        return Ok(());
+    };
+    let Some(bodies) = largest_frequency_bound(model, &dynamics.density) else {
+        return Ok(());
+    };
+    let rows: Vec<(f64, Vec<(usize, f64)>)> = system
+        .rows()
+        .iter()
+        .filter_map(|r| {
+            let w = system.penalty_weight(r)?;
+            let terms = r
+                .dofs
+                .iter()
+                .zip(&r.coeffs)
+                .filter(|(&d, _)| model.prescribed[d].is_none())
+                .map(|(&d, &c)| (d, c))
+                .collect();
+            Some((w, terms))
+        })
+        .collect();
+    let contact = penalty_frequency_bound(&rows, |d| mass.diagonal(d));
+    let omega = (bodies.omega * bodies.omega + contact).sqrt();
+    let limit = omega_dt / omega;
+    if dt <= limit {
+        return Ok(());
+    }
+    let body = &model.bodies[bodies.body];
+    let penalty = if contact > 0.0 {
+        format!(
+            " and by {:.4e} from the penalty contact rows (kappa A over the nodal masses)",
+            contact.sqrt()
+        )
+    } else {
+        String::new()
+    };
+    Err(Error::invalid(
+        &model.source,
+        "physics.dynamics.dt",
+        format!(
+            "dt = {dt:.4e} is above the stability limit {limit:.4e} of this integrator (beta {beta}, gamma {gamma}: omega dt <= {omega_dt:.4}, the largest natural frequency omega bounded by {:.4e} from element {} of body '{}'{penalty}); the run would blow up",
+            bodies.omega, bodies.cell, body.name
+        ),
+        format!(
+            "take dt <= {:.3e} (0.9 of the limit){}, or an unconditionally stable integrator such as \"average_acceleration\"",
+            0.9 * limit,
+            if contact > bodies.omega * bodies.omega { ", or a softer penalty" } else { "" }
+        ),
+    ))
+}
+
 /// The state of a time integration.
 struct Integrator<'a> {
     model: &'a Model,
@@ -222,6 +286,7 @@ impl<'a> Integrator<'a> {
         progress("assembling");
         let mut system = ContactSystem::new(model, None, None, Default::default())?;
         let mass = mass_matrix(model, &dynamics.density, dynamics.mass);
+        check_stable_step(model, dynamics, &system, &mass)?;
         let sys = system.linear_system();
         // M_ff on the pattern of K_ff (every mass entry lies in a cell block)
         let mut mass_ff = vec![0.0; sys.pattern.nnz()];

@@ -23,7 +23,7 @@ use super::sparse::{
 };
 use crate::contact::state::{IterationRecord, Termination};
 use crate::error::Result;
-use crate::solver::conditioning::condition_estimate_symmetric;
+use crate::solver::conditioning::{condition_estimate_general, condition_estimate_symmetric};
 use std::time::Instant;
 
 /// The tangent of one evaluation, on the system's pattern (both triangles).
@@ -179,6 +179,8 @@ pub fn solve_with(
                 linear_solver: last_solver,
                 condition_estimate: linear.last_condition,
                 seconds: start.elapsed().as_secs_f64(),
+                repeated_set: false,
+                cycling_remedy: false,
             });
             start = Instant::now();
         }
@@ -275,8 +277,8 @@ pub struct LinearSolver {
     pub reused: usize,
     pub seconds: f64,
     pub last_solver: &'static str,
-    /// Estimated 1-norm condition number of the last factorization (symmetric tangents;
-    /// `None` for LU), see [`crate::solver::conditioning`].
+    /// Estimated 1-norm condition number of the last factorization (Cholesky, LDL^T, and LU
+    /// with its transpose solves), see [`crate::solver::conditioning`].
     pub last_condition: Option<f64>,
 }
 
@@ -382,7 +384,17 @@ impl LinearSolver {
             .expect("analysed")
             .factor(&self.general, &tangent.values)?;
         self.last_solver = "lu";
-        self.last_condition = None;
+        self.last_condition = Some(condition_estimate_general(
+            &self.general.col_ptr,
+            &tangent.values,
+            |b, transpose| {
+                if transpose {
+                    f.solve_transpose_in_place(b)
+                } else {
+                    f.solve_in_place(b)
+                }
+            },
+        ));
         Ok(Factorization::Lu(Box::new(f)))
     }
 }

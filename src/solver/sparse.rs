@@ -945,6 +945,15 @@ impl LuFactor {
             *v = rhs[(i, 0)];
         }
     }
+
+    /// Overwrite `b` with `A^-T b`.
+    pub fn solve_transpose_in_place(&self, b: &mut [f64]) {
+        let mut rhs = Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
+        self.lu.solve_transpose_in_place(rhs.as_mut());
+        for (i, v) in b.iter_mut().enumerate() {
+            *v = rhs[(i, 0)];
+        }
+    }
 }
 
 #[cfg(test)]
