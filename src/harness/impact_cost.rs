@@ -90,11 +90,11 @@ pub fn refined(case: &Case, refinement: Refinement, level: usize, source: &str) 
                         "give the axis as {\"from\": .., \"to\": .., \"divisions\": N}",
                     )),
                 },
-                MeshSpec::Explicit(_) => {
+                MeshSpec::Explicit(_) | MeshSpec::Gmsh(_) => {
                     return Err(Error::invalid(
                         source,
                         format!("bodies[{k}].mesh"),
-                        "the cost study refines block meshes; this mesh is explicit",
+                        "the cost study refines block meshes; this mesh is explicit or read from a Gmsh file",
                         "give the bar as a \"block\" mesh with uniform divisions",
                     ))
                 }
