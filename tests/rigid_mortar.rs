@@ -149,6 +149,28 @@ fn hertz_profile_with_mortar_against_the_rigid_cylinder() {
     }
 }
 
+/// Constraint elimination against the rigid circle is refused even with dual rows: the
+/// variation of the weights under the curved master couples each row to its neighbours, so no
+/// row owns its slave dof alone; the message says so (the wording the patch and tied tables
+/// snapshot, kept).
+#[test]
+fn elimination_against_a_rigid_circle_is_refused_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = edited(
+        "cases/contact/hertz-profile-dual-mortar.json",
+        dir.path(),
+        |c| c["contact"][0]["enforcement"] = serde_json::json!({"kind": "elimination"}),
+    );
+    let o = common::run_case(&path, &dir.path().join("out"));
+    assert_ne!(o.status.code(), Some(0));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("constraint elimination does not apply"),
+        "{err}"
+    );
+    assert!(err.contains("also appears in another constraint"), "{err}");
+}
+
 /// Two-pass node-to-surface against a rigid master is refused, non-zero exit, with the reason
 /// (the second pass would take the master's nodes as slaves; a rigid surface has none) and the
 /// fix (one pass).
