@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Writes hertz-profile.json: the block-on-rigid-cylinder case (Lagrange multipliers) on a
-graded Q4 mesh, spacing 0.02 over |x| <= 0.8 and y <= 0.4, growing by 1.15 per element outside.
+graded Q4 mesh, spacing 0.02 over |x| <= 0.8 and y <= 0.4, growing by 1.15 per element outside;
+and hertz-profile-standard-mortar.json, hertz-profile-dual-mortar.json: the same with mortar
+rows (standard and dual multipliers) against the rigid circle.
 Run from this folder: python3 make_hertz_profile.py"""
 import json
 
@@ -41,3 +43,23 @@ out.update(case)
 with open("hertz-profile.json", "w") as f:
     json.dump(out, f, indent=2)
     f.write("\n")
+
+for multiplier in ["standard", "dual"]:
+    name = f"hertz-profile-{multiplier}-mortar"
+    variant = json.loads(json.dumps(out))
+    variant["name"] = name
+    variant["description"] = (
+        out["description"]
+        .replace(
+            "Hertz's cylinder on a graded mesh, for the pressure profile:",
+            f"Hertz's cylinder on a graded mesh with {multiplier} mortar against the rigid circle "
+            f"(the circle's exact radial gap weighted by the {multiplier} multipliers, no master "
+            "dofs):",
+        )
+        .replace("profile cases/contact/hertz-profile.json", f"profile cases/contact/{name}.json")
+        .replace("tests/contact_results.rs compares them.", "tests/rigid_mortar.rs compares them.")
+    )
+    variant["contact"][0]["discretization"] = {"kind": "mortar", "multiplier": multiplier}
+    with open(f"{name}.json", "w") as f:
+        json.dump(variant, f, indent=2)
+        f.write("\n")

@@ -18,7 +18,10 @@
 //!   along its own curve ([`END_EXTENSION`]); a slave node beyond that gets no row.
 //! * **Two-pass**: the rows of the pass with the roles swapped are appended (pass 2).
 //! * **Rigid masters**: a line `g = n . (x_s - p)` or a circle `g = |x_s - c| - R` with
-//!   `n = (x_s - c)/|x_s - c|`; only slave dofs appear.
+//!   `n = (x_s - c)/|x_s - c|`; only slave dofs appear. Node-to-surface takes one pass (a
+//!   second pass would need the master's nodes as slaves; a rigid surface has none, so it is
+//!   refused with that reason); mortar (standard and dual) weighs the exact surface's pointwise
+//!   gap with the multipliers (see `mortar`).
 //! * **Mortar** (standard and dual, segment-based integration): see `mortar`.
 //! * **Tied** pairs use the same weights with one bilateral row per global direction
 //!   (`e_x`, `e_y`) and zero initial gap: the interface keeps its initial geometry.
@@ -180,12 +183,12 @@ pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>,
                     "node-to-node needs a master body with nodes, not a rigid surface".into(),
                 )
             }
-            DiscretizationSpec::Mortar { .. } => {
-                return Err("mortar needs a master body with facets, not a rigid surface".into())
+            DiscretizationSpec::Mortar { multiplier } => {
+                mortar::rigid_mortar_rows(&mut rows, &slave, rigid, multiplier)?
             }
             _ => {
                 return Err(
-                    "two passes need a master body; a rigid surface has no nodes to act as slaves"
+                    "two passes need a master body: the second pass takes the master's nodes as slaves, and a rigid surface has none; use one pass (\"passes\": 1), which is the whole pair against a rigid master"
                         .into(),
                 )
             }
@@ -454,14 +457,20 @@ fn node_to_surface(
 /// The second derivative of a row's gap with respect to its slave node's displacement
 /// (`2 x 2`, row-major), where the row's master makes it non-zero: against a rigid circle,
 /// `g = |x_s - c| - R` gives `d2g/dx_s2 = (I - n n^T) / |x_s - c|` at the slave position `x_s`
-/// (in the configuration the row is linearized in). Rigid lines and ties are affine (`None`);
+/// (in the configuration the row is linearized in), for node-to-surface rows. Rigid lines and
+/// ties are affine (`None`); mortar rows against a rigid circle do not provide theirs (`None`);
 /// node-to-surface and mortar rows against deformable masters do not provide theirs yet (their
 /// geometry is then updated by a fixed point, see [`crate::solver::active_set`]).
 pub fn gap_second_derivative(model: &Model, row: &Constraint, x_s: [f64; 2]) -> Option<[f64; 4]> {
-    let MasterSide::Rigid(RigidSurface::Circle { centre, .. }) = model.contact[row.pair].master
-    else {
+    let pair = &model.contact[row.pair];
+    let MasterSide::Rigid(RigidSurface::Circle { centre, .. }) = pair.master else {
         return None;
     };
+    // a mortar row's gap is a weighted integral over the slave facets, not the distance of
+    // the slave node: it provides no nodal second derivative (fixed point, as against bodies)
+    if matches!(pair.discretization, DiscretizationSpec::Mortar { .. }) {
+        return None;
+    }
     if row.bilateral {
         return None;
     }
@@ -482,22 +491,7 @@ pub fn gap_second_derivative(model: &Model, row: &Constraint, x_s: [f64; 2]) -> 
 fn rigid_rows(rows: &mut Rows, slave: &Surface, rigid: &RigidSurface) -> Result<(), String> {
     let sb = &rows.model.bodies[slave.body];
     for &s in slave.nodes.keys() {
-        let p = sb.mesh.nodes[s];
-        let (nu, g0) = match *rigid {
-            RigidSurface::Line { point, normal } => {
-                let l = (normal[0] * normal[0] + normal[1] * normal[1]).sqrt();
-                let n = [normal[0] / l, normal[1] / l];
-                (n, n[0] * (p[0] - point[0]) + n[1] * (p[1] - point[1]))
-            }
-            RigidSurface::Circle { centre, radius } => {
-                let d = [p[0] - centre[0], p[1] - centre[1]];
-                let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
-                if l <= 1e-12 * radius {
-                    return Err(format!("slave node at ({}, {}) sits at the centre of the rigid circle, where the normal is undefined", p[0], p[1]));
-                }
-                ([d[0] / l, d[1] / l], l - radius)
-            }
-        };
+        let (g0, nu) = mortar::rigid_gap(rigid, sb.mesh.nodes[s])?;
         rows.node(slave, s, nu, g0, None, 1);
     }
     Ok(())

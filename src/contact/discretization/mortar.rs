@@ -41,7 +41,7 @@ use super::geometry::{closest_point, edge_shape, facet_point, Surface};
 use super::search::BucketGrid;
 use super::Rows;
 use crate::fe::{gauss_legendre, EdgeKind};
-use crate::io::scene::MultiplierSpace;
+use crate::io::scene::{MultiplierSpace, RigidSurface};
 use std::collections::BTreeMap;
 
 /// Multiplier function values at `s` on a slave facet.
@@ -189,6 +189,148 @@ pub(crate) fn mortar_rows(
     }
     if rows.out.is_empty() {
         return Err("no slave facet overlaps a master facet".into());
+    }
+    Ok(())
+}
+
+/// Gauss points per slave facet for the mortar integrals against a rigid circle.
+pub const RIGID_CIRCLE_GAUSS: usize = 8;
+
+/// The pointwise gap to a rigid surface at `x` and its gradient (the unit normal there).
+pub(crate) fn rigid_gap(rigid: &RigidSurface, x: [f64; 2]) -> Result<(f64, [f64; 2]), String> {
+    match *rigid {
+        RigidSurface::Line { point, normal } => {
+            let l = normal[0].hypot(normal[1]);
+            let n = [normal[0] / l, normal[1] / l];
+            Ok((n[0] * (x[0] - point[0]) + n[1] * (x[1] - point[1]), n))
+        }
+        RigidSurface::Circle { centre, radius } => {
+            let d = [x[0] - centre[0], x[1] - centre[1]];
+            let l = d[0].hypot(d[1]);
+            if l <= 1e-12 * radius {
+                return Err(format!(
+                    "the slave surface at ({}, {}) sits at the centre of the rigid circle, where the normal is undefined",
+                    x[0], x[1]
+                ));
+            }
+            Ok((l - radius, [d[0] / l, d[1] / l]))
+        }
+    }
+}
+
+/// Mortar rows of `slave` against a rigid surface (see the module notes).
+pub(crate) fn rigid_mortar_rows(
+    rows: &mut Rows,
+    slave: &Surface,
+    rigid: &RigidSurface,
+    space: MultiplierSpace,
+) -> Result<(), String> {
+    let model = rows.model;
+    let ks = slave.kind;
+    let ns = ks.node_count();
+    let gauss = gauss_legendre(match rigid {
+        RigidSurface::Circle { .. } => RIGID_CIRCLE_GAUSS,
+        RigidSurface::Line { .. } if ks == EdgeKind::Line3 => 4,
+        RigidSurface::Line { .. } => 3,
+    });
+    // per slave node j: D_jk, int Phi_j g, and int Phi_j N_k n (per k)
+    let mut d: BTreeMap<usize, BTreeMap<usize, f64>> = BTreeMap::new();
+    let mut weighted_gap: BTreeMap<usize, f64> = BTreeMap::new();
+    let mut gradient: BTreeMap<usize, BTreeMap<usize, [f64; 2]>> = BTreeMap::new();
+    for (f, coords) in slave.coords.iter().enumerate() {
+        for &(s, wq) in &gauss {
+            let (x, t) = facet_point(ks, coords, s);
+            let jac = t[0].hypot(t[1]) * model.thickness;
+            let (g, n) = rigid_gap(rigid, x)?;
+            let (n_s, _) = edge_shape(ks, s);
+            let phi = multiplier(ks, space, s);
+            for j in 0..ns {
+                let w = wq * jac * phi[j];
+                let node = slave.facets[f][j];
+                *weighted_gap.entry(node).or_default() += w * g;
+                let dj = d.entry(node).or_default();
+                let cj = gradient.entry(node).or_default();
+                for k in 0..ns {
+                    let other = slave.facets[f][k];
+                    *dj.entry(other).or_default() += w * n_s[k];
+                    let c = cj.entry(other).or_default();
+                    c[0] += w * n_s[k] * n[0];
+                    c[1] += w * n_s[k] * n[1];
+                }
+            }
+        }
+    }
+    // the weights' own variation: d(int Phi_j g dGamma / A_j) also holds
+    // int Phi_j (g - g_j) d(dGamma), with d(dGamma)/dx_k = t N_k' x'/|x'| ds
+    let mut weight_term: BTreeMap<usize, BTreeMap<usize, [f64; 2]>> = BTreeMap::new();
+    for (f, coords) in slave.coords.iter().enumerate() {
+        for &(s, wq) in &gauss {
+            let (x, t) = facet_point(ks, coords, s);
+            let l = t[0].hypot(t[1]);
+            let (g, _) = rigid_gap(rigid, x)?;
+            let (_, dn_s) = edge_shape(ks, s);
+            let phi = multiplier(ks, space, s);
+            for j in 0..ns {
+                let node = slave.facets[f][j];
+                let area: f64 = d[&node].values().sum();
+                let g_j = weighted_gap[&node] / area;
+                let w = wq * model.thickness * phi[j] * (g - g_j);
+                let cj = weight_term.entry(node).or_default();
+                for k in 0..ns {
+                    let c = cj.entry(slave.facets[f][k]).or_default();
+                    c[0] += w * dn_s[k] * t[0] / l;
+                    c[1] += w * dn_s[k] * t[1] / l;
+                }
+            }
+        }
+    }
+    let sb = &model.bodies[slave.body];
+    for (&j, dj) in &d {
+        let area: f64 = dj.values().sum();
+        if area <= 1e-12 * slave.facet_size() * model.thickness {
+            continue;
+        }
+        let order: Vec<usize> = std::iter::once(j)
+            .chain(dj.keys().copied().filter(|&k| k != j))
+            .collect();
+        let slave_terms: Vec<(usize, f64)> = order.iter().map(|&k| (k, dj[&k] / area)).collect();
+        let cj = &gradient[&j];
+        let sum = cj
+            .values()
+            .fold([0.0; 2], |a, c| [a[0] + c[0], a[1] + c[1]]);
+        let l = sum[0].hypot(sum[1]);
+        let nu = [sum[0] / l, sum[1] / l];
+        let g0 = weighted_gap[&j] / area;
+        let before = rows.out.len();
+        rows.push(slave, j, nu, g0, &slave_terms, None, area, 1);
+        if !rows.tied {
+            // the exact gradient in place of the weights times one direction (the same on a line)
+            let row = &mut rows.out[before];
+            let largest = cj
+                .values()
+                .fold(0.0f64, |a, c| a.max(c[0].abs()).max(c[1].abs()));
+            row.dofs.clear();
+            row.coeffs.clear();
+            let extra = &weight_term[&j];
+            for &k in &order {
+                for i in 0..2 {
+                    let c = (cj[&k][i] + extra[&k][i]) / area;
+                    if c.abs() > 1e-12 * largest / area {
+                        row.dofs.push(sb.dof(k, i));
+                        row.coeffs.push(c);
+                    }
+                }
+            }
+        }
+        if space == MultiplierSpace::Standard {
+            let mass: Vec<(usize, f64)> = order.iter().map(|&k| (k, dj[&k])).collect();
+            for r in &mut rows.out[before..] {
+                r.mass = mass.clone();
+            }
+        }
+    }
+    if rows.out.is_empty() {
+        return Err("no slave node carries a mortar row against the rigid surface".into());
     }
     Ok(())
 }
