@@ -1,4 +1,41 @@
 //! The `contact-patch` command-line tool.
+//!
+//! Everything it prints goes through [`write_to`]: a reader that has gone away (`contact-patch
+//! table | head`, a closed terminal) stops the printing, not the work. The command still writes
+//! its files and ends with its own exit code, where the standard `println!` would panic on the
+//! broken pipe and leave the run half done.
+
+/// `println!` for a standard output that may have been closed (see [`write_to`]).
+macro_rules! println {
+    () => { write_to(Stream::Out, format_args!("\n")) };
+    ($($arg:tt)*) => { write_to(Stream::Out, format_args!("{}\n", format_args!($($arg)*))) };
+}
+/// `print!` for a standard output that may have been closed.
+macro_rules! print {
+    ($($arg:tt)*) => { write_to(Stream::Out, format_args!($($arg)*)) };
+}
+/// `eprintln!` for a standard error that may have been closed.
+macro_rules! eprintln {
+    ($($arg:tt)*) => { write_to(Stream::Err, format_args!("{}\n", format_args!($($arg)*))) };
+}
+
+/// Which standard stream [`write_to`] writes.
+#[derive(Clone, Copy)]
+enum Stream {
+    Out,
+    Err,
+}
+
+/// Write `text` to a standard stream; a write that fails (a closed pipe, a full disk under a
+/// redirection) is dropped: what is printed is a copy of what the command writes to its files
+/// and of its exit code, so nothing is lost that the user cannot read from those.
+fn write_to(stream: Stream, text: std::fmt::Arguments) {
+    use std::io::Write;
+    let _ignored = match stream {
+        Stream::Out => std::io::stdout().lock().write_fmt(text),
+        Stream::Err => std::io::stderr().lock().write_fmt(text),
+    };
+}
 
 use clap::{Parser, Subcommand};
 use contact_patch::harness::{baseline, junit};
