@@ -228,6 +228,22 @@ case(
     ],
 )
 
+# 7b. the same on the Newton scheme: no load and no prescribed motion, so the gaps alone drive
+# the solve (before, its force scale was zero and iteration 0 ended "not finite")
+c = copy.deepcopy(c)
+c["solver"] = {"scheme": "newton"}
+case(
+    "initial-penetration-newton",
+    f"Case 7 (initial-penetration) on the Newton scheme: the gaps alone drive the solve, so the force that closes the largest active gap is the residual's scale until the multipliers carry force; the same uniform compression sigma_yy = {sigma:.10g}.",
+    c,
+    [
+        converged(),
+        stress(-sigma),
+        {"check": "contact_pressure", "pair": "ground", "tol": 1e-10},
+        load_carried("ground", -sigma * 3.0, 1e-10),
+    ],
+)
+
 # 8. a tilted master: the Signorini block rotated by 30 degrees with its rigid line
 theta = math.radians(30.0)
 ct, st = math.cos(theta), math.sin(theta)

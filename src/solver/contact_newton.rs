@@ -821,6 +821,10 @@ impl System for ContactSystem<'_> {
             force_scale: max_abs(&self.sys.rhs),
             ..Evaluation::default()
         };
+        // A scene driven by its gaps alone (no load, no prescribed motion: a body placed into
+        // an obstacle) has no force scale before its multipliers move; the force that closes
+        // the largest active gap, rho |g|, is then the scale (used only when nothing else is).
+        let mut closing_force = 0.0_f64;
         let geometric = current && self.model.solver.geometric_stiffness;
         let symmetrized = self.model.solver.friction_tangent == FrictionTangent::Symmetrized;
         // unsymmetric entries (row equation, column equation, value) of slipping points
@@ -945,6 +949,7 @@ impl System for ContactSystem<'_> {
                         continue;
                     }
                     residual[j] = -rho * g;
+                    closing_force = closing_force.max((rho * g).abs());
                     for &(e, c) in &terms {
                         upper[self.pattern.position(e, j).expect("coupling")] = -rho * c;
                     }
@@ -1007,6 +1012,9 @@ impl System for ContactSystem<'_> {
         self.active = active;
         self.forces = forces;
         self.status = status;
+        if eval.force_scale == 0.0 {
+            eval.force_scale = closing_force;
+        }
         self.evaluations += 1;
         self.sets_settled = eval.status_changes == 0;
         self.holding = false;
