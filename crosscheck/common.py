@@ -19,7 +19,9 @@ Each solver receives supports as (node coordinates, component, values) and loads
 (facet box, traction function), and finds its own dofs and facets geometrically.
 
 Contact (src/contact/): a single-body case may declare frictionless pairs of the body against a
-rigid line or circle with node-to-surface rows and a penalty (`RigidContact`); a two-body case
+rigid line or circle with node-to-surface rows and a penalty (`RigidContact`), or Coulomb pairs
+against a rigid line (penalty return map of src/contact/friction.rs, load-stepped along the
+supports' and loads' `path` factors, `Problem.factor`); a two-body case
 may tie its bodies with a mortar pair (`TiedCase`). `Sampler` evaluates a nodal field of one of
 our .vtu meshes at arbitrary points (as `src/post.rs::CellLocator`), for the distances of the
 tied-layer and two-block studies.
@@ -154,7 +156,7 @@ class Problem:
             raise Unsupported(f"{len(bodies)} bodies (two-body cases are cross-checked as ties)")
         for key in c:
             if key not in {"name", "description", "analysis", "materials", "bodies", "exact",
-                           "supports", "loads", "checks", "physics", "contact"}:
+                           "supports", "loads", "checks", "physics", "contact", "solver"}:
                 raise Unsupported(f"case section {key!r}")
         physics = dict(c.get("physics", {}) or {})
         # a time history (physics.dynamics) only for the callers that step it (`dynamic`)
@@ -198,6 +200,30 @@ class Problem:
         self.loads = self._loads()
         self.contact = [] if self.multi else [RigidContact(p, self)
                                               for p in c.get("contact", []) or []]
+        # Load steps (src/io/scene.rs: `path` per support and load, one factor per step of
+        # `solver.load_steps`, default k / n at step k). Only the Coulomb solve
+        # (ref_dolfinx.solve_friction) follows the steps; the other solves need a path that
+        # ends at 1 (their solution is the last step's: frictionless and elastic problems
+        # are path independent).
+        solver = dict(c.get("solver", {}) or {})
+        self.load_steps = int(solver.pop("load_steps", 1))
+        if solver.pop("scheme", "newton") != "newton" or solver:
+            raise Unsupported(f"solver {c.get('solver')} (the references run Newton only)")
+        self.support_paths = [s.get("path") for s in c.get("supports", [])
+                              if s["body"] == self.body for k in ("x", "y") if s.get(k) is not None]
+        self.load_paths = [ld.get("path") for ld in c.get("loads", []) if ld["body"] == self.body]
+        self.frictional = any(pair.mu is not None for pair in self.contact)
+        if not self.frictional and any(self.factor(pth, self.load_steps) != 1.0
+                                       for pth in self.support_paths + self.load_paths):
+            raise Unsupported("a load path that does not end at 1 without friction")
+
+    def factor(self, path, step):
+        """The factor of a support or load with `path` at load step `step` (1-based)."""
+        if path is None:
+            return step / self.load_steps
+        if len(path) != self.load_steps:
+            raise Unsupported(f"a path of {len(path)} factors for {self.load_steps} load steps")
+        return float(path[step - 1])
 
     # --- sets -----------------------------------------------------------------------------
     def _side_box(self, name):
@@ -360,7 +386,13 @@ class RigidContact:
         else:
             raise Unsupported(f"rigid surface kind {self.kind!r}")
         inter = spec.get("interaction", "frictionless")
-        if inter != "frictionless":
+        # Coulomb friction (src/contact/friction.rs, penalty return map): mu and the
+        # tangential penalty kappa_t (default: the normal kappa), line masters only
+        self.mu = self.kappa_t = None
+        if isinstance(inter, dict) and set(inter) == {"coulomb"} and self.kind == "line":
+            self.mu = float(inter["coulomb"]["mu"])
+            self.kappa_t = inter["coulomb"].get("kappa_t")
+        elif inter != "frictionless":
             raise Unsupported(f"contact '{self.name}': interaction {inter!r} against a rigid surface")
         disc = spec["discretization"]
         if disc.get("kind") != "node_to_surface" or int(disc.get("passes", 1)) != 1:
@@ -372,6 +404,10 @@ class RigidContact:
             raise Unsupported(f"contact '{self.name}': enforcement {enf.get('kind')!r} "
                               "(the cross-check solves penalty problems)")
         self.kappa = float(enf["kappa"])
+        if self.mu is not None:
+            if enf.get("kind") != "penalty":
+                raise Unsupported(f"contact '{self.name}': Coulomb with {enf.get('kind')!r}")
+            self.kappa_t = self.kappa if self.kappa_t is None else float(self.kappa_t)
         self.rule = NODAL_RULE[pb.element]
 
     def gap(self, x, y, ux, uy, sqrt):

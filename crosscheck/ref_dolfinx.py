@@ -22,6 +22,14 @@ the active set is then the exact solution of the linear problem on that set, up 
 Two-body tied cases are not solved here (the tied layer's DOLFINx reference is the one-body
 mesh); their reference file says so.
 
+Penalty Coulomb contact on a rigid line (`solve_friction`; Wriggers, *Computational Contact
+Mechanics*, 2nd ed., s. 5.2 and 6.3, as src/contact/friction.rs): DOLFINx assembles the
+stiffness matrix, each load's vector and the nodal weights `A_a` (the GLL rule above); per load
+step (the case's `path` factors) Newton's method in numpy/scipy on `K u - f - sum_a (lambda_n n
++ lambda_t t)_a`, `lambda_n = kappa A (-g)_+`, the trial force `-kappa_t A (g_t - g_t^{p,n})`
+returned onto `|lambda_t| <= mu lambda_n`, the plastic slip committed at the end of each step
+(see the function's text for the branches and the unsymmetric tangent).
+
 Elastic waves (`physics.dynamics`, no contact; `solve_wave`): the stiffness form above and the
 consistent mass form `int t rho u . v dx` (quadrature of our `mass_rule`: Gauss 3x3 on Q4, 4x4
 on Q9; exact on triangles) assembled by DOLFINx on the same mesh, the lumped mass as the row
@@ -62,6 +70,8 @@ from dolfinx import fem, mesh as dmesh
 from dolfinx.io.utils import cell_perm_vtk
 from mpi4py import MPI
 from petsc4py import PETSc
+import scipy.sparse
+import scipy.sparse.linalg
 from scipy.spatial import cKDTree
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -155,11 +165,13 @@ def solve(pb: Problem, vtu_path=None):
     # Facets carry ("load", k) and ("contact", j) keys; one tag per combination.
     on_facet = {}
     L = None
+    load_terms = {}   # per load: its terms (the Coulomb solve scales each by its path)
     for k, ld in enumerate(pb.loads):
         if ld.box is None:
             dxb = ufl.Measure("dx", domain=msh, metadata={"quadrature_degree": BODY_FORCE_DEGREE})
             term = th * ufl.dot(ufl.as_vector(ld.value), v) * dxb
             L = term if L is None else L + term
+            load_terms.setdefault(k, []).append(term)
             continue
         f = dmesh.locate_entities_boundary(msh, fdim, lambda X, box=ld.box: in_box(X[:2].T, box))
         if len(f) == 0:
@@ -191,6 +203,7 @@ def solve(pb: Problem, vtu_path=None):
                 t = pb.loads[k].traction(x[0], x[1], n)
                 term = th * ufl.dot(ufl.as_vector(t), v) * ds(tag)
                 L = term if L is None else L + term
+                load_terms.setdefault(k, []).append(term)
     if L is None:
         L = ufl.dot(ufl.as_vector([0.0, 0.0]), v) * dx
 
@@ -228,7 +241,10 @@ def solve(pb: Problem, vtu_path=None):
     extra = {"match_distance": dist, "dofs": 2 * X.shape[0],
              "stiffness_quadrature_degree": STIFFNESS_DEGREE[pb.element],
              "load_quadrature_degree": LOAD_DEGREE}
-    if pb.contact:
+    if pb.frictional:
+        uh, contact = solve_friction(pb, msh, V, a, load_terms, mt, contact_terms, th, ids)
+        extra["contact"] = contact
+    elif pb.contact:
         uh, contact = newton_penalty(pb, msh, V, a, L, bcs, bcs0, mt, contact_terms, th, ids)
         extra["contact"] = contact
     else:
@@ -243,13 +259,13 @@ def solve(pb: Problem, vtu_path=None):
         if reason <= 0:
             raise RuntimeError(f"{pb.name}: PETSc solve did not converge (reason {reason})")
 
-    if vtu_path is not None:
+    if vtu_path is not None and not pb.frictional:
         fields = contact_point_fields(msh, degree, V, uh, pb, extra["contact"]) \
             if pb.contact else ()
         write_vtu(vtu_path, msh, degree, uh, sigma, fields)
     for entry in extra.get("contact", {}).get("pairs", []):   # not for the reference file
         for key in ("nodal_force", "dofs", "gap"):
-            entry.pop(key)
+            entry.pop(key, None)
     U = uh.x.array.reshape(-1, 2)
     out = np.empty_like(pb.u_ours)
     out[ids] = U
@@ -510,6 +526,153 @@ def newton_penalty(pb, msh, V, a, L, bcs_values, bcs0, mt, contact_terms, th, id
                         "gap": np.broadcast_to(gap, dn.shape).tolist()})
     return uh, {"pairs": contact, "newton": history, "iterations": len(history),
                 "relative_residual": res,
+                "contact_quadrature": f"GLL degree {CONTACT_RULE[pb.element]}"}
+
+
+def solve_friction(pb, msh, V, a, load_terms, mt, contact_terms, th, ids):
+    """Penalty Coulomb contact against a rigid line, load step by load step (see the module
+    text): DOLFINx assembles the stiffness matrix K, each load's vector and the nodal contact
+    weights A_a (GLL rule = our rows' tributary areas); numpy/scipy run Newton's method on
+    R(u) = K u - sum_k c_k f_k - sum_a (lambda_n n + lambda_t t)_a with the return map of
+    src/contact/friction.rs per slave node: lambda_n = kappa A (-g)_+ (closed iff g < 0),
+    trial lambda_t = -kappa_t A (g_t - g_t^{p,n}), stick if |trial| <= mu lambda_n, else slip
+    at sign(trial) mu lambda_n with g_t^p = g_t + lambda_t / (kappa_t A); open: g_t^p = g_t.
+    The plastic slip is committed at the end of each step. Tangent: K + w_n n n^T (closed),
+    + w_t t t^T (stick), + s mu w_n t n^T (slip; unsymmetric), solved by SuperLU."""
+    v = ufl.TestFunction(V)
+    dsc = ufl.Measure("ds", domain=msh, subdomain_data=mt,
+                      metadata={"quadrature_rule": "GLL",
+                                "quadrature_degree": CONTACT_RULE[pb.element]})
+    Kp = dolfinx.fem.petsc.assemble_matrix(fem.form(a))
+    Kp.assemble()
+    ip, jp, vals = Kp.getValuesCSR()
+    ndof = V.dofmap.index_map.size_local * 2
+    K = scipy.sparse.csr_matrix((vals, jp, ip), shape=(ndof, ndof))
+    f_load = {k: dolfinx.fem.petsc.assemble_vector(fem.form(sum(t[1:], t[0]))).array.copy()
+              for k, t in load_terms.items()}
+    X = V.tabulate_dof_coordinates()[:, :2]          # one row per node; dof = 2 node + comp
+    tree = cKDTree(X)
+    fixed, fixed_vals = {}, {}
+    for (coords, comp, values), path in zip(pb.supports, pb.support_paths):
+        d, idx = tree.query(coords)
+        if d.max() > pb.tol:
+            raise RuntimeError(f"{pb.name}: support node not found (distance {d.max():.3e})")
+        for node, val in zip(idx, values):
+            fixed[2 * int(node) + comp] = (float(val), path)   # later supports win
+    fixed_dofs = np.array(sorted(fixed), dtype=np.int64)
+    free = np.setdiff1d(np.arange(ndof), fixed_dofs)
+
+    inv = np.empty(len(ids), dtype=np.int64)
+    inv[ids] = np.arange(len(ids))
+    pairs = []
+    for k, pair in enumerate(pb.contact):
+        tags = [tag for kk, tag in contact_terms if kk == k]
+        form = sum((th * v[0] * dsc(tag) for tag in tags[1:]), th * v[0] * dsc(tags[0]))
+        area = dolfinx.fem.petsc.assemble_vector(fem.form(form)).array.reshape(-1, 2)[:, 0]
+        vn = np.array(sorted({nd for f in facets_in_box(pb, pair.box) for nd in f}))
+        dn = inv[vn]
+        n = np.asarray(pair.normal, dtype=float)
+        t = np.array([n[1], -n[0]])
+        g0 = (pb.points[vn] - pair.point) @ n
+        pairs.append({"pair": pair, "vn": vn, "dn": dn, "A": area[dn], "n": n, "t": t,
+                      "g0": g0, "committed": np.zeros(len(vn))})
+
+    def contact(u, pr, first=False):
+        """Per node: forces (lambda_n, lambda_t), statuses, plastic slips, weights, slip sign.
+        `first` (a step's first iteration, as our rows' `closed_at_start`): a node touching
+        (g <= 0) counts as closed, so a block resting on the line with g = 0 and held in x by
+        friction alone has a regular first tangent."""
+        pair = pr["pair"]
+        U = u.reshape(-1, 2)[pr["dn"]]
+        g = pr["g0"] + U @ pr["n"]
+        g_t = U @ pr["t"]
+        w_n, w_t = pair.kappa * pr["A"], pair.kappa_t * pr["A"]
+        closed = (g <= 0.0) if first else (g < 0.0)
+        lam_n = np.where(closed, -w_n * g, 0.0)
+        trial = -w_t * (g_t - pr["committed"])
+        bound = pair.mu * np.maximum(lam_n, 0.0)
+        stick = closed & (np.abs(trial) <= bound)
+        slip = closed & ~stick
+        lam_t = np.where(stick, trial, np.where(slip, np.sign(trial) * bound, 0.0))
+        plastic = np.where(stick, pr["committed"],
+                           np.where(slip, g_t + lam_t / np.where(w_t > 0, w_t, 1.0), g_t))
+        status = np.where(~closed, "open", np.where(stick, "stick", "slip"))
+        return lam_n, lam_t, status, plastic, w_n, w_t, np.sign(trial)
+
+    def assemble(u, first=False):
+        R = K @ u
+        rows, cols, data = [], [], []
+        for pr in pairs:
+            lam_n, lam_t, status, _, w_n, w_t, s = contact(u, pr, first)
+            n, t = pr["n"], pr["t"]
+            for i, d in enumerate(pr["dn"]):
+                dofs = [2 * d, 2 * d + 1]
+                R[dofs] -= lam_n[i] * n + lam_t[i] * t
+                blk = np.zeros((2, 2))
+                if status[i] != "open":
+                    blk += w_n[i] * np.outer(n, n)
+                if status[i] == "stick":
+                    blk += w_t[i] * np.outer(t, t)
+                elif status[i] == "slip":
+                    blk += s[i] * pr["pair"].mu * w_n[i] * np.outer(t, n)
+                for a_ in range(2):
+                    for b_ in range(2):
+                        rows.append(dofs[a_])
+                        cols.append(dofs[b_])
+                        data.append(blk[a_, b_])
+        Kc = scipy.sparse.csr_matrix((data, (rows, cols)), shape=(ndof, ndof))
+        return R, (K + Kc).tocsr()
+
+    u = np.zeros(ndof)
+    history, steps = [], []
+    res = 0.0
+    for step in range(1, pb.load_steps + 1):
+        f = np.zeros(ndof)
+        for k, fk in f_load.items():
+            f += pb.factor(pb.load_paths[k], step) * fk
+        for d, (val, path) in fixed.items():
+            u[d] = pb.factor(path, step) * val
+        f_scale = max(float(np.abs(f).max()), float(np.abs(K @ u).max()), np.finfo(float).tiny)
+        for it in range(1, 101):
+            R, J = assemble(u, first=it == 1)
+            R -= f
+            du = scipy.sparse.linalg.spsolve(J[free][:, free].tocsc(), -R[free])
+            if not np.all(np.isfinite(du)):
+                raise RuntimeError(f"{pb.name}: step {step}, iteration {it}: singular tangent")
+            u[free] += du
+            R, _ = assemble(u)
+            res = float(np.abs((R - f)[free]).max()) / f_scale
+            history.append({"step": step, "iteration": it, "relative_residual": res,
+                            "status": [{str(k): int(c) for k, c in
+                                        zip(*np.unique(contact(u, pr)[2], return_counts=True))}
+                                       for pr in pairs]})
+            if res <= 1e-12:
+                break
+        else:
+            raise RuntimeError(f"{pb.name}: step {step}: Newton did not converge in 100 "
+                               f"iterations (relative residual {res:.2e})")
+        final = [contact(u, pr) for pr in pairs]   # the step's map, before its commit
+        for pr, m in zip(pairs, final):
+            pr["committed"] = m[3]
+        steps.append({"step": step, "iterations": it, "relative_residual": res,
+                      "status": [{str(k): int(c) for k, c in
+                                  zip(*np.unique(m[2], return_counts=True))} for m in final]})
+
+    out_pairs = []
+    for pr, m in zip(pairs, final):
+        lam_n, lam_t, status, plastic, *_ = m
+        force = np.outer(lam_n, pr["n"]) + np.outer(lam_t, pr["t"])
+        out_pairs.append({"name": pr["pair"].name, "total_force": force.sum(axis=0).tolist(),
+                          "nodes": pr["vn"].tolist(), "area": pr["A"].tolist(),
+                          "pressure": (lam_n / pr["A"]).tolist(),
+                          "active": [bool(s_ != "open") for s_ in status],
+                          "slave_force": force.tolist(), "status": status.tolist(),
+                          "tangential_force": lam_t.tolist(),
+                          "plastic_slip": plastic.tolist()})
+    uh = fem.Function(V)
+    uh.x.array[:] = u
+    return uh, {"pairs": out_pairs, "newton": history, "steps": steps,
+                "iterations": len(history), "relative_residual": res,
                 "contact_quadrature": f"GLL degree {CONTACT_RULE[pb.element]}"}
 
 

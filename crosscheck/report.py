@@ -20,6 +20,10 @@ contact results or the tie solutions; see ref_dolfinx.py and ref_skfem.py). Quan
   TOL_CONTACT = 1e-8 for every row of the case: both references stop Newton's method with a
   relative residual below 1e-9. The cylinder cases also feed the Hertz table (benchmarks.md
   s. 3): peak pressure within 3% of p0, half-width within one node spacing of a.
+* penalty Coulomb contact on a rigid line (ref_dolfinx.solve_friction, DOLFINx only; load
+  steps): the field, the total contact force (x, y), the nodal contact force at every slave
+  node (ours: `<pair>.contact.csv`), each node's last status (equal); TOL_FRICTION = 1e-10
+  (both Newton solves end below 1e-12). scikit-fem: not applicable.
 * two bodies tied by a mortar pair: scikit-fem's mortar tie with the same multipliers; the
   field over both bodies (and per body), tolerance 1e-10. DOLFINx: not applicable (n/a).
 * elastic waves (physics.dynamics, no contact): DOLFINx only (ref_dolfinx.solve_wave, the
@@ -38,6 +42,7 @@ contact results or the tie solutions; see ref_dolfinx.py and ref_skfem.py). Quan
 Exit status 1 when any verdict fails (including a missing or failed reference solve).
 """
 
+import csv
 import json
 import math
 import os
@@ -58,6 +63,7 @@ from common import (ELEMENT_OF_MESHIO, Exact, Material, Problem, Sampler,  # noq
 
 TOL = 1e-10            # same discrete linear problem: round-off
 TOL_CONTACT = 1e-8     # penalty contact: the references' Newton residuals are <= 1e-9
+TOL_FRICTION = 1e-10   # penalty Coulomb (DOLFINx only): both Newton solves end below 1e-12
 TOL_DU = 1e-8          # tied-layer du: absolute, between codes and against tied-layer.json
 HERTZ_PEAK = 0.03      # peak nodal pressure within 3% of Hertz's p0
 EXACT_MARGIN = 10.0    # the two-block reference must be this much closer to the exact field
@@ -253,7 +259,7 @@ def case_entry(case_path, root, repo):
             kind = "wave"
         else:
             pb = Problem(case_path, out)
-            kind = "contact" if pb.contact else "elasticity"
+            kind = "friction" if pb.frictional else "contact" if pb.contact else "elasticity"
     except Exception as e:  # noqa: BLE001  (any failure here is a failed verdict, with its text)
         entry.update({"kind": "?", "error": f"cannot read the case or our output: "
                       f"{type(e).__name__}: {e}", "verdict": "fail", "quantities": []})
@@ -280,11 +286,12 @@ def case_entry(case_path, root, repo):
     try:
         if kind == "tie":
             rows = tie_rows(entry, tc, datas, errors, na)
-        elif kind == "wave":
-            if "dolfinx" in na:   # DOLFINx must step every wave case
+        elif kind in ("wave", "friction"):
+            if "dolfinx" in na:   # DOLFINx must solve every wave and friction case
                 errors["dolfinx"] = f"not applicable to a wave case: {na.pop('dolfinx')}"
                 entry["errors"] = errors
-            rows = wave_rows(entry, pb, out, datas, errors, na)
+            rows = (wave_rows(entry, pb, out, datas, errors, na) if kind == "wave"
+                    else friction_rows(entry, pb, out, summary, datas, errors, na))
         else:
             if na:   # a one-body case must be solved by both references
                 for s, why in na.items():
@@ -387,6 +394,61 @@ def body_rows(entry, pb, summary, kind, datas, errors):
                       "bound_text": f"node spacing {spacing:.3g}",
                       "verdict": verdict(herr, spacing)}]}
     return rows, hertz
+
+
+def friction_rows(entry, pb, out, summary, datas, errors, na):
+    """Penalty Coulomb contact on a rigid line, load-stepped (ref_dolfinx.solve_friction; the
+    same rows, return map and committed history, so round-off): the displacement field, the
+    total contact force (normal and tangential), the nodal contact forces at every slave node
+    (ours: `<pair>.contact.csv` force_x, force_y), each node's status (open, stick, slip) at
+    the last step (equal)."""
+    entry.update({"element": pb.element, "plane": pb.material.plane, "nodes": len(pb.points),
+                  "cells": len(pb.cells)})
+    refs = {s: np.asarray(d["u"], dtype=float) for s, d in datas.items()}
+    rows = Rows(refs, errors, na)
+    tol, txt = TOL_FRICTION, tol_text(TOL_FRICTION)
+    corner = pb.node_set("top_right")
+    field_rows(rows, pb.u_ours, refs, tol, txt, int(corner[0]) if len(corner) == 1 else None)
+    c = summary.get("contact")
+    if c is None:
+        raise RuntimeError("our summary.json has no contact section")
+    F = np.asarray(c["total_force"], dtype=float)
+    fn = float(np.linalg.norm(F)) or 1.0
+    totals = {s: np.sum([p["total_force"] for p in d["contact"]["pairs"]], axis=0)
+              for s, d in datas.items()}
+    for k, xy in ((0, "x"), (1, "y")):
+        rows.add(f"total contact force {xy} (rel. to |F|)", float(F[k]),
+                 {s: float(t[k]) for s, t in totals.items()},
+                 {s: abs(float(t[k]) - F[k]) / fn for s, t in totals.items()}, tol, txt,
+                 fmt="signed")
+    ours_force, ours_status = {}, {}
+    for pair in pb.contact:
+        with open(out / f"{pair.name}.contact.csv", newline="") as f:
+            for r in csv.DictReader(f):
+                if r["side"] != "slave":
+                    continue
+                node = int(r["node"])
+                if np.abs(pb.points[node] - [float(r["x"]), float(r["y"])]).max() > pb.tol:
+                    raise RuntimeError(f"{pair.name}.contact.csv node {node} is not .vtu point {node}")
+                ours_force[node] = np.array([float(r["force_x"]), float(r["force_y"])])
+                ours_status[node] = r["status"]
+    scale = max(float(np.abs(v).max()) for v in ours_force.values()) or 1.0
+    fdiff, sdiff, fref = {}, {}, {}
+    for s, d in datas.items():
+        ref_force = {n: np.asarray(f) for p in d["contact"]["pairs"]
+                     for n, f in zip(p["nodes"], p["slave_force"])}
+        ref_status = {n: st for p in d["contact"]["pairs"] for n, st in zip(p["nodes"], p["status"])}
+        if sorted(ref_force) != sorted(ours_force):
+            raise RuntimeError(f"{NAMES[s]}'s slave nodes differ from ours")
+        fdiff[s] = max(float(np.abs(ref_force[n] - ours_force[n]).max()) for n in ours_force) / scale
+        fref[s] = max(float(np.abs(v).max()) for v in ref_force.values())
+        sdiff[s] = float(sum(ref_status[n] != ours_status[n] for n in ours_status))
+    rows.add("nodal contact forces (max abs)", scale, fref, fdiff, tol, txt)
+    counts = {st: sum(v == st for v in ours_status.values()) for st in ("open", "stick", "slip")}
+    rows.add(f"nodes with another status (ours: {counts['open']} open, {counts['stick']} stick, "
+             f"{counts['slip']} slip)", 0, {s: int(v) for s, v in sdiff.items()}, sdiff,
+             0.0, "equal", kind="equal", fmt="int")
+    return rows
 
 
 def our_frames(out, body):
@@ -1035,7 +1097,7 @@ def main(argv):
         "python": sys.version.split()[0],
         "versions": versions,
         "tolerances": {"linear": TOL, "linear_rule": "max(1e-10, kappa_1 eps) with kappa_1 "
-                       "scikit-fem's cond1_estimate", "contact": TOL_CONTACT,
+                       "scikit-fem's cond1_estimate", "contact": TOL_CONTACT, "friction": TOL_FRICTION,
                        "tie": TOL, "tied_layer_du": TOL_DU, "hertz_peak": HERTZ_PEAK,
                        "hertz_half_width": "one node spacing",
                        "two_block_exact_margin": EXACT_MARGIN},
