@@ -823,7 +823,12 @@ def write_md(path, report):
         "mesh and ref_dolfinx.py steps Newmark's method with the case's beta, gamma and dt "
         "(consistent mass, or its row sums for the lumped case); the displacement history at "
         "every frame and node, at two nodes, and the energy histories are compared, tolerance "
-        "1e-10 (the same discrete problem); scikit-fem: n/a.",
+        "1e-10 (the same discrete problem); scikit-fem: n/a. Penalty Coulomb contact "
+        "(`coulomb-block-*`, load steps): DOLFINx assembles the stiffness and load vectors and "
+        "ref_dolfinx.py runs the same return map per slave node with the plastic slip committed "
+        "per step; the field, the total contact force, the nodal contact forces (max abs "
+        "difference over the largest nodal force) and each node's last status (equal) are "
+        "compared, tolerance 1e-10; scikit-fem: n/a.",
         "",
         "| case | element | plane | nodes | quantity | ours | DOLFINx | scikit-fem "
         "| rel. diff DOLFINx | rel. diff scikit-fem | tol | verdict |",
