@@ -481,6 +481,70 @@ mod tests {
         }
     }
 
+    /// [`Cubic`] with the round-off floor of its residual: `ROUNDOFF_TERMS eps` times the
+    /// largest row sum of `|4 x_i| + |c x_i^3| + |f_i| + |x_(i-1)| + |x_(i+1)|`.
+    struct FlooredCubic(Cubic);
+
+    impl System for FlooredCubic {
+        fn pattern(&self) -> &SymmetricPattern {
+            &self.0.pattern
+        }
+        fn evaluate(
+            &mut self,
+            x: &[f64],
+            general: &GeneralPattern,
+            residual: &mut [f64],
+            tangent: &mut Tangent,
+        ) -> Result<Evaluation> {
+            let mut eval = self.0.evaluate(x, general, residual, tangent)?;
+            let n = x.len();
+            let magnitude = (0..n)
+                .map(|i| {
+                    4.0 * x[i].abs()
+                        + (self.0.c * x[i].powi(3)).abs()
+                        + self.0.f[i].abs()
+                        + if i > 0 { x[i - 1].abs() } else { 0.0 }
+                        + if i + 1 < n { x[i + 1].abs() } else { 0.0 }
+                })
+                .fold(0.0f64, f64::max);
+            eval.residual_floor = ROUNDOFF_TERMS * f64::EPSILON * magnitude;
+            Ok(eval)
+        }
+    }
+
+    #[test]
+    fn a_tolerance_below_round_off_ends_at_the_residual_floor_not_at_the_limit() {
+        let settings = Settings {
+            max_iterations: 50,
+            // below what f64 can give: only the floor can end the iteration
+            tolerance: 1e-30,
+            factor_limit: UNLIMITED,
+        };
+        let mut x = vec![0.0; 20];
+        let plain = solve(&mut cubic(20, 0.5, 0.0), &mut x, settings).unwrap();
+        assert_eq!(plain.termination, Termination::IterationLimit);
+        let mut s = FlooredCubic(cubic(20, 0.5, 0.0));
+        let mut x = vec![0.0; 20];
+        let out = solve(&mut s, &mut x, settings).unwrap();
+        assert_eq!(out.termination, Termination::Converged);
+        assert!(out.iterations < 10, "{} iterations", out.iterations);
+        // the answer solves the system to round-off: recompute its residual independently
+        let n = x.len();
+        for i in 0..n {
+            let mut r = 4.0 * x[i] + 0.5 * x[i].powi(3) - (1.0 + i as f64);
+            if i > 0 {
+                r -= x[i - 1];
+            }
+            if i + 1 < n {
+                r -= x[i + 1];
+            }
+            assert!(
+                r.abs() <= 1e-12 * (1.0 + i as f64),
+                "row {i}: residual {r:e}"
+            );
+        }
+    }
+
     fn cubic(n: usize, c: f64, unsymmetric: f64) -> Cubic {
         let mut b = PatternBuilder::new(n);
         for i in 0..n - 1 {
