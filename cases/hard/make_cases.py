@@ -131,6 +131,18 @@ case(
     [converged(), stress(P, 1e-7), {"check": "equilibrium", "tol": 1e-12, "per_condition": 1.0}],
 )
 
+# 2b. the same on the Newton scheme: the stiff punch's K x sums terms about 1e6 times the loads,
+# so the residual stalls at its round-off floor (about 5e-10 of the load) above the relative
+# tolerance 1e-10; before, Newton ran to its 200-iteration limit there
+c = copy.deepcopy(c)
+c["solver"] = {"scheme": "newton"}
+case(
+    "stiffness-ratio-1e6-newton",
+    "Case 2 (stiffness-ratio-1e6) on the Newton scheme: the stiff punch's internal forces sum terms about 1e6 times the load, so the residual cannot fall below its round-off floor (16 eps of the summed terms' magnitude) to the relative tolerance 1e-10; Newton stops converged at that floor once a step has moved the iterate by at most 1e-6 of its size. The same uniform stress sigma_yy = -10 to 1e-7 and equilibrium relative to the condition estimate.",
+    c,
+    [converged(), stress(P, 1e-7), {"check": "equilibrium", "tol": 1e-12, "per_condition": 1.0}],
+)
+
 # 3. nu = 0.4999 (nearly incompressible, plane strain), Lagrange on mesh A and mesh C two-pass
 for mesh, disc, label in [
     ("A", {"kind": "node_to_node"}, "node-to-node"),

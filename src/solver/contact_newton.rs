@@ -806,6 +806,10 @@ impl System for ContactSystem<'_> {
             upper[p] = self.sys.k[k];
         }
         residual.iter_mut().for_each(|v| *v = 0.0);
+        // the magnitude of the terms summed into each row of the residual, whose round-off is
+        // the floor of the residual (small strain only: under finite kinematics it stays empty
+        // and only the relative tolerance counts)
+        let mut magnitude: Vec<f64> = Vec::new();
         if let Some(r) = solid_residual {
             residual[..n].copy_from_slice(&r);
         } else {
@@ -816,6 +820,14 @@ impl System for ContactSystem<'_> {
                 .iter_mut()
                 .zip(&self.sys.rhs)
                 .for_each(|(r, f)| *r -= f);
+            magnitude = vec![0.0; residual.len()];
+            let abs_k: Vec<f64> = self.sys.k.iter().map(|v| v.abs()).collect();
+            let abs_x: Vec<f64> = x[..n].iter().map(|v| v.abs()).collect();
+            self.sys.pattern.mul(&abs_k, &abs_x, &mut magnitude[..n]);
+            magnitude[..n]
+                .iter_mut()
+                .zip(&self.sys.rhs)
+                .for_each(|(m, f)| *m += f.abs());
         }
         let mut eval = Evaluation {
             force_scale: max_abs(&self.sys.rhs),
@@ -865,6 +877,9 @@ impl System for ContactSystem<'_> {
                 for &(e, c) in &tangential {
                     residual[e] -= map.force * c;
                     eval.force_scale = eval.force_scale.max((map.force * c).abs());
+                    if let Some(m) = magnitude.get_mut(e) {
+                        *m += (map.force * c).abs();
+                    }
                 }
                 if let Some(jt) = self.tangential[i] {
                     // Lagrange rows: the force -rho x_t b_t, and the row of the set
@@ -946,10 +961,23 @@ impl System for ContactSystem<'_> {
                         // R_mu = -rho mu drives the multiplier to zero; it exerts no force
                         residual[j] = -rho * x[j];
                         upper[self.pattern.position(j, j).expect("diagonal")] = -rho;
+                        if let Some(m) = magnitude.get_mut(j) {
+                            *m += (rho * x[j]).abs();
+                        }
                         continue;
                     }
                     residual[j] = -rho * g;
                     closing_force = closing_force.max((rho * g).abs());
+                    if let Some(m) = magnitude.get_mut(j) {
+                        // g = g0 + sum_d c_d u_d
+                        *m += rho
+                            * (r.g0.abs()
+                                + r.dofs
+                                    .iter()
+                                    .zip(&r.coeffs)
+                                    .map(|(&d, c)| (c * u[d]).abs())
+                                    .sum::<f64>());
+                    }
                     for &(e, c) in &terms {
                         upper[self.pattern.position(e, j).expect("coupling")] = -rho * c;
                     }
@@ -963,6 +991,9 @@ impl System for ContactSystem<'_> {
             for &(e, c) in &terms {
                 residual[e] -= force * c;
                 eval.force_scale = eval.force_scale.max((shown * c).abs());
+                if let Some(m) = magnitude.get_mut(e) {
+                    *m += (force * c).abs();
+                }
             }
             for (a, &(ea, ca)) in terms.iter().enumerate() {
                 for &(eb, cb) in &terms[a..] {
@@ -1015,6 +1046,8 @@ impl System for ContactSystem<'_> {
         if eval.force_scale == 0.0 {
             eval.force_scale = closing_force;
         }
+        eval.residual_floor =
+            newton::ROUNDOFF_TERMS * f64::EPSILON * magnitude.iter().fold(0.0f64, |a, &m| a.max(m));
         self.evaluations += 1;
         self.sets_settled = eval.status_changes == 0;
         self.holding = false;

@@ -9,6 +9,10 @@
 //! gives the tangent of the branch it chose. An iteration has converged when the residual at
 //! the iterate is below `tolerance` times the system's force scale and the status of no point
 //! changed in that evaluation; a linear problem with a fixed status converges in one solve.
+//! A residual that cannot reach the tolerance in floating point (terms far larger than the
+//! loads cancel, as in a body `1e6` times stiffer than the other) counts as converged at its
+//! round-off floor ([`Evaluation::residual_floor`]) once a step has moved the iterate by at
+//! most [`SETTLED_STEP`] of its size.
 //! Augmented Lagrangian updates (Uzawa) are the system's business too:
 //! [`System::augment`] runs between iterations and tells whether it moved a multiplier.
 //!
@@ -52,6 +56,30 @@ pub struct Evaluation {
     pub max_gap_violation: f64,
     /// Largest change of a point's force against the last evaluation.
     pub multiplier_change: f64,
+    /// The round-off floor of the residual's evaluation (absolute, in the residual's max
+    /// norm): [`ROUNDOFF_TERMS`] `eps max_i sum_j |a_ij x_j|` over the terms the system sums
+    /// into row `i`. A residual at or below it cannot be reduced further in floating point; the
+    /// iteration is then converged even when the relative tolerance is out of reach (a stiff
+    /// body's `K x` cancels terms `1e6` times larger than the loads). Zero: no floor (only the
+    /// relative tolerance counts).
+    pub residual_floor: f64,
+}
+
+/// How many unit round-offs of the summed terms' magnitude make the floor of a residual's
+/// evaluation: a sum of `m` terms errs by up to `m eps` of their magnitude (Higham, Accuracy
+/// and Stability of Numerical Algorithms, 2nd ed. 2002, sec. 3.1), typically by about
+/// `sqrt(m) eps`; a Q4 row sums 18 stiffness terms, and the iterate itself is rounded to
+/// `eps`. On `cases/hard/stiffness-ratio-1e6` (Newton) the residual stalls at 0.1 to 0.8 of
+/// `eps` times the magnitude.
+pub const ROUNDOFF_TERMS: f64 = 16.0;
+
+/// The residual's round-off floor ends the iteration only after a step that moved the iterate by
+/// at most this fraction of its largest entry (max norms): Newton has settled, and the residual
+/// stalls because of round-off, not because the iterate is far off.
+pub const SETTLED_STEP: f64 = 1e-6;
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, a| m.max(a.abs()))
 }
 
 /// A nonlinear problem in `n` unknowns with a fixed sparsity pattern.
@@ -134,6 +162,8 @@ pub fn solve_with(
     let mut solves = 0;
     let mut start = Instant::now();
     let (mut augmented, mut augmentations) = (false, 0);
+    // whether the last step moved the iterate by at most SETTLED_STEP of its size
+    let mut settled = false;
     // factoring time and solver name of the linear solvers of earlier patterns
     let mut earlier_seconds = 0.0;
     let mut last_solver = "none";
@@ -145,6 +175,7 @@ pub fn solve_with(
             version = system.pattern_version();
             *x = system.carry(x);
             residual = vec![0.0; x.len()];
+            settled = false;
         }
         let mut tangent = Tangent {
             values: vec![0.0; linear.general.nnz()],
@@ -165,7 +196,9 @@ pub fn solve_with(
             }
         });
         let relative = norm / eval.force_scale.max(f64::MIN_POSITIVE);
-        let small = relative <= settings.tolerance;
+        // at the round-off floor only once Newton has settled: a wild iterate (a sliding body
+        // sent far by one step) has a large floor of its own, and is not an answer
+        let small = relative <= settings.tolerance || (settled && norm <= eval.residual_floor);
         if solves > 0 && !augmented {
             history.push(IterationRecord {
                 step: 0,
@@ -231,6 +264,7 @@ pub fn solve_with(
             ));
         }
         x.iter_mut().zip(&residual).for_each(|(a, d)| *a += d);
+        settled = max_abs(&residual) <= SETTLED_STEP * max_abs(x);
         last_solver = linear.last_solver;
         solves += 1;
     };
@@ -444,6 +478,70 @@ mod tests {
                 force_scale: self.f.iter().fold(0.0, |m: f64, v| m.max(v.abs())),
                 ..Evaluation::default()
             })
+        }
+    }
+
+    /// [`Cubic`] with the round-off floor of its residual: `ROUNDOFF_TERMS eps` times the
+    /// largest row sum of `|4 x_i| + |c x_i^3| + |f_i| + |x_(i-1)| + |x_(i+1)|`.
+    struct FlooredCubic(Cubic);
+
+    impl System for FlooredCubic {
+        fn pattern(&self) -> &SymmetricPattern {
+            &self.0.pattern
+        }
+        fn evaluate(
+            &mut self,
+            x: &[f64],
+            general: &GeneralPattern,
+            residual: &mut [f64],
+            tangent: &mut Tangent,
+        ) -> Result<Evaluation> {
+            let mut eval = self.0.evaluate(x, general, residual, tangent)?;
+            let n = x.len();
+            let magnitude = (0..n)
+                .map(|i| {
+                    4.0 * x[i].abs()
+                        + (self.0.c * x[i].powi(3)).abs()
+                        + self.0.f[i].abs()
+                        + if i > 0 { x[i - 1].abs() } else { 0.0 }
+                        + if i + 1 < n { x[i + 1].abs() } else { 0.0 }
+                })
+                .fold(0.0f64, f64::max);
+            eval.residual_floor = ROUNDOFF_TERMS * f64::EPSILON * magnitude;
+            Ok(eval)
+        }
+    }
+
+    #[test]
+    fn a_tolerance_below_round_off_ends_at_the_residual_floor_not_at_the_limit() {
+        let settings = Settings {
+            max_iterations: 50,
+            // below what f64 can give: only the floor can end the iteration
+            tolerance: 1e-30,
+            factor_limit: UNLIMITED,
+        };
+        let mut x = vec![0.0; 20];
+        let plain = solve(&mut cubic(20, 0.5, 0.0), &mut x, settings).unwrap();
+        assert_eq!(plain.termination, Termination::IterationLimit);
+        let mut s = FlooredCubic(cubic(20, 0.5, 0.0));
+        let mut x = vec![0.0; 20];
+        let out = solve(&mut s, &mut x, settings).unwrap();
+        assert_eq!(out.termination, Termination::Converged);
+        assert!(out.iterations < 10, "{} iterations", out.iterations);
+        // the answer solves the system to round-off: recompute its residual independently
+        let n = x.len();
+        for i in 0..n {
+            let mut r = 4.0 * x[i] + 0.5 * x[i].powi(3) - (1.0 + i as f64);
+            if i > 0 {
+                r -= x[i - 1];
+            }
+            if i + 1 < n {
+                r -= x[i + 1];
+            }
+            assert!(
+                r.abs() <= 1e-12 * (1.0 + i as f64),
+                "row {i}: residual {r:e}"
+            );
         }
     }
 
