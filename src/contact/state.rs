@@ -16,6 +16,9 @@ pub enum Termination {
     ActiveSetCycling(String),
     /// The linear system could not be solved (the message says why).
     Singular(String),
+    /// The iterations reached the work limit of the case (`limits.iteration_dofs`) before the
+    /// set settled (the message says how far it got and what to change).
+    WorkLimit(String),
 }
 
 /// What the contact solve found.

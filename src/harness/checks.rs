@@ -239,11 +239,19 @@ pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
                     )
                 })
                 .unwrap_or_default();
+            // an unfinished loop leaves an iterate that need not close its gaps, whatever the
+            // method
+            let cause = if state.termination == Termination::Converged {
+                "the answer is that of a soft interface: raise the penalty kappa (about 10 E / h \
+                 or more) or use Lagrange multipliers"
+            } else {
+                "the contact iterations stopped before the active set settled (see how the \
+                 contact solve ended), and this iterate is not the answer"
+            };
             format!(
                 "contact '{}': penetration {:.3e}{at} is {:.3} times the contact element size \
-                 (warning above {PENETRATION_WARNING_SHARE}); the answer is that of a soft \
-                 interface: raise the penalty kappa (about 10 E / h or more) or use Lagrange \
-                 multipliers; a `max_penetration` check makes this a failure",
+                 (warning above {PENETRATION_WARNING_SHARE}); {cause}; a `max_penetration` \
+                 check makes this a failure",
                 model.contact[f.pair].name, f.penetration.depth, f.penetration.share_of_element
             )
         });
@@ -369,14 +377,16 @@ pub fn evaluate_with(
                         Some(Termination::IterationLimit) => (Some(TerminationReason::IterationLimit), String::new()),
                         Some(Termination::ActiveSetCycling(m)) => (Some(TerminationReason::ActiveSetCycling), m.clone()),
                         Some(Termination::Singular(m)) => (Some(TerminationReason::Singular), m.clone()),
+                        Some(Termination::WorkLimit(m)) => (Some(TerminationReason::WorkLimit), m.clone()),
                         None => (None, String::new()),
                     };
                     // the message of the stop and the run's warnings (diagnoses) are searched
                     let said = format!("{text}\n{}", warnings(model, solution).join("\n"));
                     let found = contains.as_ref().is_none_or(|c| said.contains(c.as_str()));
                     let with = contains.as_ref().map(|c| format!(" with a message containing {c:?}")).unwrap_or_default();
+                    let how = if text.is_empty() { String::new() } else { format!(": {text}") };
                     (
-                        format!("the contact solve ends {reason:?}{with} (it ended {got:?})"),
+                        format!("the contact solve ends {reason:?}{with} (it ended {got:?}{how})"),
                         if got == Some(*reason) && found { 0.0 } else { f64::INFINITY },
                         0.0,
                     )

@@ -46,6 +46,7 @@ fn termination_name(t: &Termination) -> &'static str {
         Termination::IterationLimit => "iteration_limit",
         Termination::ActiveSetCycling(_) => "active_set_cycling",
         Termination::Singular(_) => "singular",
+        Termination::WorkLimit(_) => "work_limit",
     }
 }
 

@@ -370,6 +370,9 @@ fn summary_with(outcome: &Outcome, nodal: &[Vec<[f64; 3]>], results: &[PairResul
                 crate::solver::active_set::Termination::ActiveSetCycling(m) => {
                     format!("ActiveSetCycling: {m}")
                 }
+                crate::solver::active_set::Termination::WorkLimit(m) => {
+                    format!("WorkLimit: {m}")
+                }
                 t => format!("{t:?}"),
             },
             iterations: c.iterations,

@@ -177,10 +177,22 @@ pub struct Limits {
     /// the 1.3e11 of the Cholesky factor of the million-dof square in `cases/large`.
     #[serde(default = "default_factor_operations")]
     pub factor_operations: f64,
+    /// The most iterations times dofs one contact iteration loop (the active-set loop of one
+    /// load step and geometry update) may take (default 5,000,000: 11 iterations of the
+    /// 440,000-dof mesh that takes about half a second an iteration on this 2-core machine,
+    /// 200 of a 25,000-dof one). A loop that reaches it stops with `work_limit`, naming this
+    /// limit.
+    #[serde(default = "default_iteration_dofs")]
+    pub iteration_dofs: u64,
 }
 
 pub const DEFAULT_MAX_NODES: usize = 2_000_000;
 pub const DEFAULT_MAX_STEP_DOFS: u64 = 100_000_000;
+pub const DEFAULT_ITERATION_DOFS: u64 = 5_000_000;
+
+fn default_iteration_dofs() -> u64 {
+    DEFAULT_ITERATION_DOFS
+}
 
 fn default_max_step_dofs() -> u64 {
     DEFAULT_MAX_STEP_DOFS
@@ -208,6 +220,7 @@ impl Default for Limits {
             step_dofs: DEFAULT_MAX_STEP_DOFS,
             factor_gigabytes: DEFAULT_FACTOR_GIGABYTES,
             factor_operations: DEFAULT_FACTOR_OPERATIONS,
+            iteration_dofs: DEFAULT_ITERATION_DOFS,
         }
     }
 }
@@ -1107,4 +1120,5 @@ pub enum TerminationReason {
     IterationLimit,
     ActiveSetCycling,
     Singular,
+    WorkLimit,
 }

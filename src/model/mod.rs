@@ -184,6 +184,8 @@ pub struct Model {
     pub warnings: Vec<String>,
     /// The most memory and operations one sparse factorization may take (`limits`).
     pub factor_limit: crate::solver::sparse::WorkLimit,
+    /// The most iterations times dofs of one contact iteration loop (`limits.iteration_dofs`).
+    pub iteration_dofs: u64,
 }
 
 /// Parse case JSON; errors carry line, column and a hint.
@@ -534,6 +536,7 @@ impl Model {
                 gigabytes: case.limits.factor_gigabytes,
                 operations: case.limits.factor_operations,
             },
+            iteration_dofs: case.limits.iteration_dofs,
         };
         model.apply_supports(case)?;
         model.apply_loads(case)?;

@@ -10,6 +10,23 @@
 //! multiplier mass, which keep their multipliers, an active row stays while `lambda >= 0` and
 //! an inactive one closes when `g + C lambda < 0`). The loop ends with a [`Termination`] reason.
 //!
+//! The penalty predictor (Lagrange multipliers and elimination): a set that is too small lets
+//! the body penetrate far beyond its contact zone, and the next set, every penetrating row, is
+//! far too large. The multipliers of a too-large set are tensile only at the edges of the zone
+//! (the gap is forced shut there), so the loop would open one row per edge and iteration, a
+//! count that grows with the mesh. At the first set that grows, the loop therefore hands the
+//! set to a penalty iteration, `(K + sum kappa A_i b_i b_i^T) u = f - sum kappa A_i g0_i b_i`
+//! with the rule "active while compressive", whose tension spreads over many rows and sheds
+//! them together; it runs at `kappa = E / L` (the largest Young's modulus over the model size)
+//! and then at 100 times as much per level up to the stiffness scale, each level from the set of
+//! the one before, and the multiplier loop resumes from its set (`Kernel::penalty_predictor`).
+//! Its iterations are in the history and count against the iteration limits. A penalty
+//! iterate is never the answer: the loop ends only on a multiplier iterate whose set is stable.
+//!
+//! Work limit: a loop takes at most `limits.iteration_dofs / dofs` iterations (at least one);
+//! when that is below `solver.max_iterations` and reached, the loop ends with
+//! [`Termination::WorkLimit`], saying how far the set got and how to raise the limit.
+//!
 //! Cycling: for the methods without a multiplier iteration of their own (Lagrange,
 //! elimination, penalty, perturbed Lagrangian) the set alone determines the iterate, so a set
 //! chosen a second time in one loop (the sets are kept in a hash set) repeats its iterate and
@@ -555,6 +572,7 @@ fn solve_at(
         linear_solver: "cholesky",
         cache: None,
         factorizations: 0.0,
+        estimate_condition: true,
     };
     let state = kernel.active_set_loop(method, &rows)?;
     let (x, forces, active, termination, iterations) = state;
@@ -742,6 +760,9 @@ impl Saddle {
 }
 
 struct Kernel<'a> {
+    /// Whether [`Kernel::factor`] estimates the condition number of what it factors (not for
+    /// the penalty predictor, whose systems are never the answer's).
+    estimate_condition: bool,
     /// The active set `prepare` last ran for.
     prepared_for: Option<Vec<bool>>,
     model: &'a Model,
@@ -820,6 +841,16 @@ impl From<String> for StepError {
 
 type Step<T> = std::result::Result<T, StepError>;
 
+/// The most stiffness levels of the penalty predictor ([`Kernel::penalty_predictor`]), and the
+/// most iterations at one level.
+const PREDICTOR_LEVELS: usize = 12;
+const PREDICTOR_LEVEL_ITERATIONS: usize = 30;
+/// The factor between the penalties of consecutive levels of the predictor, and the share of
+/// status changes (one in this many active rows) at which a level that is not the last hands its
+/// set on.
+const PREDICTOR_STEP: f64 = 100.0;
+const PREDICTOR_SETTLED: usize = 100;
+
 impl Kernel<'_> {
     /// Gap below which a row counts as closed when the active set starts and when a row is
     /// activated: `1e-14` times the model size.
@@ -879,11 +910,15 @@ impl Kernel<'_> {
             .chol
             .factor(&self.sys.pattern, &values)
             .map_err(|e| self.sys.factor_error(self.model, e).to_string())?;
-        self.condition = Some(condition_estimate_symmetric(
-            &self.sys.pattern,
-            &values,
-            |b| f.solve_in_place(b),
-        ));
+        self.condition = if self.estimate_condition {
+            Some(condition_estimate_symmetric(
+                &self.sys.pattern,
+                &values,
+                |b| f.solve_in_place(b),
+            ))
+        } else {
+            None
+        };
         self.factorizations += t.elapsed().as_secs_f64();
         let f = std::rc::Rc::new(f);
         self.cache = Some((active.to_vec(), w.to_vec(), f.clone()));
@@ -1767,8 +1802,16 @@ impl Kernel<'_> {
         let mut flips = vec![0usize; nrows];
         let mut held: Vec<usize> = Vec::new();
         let remedy = self.model.solver.cycling_remedy;
-        let max_iterations = self.model.solver.max_iterations;
-        for it in 1..=max_iterations {
+        // the iteration limit, and the work limit: iterations times the size of the system
+        let dofs = self.sys.n.max(1);
+        let affordable = (self.model.iteration_dofs / dofs as u64).max(1) as usize;
+        let max_iterations = self.model.solver.max_iterations.min(affordable);
+        let work_bound = affordable < self.model.solver.max_iterations;
+        // the penalty predictor of the set (Lagrange and elimination), used once
+        let mut predicted = false;
+        let mut it = 0;
+        while it < max_iterations {
+            it += 1;
             let iteration_start = Instant::now();
             let previous_forces = forces.clone();
             self.iteration = it;
@@ -1999,16 +2042,154 @@ impl Kernel<'_> {
                     }
                 }
             }
+            // a set-determined method that must grow its set lets a penalty predictor choose the
+            // next one (see [`Kernel::penalty_predictor`])
+            let grows = (0..nrows).any(|i| new_active[i] && !active[i]);
+            if grows
+                && !predicted
+                && matches!(method, Method::Lagrange | Method::Elimination)
+                && held.is_empty()
+            {
+                predicted = true;
+                let (predicted_set, used) =
+                    self.penalty_predictor(new_active.clone(), rows, it, max_iterations);
+                it += used;
+                if predicted_set != new_active {
+                    for i in 0..nrows {
+                        if predicted_set[i] != new_active[i] {
+                            flips[i] += 1;
+                        }
+                    }
+                    new_active = predicted_set;
+                }
+            }
             seen.insert(new_active.clone());
             active = new_active;
         }
-        Ok((
-            x,
-            forces,
-            active,
-            Termination::IterationLimit,
-            max_iterations,
-        ))
+        let termination = if work_bound {
+            let changes = self.history.last().map_or(0, |h| h.status_changes);
+            Termination::WorkLimit(format!(
+                "the active set had not settled after {max_iterations} iterations ({changes} rows still changing status): {max_iterations} iterations of {dofs} dofs reach the work limit of {} iteration-dofs (limits.iteration_dofs); raise \"limits\": {{\"iteration_dofs\": N}} if the machine has the time, use a coarser mesh, or apply the load in more load steps (solver.load_steps) so that each step changes the set less",
+                self.model.iteration_dofs
+            ))
+        } else {
+            Termination::IterationLimit
+        };
+        Ok((x, forces, active, termination, max_iterations))
+    }
+
+    /// The penalty predictor of the active set of a set-determined method (Lagrange
+    /// multipliers, elimination). When a set is too small, the body penetrates the master
+    /// far beyond the contact zone it will have, and the next set closes every penetrating
+    /// row: a set far too large. With multipliers its iterate is held by tensile forces only at
+    /// the two edges of the zone (the stress singularity of a gap forced shut), so the loop
+    /// opens a row or two per iteration, and the number of iterations grows with the mesh.
+    /// A penalty regularization spreads the tension of a too-large set over many rows and
+    /// sheds them together. The predictor solves `(K + sum_active w_i b_i b_i^T) u = f -
+    /// sum_active w_i g0_i b_i` with the rule "active while the trial force `-w_i g_i` is
+    /// compressive", from `start` until the set is stable, at weights `w_i = theta rho` for
+    /// `theta` in 1e-3, 1e-2, 1e-1, 1 (`rho` the stiffness scale); each stiffer level starts
+    /// from the set of the softer one and its zone is closer to the Lagrange one. Its
+    /// iterations are recorded in the history (linear solver `penalty-predictor`) and count
+    /// against `solver.max_iterations`; it returns the set and the number of iterations it
+    /// took. A step that fails (a singular system) ends it with the last set.
+    fn penalty_predictor(
+        &mut self,
+        start: Vec<bool>,
+        rows: &[Constraint],
+        after: usize,
+        max_iterations: usize,
+    ) -> (Vec<bool>, usize) {
+        self.estimate_condition = false;
+        self.cache = None;
+        let set = self.predictor_levels(start, rows, after, max_iterations);
+        self.estimate_condition = true;
+        self.cache = None;
+        self.condition = None;
+        set
+    }
+
+    /// The levels of [`Kernel::penalty_predictor`].
+    fn predictor_levels(
+        &mut self,
+        start: Vec<bool>,
+        rows: &[Constraint],
+        after: usize,
+        max_iterations: usize,
+    ) -> (Vec<bool>, usize) {
+        let nrows = self.rows.len();
+        let rho = self.stiffness_scale();
+        let modulus = self
+            .model
+            .bodies
+            .iter()
+            .map(|b| b.material.youngs_modulus)
+            .fold(0.0f64, f64::max);
+        let zero = vec![0.0; nrows];
+        let mut active = start;
+        let mut used = 0;
+        let mut previous_forces = vec![0.0; nrows];
+        let mut kappa = modulus / self.model.size();
+        for _level in 0..PREDICTOR_LEVELS {
+            let w: Vec<f64> = rows.iter().map(|r| kappa * r.area).collect();
+            for _ in 0..PREDICTOR_LEVEL_ITERATIONS {
+                if after + used >= max_iterations {
+                    return (active, used);
+                }
+                used += 1;
+                let iteration_start = Instant::now();
+                self.prepare(&active);
+                let Ok(x) = self.regularized(&active, &w, &zero) else {
+                    return (active, used);
+                };
+                let gaps: Vec<f64> = self.rows.iter().map(|r| r.g0 + r.dot(&x)).collect();
+                let forces: Vec<f64> = (0..nrows)
+                    .map(|i| if active[i] { -w[i] * gaps[i] } else { 0.0 })
+                    .collect();
+                let fmax = forces.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let force_tol = 1e-10 * fmax;
+                let next: Vec<bool> = (0..nrows)
+                    .map(|i| rows[i].bilateral || -w[i] * gaps[i] > force_tol)
+                    .collect();
+                let changes = next.iter().zip(&active).filter(|(a, b)| a != b).count();
+                self.history.push(IterationRecord {
+                    step: 0,
+                    geometry_update: 0,
+                    iteration: after + used,
+                    residual: self.equilibrium_residual(&x, &forces, &active),
+                    active: active.iter().filter(|&&a| a).count(),
+                    status_changes: changes,
+                    max_gap_violation: (0..nrows)
+                        .filter(|&i| !rows[i].bilateral)
+                        .fold(0.0f64, |m, i| m.max(-gaps[i])),
+                    multiplier_change: forces
+                        .iter()
+                        .zip(&previous_forces)
+                        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())),
+                    linear_solver: "penalty-predictor",
+                    condition_estimate: self.condition,
+                    seconds: iteration_start.elapsed().as_secs_f64(),
+                    repeated_set: false,
+                    cycling_remedy: false,
+                });
+                previous_forces = forces;
+                active = next;
+                let last_level = w.iter().fold(0.0f64, |m, &v| m.max(v)) >= rho;
+                let settled = if last_level {
+                    changes == 0
+                } else {
+                    changes * PREDICTOR_SETTLED <= active.iter().filter(|&&a| a).count()
+                };
+                if settled {
+                    break;
+                }
+            }
+            if w.iter().fold(0.0f64, |m, &v| m.max(v)) >= rho {
+                break;
+            }
+            kappa *= PREDICTOR_STEP;
+        }
+        (active, used)
     }
 }
 

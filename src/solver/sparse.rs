@@ -593,9 +593,67 @@ fn multipliers_after_their_displacements(
     Ok((fwd, inv))
 }
 
+/// The symbolic factor for the order "AMD of the leading `leading x leading` block, then the
+/// remaining equations (the multipliers) in order".
+fn multipliers_last(
+    pattern: &SymmetricPattern,
+    leading: usize,
+) -> Result<SymbolicCholesky<usize>, FactorError> {
+    fn other(e: impl std::fmt::Debug) -> FactorError {
+        FactorError::Other(format!("{e:?}"))
+    }
+    let n = pattern.n;
+    let nnz = pattern.col_ptr[leading];
+    let block = SymbolicSparseColMatRef::new_checked(
+        leading,
+        leading,
+        &pattern.col_ptr[..=leading],
+        None,
+        &pattern.row_idx[..nnz],
+    );
+    let mut fwd = vec![0usize; n];
+    let mut inv = vec![0usize; n];
+    let mut mem = MemBuffer::new(faer::sparse::linalg::amd::order_scratch::<usize>(
+        leading, nnz,
+    ));
+    faer::sparse::linalg::amd::order(
+        &mut fwd[..leading],
+        &mut inv[..leading],
+        block,
+        Default::default(),
+        MemStack::new(&mut mem),
+    )
+    .map_err(other)?;
+    for k in leading..n {
+        fwd[k] = k;
+        inv[k] = k;
+    }
+    let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
+    factorize_symbolic_cholesky(
+        pattern.symbolic(),
+        Side::Upper,
+        SymmetricOrdering::Custom(perm),
+        Default::default(),
+    )
+    .map_err(other)
+}
+
 /// Sparse `L D L^T` of a symmetric indefinite matrix with known pivot signs.
 pub struct Ldlt {
     symbolic: Arc<SymbolicCholesky<usize>>,
+    /// With the interleaved order chosen, the multipliers-last order to fall back on.
+    fallback: Option<Fallback>,
+}
+
+/// The interleaved order matches each multiplier to one displacement of its pattern, which
+/// may carry a zero coefficient in the values (a tangential row on a node's normal dof): its
+/// pivot can then vanish although the matrix is regular. A pivot failure of that order is
+/// retried with multipliers last (whose pivots have their expected signs whenever the rows
+/// are independent), analysed then, and that order is kept from then on.
+struct Fallback {
+    leading: usize,
+    limit: WorkLimit,
+    last: std::sync::OnceLock<Result<Arc<SymbolicCholesky<usize>>, FactorError>>,
 }
 
 /// A numeric `L D L^T` factorization.
@@ -605,10 +663,13 @@ pub struct LdltFactor {
 }
 
 impl Ldlt {
-    /// Symbolic analysis with the ordering "AMD of the leading `leading x leading` block, then
-    /// the remaining equations in order", so that multipliers (numbered last) are eliminated
-    /// after their displacements and every pivot has its expected sign exactly. A factor whose
-    /// work exceeds `limit` is [`FactorError::TooLarge`].
+    /// Symbolic analysis with the cheaper of two orders for the multipliers (numbered from
+    /// `leading` on): "AMD of the leading `leading x leading` block, then the multipliers in
+    /// order", whose pivots have their expected signs exactly when the rows are independent,
+    /// or each multiplier right after one of its displacements
+    /// ([`multipliers_after_their_displacements`]), with multipliers last as the fallback of
+    /// a pivot failure ([`Fallback`]). A factor whose work exceeds `limit` is
+    /// [`FactorError::TooLarge`].
     pub fn analyse(
         pattern: &SymmetricPattern,
         leading: usize,
@@ -618,48 +679,15 @@ impl Ldlt {
         fn other(e: impl std::fmt::Debug) -> FactorError {
             FactorError::Other(format!("{e:?}"))
         }
-        let nnz = pattern.col_ptr[leading];
-        let block = SymbolicSparseColMatRef::new_checked(
-            leading,
-            leading,
-            &pattern.col_ptr[..=leading],
-            None,
-            &pattern.row_idx[..nnz],
-        );
-        let mut fwd = vec![0usize; n];
-        let mut inv = vec![0usize; n];
-        let mut mem = MemBuffer::new(faer::sparse::linalg::amd::order_scratch::<usize>(
-            leading, nnz,
-        ));
-        faer::sparse::linalg::amd::order(
-            &mut fwd[..leading],
-            &mut inv[..leading],
-            block,
-            Default::default(),
-            MemStack::new(&mut mem),
-        )
-        .map_err(other)?;
-        for k in leading..n {
-            fwd[k] = k;
-            inv[k] = k;
-        }
-        let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
-        let symbolic = factorize_symbolic_cholesky(
-            pattern.symbolic(),
-            Side::Upper,
-            SymmetricOrdering::Custom(perm),
-            Default::default(),
-        )
-        .map_err(other)?;
-        let last = FactorWork::of(&symbolic);
-        if last.check(limit).is_ok() {
-            return Ok(Ldlt {
-                symbolic: Arc::new(symbolic),
-            });
-        }
-        // multipliers last fill their whole block in when a multiplier couples displacements far
-        // apart (a long interface against a coarse master): eliminate each one right after its
-        // displacements instead
+        // Two orders: each multiplier right after its displacements, and all multipliers last.
+        // Multipliers last fill their whole block in when the multipliers couple displacements
+        // far apart (a long interface: the Schur complement of the displacements on the
+        // multipliers is dense, m(m+1)/2 entries for m multipliers), where the interleaved
+        // order costs far less; with few multipliers, or multipliers of separate small
+        // interfaces, multipliers last costs less. The cheaper of the two is kept. The
+        // multipliers-last analysis itself takes time in proportion to its entries, so it is
+        // skipped when a dense multiplier block alone would outnumber the interleaved factor's
+        // entries (it could not be the cheaper one then unless its block stayed sparse).
         let (fwd, inv) = multipliers_after_their_displacements(pattern, leading)?;
         let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
         let interleaved = factorize_symbolic_cholesky(
@@ -670,16 +698,28 @@ impl Ldlt {
         )
         .map_err(other)?;
         let work = FactorWork::of(&interleaved);
-        if work.check(limit).is_ok() {
+        let m = (n - leading) as f64;
+        let (symbolic, smaller, is_interleaved) = if m * (m + 1.0) / 2.0 > work.entries as f64 {
+            (interleaved, work, true)
+        } else {
+            let last = multipliers_last(pattern, leading)?;
+            let last_work = FactorWork::of(&last);
+            if work.operations < last_work.operations {
+                (interleaved, work, true)
+            } else {
+                (last, last_work, false)
+            }
+        };
+        if smaller.check(limit).is_ok() {
             return Ok(Ldlt {
-                symbolic: Arc::new(interleaved),
+                symbolic: Arc::new(symbolic),
+                fallback: is_interleaved.then(|| Fallback {
+                    leading,
+                    limit: *limit,
+                    last: std::sync::OnceLock::new(),
+                }),
             });
         }
-        let smaller = if work.operations < last.operations {
-            work
-        } else {
-            last
-        };
         Err(FactorError::TooLarge {
             work: smaller,
             limit: *limit,
@@ -700,71 +740,115 @@ impl Ldlt {
         epsilon: f64,
         zero_diagonal_scale: f64,
     ) -> Result<LdltFactor, FactorError> {
-        let mut l = vec![0.0; self.symbolic.len_val()];
-        let par = Par::Seq;
-        let mut mem = MemBuffer::new(
-            self.symbolic
-                .factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
-        );
-        let mat = SparseColMatRef::new(pattern.symbolic(), values);
-        let regularization = faer::linalg::cholesky::ldlt::factor::LdltRegularization {
-            dynamic_regularization_signs: Some(signs),
-            dynamic_regularization_delta: epsilon,
-            dynamic_regularization_epsilon: epsilon,
+        let Some(fallback) = &self.fallback else {
+            return ldlt_numeric(
+                &self.symbolic,
+                pattern,
+                values,
+                signs,
+                epsilon,
+                zero_diagonal_scale,
+            );
         };
-        let sym = &*self.symbolic;
-        sym.factorize_numeric_ldlt(
-            &mut l,
-            mat,
-            Side::Upper,
-            regularization,
-            par,
-            MemStack::new(&mut mem),
-            Default::default(),
-        )
-        .map_err(|e| match e {
-            faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
-                let k = match sym.raw() {
-                    SymbolicCholeskyRaw::Simplicial(_) => index - 1,
-                    SymbolicCholeskyRaw::Supernodal(_) => index,
-                };
-                FactorError::ZeroPivot {
-                    equation: original(sym, k),
-                    ratio: 0.0,
-                    regularized: 0,
-                }
-            }
-        })?;
-        // a replaced pivot holds exactly +-epsilon with its expected sign
-        let diag = diagonal(pattern, values);
-        let d = pivots(sym, &l, false);
-        let scale = |e: usize| {
-            if diag[e] != 0.0 {
-                diag[e].abs()
-            } else {
-                zero_diagonal_scale
-            }
-        };
-        let regularized: Vec<usize> = (0..d.len())
-            .filter(|&k| f64::from(signs[original(sym, k)]) * d[k] <= epsilon)
-            .collect();
-        let tiny = (0..d.len()).find(|&k| {
-            let e = original(sym, k);
-            d[k].is_nan() || d[k].abs() <= TINY_PIVOT * scale(e)
-        });
-        if let Some(k) = regularized.first().copied().or(tiny) {
-            let e = original(sym, k);
-            return Err(FactorError::ZeroPivot {
-                equation: e,
-                ratio: d[k].abs() / scale(e),
-                regularized: regularized.len(),
-            });
+        // once the interleaved order failed, multipliers last
+        if let Some(Ok(last)) = fallback.last.get() {
+            return ldlt_numeric(last, pattern, values, signs, epsilon, zero_diagonal_scale);
         }
-        Ok(LdltFactor {
-            symbolic: self.symbolic.clone(),
-            values: l,
-        })
+        let first = ldlt_numeric(
+            &self.symbolic,
+            pattern,
+            values,
+            signs,
+            epsilon,
+            zero_diagonal_scale,
+        );
+        let Err(FactorError::ZeroPivot { .. }) = &first else {
+            return first;
+        };
+        let last = fallback.last.get_or_init(|| {
+            let symbolic = multipliers_last(pattern, fallback.leading)?;
+            FactorWork::of(&symbolic).check(&fallback.limit)?;
+            Ok(Arc::new(symbolic))
+        });
+        match last {
+            Ok(last) => ldlt_numeric(last, pattern, values, signs, epsilon, zero_diagonal_scale),
+            // multipliers last would exceed the limit: the interleaved order's failure stands
+            Err(_) => first,
+        }
     }
+}
+
+/// The numeric `L D L^T` of `values` with the analysis `symbolic` (see [`Ldlt::factor`]).
+fn ldlt_numeric(
+    symbolic: &Arc<SymbolicCholesky<usize>>,
+    pattern: &SymmetricPattern,
+    values: &[f64],
+    signs: &[i8],
+    epsilon: f64,
+    zero_diagonal_scale: f64,
+) -> Result<LdltFactor, FactorError> {
+    let mut l = vec![0.0; symbolic.len_val()];
+    let par = Par::Seq;
+    let mut mem =
+        MemBuffer::new(symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()));
+    let mat = SparseColMatRef::new(pattern.symbolic(), values);
+    let regularization = faer::linalg::cholesky::ldlt::factor::LdltRegularization {
+        dynamic_regularization_signs: Some(signs),
+        dynamic_regularization_delta: epsilon,
+        dynamic_regularization_epsilon: epsilon,
+    };
+    let sym = &**symbolic;
+    sym.factorize_numeric_ldlt(
+        &mut l,
+        mat,
+        Side::Upper,
+        regularization,
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    )
+    .map_err(|e| match e {
+        faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
+            let k = match sym.raw() {
+                SymbolicCholeskyRaw::Simplicial(_) => index - 1,
+                SymbolicCholeskyRaw::Supernodal(_) => index,
+            };
+            FactorError::ZeroPivot {
+                equation: original(sym, k),
+                ratio: 0.0,
+                regularized: 0,
+            }
+        }
+    })?;
+    // a replaced pivot holds exactly +-epsilon with its expected sign
+    let diag = diagonal(pattern, values);
+    let d = pivots(sym, &l, false);
+    let scale = |e: usize| {
+        if diag[e] != 0.0 {
+            diag[e].abs()
+        } else {
+            zero_diagonal_scale
+        }
+    };
+    let regularized: Vec<usize> = (0..d.len())
+        .filter(|&k| f64::from(signs[original(sym, k)]) * d[k] <= epsilon)
+        .collect();
+    let tiny = (0..d.len()).find(|&k| {
+        let e = original(sym, k);
+        d[k].is_nan() || d[k].abs() <= TINY_PIVOT * scale(e)
+    });
+    if let Some(k) = regularized.first().copied().or(tiny) {
+        let e = original(sym, k);
+        return Err(FactorError::ZeroPivot {
+            equation: e,
+            ratio: d[k].abs() / scale(e),
+            regularized: regularized.len(),
+        });
+    }
+    Ok(LdltFactor {
+        symbolic: symbolic.clone(),
+        values: l,
+    })
 }
 
 impl LdltFactor {
@@ -1082,7 +1166,7 @@ mod tests {
     fn multipliers_beside_their_own_displacements_keep_the_factor_sparse_and_solve() {
         let n = 300;
         let (p, v) = hub_saddle(n);
-        let last = FactorWork::of(&Ldlt::analyse(&p, n, &UNLIMITED).unwrap().symbolic);
+        let last = FactorWork::of(&multipliers_last(&p, n).unwrap());
         // multipliers last: the hub couples them all, their block is dense, m^3/3 and more
         let m = (n - 1) as f64;
         assert!(last.operations >= m * m * m / 3.0, "{last:?}");
@@ -1105,6 +1189,11 @@ mod tests {
         assert!(
             interleaved.operations <= 100.0 * p.n as f64,
             "{interleaved:?}"
+        );
+        // without a limit the analysis keeps the cheaper order
+        assert_eq!(
+            FactorWork::of(&Ldlt::analyse(&p, n, &UNLIMITED).unwrap().symbolic),
+            interleaved
         );
         // under a limit only the interleaved order meets, the analysis takes it and solves
         let limit = WorkLimit {
@@ -1133,6 +1222,39 @@ mod tests {
             Err(FactorError::TooLarge { work, .. }) => assert_eq!(work, interleaved),
             other => panic!("not refused: {:?}", other.map(|_| ())),
         }
+    }
+
+    #[test]
+    fn with_few_multipliers_the_analysis_keeps_the_cheaper_of_the_two_orders() {
+        // a chain of 60 displacements and 2 multipliers tying far-apart pairs of them: both
+        // orders are analysed, and the one kept costs the fewer operations of the two
+        let n = 60;
+        let mut pb = PatternBuilder::new(n + 2);
+        for i in 0..n - 1 {
+            pb.add_block(&[i, i + 1]);
+        }
+        pb.add_block(&[0, n - 1, n]);
+        pb.add_block(&[10, 40, n + 1]);
+        let p = pb.build();
+        let last = FactorWork::of(&multipliers_last(&p, n).unwrap());
+        let (fwd, inv) = multipliers_after_their_displacements(&p, n).unwrap();
+        let perm = faer::perm::PermRef::new_checked(&fwd, &inv, p.n);
+        let interleaved = FactorWork::of(
+            &factorize_symbolic_cholesky(
+                p.symbolic(),
+                Side::Upper,
+                SymmetricOrdering::Custom(perm),
+                Default::default(),
+            )
+            .unwrap(),
+        );
+        let kept = FactorWork::of(&Ldlt::analyse(&p, n, &UNLIMITED).unwrap().symbolic);
+        let cheaper = if interleaved.operations < last.operations {
+            interleaved
+        } else {
+            last
+        };
+        assert_eq!(kept, cheaper, "last {last:?}, interleaved {interleaved:?}");
     }
 
     #[test]
