@@ -326,6 +326,17 @@ case(
     [converged(), load_carried("cylinder", 4.0, 1e-10), {"check": "force_balance", "tol": 1e-10}],
 )
 
+# 9b. a finer cylinder case under a work limit its active set cannot settle within
+c = copy.deepcopy(cyl)
+c["bodies"][0]["mesh"]["block"]["x"]["divisions"] = 200
+c["limits"] = {"iteration_dofs": 2 * 4421}
+case(
+    "curved-master-cylinder-work-limit",
+    "The block on the rigid cylinder with 200 x 10 elements (4,421 free dofs) and limits.iteration_dofs = 8842, two iterations' worth: from the three closest points the block penetrates the cylinder over far more rows than its contact zone, the active set has not settled after two iterations, and the solve stops with `work_limit`, naming the limit and how to raise it (without the limit it converges, see tests/active_set_predictor.rs).",
+    c,
+    [stops("work_limit", "limits.iteration_dofs")],
+)
+
 # 10. a rigid circle much smaller than the slave elements
 c = copy.deepcopy(cyl)
 c["contact"][0]["master"]["rigid"] = {"kind": "circle", "centre": [0, -0.01], "radius": 0.01}

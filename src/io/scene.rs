@@ -177,11 +177,11 @@ pub struct Limits {
     /// the 1.3e11 of the Cholesky factor of the million-dof square in `cases/large`.
     #[serde(default = "default_factor_operations")]
     pub factor_operations: f64,
-    /// The most iterations times dofs one contact iteration loop (the active-set loop of one
-    /// load step and geometry update) may take (default 5,000,000: 11 iterations of the
-    /// 440,000-dof mesh that takes about half a second an iteration on this 2-core machine,
-    /// 200 of a 25,000-dof one). A loop that reaches it stops with `work_limit`, naming this
-    /// limit.
+    /// The most iterations times unknowns one iteration loop may take: the active-set loop of
+    /// one load step and geometry update, or one Newton solve (a load step, a time step);
+    /// default 5,000,000: 11 iterations of the 440,000-dof mesh that takes about half a second
+    /// an iteration on this 2-core machine, 200 of a 25,000-dof one. A loop that reaches it
+    /// stops with `work_limit`, naming this limit.
     #[serde(default = "default_iteration_dofs")]
     pub iteration_dofs: u64,
 }

@@ -1163,6 +1163,7 @@ pub(crate) fn solve_step(
                 RESIDUAL_TOLERANCE
             },
             factor_limit: model.factor_limit,
+            iteration_dofs: model.iteration_dofs,
         },
     )?;
     if model.physics.kinematics == Kinematics::Finite

@@ -872,6 +872,7 @@ fn newton_step(
             max_iterations: model.solver.max_iterations,
             tolerance: super::contact_newton::RESIDUAL_TOLERANCE,
             factor_limit: model.factor_limit,
+            iteration_dofs: model.iteration_dofs,
         },
         linear,
     )?;

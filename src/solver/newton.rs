@@ -125,6 +125,10 @@ pub struct Settings {
     pub tolerance: f64,
     /// The most memory and operations one factorization of the tangent may take.
     pub factor_limit: WorkLimit,
+    /// The most Newton iterations times unknowns of this solve (`limits.iteration_dofs`): the
+    /// solve takes at most `iteration_dofs / unknowns` iterations (at least one) and, when that
+    /// is below `max_iterations` and reached, ends with [`Termination::WorkLimit`].
+    pub iteration_dofs: u64,
 }
 
 /// How a Newton solve ended.
@@ -154,6 +158,8 @@ pub fn solve_with(
     linear: &mut LinearSolver,
 ) -> Result<Outcome> {
     let n = x.len();
+    let affordable = (settings.iteration_dofs / n.max(1) as u64).max(1) as usize;
+    let max_iterations = settings.max_iterations.min(affordable);
     // factoring seconds the solver had before this solve
     let mut base_seconds = linear.seconds;
     let mut version = system.pattern_version();
@@ -237,7 +243,13 @@ pub fn solve_with(
                 "the residual of Newton iteration {solves} is not finite"
             ));
         }
-        if solves >= settings.max_iterations {
+        if solves >= max_iterations {
+            if max_iterations < settings.max_iterations {
+                break Termination::WorkLimit(format!(
+                    "Newton had not converged after {solves} iterations (relative residual {relative:.2e}): {solves} iterations of {n} unknowns reach the work limit of {} iteration-dofs (limits.iteration_dofs); raise \"limits\": {{\"iteration_dofs\": N}} if the machine has the time, use a coarser mesh, or apply the load in more load steps (solver.load_steps)",
+                    settings.iteration_dofs
+                ));
+            }
             break Termination::IterationLimit;
         }
         residual.iter_mut().for_each(|v| *v = -*v);
@@ -519,6 +531,7 @@ mod tests {
             // below what f64 can give: only the floor can end the iteration
             tolerance: 1e-30,
             factor_limit: UNLIMITED,
+            iteration_dofs: u64::MAX,
         };
         let mut x = vec![0.0; 20];
         let plain = solve(&mut cubic(20, 0.5, 0.0), &mut x, settings).unwrap();
@@ -570,6 +583,7 @@ mod tests {
                     max_iterations: 30,
                     tolerance: 1e-14,
                     factor_limit: UNLIMITED,
+                    iteration_dofs: u64::MAX,
                 },
             )
             .unwrap();
@@ -605,6 +619,7 @@ mod tests {
             max_iterations: 10,
             tolerance: 1e-13,
             factor_limit: UNLIMITED,
+            iteration_dofs: u64::MAX,
         };
         let out = solve(&mut s, &mut x, settings).unwrap();
         assert_eq!(out.termination, Termination::Converged);
@@ -636,10 +651,39 @@ mod tests {
                 max_iterations: 2,
                 tolerance: 1e-14,
                 factor_limit: UNLIMITED,
+                iteration_dofs: u64::MAX,
             },
         )
         .unwrap();
         assert_eq!(out.termination, Termination::IterationLimit);
         assert_eq!(out.iterations, 2);
+    }
+
+    #[test]
+    fn the_work_limit_stops_before_the_iteration_limit_and_names_itself() {
+        // 10 unknowns and 35 iteration-dofs: 3 iterations, below the iteration limit of 20
+        let mut s = cubic(10, 50.0, 0.0);
+        let mut x = vec![0.0; 10];
+        let settings = Settings {
+            max_iterations: 20,
+            tolerance: 1e-14,
+            factor_limit: UNLIMITED,
+            iteration_dofs: 35,
+        };
+        let out = solve(&mut s, &mut x, settings).unwrap();
+        assert_eq!(out.iterations, 3);
+        let Termination::WorkLimit(msg) = &out.termination else {
+            panic!("{:?}", out.termination);
+        };
+        assert!(msg.contains("after 3 iterations"), "{msg}");
+        assert!(msg.contains("limits.iteration_dofs"), "{msg}");
+        // with room for the iterations it needs, the same solve converges
+        let mut x = vec![0.0; 10];
+        let roomy = Settings {
+            iteration_dofs: 10 * 20,
+            ..settings
+        };
+        let out = solve(&mut s, &mut x, roomy).unwrap();
+        assert_eq!(out.termination, Termination::Converged);
     }
 }
