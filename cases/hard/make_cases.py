@@ -337,6 +337,18 @@ case(
     [stops("work_limit", "limits.iteration_dofs")],
 )
 
+# 9c. Lagrange-multiplier friction on the Cattaneo-Mindlin cylinder: the semi-smooth Newton
+# iteration cycles between stick and slip sets in the first load step
+c = load("cases/friction-bench/cattaneo-mindlin-L1.json")
+c.pop("checks", None)
+c["contact"][0]["enforcement"] = {"kind": "lagrange"}
+case(
+    "cattaneo-lagrange-friction-cycles",
+    "The Cattaneo-Mindlin cylinder of cases/friction-bench (level 1, 8468 dofs, Coulomb mu = 0.3, Newton scheme) with Lagrange multipliers for both the normal and the tangential force: in the first load step the semi-smooth Newton iteration settles on 13 closed points of which 12 flip between stick and slip at every iteration, the residual repeating at 1.3e-2 with period 2; the solve stops with `active_set_cycling` after the cycle has held for six iterations instead of running to the iteration limit (the penalty Coulomb law of the study converges).",
+    c,
+    [stops("active_set_cycling", "cycles between sets")],
+)
+
 # 10. a rigid circle much smaller than the slave elements
 c = copy.deepcopy(cyl)
 c["contact"][0]["master"]["rigid"] = {"kind": "circle", "centre": [0, -0.01], "radius": 0.01}

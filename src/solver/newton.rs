@@ -65,6 +65,27 @@ pub struct Evaluation {
     pub residual_floor: f64,
 }
 
+/// Iterations over which a cycle must hold before the iteration stops ([`cycle_period`]).
+const CYCLE_ITERATIONS: usize = 6;
+
+/// The period (1 or 2) of a cycle at the end of `history` (relative residual and status
+/// changes of each iteration): in each of the last [`CYCLE_ITERATIONS`] iterations some point
+/// changed status, and the residual equals (to 1e-9 of itself) the one `period` iterations
+/// earlier. A semi-smooth Newton iteration whose sets flip back and forth repeats its iterates
+/// and residuals exactly; one that makes progress does not repeat its residual.
+fn cycle_period(history: &[(f64, usize)]) -> Option<usize> {
+    let n = history.len();
+    if n < CYCLE_ITERATIONS || history[n - CYCLE_ITERATIONS..].iter().any(|h| h.1 == 0) {
+        return None;
+    }
+    (1..=2).find(|&p| {
+        (n - CYCLE_ITERATIONS + p..n).all(|k| {
+            let (a, b) = (history[k].0, history[k - p].0);
+            a.is_finite() && (a - b).abs() <= 1e-9 * a.abs()
+        })
+    })
+}
+
 /// How many unit round-offs of the summed terms' magnitude make the floor of a residual's
 /// evaluation: a sum of `m` terms errs by up to `m eps` of their magnitude (Higham, Accuracy
 /// and Stability of Numerical Algorithms, 2nd ed. 2002, sec. 3.1), typically by about
@@ -173,6 +194,8 @@ pub fn solve_with(
     // factoring time and solver name of the linear solvers of earlier patterns
     let mut earlier_seconds = 0.0;
     let mut last_solver = "none";
+    // relative residual and status changes of each Newton iteration (cycle detection)
+    let mut changing: Vec<(f64, usize)> = Vec::new();
     let termination = loop {
         if system.pattern_version() != version {
             earlier_seconds += linear.seconds - base_seconds;
@@ -226,6 +249,16 @@ pub fn solve_with(
         // an augmentation (Uzawa) moves multipliers: the next evaluation does not augment again
         // and is always followed by a Newton step
         let converged = small && eval.status_changes == 0 && !augmented;
+        if solves > 0 && !augmented {
+            changing.push((relative, eval.status_changes));
+            if let Some(period) = cycle_period(&changing) {
+                break Termination::ActiveSetCycling(format!(
+                    "Newton iteration {solves} repeats the residual {relative:.3e} of iteration {} while {} contact point(s) change status at every iteration (open, closed, stick or slip): the semi-smooth Newton iteration cycles between sets, none of which is the solution; apply the load in more load steps (solver.load_steps), or for friction use a tangential penalty (penalty or augmented Lagrangian enforcement with kappa_t), whose return map is continuous in the slip",
+                    solves - period,
+                    eval.status_changes
+                ));
+            }
+        }
         if solves > 0 && !augmented && system.augment(x, converged) {
             augmented = true;
             augmentations += 1;
@@ -657,6 +690,28 @@ mod tests {
         .unwrap();
         assert_eq!(out.termination, Termination::IterationLimit);
         assert_eq!(out.iterations, 2);
+    }
+
+    #[test]
+    fn a_cycle_is_a_residual_that_repeats_while_statuses_change() {
+        // period 2: the residual alternates, points flip at every iteration
+        let two: Vec<(f64, usize)> = (0..8)
+            .map(|k| (if k % 2 == 0 { 1.3e-2 } else { 2.7e-3 }, 12))
+            .collect();
+        assert_eq!(cycle_period(&two), Some(2));
+        // period 1: the same residual each time
+        assert_eq!(cycle_period(&[(5e-3, 3); 6]), Some(1));
+        // one iteration too few, or an iteration that changed no status: no verdict
+        assert_eq!(cycle_period(&two[..5]), None);
+        let mut calm = two.clone();
+        calm[5].1 = 0;
+        assert_eq!(cycle_period(&calm), None);
+        // a converging iteration changes its residual
+        let converging: Vec<(f64, usize)> = (0..8).map(|k| (0.5f64.powi(k), 2)).collect();
+        assert_eq!(cycle_period(&converging), None);
+        // a residual that differs by more than 1e-9 of itself is not a repeat
+        let drifting: Vec<(f64, usize)> = (0..8).map(|k| (1.0 + 1e-8 * k as f64, 4)).collect();
+        assert_eq!(cycle_period(&drifting), None);
     }
 
     #[test]
