@@ -667,8 +667,8 @@ impl Ldlt {
     /// `leading` on): "AMD of the leading `leading x leading` block, then the multipliers in
     /// order", whose pivots have their expected signs exactly when the rows are independent,
     /// or each multiplier right after one of its displacements
-    /// ([`multipliers_after_their_displacements`]), with multipliers last as the fallback of
-    /// a pivot failure ([`Fallback`]). A factor whose work exceeds `limit` is
+    /// (`multipliers_after_their_displacements`), with multipliers last as the fallback of a
+    /// pivot failure (`Fallback`). A factor whose work exceeds `limit` is
     /// [`FactorError::TooLarge`].
     pub fn analyse(
         pattern: &SymmetricPattern,
