@@ -607,3 +607,100 @@ fn the_impact_studies_refuse_cases_they_cannot_measure() {
         .to_string();
     assert!(e.contains("striker bar"), "{e}");
 }
+
+/// Coulomb friction in time (`cases/dynamics/sliding-block-friction-*.json`): a block sliding
+/// on a rigid floor under a suddenly applied pressure P = 1. Every closed point slips against
+/// the motion in every step, so the friction force is `-mu` times the normal force, and
+/// Newmark's momentum balance `M (v_{n+1} - v_n) = dt ((1 - gamma) F_n + gamma F_{n+1})`
+/// summed over the steps gives `p_x(T) - p_x(0) = -mu (p_y(T) - p_y(0) + P T)` (the contact
+/// forces are zero at t = 0). Both enforcements meet it to round-off; friction only removes
+/// energy; the block slows; the tangential force of the last step is `-mu` times the normal
+/// one and every closed point slips; and the friction survives only where it can be
+/// integrated (the explicit member, the contact-stabilized projection and the
+/// augmented Lagrangian are refused with the reason).
+#[test]
+fn a_block_sliding_on_a_rigid_floor_loses_momentum_to_coulomb_friction() {
+    let (mu, load, end) = (0.3, 1.0, 0.5);
+    for name in ["lagrange", "penalty"] {
+        let v = read(&format!(
+            "cases/dynamics/sliding-block-friction-{name}.json"
+        ));
+        let case = parse(&v.to_string(), "sliding").unwrap();
+        let model = admit(Model::build(&case, "sliding").unwrap()).unwrap();
+        let solution = contact_patch::solver::solve_static(&model, &mut |_| {}).unwrap();
+        let steps = &solution.dynamics.as_ref().unwrap().steps;
+        let (first, last) = (&steps[0], steps.last().unwrap());
+        assert!((last.time - end).abs() < 1e-12);
+        let dpx = last.momentum[0] - first.momentum[0];
+        let dpy = last.momentum[1] - first.momentum[1];
+        let expected = -mu * (dpy + load * end);
+        assert!(
+            (dpx - expected).abs() <= 1e-10 * expected.abs(),
+            "{name}: dp_x {dpx} against -mu (dp_y + P T) {expected}"
+        );
+        // slowed, but by less than a rigid block's mu P T (the friction moment lifts the
+        // trailing edge, and the normal force oscillates)
+        assert!(last.momentum[0] > 0.5 - mu * load * end && last.momentum[0] < 0.4);
+        // friction removes energy: the total never grows
+        for w in steps.windows(2) {
+            assert!(
+                w[1].total <= w[0].total + 1e-12 * first.total,
+                "{name}: energy grew at t = {}",
+                w[1].time
+            );
+        }
+        // the last step: every closed point slips, the tangential force is -mu N
+        let state = solution.contact.as_ref().unwrap();
+        let points: Vec<_> = state
+            .friction
+            .iter()
+            .zip(&state.active)
+            .filter(|(_, &a)| a)
+            .map(|(f, _)| f.expect("a frictional row"))
+            .collect();
+        assert!(!points.is_empty());
+        for p in &points {
+            assert_eq!(
+                p.status,
+                contact_patch::contact::friction::Status::Slip,
+                "{name}"
+            );
+            // the force on the slave along x (the tangent's direction may point either way)
+            let fx = p.force * p.direction[0];
+            assert!(
+                fx < 0.0 && (p.force.abs() - mu * p.normal_force).abs() <= 1e-12 * p.normal_force,
+                "{name}: lambda_t {} along {:?}, lambda_n {}",
+                p.force,
+                p.direction,
+                p.normal_force
+            );
+            assert!(
+                p.dissipation >= 0.0,
+                "{name}: dissipation {}",
+                p.dissipation
+            );
+        }
+        // equilibrium with the inertia and both contact forces
+        assert!(
+            solution.relative_residual <= 1e-10,
+            "{name}: {}",
+            solution.relative_residual
+        );
+    }
+    let base = read("cases/dynamics/sliding-block-friction-penalty.json");
+    let mut v = base.clone();
+    v["physics"]["dynamics"]["integrator"] = json!("central_difference");
+    let e = build_error(&v);
+    assert!(
+        e.contains("contact[0] 'floor'") && e.contains("implicit integrator"),
+        "{e}"
+    );
+    let mut v = base.clone();
+    v["physics"]["dynamics"]["impact"] = json!("contact_stabilized");
+    let e = build_error(&v);
+    assert!(e.contains("contact-stabilized projection"), "{e}");
+    let mut v = base.clone();
+    v["contact"][0]["enforcement"] = json!({"kind": "augmented_lagrange", "kappa": 1e5});
+    let e = build_error(&v);
+    assert!(e.contains("contact[0] 'floor'.enforcement"), "{e}");
+}

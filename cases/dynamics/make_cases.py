@@ -119,3 +119,47 @@ def block_drop(name, discretization, rigid=False):
 write(block_drop("block-drop-node-to-surface", {"kind": "node_to_surface", "passes": 1}))
 write(block_drop("block-drop-mortar", {"kind": "mortar"}))
 write(block_drop("block-drop-rigid", {"kind": "node_to_surface", "passes": 1}, rigid=True))
+
+
+def sliding_block(name, enforcement, interaction):
+    """A block sliding on a rigid floor under a suddenly applied pressure, Coulomb friction."""
+    how = ("Lagrange multipliers for the normal and the tangential force" if enforcement["kind"] == "lagrange"
+           else f"penalty kappa = {enforcement['kappa']:g}, kappa_t = {interaction['coulomb']['kappa_t']:g}")
+    return {
+        "$schema": "../case.schema.json",
+        "name": name,
+        "description": "A block [0, 1] x [0, 1] (Q4 4 x 4, E = 100, nu = 0.3, rho = 1, plane strain) "
+                       "resting on a rigid floor (the line y = 0) slides at v = (0.5, 0) under a "
+                       "pressure p = 1 on its top applied at t = 0; Coulomb friction mu = 0.3 "
+                       f"({how}), average acceleration, dt = 0.01 to t = 0.5, plain impact "
+                       "treatment. Every closed point slips backwards against the motion, so "
+                       "the friction force is -mu times the normal force at every step and "
+                       "Newmark's momentum balance gives p_x(T) - p_x(0) = -mu (p_y(T) - p_y(0) + P T) "
+                       "with P = 1 the total load (tests/dynamics.rs, to round-off); the block "
+                       "slows from p_x = 0.5 to about 0.357 (a rigid block would reach "
+                       "0.5 - mu P T = 0.35) and the friction moment lifts its trailing edge.",
+        "analysis": {"plane": "strain", "thickness": 1.0},
+        "materials": {"m": {"E": 100.0, "nu": 0.3, "density": 1.0}},
+        "bodies": [{"name": "block", "material": "m",
+                    "mesh": {"block": {"element": "Q4", "x": {"from": 0.0, "to": 1.0, "divisions": 4},
+                                       "y": {"from": 0.0, "to": 1.0, "divisions": 4}}}}],
+        "supports": [],
+        "loads": [{"body": "block", "set": "top", "pressure": 1.0}],
+        "physics": {"dynamics": {"integrator": "average_acceleration", "dt": 0.01, "end_time": 0.5,
+                                 "mass": "lumped", "impact": "plain",
+                                 "initial_velocity": [{"body": "block", "velocity": [0.5, 0.0]}]}},
+        "contact": [{"name": "floor", "slave": {"body": "block", "set": "bottom"},
+                     "master": {"rigid": {"kind": "line", "point": [0.0, 0.0], "normal": [0.0, 1.0]}},
+                     "discretization": {"kind": "node_to_surface", "passes": 1},
+                     "enforcement": enforcement, "interaction": interaction}],
+        "solver": {"scheme": "newton"},
+        # dynamic equilibrium K d - f - B^T lambda - T^T lambda_t + M a = 0 at the last step;
+        # Lagrange multipliers let no node penetrate, the penalty lets it by about N / kappa
+        "checks": [{"check": "equilibrium", "tol": 1e-11},
+                   {"check": "max_penetration",
+                    "share": 1e-12 if enforcement["kind"] == "lagrange" else 1e-4}],
+    }
+
+write(sliding_block("sliding-block-friction-lagrange", {"kind": "lagrange"}, {"coulomb": {"mu": 0.3}}))
+write(sliding_block("sliding-block-friction-penalty", {"kind": "penalty", "kappa": 1e5},
+                    {"coulomb": {"mu": 0.3, "kappa_t": 1e5}}))

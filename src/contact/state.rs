@@ -66,23 +66,31 @@ impl ContactState {
         &self,
     ) -> std::collections::HashMap<crate::contact::RowKey, crate::contact::friction::Committed>
     {
-        self.rows
-            .iter()
-            .zip(&self.friction)
-            .filter_map(|(r, f)| {
-                f.map(|f| {
-                    (
-                        crate::contact::row_key(r),
-                        crate::contact::friction::Committed {
-                            slip: f.plastic_slip,
-                            normal_force: f.normal_force,
-                            tangential_force: f.force,
-                        },
-                    )
-                })
-            })
-            .collect()
+        committed_history(&self.rows, &self.friction)
     }
+}
+
+/// The committed slip and the forces of every frictional point of `rows` (`friction` aligned
+/// with them) at the end of a step, by point.
+pub(crate) fn committed_history(
+    rows: &[crate::contact::Constraint],
+    friction: &[Option<crate::contact::friction::FrictionPoint>],
+) -> std::collections::HashMap<crate::contact::RowKey, crate::contact::friction::Committed> {
+    rows.iter()
+        .zip(friction)
+        .filter_map(|(r, f)| {
+            f.map(|f| {
+                (
+                    crate::contact::row_key(r),
+                    crate::contact::friction::Committed {
+                        slip: f.plastic_slip,
+                        normal_force: f.normal_force,
+                        tangential_force: f.force,
+                    },
+                )
+            })
+        })
+        .collect()
 }
 
 /// One converged (or stopped) load step.

@@ -140,11 +140,34 @@ pub fn resolve(case: &Case, model: &Model) -> Result<Option<Dynamics>> {
     for (k, pair) in model.contact.iter().enumerate() {
         let at = format!("contact[{k}] '{}'", pair.name);
         if matches!(pair.interaction, Interaction::Coulomb { .. }) {
-            return Err(invalid(
-                &at,
-                "Coulomb friction is not integrated in time yet".into(),
-                "use \"interaction\": \"frictionless\" or \"tied\" in a dynamic run",
-            ));
+            // the frictional history is committed after every time step, as after a load step;
+            // the explicit member has no Newton solve to return-map in, the contact-stabilized
+            // projection has no tangential rows, and the augmented and perturbed forms keep
+            // per-step state of their own that is not carried across time steps (yet)
+            if beta == 0.0 {
+                return Err(invalid(
+                    &at,
+                    "Coulomb friction in time needs an implicit integrator (the return map runs in the Newton solve of each step)".into(),
+                    "use \"integrator\": \"average_acceleration\", or a frictionless interaction",
+                ));
+            }
+            if spec.impact == ImpactTreatment::ContactStabilized {
+                return Err(invalid(
+                    &at,
+                    "the contact-stabilized projection holds the normal contact only; with Coulomb friction it would project without the tangential forces".into(),
+                    "use \"impact\": \"plain\" or \"post_impact\" with friction",
+                ));
+            }
+            if !matches!(
+                pair.enforcement,
+                EnforcementSpec::Penalty { .. } | EnforcementSpec::Lagrange
+            ) {
+                return Err(invalid(
+                    &format!("{at}.enforcement"),
+                    "Coulomb friction in time is integrated with penalty or Lagrange-multiplier enforcement; the other forms keep per-step multipliers that are not carried across time steps".into(),
+                    "use {\"kind\": \"penalty\", \"kappa\": ..} (with \"kappa_t\" in the Coulomb interaction if wanted) or {\"kind\": \"lagrange\"}",
+                ));
+            }
         }
         if beta == 0.0 && !matches!(pair.enforcement, EnforcementSpec::Penalty { .. }) {
             return Err(invalid(

@@ -705,6 +705,18 @@ impl ContactSystem<'_> {
         let (active, forces, gaps, _) = self.state(x);
         (active, forces, gaps)
     }
+
+    /// The frictional points at the unknowns `x` (`None` for a frictionless row).
+    pub(crate) fn friction_state(&self, x: &[f64]) -> Vec<Option<FrictionPoint>> {
+        self.state(x).3
+    }
+
+    /// Commit the frictional history of `friction` (the points at the end of a converged time
+    /// step): each point's plastic slip or stick position and its forces become what the next
+    /// step starts from, as between load steps ([`ContactState::friction_history`]).
+    pub(crate) fn commit_friction(&mut self, friction: &[Option<FrictionPoint>]) {
+        self.committed = crate::contact::state::committed_history(&self.rows, friction);
+    }
 }
 
 impl System for ContactSystem<'_> {

@@ -19,6 +19,14 @@
 //! contact): `d_{n+1} = d~`, `a_{n+1} = M^-1 (f - K d_{n+1} + B^T lambda(d_{n+1}))`.
 //! `a_0 = M^-1 (f - K d_0)`: the bodies start undeformed, contact forces zero.
 //!
+//! **Coulomb friction** (implicit, `plain` or `post_impact`, penalty or Lagrange multipliers;
+//! [`crate::model::dynamics`] refuses the rest): each step's Newton solve runs the return map of
+//! [`crate::contact::friction`] against the slip history committed after the last step, as a
+//! load step does against the last load step; the step's frictional points are then committed
+//! (`ContactSystem::commit_friction`) and their tangential forces enter the reported
+//! equilibrium. With every closed point slipping one way, Newmark's momentum balance gives
+//! `Delta p_t = -mu (Delta p_n + P T)` over the steps (the contact forces are zero at `t = 0`).
+//!
 //! **Impact and release.** At impact plain Newmark leaves the two nodes of a contacting pair with
 //! different velocities and accelerations (Taylor 2004, "1974-77: The Foundations": "this
 //! violates the physics"; Hughes, Taylor, Sackman, Curnier & Kanoknukulchai, CMAME 8 (1976)
@@ -270,6 +278,8 @@ struct Integrator<'a> {
     x: Vec<f64>,
     /// Row forces (after the treatment) of the last step.
     forces: Vec<f64>,
+    /// The frictional points at the end of the last step (`None` for frictionless rows).
+    friction: Vec<Option<crate::contact::friction::FrictionPoint>>,
     timings: Timings,
     history: Vec<StepRecord>,
     frames: Vec<(f64, Vec<f64>)>,
@@ -358,6 +368,7 @@ impl<'a> Integrator<'a> {
             v,
             x: vec![0.0; n_unknowns],
             forces: vec![0.0; rows],
+            friction: vec![None; rows],
             timings,
             history: Vec::new(),
             frames: Vec::new(),
@@ -417,6 +428,11 @@ impl<'a> Integrator<'a> {
             let iterations = self.step(step, time)?;
             self.iterations += iterations;
             let (active, mut forces, _) = self.system.row_state(&self.x);
+            // the step's frictional points, and their history committed for the next step
+            self.friction = self.system.friction_state(&self.x);
+            if self.friction.iter().any(Option::is_some) {
+                self.system.commit_friction(&self.friction);
+            }
             let active_rows: Vec<usize> = (0..active.len()).filter(|&i| active[i]).collect();
             let jumps_before = (
                 self.largest_rate(&active_rows, &self.v),
@@ -776,9 +792,20 @@ impl<'a> Integrator<'a> {
         let model = self.model;
         let (active, _, gaps) = self.system.row_state(&self.x);
         let mut contact_force = vec![0.0; model.dof_count];
-        for (r, f) in self.system.rows().iter().zip(&self.forces) {
+        for ((r, f), fr) in self
+            .system
+            .rows()
+            .iter()
+            .zip(&self.forces)
+            .zip(&self.friction)
+        {
             for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
                 contact_force[d] += c * f;
+            }
+            if let (Some(t), Some(fr)) = (&r.tangent, fr) {
+                for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
+                    contact_force[d] += c * fr.force;
+                }
             }
         }
         // dynamic equilibrium: K d - f - B^T lambda + M a = 0 at the free dofs
@@ -811,7 +838,7 @@ impl<'a> Integrator<'a> {
                 steps: Vec::new(),
                 history: Vec::new(),
                 geometry_changes: Vec::new(),
-                friction: vec![None; self.system.rows().len()],
+                friction: self.friction.clone(),
             });
         }
         let dyn_ = self.dynamics;
