@@ -136,6 +136,12 @@ pub trait System {
     fn augment(&mut self, _x: &[f64], _converged: bool) -> bool {
         false
     }
+    /// When the iteration cycles ([`cycle_period`]): change what steers the path without
+    /// changing the solution, and say what was changed (`None`: nothing left to change; the
+    /// solve then stops with [`Termination::ActiveSetCycling`]).
+    fn remedy_cycle(&mut self) -> Option<String> {
+        None
+    }
 }
 
 /// Limits and tolerance of one Newton solve.
@@ -196,6 +202,8 @@ pub fn solve_with(
     let mut last_solver = "none";
     // relative residual and status changes of each Newton iteration (cycle detection)
     let mut changing: Vec<(f64, usize)> = Vec::new();
+    // what the system changed to leave a cycle ([`System::remedy_cycle`])
+    let mut remedies: Vec<String> = Vec::new();
     let termination = loop {
         if system.pattern_version() != version {
             earlier_seconds += linear.seconds - base_seconds;
@@ -252,11 +260,22 @@ pub fn solve_with(
         if solves > 0 && !augmented {
             changing.push((relative, eval.status_changes));
             if let Some(period) = cycle_period(&changing) {
-                break Termination::ActiveSetCycling(format!(
-                    "Newton iteration {solves} repeats the residual {relative:.3e} of iteration {} while {} contact point(s) change status at every iteration (open, closed, stick or slip): the semi-smooth Newton iteration cycles between sets, none of which is the solution; apply the load in more load steps (solver.load_steps), or for friction use a tangential penalty (penalty or augmented Lagrangian enforcement with kappa_t), whose return map is continuous in the slip",
-                    solves - period,
-                    eval.status_changes
-                ));
+                if let Some(what) = system.remedy_cycle() {
+                    // a new path from this iterate: the cycle must show itself again
+                    remedies.push(what);
+                    changing.clear();
+                } else {
+                    let tried = if remedies.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" (after {})", remedies.join(", then "))
+                    };
+                    break Termination::ActiveSetCycling(format!(
+                        "Newton iteration {solves} repeats the residual {relative:.3e} of iteration {} while {} contact point(s) change status at every iteration (open, closed, stick or slip){tried}: the semi-smooth Newton iteration cycles between sets, none of which is the solution; apply the load in more load steps (solver.load_steps), or for friction use a tangential penalty (penalty or augmented Lagrangian enforcement with kappa_t), whose return map is continuous in the slip",
+                        solves - period,
+                        eval.status_changes
+                    ));
+                }
             }
         }
         if solves > 0 && !augmented && system.augment(x, converged) {
