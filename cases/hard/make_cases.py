@@ -349,6 +349,18 @@ case(
     [converged(), {"check": "equilibrium", "tol": 1e-10}, {"check": "max_penetration", "share": 1e-12}],
 )
 
+# 9d. the same with a vanishing friction coefficient: every closed point slips with a force of
+# round-off size, whose direction must not count as a change of status
+c = load("cases/friction-bench/cattaneo-mindlin-L1.json")
+c["contact"][0]["enforcement"] = {"kind": "lagrange"}
+c["contact"][0]["interaction"]["coulomb"]["mu"] = 1e-300
+case(
+    "cattaneo-lagrange-friction-vanishing-mu",
+    "The Cattaneo-Mindlin cylinder with Lagrange friction and mu = 1e-300: every closed point slips with |lambda_t| = mu lambda_n, zero to round-off, and the direction of such a slip flips with the round-off of the slip itself; a reversal of a slip whose force is below the force tolerance is not a change of status, so each step converges (5 and 2 iterations; it ran to the iteration limit when it counted) to the frictionless answer, with no tangential force on the pair.",
+    c,
+    [converged(), {"check": "contact_force", "pair": "interface", "component": "x", "value": 0.0, "tol": 1e-12}, {"check": "equilibrium", "tol": 1e-10}],
+)
+
 # 10. a rigid circle much smaller than the slave elements
 c = copy.deepcopy(cyl)
 c["contact"][0]["master"]["rigid"] = {"kind": "circle", "centre": [0, -0.01], "radius": 0.01}
