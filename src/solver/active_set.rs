@@ -1979,13 +1979,8 @@ impl Kernel<'_> {
                     .zip(&active)
                     .filter(|(a, b)| a != b)
                     .count(),
-                max_gap_violation: (0..nrows)
-                    .filter(|&i| !rows[i].bilateral)
-                    .fold(0.0f64, |m, i| m.max(-gaps[i])),
-                multiplier_change: forces
-                    .iter()
-                    .zip(&previous_forces)
-                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())),
+                max_gap_violation: largest_penetration(rows, &gaps),
+                multiplier_change: largest_change(&forces, &previous_forces),
                 linear_solver: self.linear_solver,
                 condition_estimate: self.condition,
                 seconds: iteration_start.elapsed().as_secs_f64(),
@@ -2159,13 +2154,8 @@ impl Kernel<'_> {
                     residual: self.equilibrium_residual(&x, &forces, &active),
                     active: active.iter().filter(|&&a| a).count(),
                     status_changes: changes,
-                    max_gap_violation: (0..nrows)
-                        .filter(|&i| !rows[i].bilateral)
-                        .fold(0.0f64, |m, i| m.max(-gaps[i])),
-                    multiplier_change: forces
-                        .iter()
-                        .zip(&previous_forces)
-                        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())),
+                    max_gap_violation: largest_penetration(rows, &gaps),
+                    multiplier_change: largest_change(&forces, &previous_forces),
                     linear_solver: "penalty-predictor",
                     condition_estimate: self.condition,
                     seconds: iteration_start.elapsed().as_secs_f64(),
@@ -2191,6 +2181,22 @@ impl Kernel<'_> {
         }
         (active, used)
     }
+}
+
+/// The largest penetration `-g` over the contact rows (ties excluded) of an iteration.
+fn largest_penetration(rows: &[Constraint], gaps: &[f64]) -> f64 {
+    rows.iter()
+        .zip(gaps)
+        .filter(|(r, _)| !r.bilateral)
+        .fold(0.0f64, |m, (_, g)| m.max(-g))
+}
+
+/// The largest change of a row force between two iterations.
+fn largest_change(forces: &[f64], previous: &[f64]) -> f64 {
+    forces
+        .iter()
+        .zip(previous)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
 }
 
 /// Minimum-norm solution of the symmetric positive semi-definite system `S x = r` (`m x m`,

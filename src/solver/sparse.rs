@@ -740,31 +740,27 @@ impl Ldlt {
         epsilon: f64,
         zero_diagonal_scale: f64,
     ) -> Result<LdltFactor, FactorError> {
-        let Some(fallback) = &self.fallback else {
-            return ldlt_numeric(
-                &self.symbolic,
-                pattern,
-                values,
-                signs,
-                epsilon,
-                zero_diagonal_scale,
-            );
-        };
         // once the interleaved order failed, multipliers last
-        if let Some(Ok(last)) = fallback.last.get() {
-            return ldlt_numeric(last, pattern, values, signs, epsilon, zero_diagonal_scale);
-        }
+        let fell_back = self
+            .fallback
+            .as_ref()
+            .and_then(|f| f.last.get())
+            .and_then(|last| last.as_ref().ok());
+        let symbolic = fell_back.unwrap_or(&self.symbolic);
         let first = ldlt_numeric(
-            &self.symbolic,
+            symbolic,
             pattern,
             values,
             signs,
             epsilon,
             zero_diagonal_scale,
         );
-        let Err(FactorError::ZeroPivot { .. }) = &first else {
+        let Some(fallback) = &self.fallback else {
             return first;
         };
+        if fell_back.is_some() || !matches!(first, Err(FactorError::ZeroPivot { .. })) {
+            return first;
+        }
         let last = fallback.last.get_or_init(|| {
             let symbolic = multipliers_last(pattern, fallback.leading)?;
             FactorWork::of(&symbolic).check(&fallback.limit)?;
