@@ -2082,12 +2082,15 @@ impl Kernel<'_> {
     /// A penalty regularization spreads the tension of a too-large set over many rows and
     /// sheds them together. The predictor solves `(K + sum_active w_i b_i b_i^T) u = f -
     /// sum_active w_i g0_i b_i` with the rule "active while the trial force `-w_i g_i` is
-    /// compressive", from `start` until the set is stable, at weights `w_i = theta rho` for
-    /// `theta` in 1e-3, 1e-2, 1e-1, 1 (`rho` the stiffness scale); each stiffer level starts
-    /// from the set of the softer one and its zone is closer to the Lagrange one. Its
-    /// iterations are recorded in the history (linear solver `penalty-predictor`) and count
-    /// against `solver.max_iterations`; it returns the set and the number of iterations it
-    /// took. A step that fails (a singular system) ends it with the last set.
+    /// compressive", from `start`, at weights `w_i = kappa A_i` with `kappa = E / L` (the
+    /// largest Young's modulus over the model size) and [`PREDICTOR_STEP`] times stiffer per
+    /// level, up to the level whose largest weight reaches the stiffness scale `rho`; each level
+    /// starts from the set of the one before, hands it on once at most one in
+    /// [`PREDICTOR_SETTLED`] active rows changes (the last level: none), and its zone is closer
+    /// to the Lagrange one. Its iterations are recorded in the history (linear solver
+    /// `penalty-predictor`, no condition estimate: its systems are never the answer's) and count
+    /// against the loop's iteration limit `max_iterations`; it returns the set and the number of
+    /// iterations it took. A step that fails (a singular system) ends it with the last set.
     fn penalty_predictor(
         &mut self,
         start: Vec<bool>,
@@ -2104,7 +2107,7 @@ impl Kernel<'_> {
         set
     }
 
-    /// The levels of [`Kernel::penalty_predictor`].
+    /// The levels of [`Kernel::penalty_predictor`] (its early returns leave the flags to it).
     fn predictor_levels(
         &mut self,
         start: Vec<bool>,
