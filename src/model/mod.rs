@@ -1058,17 +1058,19 @@ impl Model {
             if newton
                 && !matches!(
                     family_of(&spec.enforcement),
-                    Family::PenaltyRegularized | Family::LagrangeMultipliers
+                    Family::PenaltyRegularized
+                        | Family::LagrangeMultipliers
+                        | Family::PerturbedTangent
                 )
             {
                 return Err(Error::invalid(
                     &self.source,
                     format!("{at}.enforcement"),
                     format!(
-                        "the Newton scheme (solver.scheme \"newton\") solves penalty-type methods and Lagrange multipliers, not {}",
+                        "the Newton scheme (solver.scheme \"newton\") solves penalty-type methods, the perturbed tangent and Lagrange multipliers, not {}",
                         family_of(&spec.enforcement).describe()
                     ),
-                    "use penalty, the perturbed Lagrangian, the augmented Lagrangian or Lagrange multipliers, or solver.scheme \"active_set\"",
+                    "use penalty, the perturbed Lagrangian, the augmented Lagrangian, the perturbed tangent or Lagrange multipliers, or solver.scheme \"active_set\"",
                 ));
             }
             if newton && newton_mortar_obstacle(&spec.enforcement, &spec.discretization) {
@@ -1090,7 +1092,7 @@ impl Model {
                             first.name,
                             a.describe()
                         ),
-                        "methods of one family combine, a method per pair: penalty, perturbed Lagrangian and augmented Lagrangian; Lagrange multipliers, the perturbed tangent and constraint elimination each only with themselves (with solver.scheme \"newton\", Lagrange multipliers and penalty-type methods combine too)",
+                        "methods of one family combine, a method per pair: penalty, perturbed Lagrangian and augmented Lagrangian; Lagrange multipliers, the perturbed tangent and constraint elimination each only with themselves (with solver.scheme \"newton\", Lagrange multipliers, the perturbed tangent and penalty-type methods combine too)",
                     ));
                 }
             }
@@ -1324,7 +1326,8 @@ impl Model {
 }
 
 /// A Coulomb pair: its parameters, and what this slice of friction solves (the Newton scheme,
-/// penalty-type normal laws or Lagrange multipliers, the reference geometry).
+/// penalty-type normal laws, the perturbed tangent or Lagrange multipliers, the reference
+/// geometry).
 fn validate_coulomb(
     case: &Case,
     spec: &crate::io::scene::ContactSpec,
@@ -1412,8 +1415,8 @@ pub struct CoulombObstacle {
     pub fix: String,
 }
 
-/// What this slice of friction solves: the Newton scheme, penalty-type normal laws or Lagrange
-/// multipliers, the
+/// What this slice of friction solves: the Newton scheme, penalty-type normal laws (penalty,
+/// perturbed Lagrangian, augmented Lagrangian, perturbed tangent) or Lagrange multipliers, the
 /// reference geometry; every discretization (node-to-node, node-to-surface one- and two-pass
 /// with master or slave normals, rigid masters, standard and dual mortar with the weighted
 /// tangential slip). `None` when the combination is solved;
@@ -1446,27 +1449,21 @@ pub fn coulomb_obstacle(
             "use Lagrange multipliers (the same exact stick and slip) or the augmented Lagrangian for this pair",
         );
     }
-    if matches!(enforcement, EnforcementSpec::PerturbedTangent { .. }) {
-        return obstacle(
-            "enforcement",
-            "Coulomb friction with the perturbed tangent is not built yet (its multiplier update from the residual has no tangential counterpart here)",
-            "use the augmented Lagrangian (the same exact limit with a penalty-stiffened tangent) or Lagrange multipliers for this pair",
-        );
-    }
     if !matches!(
         enforcement,
         EnforcementSpec::Penalty { .. }
             | EnforcementSpec::PerturbedLagrange { .. }
             | EnforcementSpec::AugmentedLagrange { .. }
+            | EnforcementSpec::PerturbedTangent { .. }
             | EnforcementSpec::Lagrange
     ) {
         return obstacle(
             "enforcement",
             &format!(
-                "Coulomb friction needs the penalty, the perturbed Lagrangian, the augmented Lagrangian or Lagrange multipliers as normal law, not {}",
+                "Coulomb friction needs the penalty, the perturbed Lagrangian, the augmented Lagrangian, the perturbed tangent or Lagrange multipliers as normal law, not {}",
                 crate::contact::enforcement::method(enforcement).name()
             ),
-            "use the penalty, the perturbed Lagrangian, the augmented Lagrangian or Lagrange multipliers for this pair",
+            "use the penalty, the perturbed Lagrangian, the augmented Lagrangian, the perturbed tangent or Lagrange multipliers for this pair",
         );
     }
     if geometry != crate::io::scene::ContactGeometry::Reference {

@@ -1,7 +1,7 @@
-//! Frictionless contact as a [`System`] for the Newton core ([`super::newton`]):
-//! `solver.scheme: "newton"`, for penalty-type rows (penalty, perturbed Lagrangian with its
-//! diagonal perturbation, augmented Lagrangian) and Lagrange-multiplier rows, mixed freely
-//! pair by pair.
+//! Contact as a [`System`] for the Newton core ([`super::newton`]): `solver.scheme:
+//! "newton"`, for penalty-type rows (penalty, perturbed Lagrangian with its diagonal
+//! perturbation, augmented Lagrangian, perturbed tangent) and Lagrange-multiplier rows, mixed
+//! freely pair by pair, frictionless or with Coulomb friction.
 //!
 //! Unknowns: the free displacements `x` (prescribed values folded in, [`LinearSystem`]). Each
 //! contact row `i` (a [`Constraint`]: gap `g_i(u)`, gradient `b_i`, tributary area `A_i`) with
@@ -23,6 +23,23 @@
 //! iteration or, in an outer loop, after Newton has converged ([`MultiplierUpdate`]), until
 //! every update is negligible (`|w_i g_i| <= 1e-12` of the largest force, or the gap is at the
 //! round-off floor `1e-15` of the model size), the stopping rule of the active-set scheme.
+//!
+//! **The perturbed tangent** (Lim & Taylor 2001; Taylor 2004, "1985: Solution Methods") keeps
+//! the Lagrange residual (`R_u = K x - f - lambda b`, `g = 0`) and linearizes it with the
+//! perturbed Lagrangian's tangent, the diagonal `-1/w` in the multiplier's equation:
+//! `b . dx + d lambda / w = -g_k`. Eliminating `d lambda = -w (g_k + b . dx)` leaves
+//! `(K + w b b^T) dx = -(K x_k - f - (lambda_k - w g_k) b)`, the Newton step of the law
+//! `lambda = lambda_k - w g(x)` from `x_k`, followed by `lambda_{k+1} = lambda_k - w (g_k + b .
+//! dx)`, which is `lambda_k - w g(x_{k+1})` for our rows (their gap is linear in `u` about the
+//! point they were built at). That is the augmented Lagrangian with its Uzawa update after
+//! every iteration, so the perturbed tangent's rows are run as such rows, with the same
+//! stopping rule (the update `w g` negligible: `g = 0`, the Lagrange answer, for any `w`). In
+//! the current geometry the rows are searched again at `x_{k+1}` before the update, which then
+//! takes the gap there rather than its linearization from `x_k` (a difference of second order
+//! in the step, zero at convergence). With Coulomb friction the tangential multiplier follows
+//! the same pattern: stick linearizes `g_t - g_t^n = 0` with `-1/w_t`, slip keeps `lambda_t = s
+//! mu lambda_n` exactly, which is the augmented return map with its Uzawa update (including its
+//! rule of updating a frictional point only once the sets have settled).
 //!
 //! **Lagrange multipliers** are unknowns of their own, scaled to the stiffness scale `rho`
 //! (the largest diagonal entry of `K`): `lambda_j = rho mu_j`, one per row with free
@@ -148,6 +165,9 @@ pub(crate) struct ContactSystem<'a> {
     /// Per point: the Uzawa multiplier, the status and the force of the last evaluation.
     augmentation: HashMap<RowKey, f64>,
     active: HashMap<RowKey, bool>,
+    /// The statuses of the evaluation before the last one: the set the last Newton step solved
+    /// with (an augmentation follows an evaluation after a step).
+    stepped_active: HashMap<RowKey, bool>,
     forces: HashMap<RowKey, f64>,
     /// Rows closed in the first evaluation to hold bodies that would otherwise float.
     closed_at_start: HashSet<RowKey>,
@@ -242,6 +262,7 @@ impl<'a> ContactSystem<'a> {
             friction_c: 1.0,
             augmentation: HashMap::new(),
             active: HashMap::new(),
+            stepped_active: HashMap::new(),
             forces: HashMap::new(),
             closed_at_start,
             evaluations: 0,
@@ -306,6 +327,12 @@ impl<'a> ContactSystem<'a> {
             Method::AugmentedLagrange { kappa, update } => RowLaw::Penalty {
                 w: kappa * share * r.area,
                 update: Some(update),
+            },
+            // the perturbed tangent's iteration written in the displacements is the augmented
+            // Lagrangian's with its update after every iteration (see the module notes)
+            Method::PerturbedTangent { kappa } => RowLaw::Penalty {
+                w: kappa * share * r.area,
+                update: Some(MultiplierUpdate::PerIteration),
             },
             Method::Lagrange => RowLaw::Multiplier,
             other => unreachable!("the model refuses {other:?} with the Newton scheme"),
@@ -1094,7 +1121,7 @@ impl System for ContactSystem<'_> {
         tangent.multipliers = self.pattern.n - n;
         tangent.scale = rho;
         self.force_tolerance = 1e-10 * forces.values().fold(0.0f64, |m, f| m.max(f.abs()));
-        self.active = active;
+        self.stepped_active = std::mem::replace(&mut self.active, active);
         self.forces = forces;
         self.status = status;
         if eval.force_scale == 0.0 {
@@ -1159,6 +1186,23 @@ impl System for ContactSystem<'_> {
                 }
             }
             if !on {
+                // Uzawa's update of an open point: max(0, lambda_bar - w g) = 0 (its trial
+                // force is not compressive). Keeping the stale multiplier instead would close
+                // the point again wherever g < lambda_bar / w and push it off with a force it
+                // no longer carries: a point released at the edge of a contact zone then
+                // cycled between open and closed (a block dropped on a rigid line, 2 points)
+                if self.augmentation.get(&key).is_some_and(|&l| l != 0.0) {
+                    updates.push((key, 0.0));
+                }
+                continue;
+            }
+            if !r.bilateral && !self.stepped_active.get(&key).copied().unwrap_or(false) {
+                // a point that closed in this iteration: the step that brought it here did not
+                // hold it, so its gap is where the unconstrained motion left it, and `w g` the
+                // force of the penalty at that point, not the multiplier's correction (with `w`
+                // above the stiffness the point sees, an overshoot that pushes it off again:
+                // the released edge of a dropped block cycled). The next step holds it with
+                // the penalty law; its multiplier moves after that step
                 continue;
             }
             let g = r.gap(&u);

@@ -11,8 +11,8 @@
 //! `(K + c0 M) d_{n+1} = f + c0 M d~ + B^T lambda`, solved by the Newton core on the contact
 //! system of [`super::contact_newton`] with the inertia added to its stiffness and right-hand
 //! side (every enforcement and discretization the Newton scheme has: Lagrange multipliers,
-//! penalty, the perturbed and augmented Lagrangian; node-to-node, node-to-surface, mortar,
-//! rigid masters); then `a_{n+1} = c0 (d_{n+1} - d~)`. The matrix `K + c0 M` does not change
+//! penalty, the perturbed and augmented Lagrangian, the perturbed tangent; node-to-node,
+//! node-to-surface, mortar, rigid masters); then `a_{n+1} = c0 (d_{n+1} - d~)`. The matrix `K + c0 M` does not change
 //! between steps: with linear bodies and an unchanged active set a step is one evaluation and
 //! one back-substitution with the factorization of an earlier step ([`newton::solve_with`];
 //! the history counts factorizations and reuses). *Explicit* (`beta = 0`, lumped mass, penalty
