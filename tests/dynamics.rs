@@ -616,8 +616,8 @@ fn the_impact_studies_refuse_cases_they_cannot_measure() {
 /// forces are zero at t = 0). Both enforcements meet it to round-off; friction only removes
 /// energy; the block slows; the tangential force of the last step is `-mu` times the normal
 /// one and every closed point slips; and the friction survives only where it can be
-/// integrated (the explicit member, the contact-stabilized projection and the
-/// augmented Lagrangian are refused with the reason).
+/// integrated (the explicit member and the contact-stabilized projection are refused with the
+/// reason).
 #[test]
 fn a_block_sliding_on_a_rigid_floor_loses_momentum_to_coulomb_friction() {
     let (mu, load, end) = (0.3, 1.0, 0.5);
@@ -699,10 +699,63 @@ fn a_block_sliding_on_a_rigid_floor_loses_momentum_to_coulomb_friction() {
     v["physics"]["dynamics"]["impact"] = json!("contact_stabilized");
     let e = build_error(&v);
     assert!(e.contains("contact-stabilized projection"), "{e}");
-    let mut v = base.clone();
-    v["contact"][0]["enforcement"] = json!({"kind": "augmented_lagrange", "kappa": 1e5});
-    let e = build_error(&v);
-    assert!(e.contains("contact[0] 'floor'.enforcement"), "{e}");
+}
+
+/// The largest difference, relative to the Lagrange run's largest value, of the momentum, the
+/// contact force and the total energy over every step of `case` run with each enforcement in
+/// `enforcements` (`solver.friction_tangent` given with it where named) against the same case
+/// with Lagrange multipliers; the active points must be the same in every step.
+fn difference_from_lagrange(case: &str, enforcements: &[(Value, Option<&str>)]) -> Vec<f64> {
+    let base = read(case);
+    let with = |enforcement: &Value, tangent: Option<&str>| {
+        let mut v = base.clone();
+        v.as_object_mut().unwrap().remove("checks");
+        v["contact"][0]["enforcement"] = enforcement.clone();
+        if let Some(t) = tangent {
+            v["solver"]["friction_tangent"] = json!(t);
+        }
+        history(&v).1
+    };
+    let exact = with(&json!({"kind": "lagrange"}), None);
+    assert!(
+        exact.steps.iter().any(|s| s.active > 0),
+        "{case}: no contact"
+    );
+    let scale = |f: &dyn Fn(&contact_patch::solver::history::StepRecord) -> f64| {
+        exact.steps.iter().map(|s| f(s).abs()).fold(0.0, f64::max)
+    };
+    // one scale for both momentum components (one of them may be zero to round-off)
+    let momentum = scale(&|s| s.momentum[0].abs().max(s.momentum[1].abs()));
+    let scales = [
+        momentum,
+        momentum,
+        scale(&|s| s.contact_force),
+        scale(&|s| s.total),
+    ];
+    enforcements
+        .iter()
+        .map(|(enforcement, tangent)| {
+            let h = with(enforcement, *tangent);
+            assert_eq!(h.steps.len(), exact.steps.len(), "{enforcement}");
+            let mut worst = 0.0f64;
+            for (a, b) in h.steps.iter().zip(&exact.steps) {
+                assert_eq!(a.active, b.active, "{enforcement} step {}", a.step);
+                let pairs = [
+                    (a.momentum[0], b.momentum[0]),
+                    (a.momentum[1], b.momentum[1]),
+                    (a.contact_force, b.contact_force),
+                    (a.total, b.total),
+                ];
+                for ((x, y), s) in pairs.iter().zip(&scales) {
+                    if *s > 0.0 {
+                        worst = worst.max((x - y).abs() / s);
+                    }
+                }
+            }
+            println!("{case} {enforcement} {tangent:?}: largest relative difference from Lagrange {worst:.1e}");
+            worst
+        })
+        .collect()
 }
 
 /// The augmented Lagrangian and the perturbed tangent in time (`cases/dynamics/block-drop-rigid.json`,
@@ -717,49 +770,61 @@ fn a_block_sliding_on_a_rigid_floor_loses_momentum_to_coulomb_friction() {
 #[test]
 fn the_augmented_lagrangian_and_the_perturbed_tangent_integrate_impact_as_lagrange_multipliers_do()
 {
-    let base = read("cases/dynamics/block-drop-rigid.json");
-    assert_eq!(base["physics"]["dynamics"]["impact"], "post_impact");
-    let with = |enforcement: Value| {
-        let mut v = base.clone();
-        v.as_object_mut().unwrap().remove("checks");
-        v["contact"][0]["enforcement"] = enforcement;
-        history(&v).1
-    };
-    let exact = with(json!({"kind": "lagrange"}));
-    let scale = |f: &dyn Fn(&contact_patch::solver::history::StepRecord) -> f64| {
-        exact.steps.iter().map(|s| f(s).abs()).fold(0.0, f64::max)
-    };
-    let (p_scale, f_scale, e_scale) = (
-        scale(&|s| s.momentum[1]),
-        scale(&|s| s.contact_force),
-        scale(&|s| s.total),
-    );
-    assert!(exact.steps.iter().any(|s| s.active > 0), "no impact");
+    let case = "cases/dynamics/block-drop-rigid.json";
+    assert_eq!(read(case)["physics"]["dynamics"]["impact"], "post_impact");
     let kappa = 1e6;
-    let mut penalty_difference = 0.0f64;
-    for enforcement in [
-        json!({"kind": "augmented_lagrange", "kappa": kappa, "update": "per_iteration"}),
-        json!({"kind": "augmented_lagrange", "kappa": kappa, "update": "outer_loop"}),
-        json!({"kind": "perturbed_tangent", "kappa": kappa}),
-        json!({"kind": "penalty", "kappa": kappa}),
-    ] {
-        let h = with(enforcement.clone());
-        assert_eq!(h.steps.len(), exact.steps.len(), "{enforcement}");
-        let mut worst = 0.0f64;
-        for (a, b) in h.steps.iter().zip(&exact.steps) {
-            assert_eq!(a.active, b.active, "{enforcement} step {}", a.step);
-            worst = worst
-                .max((a.momentum[1] - b.momentum[1]).abs() / p_scale)
-                .max((a.contact_force - b.contact_force).abs() / f_scale)
-                .max((a.total - b.total).abs() / e_scale);
-        }
-        println!("{enforcement}: largest relative difference from Lagrange {worst:.1e}");
-        if enforcement["kind"] == "penalty" {
-            penalty_difference = worst;
-        } else {
-            assert!(worst <= 1e-9, "{enforcement}: {worst:e}");
-        }
+    let d = difference_from_lagrange(
+        case,
+        &[
+            (
+                json!({"kind": "augmented_lagrange", "kappa": kappa, "update": "per_iteration"}),
+                None,
+            ),
+            (
+                json!({"kind": "augmented_lagrange", "kappa": kappa, "update": "outer_loop"}),
+                None,
+            ),
+            (json!({"kind": "perturbed_tangent", "kappa": kappa}), None),
+            (json!({"kind": "penalty", "kappa": kappa}), None),
+        ],
+    );
+    for worst in &d[..3] {
+        assert!(*worst <= 1e-9, "{d:?}");
     }
     // the check can tell: the penalty's penetration shows
-    assert!(penalty_difference > 1e-5, "{penalty_difference:e}");
+    assert!(d[3] > 1e-5, "{d:?}");
+}
+
+/// Coulomb friction in time with the Uzawa methods (`cases/dynamics/sliding-block-friction-
+/// lagrange.json`, a block sliding on a rigid floor): the Uzawa multipliers, normal and
+/// tangential, and the stick points are committed after every time step as after a load step,
+/// and each step's iteration converges to the Lagrange step: the history is Lagrange's to
+/// round-off for the augmented Lagrangian (per iteration, outer loop, Laursen & Simo's form) and
+/// the perturbed tangent; the penalty of the same kappa differs by its regularization.
+#[test]
+fn uzawa_friction_in_time_reproduces_the_lagrange_history() {
+    let kappa = 1e6;
+    let d = difference_from_lagrange(
+        "cases/dynamics/sliding-block-friction-lagrange.json",
+        &[
+            (
+                json!({"kind": "augmented_lagrange", "kappa": kappa, "update": "per_iteration"}),
+                None,
+            ),
+            (
+                json!({"kind": "augmented_lagrange", "kappa": kappa, "update": "outer_loop"}),
+                None,
+            ),
+            (
+                json!({"kind": "augmented_lagrange", "kappa": kappa}),
+                Some("laursen_simo"),
+            ),
+            (json!({"kind": "perturbed_tangent", "kappa": kappa}), None),
+            (json!({"kind": "penalty", "kappa": kappa}), None),
+        ],
+    );
+    for worst in &d[..4] {
+        assert!(*worst <= 1e-9, "{d:?}");
+    }
+    assert!(d[4] > 1e-5, "{d:?}");
 }

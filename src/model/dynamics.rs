@@ -140,10 +140,10 @@ pub fn resolve(case: &Case, model: &Model) -> Result<Option<Dynamics>> {
     for (k, pair) in model.contact.iter().enumerate() {
         let at = format!("contact[{k}] '{}'", pair.name);
         if matches!(pair.interaction, Interaction::Coulomb { .. }) {
-            // the frictional history is committed after every time step, as after a load step;
+            // the frictional history (and the Uzawa multipliers of the augmented Lagrangian and
+            // the perturbed tangent) is committed after every time step, as after a load step;
             // the explicit member has no Newton solve to return-map in, the contact-stabilized
-            // projection has no tangential rows, and the augmented and perturbed forms keep
-            // per-step state of their own that is not carried across time steps (yet)
+            // projection has no tangential rows
             if beta == 0.0 {
                 return Err(invalid(
                     &at,
@@ -156,16 +156,6 @@ pub fn resolve(case: &Case, model: &Model) -> Result<Option<Dynamics>> {
                     &at,
                     "the contact-stabilized projection holds the normal contact only; with Coulomb friction it would project without the tangential forces".into(),
                     "use \"impact\": \"plain\" or \"post_impact\" with friction",
-                ));
-            }
-            if !matches!(
-                pair.enforcement,
-                EnforcementSpec::Penalty { .. } | EnforcementSpec::Lagrange
-            ) {
-                return Err(invalid(
-                    &format!("{at}.enforcement"),
-                    "Coulomb friction in time is integrated with penalty or Lagrange-multiplier enforcement; the other forms keep per-step multipliers that are not carried across time steps".into(),
-                    "use {\"kind\": \"penalty\", \"kappa\": ..} (with \"kappa_t\" in the Coulomb interaction if wanted) or {\"kind\": \"lagrange\"}",
                 ));
             }
         }

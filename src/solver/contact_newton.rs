@@ -752,8 +752,14 @@ impl ContactSystem<'_> {
     /// Commit the frictional history of `friction` (the points at the end of a converged time
     /// step): each point's plastic slip or stick position and its forces become what the next
     /// step starts from, as between load steps ([`ContactState::friction_history`]).
+    /// Augmented-Lagrangian and perturbed-tangent points start the next step from the forces
+    /// committed here as their Uzawa multipliers, as a load step does, and Laursen & Simo's
+    /// bound waits for the step's first update again.
     pub(crate) fn commit_friction(&mut self, friction: &[Option<FrictionPoint>]) {
         self.committed = crate::contact::state::committed_history(&self.rows, friction);
+        self.multipliers_current = false;
+        self.hold_next = false;
+        self.carry_uzawa_multipliers();
     }
 }
 

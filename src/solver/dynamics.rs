@@ -19,11 +19,12 @@
 //! contact): `d_{n+1} = d~`, `a_{n+1} = M^-1 (f - K d_{n+1} + B^T lambda(d_{n+1}))`.
 //! `a_0 = M^-1 (f - K d_0)`: the bodies start undeformed, contact forces zero.
 //!
-//! **Coulomb friction** (implicit, `plain` or `post_impact`, penalty or Lagrange multipliers;
-//! [`crate::model::dynamics`] refuses the rest): each step's Newton solve runs the return map of
-//! [`crate::contact::friction`] against the slip history committed after the last step, as a
-//! load step does against the last load step; the step's frictional points are then committed
-//! (`ContactSystem::commit_friction`) and their tangential forces enter the reported
+//! **Coulomb friction** (implicit, `plain` or `post_impact`, every enforcement the Newton scheme
+//! has; [`crate::model::dynamics`] refuses the rest): each step's Newton solve runs the return
+//! map of [`crate::contact::friction`] against the slip history committed after the last step,
+//! as a load step does against the last load step; the step's frictional points are then
+//! committed (`ContactSystem::commit_friction`, with the Uzawa multipliers of the augmented
+//! Lagrangian and the perturbed tangent, which start the next step from them) and their tangential forces enter the reported
 //! equilibrium. With every closed point slipping one way, Newmark's momentum balance gives
 //! `Delta p_t = -mu (Delta p_n + P T)` over the steps (the contact forces are zero at `t = 0`).
 //!
