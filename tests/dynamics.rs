@@ -705,8 +705,11 @@ fn a_block_sliding_on_a_rigid_floor_loses_momentum_to_coulomb_friction() {
 /// contact force and the total energy over every step of `case` run with each enforcement in
 /// `enforcements` (`solver.friction_tangent` given with it where named) against the same case
 /// with Lagrange multipliers; the active points must be the same in every step.
-fn difference_from_lagrange(case: &str, enforcements: &[(Value, Option<&str>)]) -> Vec<f64> {
-    let base = read(case);
+fn difference_from_lagrange(
+    case: &str,
+    base: &Value,
+    enforcements: &[(Value, Option<&str>)],
+) -> Vec<f64> {
     let with = |enforcement: &Value, tangent: Option<&str>| {
         let mut v = base.clone();
         v.as_object_mut().unwrap().remove("checks");
@@ -771,10 +774,12 @@ fn difference_from_lagrange(case: &str, enforcements: &[(Value, Option<&str>)]) 
 fn the_augmented_lagrangian_and_the_perturbed_tangent_integrate_impact_as_lagrange_multipliers_do()
 {
     let case = "cases/dynamics/block-drop-rigid.json";
-    assert_eq!(read(case)["physics"]["dynamics"]["impact"], "post_impact");
+    let base = read(case);
+    assert_eq!(base["physics"]["dynamics"]["impact"], "post_impact");
     let kappa = 1e6;
     let d = difference_from_lagrange(
         case,
+        &base,
         &[
             (
                 json!({"kind": "augmented_lagrange", "kappa": kappa, "update": "per_iteration"}),
@@ -800,31 +805,46 @@ fn the_augmented_lagrangian_and_the_perturbed_tangent_integrate_impact_as_lagran
 /// tangential, and the stick points are committed after every time step as after a load step,
 /// and each step's iteration converges to the Lagrange step: the history is Lagrange's to
 /// round-off for the augmented Lagrangian (per iteration, outer loop, Laursen & Simo's form) and
-/// the perturbed tangent; the penalty of the same kappa differs by its regularization.
+/// the perturbed tangent; the penalty of the same kappa differs by its regularization. Again
+/// with mu = 3 over 9 steps: before the tangential Uzawa update learned the round-off floor of
+/// its forces (`1e-15` of the model size times the weights), the first step stopped at the
+/// iteration limit, its tangential multipliers moving by 1e-17 at every update. Measured
+/// differences: 1.4e-10 to 1.5e-10, and 2.1e-9 for Laursen & Simo's form at mu = 3 (its slip
+/// bound mu lambda_bar_n reaches mu lambda_n only to the Uzawa stopping rule, 1e-12 of the
+/// forces, and mu = 3 carries that into the motion); the bound 1e-8 sits four decades below the
+/// penalty's 2.4e-4 and 8.1e-4.
 #[test]
 fn uzawa_friction_in_time_reproduces_the_lagrange_history() {
     let kappa = 1e6;
-    let d = difference_from_lagrange(
-        "cases/dynamics/sliding-block-friction-lagrange.json",
-        &[
-            (
-                json!({"kind": "augmented_lagrange", "kappa": kappa, "update": "per_iteration"}),
-                None,
-            ),
-            (
-                json!({"kind": "augmented_lagrange", "kappa": kappa, "update": "outer_loop"}),
-                None,
-            ),
-            (
-                json!({"kind": "augmented_lagrange", "kappa": kappa}),
-                Some("laursen_simo"),
-            ),
-            (json!({"kind": "perturbed_tangent", "kappa": kappa}), None),
-            (json!({"kind": "penalty", "kappa": kappa}), None),
-        ],
-    );
-    for worst in &d[..4] {
-        assert!(*worst <= 1e-9, "{d:?}");
+    let case = "cases/dynamics/sliding-block-friction-lagrange.json";
+    let base = read(case);
+    let mut rough = base.clone();
+    rough["contact"][0]["interaction"]["coulomb"]["mu"] = json!(3.0);
+    rough["physics"]["dynamics"]["end_time"] = json!(0.09);
+    for v in [&base, &rough] {
+        let d = difference_from_lagrange(
+            case,
+            v,
+            &[
+                (
+                    json!({"kind": "augmented_lagrange", "kappa": kappa, "update": "per_iteration"}),
+                    None,
+                ),
+                (
+                    json!({"kind": "augmented_lagrange", "kappa": kappa, "update": "outer_loop"}),
+                    None,
+                ),
+                (
+                    json!({"kind": "augmented_lagrange", "kappa": kappa}),
+                    Some("laursen_simo"),
+                ),
+                (json!({"kind": "perturbed_tangent", "kappa": kappa}), None),
+                (json!({"kind": "penalty", "kappa": kappa}), None),
+            ],
+        );
+        for worst in &d[..4] {
+            assert!(*worst <= 1e-8, "{d:?}");
+        }
+        assert!(d[4] > 1e-5, "{d:?}");
     }
-    assert!(d[4] > 1e-5, "{d:?}");
 }

@@ -1187,7 +1187,15 @@ impl System for ContactSystem<'_> {
                 let t = r.tangent.as_ref().expect("frictional");
                 let at_floor = map.status == Status::Stick
                     && (t.slip(&u) - self.committed_slip(&key)).abs() <= 1e-15 * size;
-                if (map.force - old).abs() > 1e-12 * fscale && !at_floor {
+                // the round-off floor of the force itself: a slip or gap at the round-off of
+                // the model size times the weights that turn them into forces (the slip force
+                // mu lambda_n moves with the normal one). Without it a point whose forces are
+                // tiny against that floor (a block resting lightly, mu = 3) kept moving its
+                // multiplier by 1e-17 at every update and never converged
+                let (mu, w_t) = self.coulomb(r).expect("frictional");
+                let force_floor = 1e-15 * size * w_t.max(mu * w);
+                let change = (map.force - old).abs();
+                if change > 1e-12 * fscale && change > force_floor && !at_floor {
                     tangential_updates.push((key, map.force));
                 }
             }
