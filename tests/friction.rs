@@ -1017,11 +1017,11 @@ fn force_difference(a: &Outcome, b: &Outcome) -> f64 {
         .fold(0.0, f64::max)
 }
 
-#[test]
-fn augmented_lagrangian_friction_converges_to_the_lagrange_answer() {
-    // every Uzawa variant on the frictional patch test, stick (q = mu p / 2) and slip (the top
-    // dragged), two load steps: the same statuses and forces as Lagrange multipliers, exact
-    // stress, Coulomb's inequality and non-negative dissipation in every step
+/// The frictional patch cases the Uzawa methods are held to Lagrange on: meshes A and D
+/// node-to-node, A node-to-surface, C mortar and E dual mortar, each in stick (`q = mu p / 2`)
+/// and in slip (the top dragged), two load steps: `(mesh, discretization, status, q, case)`.
+fn uzawa_patch_cases() -> Vec<(&'static str, Value, Status, f64, Value)> {
+    let mut cases = Vec::new();
     for (mesh, disc) in [
         ("A", node_to_node()),
         ("D", node_to_node()),
@@ -1034,43 +1034,59 @@ fn augmented_lagrangian_friction_converges_to_the_lagrange_answer() {
             (Status::Slip, "0.0", MU * P, Top::Displacement(0.05)),
         ] {
             let base = patch(mesh, nu, disc.clone(), sxy, top, 2);
-            let exact = run(&lagrange(base.clone()));
-            assert_eq!(termination(&exact), Termination::Converged);
-            for (label, v) in [
-                ("per iteration", augmented(base.clone(), "per_iteration")),
-                ("outer loop", augmented(base.clone(), "outer_loop")),
-                ("Laursen-Simo", laursen_simo(base.clone())),
-            ] {
-                let o = run(&v);
-                let what = format!("{mesh} {disc} {status:?} {label}");
-                assert_eq!(termination(&o), Termination::Converged, "{what}");
-                let pts = points(&o);
-                assert!(pts.iter().all(|p| p.0 == status), "{what}");
-                let d = force_difference(&o, &exact);
-                let e = stress_error(&o, [0.0, -P, sxy]) / P;
-                let state = o.solution.contact.as_ref().unwrap();
-                for step in &state.steps {
-                    let f = step.friction.as_ref().unwrap();
-                    assert!(f.max_cone_ratio <= 1.0 + 1e-12, "{what}: {f:?}");
-                    assert!(f.dissipation >= 0.0, "{what}: {f:?}");
+            cases.push((mesh, disc.clone(), status, sxy, base));
+        }
+    }
+    cases
+}
+
+/// Coulomb's inequality and non-negative dissipation in every load step of `o`.
+fn assert_coulomb_in_every_step(o: &Outcome, what: &str) {
+    for step in &o.solution.contact.as_ref().unwrap().steps {
+        let f = step.friction.as_ref().unwrap();
+        assert!(f.max_cone_ratio <= 1.0 + 1e-12, "{what}: {f:?}");
+        assert!(f.dissipation >= 0.0, "{what}: {f:?}");
+    }
+}
+
+#[test]
+fn augmented_lagrangian_friction_converges_to_the_lagrange_answer() {
+    // every Uzawa variant on the frictional patch test, stick (q = mu p / 2) and slip (the top
+    // dragged), two load steps: the same statuses and forces as Lagrange multipliers, exact
+    // stress, Coulomb's inequality and non-negative dissipation in every step
+    for (mesh, disc, status, sxy, base) in uzawa_patch_cases() {
+        let exact = run(&lagrange(base.clone()));
+        assert_eq!(termination(&exact), Termination::Converged);
+        for (label, v) in [
+            ("per iteration", augmented(base.clone(), "per_iteration")),
+            ("outer loop", augmented(base.clone(), "outer_loop")),
+            ("Laursen-Simo", laursen_simo(base.clone())),
+        ] {
+            let o = run(&v);
+            let what = format!("{mesh} {disc} {status:?} {label}");
+            assert_eq!(termination(&o), Termination::Converged, "{what}");
+            let pts = points(&o);
+            assert!(pts.iter().all(|p| p.0 == status), "{what}");
+            let d = force_difference(&o, &exact);
+            let e = stress_error(&o, [0.0, -P, sxy]) / P;
+            assert_coulomb_in_every_step(&o, &what);
+            let state = o.solution.contact.as_ref().unwrap();
+            if status == Status::Slip {
+                for p in &pts {
+                    assert!((p.1.abs() - MU * p.2).abs() <= 1e-12 * MU * P, "{what}");
                 }
-                if status == Status::Slip {
-                    for p in &pts {
-                        assert!((p.1.abs() - MU * p.2).abs() <= 1e-12 * MU * P, "{what}");
-                    }
-                } else {
-                    // stick is exact: the points end where the step started them
-                    for f in state.friction.iter().flatten() {
-                        assert!((f.slip - f.committed).abs() <= 1e-12, "{what}: {f:?}");
-                    }
+            } else {
+                // stick is exact: the points end where the step started them
+                for f in state.friction.iter().flatten() {
+                    assert!((f.slip - f.committed).abs() <= 1e-12, "{what}: {f:?}");
                 }
-                println!(
+            }
+            println!(
                     "{what}: forces vs Lagrange {d:.1e} p, stress error {e:.1e} p, Newton iterations per step {:?}",
                     iterations_per_step(&o)
                 );
-                assert!(d <= 1e-10, "{what}: {d:e}");
-                assert!(e <= 1e-8, "{what}: {e:e}");
-            }
+            assert!(d <= 1e-10, "{what}: {d:e}");
+            assert!(e <= 1e-8, "{what}: {e:e}");
         }
     }
 }
@@ -1083,52 +1099,35 @@ fn augmented_lagrangian_friction_converges_to_the_lagrange_answer() {
 /// the linear rate of an update that is not Newton's.)
 #[test]
 fn the_perturbed_tangent_carries_friction_to_the_lagrange_answer_independent_of_kappa() {
-    for (mesh, disc) in [
-        ("A", node_to_node()),
-        ("D", node_to_node()),
-        ("A", node_to_surface()),
-        ("C", mortar("standard")),
-        ("E", mortar("dual")),
-    ] {
-        for (status, nu, sxy, top) in [
-            (Status::Stick, "0.3", 0.5 * MU * P, Top::Traction),
-            (Status::Slip, "0.0", MU * P, Top::Displacement(0.05)),
-        ] {
-            let base = patch(mesh, nu, disc.clone(), sxy, top, 2);
-            let exact = run(&lagrange(base.clone()));
-            assert_eq!(termination(&exact), Termination::Converged);
-            for kappa in [KAPPA, 100.0 * KAPPA] {
-                let mut v = base.clone();
-                v["contact"][0]["enforcement"] =
-                    json!({"kind": "perturbed_tangent", "kappa": kappa});
-                let o = run(&v);
-                let what = format!("{mesh} {disc} {status:?} kappa {kappa:e}");
-                assert_eq!(termination(&o), Termination::Converged, "{what}");
-                let pts = points(&o);
-                assert!(pts.iter().all(|p| p.0 == status), "{what}");
-                let state = o.solution.contact.as_ref().unwrap();
-                for step in &state.steps {
-                    let f = step.friction.as_ref().unwrap();
-                    assert!(f.max_cone_ratio <= 1.0 + 1e-12, "{what}: {f:?}");
-                    assert!(f.dissipation >= 0.0, "{what}: {f:?}");
-                }
-                let d = force_difference(&o, &exact);
-                let e = stress_error(&o, [0.0, -P, sxy]) / P;
-                let penetration = state
-                    .gaps
-                    .iter()
-                    .zip(&state.active)
-                    .filter(|(_, &on)| on)
-                    .fold(0.0f64, |m, (g, _)| m.max(-g));
-                println!(
+    for (mesh, disc, status, sxy, base) in uzawa_patch_cases() {
+        let exact = run(&lagrange(base.clone()));
+        assert_eq!(termination(&exact), Termination::Converged);
+        for kappa in [KAPPA, 100.0 * KAPPA] {
+            let mut v = base.clone();
+            v["contact"][0]["enforcement"] = json!({"kind": "perturbed_tangent", "kappa": kappa});
+            let o = run(&v);
+            let what = format!("{mesh} {disc} {status:?} kappa {kappa:e}");
+            assert_eq!(termination(&o), Termination::Converged, "{what}");
+            let pts = points(&o);
+            assert!(pts.iter().all(|p| p.0 == status), "{what}");
+            assert_coulomb_in_every_step(&o, &what);
+            let state = o.solution.contact.as_ref().unwrap();
+            let d = force_difference(&o, &exact);
+            let e = stress_error(&o, [0.0, -P, sxy]) / P;
+            let penetration = state
+                .gaps
+                .iter()
+                .zip(&state.active)
+                .filter(|(_, &on)| on)
+                .fold(0.0f64, |m, (g, _)| m.max(-g));
+            println!(
                     "{what}: forces vs Lagrange {d:.1e} p, stress error {e:.1e} p, penetration {penetration:.1e}, Newton iterations per step {:?}",
                     iterations_per_step(&o)
                 );
-                assert!(d <= 1e-10, "{what}: {d:e}");
-                assert!(e <= 1e-8, "{what}: {e:e}");
-                // the gap closes (a penalty of this kappa leaves p / kappa ~ 1e-3 to 1e-1)
-                assert!(penetration <= 1e-10, "{what}: {penetration:e}");
-            }
+            assert!(d <= 1e-10, "{what}: {d:e}");
+            assert!(e <= 1e-8, "{what}: {e:e}");
+            // the gap closes (a penalty of this kappa leaves p / kappa ~ 1e-3 to 1e-1)
+            assert!(penetration <= 1e-10, "{what}: {penetration:e}");
         }
     }
 }
