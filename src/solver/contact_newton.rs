@@ -23,6 +23,10 @@
 //! iteration or, in an outer loop, after Newton has converged ([`MultiplierUpdate`]), until
 //! every update is negligible (`|w_i g_i| <= 1e-12` of the largest force, or the gap is at the
 //! round-off floor `1e-15` of the model size), the stopping rule of the active-set scheme.
+//! An open point's multiplier thereby returns to zero; a point that closed in the iteration
+//! is updated only after a Newton step that held it (its gap is where the unconstrained step
+//! left it, and `w g` there overshoots when `w` exceeds the stiffness the point sees: a block
+//! dropped on a rigid line cycled open/closed at its released edge).
 //!
 //! **The perturbed tangent** (Lim & Taylor 2001; Taylor 2004, "1985: Solution Methods") keeps
 //! the Lagrange residual (`R_u = K x - f - lambda b`, `g = 0`) and linearizes it with the

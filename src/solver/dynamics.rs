@@ -12,8 +12,8 @@
 //! system of [`super::contact_newton`] with the inertia added to its stiffness and right-hand
 //! side (every enforcement and discretization the Newton scheme has: Lagrange multipliers,
 //! penalty, the perturbed and augmented Lagrangian, the perturbed tangent; node-to-node,
-//! node-to-surface, mortar, rigid masters); then `a_{n+1} = c0 (d_{n+1} - d~)`. The matrix `K + c0 M` does not change
-//! between steps: with linear bodies and an unchanged active set a step is one evaluation and
+//! node-to-surface, mortar, rigid masters); then `a_{n+1} = c0 (d_{n+1} - d~)`. The matrix
+//! `K + c0 M` does not change between steps: with linear bodies and an unchanged active set a step is one evaluation and
 //! one back-substitution with the factorization of an earlier step ([`newton::solve_with`];
 //! the history counts factorizations and reuses). *Explicit* (`beta = 0`, lumped mass, penalty
 //! contact): `d_{n+1} = d~`, `a_{n+1} = M^-1 (f - K d_{n+1} + B^T lambda(d_{n+1}))`.
@@ -24,8 +24,8 @@
 //! map of [`crate::contact::friction`] against the slip history committed after the last step,
 //! as a load step does against the last load step; the step's frictional points are then
 //! committed (`ContactSystem::commit_friction`, with the Uzawa multipliers of the augmented
-//! Lagrangian and the perturbed tangent, which start the next step from them) and their tangential forces enter the reported
-//! equilibrium. With every closed point slipping one way, Newmark's momentum balance gives
+//! Lagrangian and the perturbed tangent, which start the next step from them) and their
+//! tangential forces enter the reported equilibrium. With every closed point slipping one way, Newmark's momentum balance gives
 //! `Delta p_t = -mu (Delta p_n + P T)` over the steps (the contact forces are zero at `t = 0`).
 //!
 //! **Impact and release.** At impact plain Newmark leaves the two nodes of a contacting pair with
