@@ -848,3 +848,35 @@ fn uzawa_friction_in_time_reproduces_the_lagrange_history() {
         assert!(d[4] > 1e-5, "{d:?}");
     }
 }
+
+/// A time step the Uzawa iteration cannot finish says which way kappa helps: the augmented
+/// Lagrangian's updates shrink their error by about `k / (k + kappa A)` each, so at kappa = 1e2
+/// (`w` far below the inertia's stiffness) the block drop's first contact step needs about 830
+/// iterations and stops at the limit of 200; the hint asks for a stiffer kappa, where for the
+/// penalty it asks for a softer one.
+#[test]
+fn a_slow_uzawa_step_is_told_to_stiffen_kappa() {
+    let base = read("cases/dynamics/block-drop-rigid.json");
+    let failure = |enforcement: Value| {
+        let mut v = base.clone();
+        v.as_object_mut().unwrap().remove("checks");
+        v["contact"][0]["enforcement"] = enforcement;
+        v["solver"]["max_iterations"] = json!(200);
+        let case = parse(&v.to_string(), "dynamics").unwrap();
+        match run(&case, "dynamics") {
+            Ok(_) => panic!("the run converged"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let e = failure(json!({"kind": "augmented_lagrange", "kappa": 1e2}));
+    assert!(
+        e.contains("time step 1") && e.contains("IterationLimit") && e.contains("stiffer kappa"),
+        "{e}"
+    );
+    // the same steps converge with kappa = 1e6 (the_augmented_lagrangian_and_the_perturbed_..)
+    let mut v = base.clone();
+    v.as_object_mut().unwrap().remove("checks");
+    v["contact"][0]["enforcement"] = json!({"kind": "augmented_lagrange", "kappa": 1e6});
+    let steps = history(&v).1.steps;
+    assert!(steps.iter().all(|s| s.iterations <= 10), "{steps:?}");
+}
