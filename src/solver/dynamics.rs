@@ -65,7 +65,7 @@ use super::sparse::{Cholesky, Factor, GeneralPattern, PatternBuilder, SymmetricP
 use crate::contact::enforcement::{method, Method};
 use crate::contact::state::{ContactState, Termination};
 use crate::error::{Error, Result};
-use crate::io::scene::{ImpactTreatment, MassKind};
+use crate::io::scene::{ImpactTreatment, Interaction, MassKind};
 use crate::model::dynamics::Dynamics;
 use crate::model::stable_step::{
     critical_omega_dt, largest_frequency_bound, penalty_frequency_bound,
@@ -724,15 +724,24 @@ impl<'a> Integrator<'a> {
             .map(|(f, u)| f * u)
             .sum::<f64>();
         let mut contact = 0.0;
-        for (r, &f) in self.system.rows().iter().zip(&self.forces) {
+        for (i, (r, &f)) in self.system.rows().iter().zip(&self.forces).enumerate() {
             if f == 0.0 {
                 continue;
             }
+            let pair = &self.model.contact[r.pair];
             if let Method::Regularized { kappa } | Method::PerturbedLagrange { kappa } =
-                method(&self.model.contact[r.pair].enforcement).kernel()
+                method(&pair.enforcement).kernel()
             {
                 let g = r.gap(&self.d);
                 contact += 0.5 * kappa * r.area * g * g;
+                // the tangential spring of a penalty Coulomb point stores its elastic slip
+                // g_t - g_t^p: 1/2 w_t (g_t - g_t^p)^2 (zero in the open state)
+                if let (Some(Some(point)), Interaction::Coulomb { kappa_t, .. }) =
+                    (self.friction.get(i), pair.interaction)
+                {
+                    let elastic = point.slip - point.plastic_slip;
+                    contact += 0.5 * kappa_t.unwrap_or(kappa) * r.area * elastic * elastic;
+                }
             }
         }
         Energies {

@@ -271,7 +271,7 @@ pub fn solve_with(
                         format!(" (after {})", remedies.join(", then "))
                     };
                     break Termination::ActiveSetCycling(format!(
-                        "Newton iteration {solves} repeats the residual {relative:.3e} of iteration {} while {} contact point(s) change status at every iteration (open, closed, stick or slip){tried}: the semi-smooth Newton iteration cycles between sets, none of which is the solution; apply the load in more load steps (solver.load_steps), or for friction use a tangential penalty (penalty or augmented Lagrangian enforcement with kappa_t), whose return map is continuous in the slip",
+                        "Newton iteration {solves} repeats the residual {relative:.3e} of iteration {} while {} contact point(s) change status at every iteration (open, closed, stick or slip){tried}: the semi-smooth Newton iteration cycles between sets, none of which is the solution; apply the load in more load steps (solver.load_steps) or take a smaller time step, and for Lagrange-multiplier friction consider a tangential penalty (penalty or augmented Lagrangian enforcement with kappa_t), whose return map is continuous in the slip",
                         solves - period,
                         eval.status_changes
                     ));
