@@ -66,6 +66,7 @@ fn newton_cells(case: &str) -> Vec<(String, Value)> {
                     | "augmented_lagrange"
                     | "perturbed_tangent"
                     | "lagrange"
+                    | "elimination"
             ) {
                 continue;
             }
@@ -94,6 +95,8 @@ fn newton_agrees_with_the_active_set_scheme_on_every_penalty_perturbed_tangent_a
     let mut compared = 0;
     let mut singular = 0;
     let mut refused = 0;
+    let mut eliminated = 0;
+    let mut elimination_refused = 0;
     let mut worst = 0.0f64;
     let mut cases = Vec::new();
     for mesh in ["A", "B", "C", "D", "E"] {
@@ -128,6 +131,11 @@ fn newton_agrees_with_the_active_set_scheme_on_every_penalty_perturbed_tangent_a
                     (Ok(a), Ok(b)) => (a, b),
                     (Err(a), Err(b)) => {
                         assert_eq!(a.to_string(), b.to_string(), "{name}");
+                        if pair["enforcement"]["kind"] == "elimination" {
+                            // rows that own no dof of their own: refused alike by both
+                            assert!(a.to_string().contains("does not apply"), "{name}: {a}");
+                            elimination_refused += 1;
+                        }
                         continue;
                     }
                     (a, b) => panic!(
@@ -162,12 +170,19 @@ fn newton_agrees_with_the_active_set_scheme_on_every_penalty_perturbed_tangent_a
                     new.checks,
                     new.solution.contact.as_ref().unwrap().history
                 );
+                if pair["enforcement"]["kind"] == "elimination" {
+                    eliminated += 1;
+                }
                 compared += 1;
             }
         }
     }
-    eprintln!("{compared} cells compared, largest relative difference {worst:e}; {singular} Lagrange cells with dependent rows end singular; {refused} perturbed Lagrangian standard-mortar cells refused");
+    eprintln!("{compared} cells compared ({eliminated} by constraint elimination, {elimination_refused} more refused alike), largest relative difference {worst:e}; {singular} Lagrange cells with dependent rows end singular; {refused} perturbed Lagrangian standard-mortar cells refused");
     assert!(compared >= 300, "only {compared} cells compared");
+    assert!(
+        eliminated >= 30,
+        "only {eliminated} elimination cells compared"
+    );
 }
 
 /// The rigid cylinder in the current geometry with a penalty: each Newton iteration searches
@@ -235,14 +250,31 @@ fn newton_one_and_ten_load_steps_agree() {
     }
 }
 
+/// Constraint elimination in the Newton scheme reduces every Newton step, so it combines with
+/// no other method, and it keeps to the reference geometry (rows searched again at every
+/// iterate could change the dofs they own): both are refused with the reason.
 #[test]
-fn newton_refuses_elimination_with_the_reason() {
+fn newton_elimination_refuses_mixed_pairs_and_the_current_geometry() {
     let mut v = read("cases/contact/signorini-block-on-rigid-line.json");
     v["contact"][0]["enforcement"] = json!({"kind": "elimination"});
-    let err = run(&with_scheme(&v, "newton"), "signorini").err().unwrap();
-    let msg = err.to_string();
-    assert!(msg.contains("the Newton scheme"), "{msg}");
-    assert!(msg.contains("constraint elimination"), "{msg}");
+    let mut second = v["contact"][0].clone();
+    second["name"] = json!("second");
+    second["enforcement"] = json!({"kind": "lagrange"});
+    let mut mixed = v.clone();
+    mixed["contact"] = json!([v["contact"][0].clone(), second]);
+    let msg = run(&with_scheme(&mixed, "newton"), "mixed")
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(msg.contains("contact[1] 'second'.enforcement"), "{msg}");
+    assert!(msg.contains("combines only with itself"), "{msg}");
+    let mut current = v.clone();
+    current["physics"]["contact_geometry"] = json!("current");
+    let msg = run(&with_scheme(&current, "newton"), "current")
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(msg.contains("reference contact geometry only"), "{msg}");
     assert!(msg.contains("solver.scheme"), "{msg}");
 }
 

@@ -1061,16 +1061,44 @@ impl Model {
                     Family::PenaltyRegularized
                         | Family::LagrangeMultipliers
                         | Family::PerturbedTangent
+                        | Family::Elimination
                 )
             {
                 return Err(Error::invalid(
                     &self.source,
                     format!("{at}.enforcement"),
                     format!(
-                        "the Newton scheme (solver.scheme \"newton\") solves penalty-type methods, the perturbed tangent and Lagrange multipliers, not {}",
+                        "the Newton scheme (solver.scheme \"newton\") solves penalty-type methods, the perturbed tangent, Lagrange multipliers and constraint elimination, not {}",
                         family_of(&spec.enforcement).describe()
                     ),
                     "use penalty, the perturbed Lagrangian, the augmented Lagrangian, the perturbed tangent or Lagrange multipliers, or solver.scheme \"active_set\"",
+                ));
+            }
+            if let (true, Some(first)) = (newton, self.contact.first()) {
+                // elimination reduces the whole Newton step: it combines with itself only
+                let eliminates = |e| family_of(e) == Family::Elimination;
+                if eliminates(&first.enforcement) != eliminates(&spec.enforcement) {
+                    return Err(Error::invalid(
+                        &self.source,
+                        format!("{at}.enforcement"),
+                        format!(
+                            "with solver.scheme \"newton\", constraint elimination reduces every Newton step and combines only with itself, and pair '{}' uses {}",
+                            first.name,
+                            family_of(&first.enforcement).describe()
+                        ),
+                        "use constraint elimination for every pair, or another method for this one",
+                    ));
+                }
+            }
+            if newton
+                && family_of(&spec.enforcement) == Family::Elimination
+                && case.physics.contact_geometry == crate::io::scene::ContactGeometry::Current
+            {
+                return Err(Error::invalid(
+                    &self.source,
+                    format!("{at}.enforcement"),
+                    "with solver.scheme \"newton\", constraint elimination is solved in the reference contact geometry only (the rows searched again at every iterate could change the dofs they own)".to_string(),
+                    "set \"physics\": {\"contact_geometry\": \"reference\"}, or solver.scheme \"active_set\"",
                 ));
             }
             if newton && newton_mortar_obstacle(&spec.enforcement, &spec.discretization) {

@@ -444,18 +444,7 @@ fn solve_at(
     let t = Instant::now();
     // each pair is enforced by its own method; the pairs of one solve share a family
     // (validated in the model), whose first member drives the loop
-    for (k, pair) in model.contact.iter().enumerate() {
-        let enforcement = method(&pair.enforcement);
-        let of_pair: Vec<Constraint> = rows.iter().filter(|r| r.pair == k).cloned().collect();
-        if let Some(why) = enforcement.obstacle(&of_pair, &model.prescribed) {
-            return Err(Error::invalid(
-                &model.source,
-                format!("contact '{}'", pair.name),
-                format!("{} does not apply: {why}", enforcement.title()),
-                "use another enforcement method for this pair",
-            ));
-        }
-    }
+    crate::contact::enforcement::refuse_obstacles(model, &rows)?;
     let method = method(&model.contact[0].enforcement).kernel();
     progress("assembling");
     let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.dofs.clone()).collect();

@@ -1,7 +1,10 @@
 //! Contact as a [`System`] for the Newton core ([`super::newton`]): `solver.scheme:
 //! "newton"`, for penalty-type rows (penalty, perturbed Lagrangian with its diagonal
 //! perturbation, augmented Lagrangian, perturbed tangent) and Lagrange-multiplier rows, mixed
-//! freely pair by pair, frictionless or with Coulomb friction.
+//! freely pair by pair, frictionless or with Coulomb friction; and constraint-elimination rows
+//! on their own (frictionless): the Lagrange rows' residual and sets, with every Newton step
+//! solved by eliminating each active row's owned dof instead of factoring the saddle point
+//! ([`super::newton::Tangent::elimination`]).
 //!
 //! Unknowns: the free displacements `x` (prescribed values folded in, [`LinearSystem`]). Each
 //! contact row `i` (a [`Constraint`]: gap `g_i(u)`, gradient `b_i`, tributary area `A_i`) with
@@ -231,6 +234,7 @@ impl<'a> ContactSystem<'a> {
         };
         let start = vec![0.0; model.dof_count];
         let rows = rows_at(model, current.then(|| (u.unwrap_or(&start), &areas)))?;
+        crate::contact::enforcement::refuse_obstacles(model, &rows)?;
         let search_seconds = t.elapsed().as_secs_f64();
         let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.all_dofs()).collect();
         let sys = assemble(model, &blocks);
@@ -347,9 +351,15 @@ impl<'a> ContactSystem<'a> {
                 w: kappa * share * r.area,
                 update: Some(MultiplierUpdate::PerIteration),
             },
-            Method::Lagrange => RowLaw::Multiplier,
-            other => unreachable!("the model refuses {other:?} with the Newton scheme"),
+            // constraint elimination: the Lagrange rows' residual and sets, with the Newton
+            // step solved by eliminating each active row's owned dof (`Tangent::elimination`)
+            Method::Lagrange | Method::Elimination => RowLaw::Multiplier,
         }
+    }
+
+    /// Whether row `r` is enforced by constraint elimination.
+    fn eliminated(&self, r: &Constraint) -> bool {
+        method(&self.model.contact[r.pair].enforcement).kernel() == Method::Elimination
     }
 
     /// The friction coefficient and tangential weight `w_t = kappa_t A` of a frictional row.
@@ -1191,6 +1201,21 @@ impl System for ContactSystem<'_> {
         }
         tangent.multipliers = self.pattern.n - n;
         tangent.scale = rho;
+        // constraint elimination (the model admits it only on its own): each active row is
+        // solved for its owned dof
+        if self.rows.iter().any(|r| self.eliminated(r)) {
+            let mut owned = Vec::new();
+            for (i, r) in self.rows.iter().enumerate() {
+                let (Some(j), true) = (self.multiplier[i], active[&row_key(r)]) else {
+                    continue;
+                };
+                let [(o, _)] = self.free_of(&[r.owner], &[1.0])[..] else {
+                    unreachable!("an elimination row owns a free dof (its obstacle check)")
+                };
+                owned.push((j, o));
+            }
+            tangent.elimination = Some(owned);
+        }
         self.force_tolerance = 1e-10 * forces.values().fold(0.0f64, |m, f| m.max(f.abs()));
         self.stepped_active = std::mem::replace(&mut self.active, active);
         self.forces = forces;
@@ -1527,6 +1552,7 @@ impl<'a> Probe<'a> {
             symmetric: true,
             multipliers: 0,
             scale: 1.0,
+            elimination: None,
         };
         self.system
             .evaluate(x, &self.general, &mut residual, &mut tangent)?;

@@ -400,6 +400,7 @@ impl<'a> Integrator<'a> {
             symmetric: true,
             multipliers: 0,
             scale: 1.0,
+            elimination: None,
         };
         self.system
             .evaluate(&self.x, &general, &mut residual, &mut tangent)?;
@@ -993,6 +994,7 @@ pub fn probe_first_step(model: &Model, x: &[f64]) -> Result<(Vec<f64>, Vec<Vec<f
         symmetric: true,
         multipliers: 0,
         scale: 1.0,
+        elimination: None,
     };
     integrator
         .system

@@ -21,6 +21,7 @@
 //! meets a pivot that is not positive (a symmetric tangent made indefinite by a geometric
 //! term); a factorization is reused when the tangent's values have not changed.
 
+use super::constraints::ConstraintBuilder;
 use super::sparse::{
     Cholesky, Factor, FactorError, GeneralPattern, Ldlt, LdltFactor, Lu, LuFactor,
     SymmetricPattern, WorkLimit,
@@ -42,6 +43,10 @@ pub struct Tangent {
     /// The stiffness scale of the saddle-point matrix (its pivots below `1e-13` of it count as
     /// zero).
     pub scale: f64,
+    /// Constraint elimination: the saddle-point matrix is not factored; each active multiplier
+    /// row `(j, o)` is solved for its owned unknown `o` instead (see
+    /// [`LinearSolver::solve_eliminating`]). `None`: factor the matrix.
+    pub elimination: Option<Vec<(usize, usize)>>,
 }
 
 /// What an evaluation reports besides the residual and the tangent.
@@ -219,6 +224,7 @@ pub fn solve_with(
             symmetric: true,
             multipliers: 0,
             scale: 1.0,
+            elimination: None,
         };
         let eval = system.evaluate(x, &linear.general, &mut residual, &mut tangent)?;
         if system.pattern_version() != version {
@@ -404,6 +410,14 @@ impl LinearSolver {
         tangent: &Tangent,
         b: &mut [f64],
     ) -> std::result::Result<(), FactorError> {
+        if let Some(rows) = &tangent.elimination {
+            let t = Instant::now();
+            let solved = self.solve_eliminating(tangent, rows, b);
+            self.seconds += t.elapsed().as_secs_f64();
+            self.factorizations += 1;
+            self.last = None;
+            return solved;
+        }
         if let Some((values, f)) = &self.last {
             if *values == tangent.values {
                 self.reused += 1;
@@ -418,6 +432,97 @@ impl LinearSolver {
         factor.solve_in_place(b);
         self.factorizations += 1;
         self.last = Some((tangent.values.clone(), factor));
+        Ok(())
+    }
+
+    /// Constraint elimination of the saddle-point system `[[A, C], [C^T, D]] [dx; dmu] = [b_u;
+    /// b_mu]` (`C = -rho B^T`, `D` the diagonal `-rho` of the inactive multipliers, zero on
+    /// the active ones): each active row `j`, `sum_k C_kj dx_k = b_j`, is solved for its owned
+    /// unknown `o` (a free slave dof that no other row touches),
+    /// `dx_o = (b_j - sum_{k != o} C_kj dx_k) / C_oj`, which makes `dx = T y + t`; the reduced
+    /// `T^T A T y = T^T (b_u - A t)` is factored by Cholesky (the multiplier columns drop out:
+    /// `T^T C_A = 0`); the multiplier follows from the owned equation,
+    /// `dmu_j = (b_o - (A dx)_o) / C_oj`, and an inactive one from its diagonal. The step is
+    /// the one `L D L^T` gives (the same linear system), reached without multipliers in the
+    /// factored matrix, as in the active-set scheme's elimination.
+    fn solve_eliminating(
+        &mut self,
+        tangent: &Tangent,
+        rows: &[(usize, usize)],
+        b: &mut [f64],
+    ) -> std::result::Result<(), FactorError> {
+        let n = self.general.n;
+        let leading = n - tangent.multipliers;
+        let p = &self.symmetric;
+        let upper = self.general.upper_values(&tangent.values, p.nnz());
+        // the displacement block: the first `leading` columns of the upper triangle (the
+        // multipliers are numbered last)
+        let end = p.col_ptr[leading];
+        let block = SymmetricPattern {
+            n: leading,
+            col_ptr: p.col_ptr[..=leading].to_vec(),
+            row_idx: p.row_idx[..end].to_vec(),
+        };
+        let a = &upper[..end];
+        let cannot = |why: String| FactorError::Other(format!("constraint elimination: {why}"));
+        let mut builder = ConstraintBuilder::new(leading);
+        let mut owner_coefficient = vec![None; n];
+        for &(j, o) in rows {
+            let column = p.col_ptr[j]..p.col_ptr[j + 1];
+            let terms: Vec<(usize, f64)> = column
+                .filter(|&k| p.row_idx[k] < leading && upper[k] != 0.0)
+                .map(|k| (p.row_idx[k], upper[k]))
+                .collect();
+            let Some(&(_, c_o)) = terms.iter().find(|t| t.0 == o) else {
+                return Err(cannot(format!(
+                    "the row of unknown {j} does not touch its owned unknown {o}"
+                )));
+            };
+            let masters: Vec<(usize, f64)> = terms
+                .iter()
+                .filter(|t| t.0 != o)
+                .map(|&(k, c)| (k, -c / c_o))
+                .collect();
+            builder
+                .constrain(o, &masters, b[j] / c_o)
+                .map_err(|e| cannot(e.to_string()))?;
+            owner_coefficient[j] = Some((o, c_o));
+        }
+        let constraints = builder.close().map_err(|e| cannot(e.to_string()))?;
+        let reduction = constraints.reduction(&block);
+        let values = reduction.matrix(a);
+        let mut y = reduction.rhs(a, &b[..leading]);
+        let free = constraints.free_dofs();
+        let f = Cholesky::analyse(&reduction.pattern, &self.limit)?
+            .factor(&reduction.pattern, &values)
+            .map_err(|e| e.map_equation(|q| free[q]))?;
+        self.last_solver = "elimination";
+        self.last_condition = Some(condition_estimate_symmetric(
+            &reduction.pattern,
+            &values,
+            |v| f.solve_in_place(v),
+        ));
+        f.solve_in_place(&mut y);
+        let dx = constraints.expand(&y);
+        let mut a_dx = vec![0.0; leading];
+        block.mul(a, &dx, &mut a_dx);
+        for j in leading..n {
+            b[j] = match owner_coefficient[j] {
+                Some((o, c_o)) => (b[o] - a_dx[o]) / c_o,
+                None => {
+                    let diagonal = p.position(j, j).map_or(0.0, |k| upper[k]);
+                    let coupled = (p.col_ptr[j]..p.col_ptr[j + 1])
+                        .any(|k| p.row_idx[k] != j && upper[k] != 0.0);
+                    if diagonal == 0.0 || coupled {
+                        return Err(cannot(format!(
+                            "the inactive multiplier {j} is coupled to other unknowns"
+                        )));
+                    }
+                    b[j] / diagonal
+                }
+            };
+        }
+        b[..leading].copy_from_slice(&dx);
         Ok(())
     }
 
@@ -657,6 +762,7 @@ mod tests {
                 symmetric: true,
                 multipliers: 0,
                 scale: 1.0,
+                elimination: None,
             };
             s.evaluate(&x, &general, &mut res, &mut t).unwrap();
             assert!(res.iter().all(|v| v.abs() < 1e-12), "{res:?}");
@@ -683,6 +789,7 @@ mod tests {
             symmetric: true,
             multipliers: 0,
             scale: 1.0,
+            elimination: None,
         };
         let mut r = vec![0.0; 10];
         s.evaluate(&x, &general, &mut r, &mut t).unwrap();
