@@ -45,6 +45,7 @@
 pub mod contact;
 pub mod error;
 pub mod fe;
+pub mod fe3d;
 pub mod harness;
 pub mod io;
 pub(crate) mod mesh;
