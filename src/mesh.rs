@@ -420,9 +420,243 @@ pub fn block(
     Ok(Mesh::new(kind, nodes, conn))
 }
 
+/// Problems found while generating a 3D block mesh: those of the 2D block, or a move from
+/// a point where the block has no node.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Block3Error {
+    Breaks(BlockError),
+    NoNodeAt { from: [f64; 3] },
+}
+
+impl std::fmt::Display for Block3Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Block3Error::Breaks(e) => e.fmt(f),
+            Block3Error::NoNodeAt { from } => write!(
+                f,
+                "a move starts at ({}, {}, {}), where the block has no node; use the coordinates of a grid vertex, or of a mid-edge, face or centre node as the vertex moves leave it",
+                from[0], from[1], from[2]
+            ),
+        }
+    }
+}
+
+/// The breaks of one axis checked: at least two, strictly increasing.
+fn check_breaks(axis: char, b: &[f64]) -> Result<(), BlockError> {
+    if b.len() < 2 {
+        return Err(BlockError::TooFewBreaks {
+            axis,
+            count: b.len(),
+        });
+    }
+    for i in 1..b.len() {
+        if b[i].partial_cmp(&b[i - 1]) != Some(std::cmp::Ordering::Greater) {
+            return Err(BlockError::NotIncreasing {
+                axis,
+                index: i,
+                value: b[i],
+                previous: b[i - 1],
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The six tetrahedra of the Kuhn (Freudenthal) split of the unit cube, as vertex offsets:
+/// one tetrahedron per order of the axes, along the path `(0,0,0) -> e_p -> e_p + e_q ->
+/// (1,1,1)`. Every cube is split alike, so each cube face is cut along the same diagonal
+/// from both sides and the split is conforming. The vertices of each are ordered for a
+/// positive volume.
+const KUHN_TETRAHEDRA: [[[usize; 3]; 4]; 6] = [
+    [[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 1, 1]],
+    [[0, 0, 0], [1, 0, 1], [1, 0, 0], [1, 1, 1]],
+    [[0, 0, 0], [1, 1, 0], [0, 1, 0], [1, 1, 1]],
+    [[0, 0, 0], [0, 1, 0], [0, 1, 1], [1, 1, 1]],
+    [[0, 0, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1]],
+    [[0, 0, 0], [0, 1, 1], [0, 0, 1], [1, 1, 1]],
+];
+
+/// Generate a structured 3D block mesh: vertices at the breaks `xs x ys x zs`, moved by the
+/// vertex moves, the higher-order nodes placed from the moved vertices (mid-edge nodes at
+/// edge midpoints, Hex27 face and body centres at the mean of their corners, so every element
+/// keeps straight edges), then moves of single higher-order nodes as in [`block`].
+/// Hexahedra are the grid cells; tetrahedra split each cell into six (see
+/// [`KUHN_TETRAHEDRA`]), conformingly.
+pub fn block3(
+    kind: SolidKind,
+    xs: &[f64],
+    ys: &[f64],
+    zs: &[f64],
+    moves: &[([f64; 3], [f64; 3])],
+) -> Result<Mesh3, Block3Error> {
+    for (axis, b) in [('x', xs), ('y', ys), ('z', zs)] {
+        check_breaks(axis, b).map_err(Block3Error::Breaks)?;
+    }
+    let cells = [xs.len() - 1, ys.len() - 1, zs.len() - 1];
+    let vertex_index = |i: usize, j: usize, k: usize| (k * (cells[1] + 1) + j) * (cells[0] + 1) + i;
+    let mut vertex = vec![[0.0; 3]; (cells[0] + 1) * (cells[1] + 1) * (cells[2] + 1)];
+    for k in 0..=cells[2] {
+        for j in 0..=cells[1] {
+            for i in 0..=cells[0] {
+                vertex[vertex_index(i, j, k)] = [xs[i], ys[j], zs[k]];
+            }
+        }
+    }
+    let size = (xs[cells[0]] - xs[0])
+        .max(ys[cells[1]] - ys[0])
+        .max(zs[cells[2]] - zs[0]);
+    let at = |p: [f64; 3], from: [f64; 3]| (0..3).all(|i| (p[i] - from[i]).abs() <= 1e-9 * size);
+    let mut node_moves = Vec::new();
+    for &(from, to) in moves {
+        match vertex.iter().position(|&v| at(v, from)) {
+            Some(k) => vertex[k] = to,
+            None => node_moves.push((from, to)),
+        }
+    }
+    // Node lattice: step 1 (linear) or 2 (quadratic) per cell. A lattice point is placed at
+    // the mean of the vertices around it (over each odd coordinate, both neighbours), which
+    // is the edge midpoint, face centre or body centre; the Tet10 mid-edge nodes on a face or
+    // body diagonal are placed at that diagonal's midpoint instead.
+    let q = if kind.is_quadratic() { 2 } else { 1 };
+    let lattice = [q * cells[0] + 1, q * cells[1] + 1, q * cells[2] + 1];
+    let mut id = vec![usize::MAX; lattice[0] * lattice[1] * lattice[2]];
+    let mut nodes: Vec<[f64; 3]> = Vec::new();
+    let v = |p: [usize; 3]| vertex[vertex_index(p[0], p[1], p[2])];
+    let mut node_at = |l: [usize; 3], place: &dyn Fn() -> [f64; 3], nodes: &mut Vec<[f64; 3]>| {
+        let k = (l[2] * lattice[1] + l[1]) * lattice[0] + l[0];
+        if id[k] == usize::MAX {
+            id[k] = nodes.len();
+            nodes.push(place());
+        }
+        id[k]
+    };
+    let mean_around = |l: [usize; 3]| -> [f64; 3] {
+        if q == 1 {
+            return v(l);
+        }
+        let mut sum = [0.0; 3];
+        let mut count = 0.0;
+        for corner in 0..8usize {
+            let mut p = [0; 3];
+            let mut skip = false;
+            for axis in 0..3 {
+                let bit = (corner >> axis) & 1;
+                if l[axis].is_multiple_of(2) {
+                    if bit == 1 {
+                        skip = true;
+                    }
+                    p[axis] = l[axis] / 2;
+                } else {
+                    p[axis] = l[axis] / 2 + bit;
+                }
+            }
+            if skip {
+                continue;
+            }
+            let x = v(p);
+            for i in 0..3 {
+                sum[i] += x[i];
+            }
+            count += 1.0;
+        }
+        sum.map(|s| s / count)
+    };
+    let mut conn = Vec::new();
+    for k in 0..cells[2] {
+        for j in 0..cells[1] {
+            for i in 0..cells[0] {
+                let base = [q * i, q * j, q * k];
+                match kind {
+                    SolidKind::Hex8 | SolidKind::Hex27 => {
+                        for xi in kind.node_coordinates() {
+                            // natural -1, 0, 1 to lattice offsets 0, q/2, q
+                            let l = [0, 1, 2]
+                                .map(|a| base[a] + ((xi[a] + 1.0) * 0.5 * q as f64) as usize);
+                            conn.push(node_at(l, &|| mean_around(l), &mut nodes));
+                        }
+                    }
+                    SolidKind::Tet4 | SolidKind::Tet10 => {
+                        for tet in KUHN_TETRAHEDRA {
+                            let corner = |c: usize| [0, 1, 2].map(|a| base[a] + q * tet[c][a]);
+                            for c in 0..4 {
+                                let l = corner(c);
+                                conn.push(node_at(l, &|| v(l.map(|x| x / q)), &mut nodes));
+                            }
+                            if kind == SolidKind::Tet10 {
+                                for [a, b] in [[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]] {
+                                    let (la, lb) = (corner(a), corner(b));
+                                    let l = [0, 1, 2].map(|x| (la[x] + lb[x]) / 2);
+                                    let place = || {
+                                        let (pa, pb) = (v(la.map(|x| x / 2)), v(lb.map(|x| x / 2)));
+                                        [0, 1, 2].map(|x| 0.5 * (pa[x] + pb[x]))
+                                    };
+                                    conn.push(node_at(l, &place, &mut nodes));
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    for (from, to) in node_moves {
+        let k = nodes
+            .iter()
+            .position(|&p| at(p, from))
+            .ok_or(Block3Error::NoNodeAt { from })?;
+        nodes[k] = to;
+    }
+    Ok(Mesh::new(kind, nodes, conn))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn block3_counts_sets_and_positive_volumes() {
+        let (xs, ys, zs) = ([0.0, 1.0, 3.0], [0.0, 2.0], [0.0, 0.5, 1.0]);
+        for (kind, nodes, cells) in [
+            (SolidKind::Hex8, 3 * 2 * 3, 4),
+            (SolidKind::Hex27, 5 * 3 * 5, 4),
+            (SolidKind::Tet4, 3 * 2 * 3, 24),
+            (SolidKind::Tet10, 5 * 3 * 5, 24),
+        ] {
+            let m = block3(kind, &xs, &ys, &zs, &[([1.0, 2.0, 0.5], [1.1, 2.0, 0.45])]).unwrap();
+            assert_eq!((m.nodes.len(), m.cell_count()), (nodes, cells), "{kind:?}");
+            // boundary faces: 2 (x sides) * 1*2 + 2 (y) * 2*2 + 2 (z) * 2*1 cell faces = 16,
+            // two triangles each for tetrahedra
+            let per_face = if kind.is_hexahedron() { 1 } else { 2 };
+            assert_eq!(m.boundary_facets().len(), 16 * per_face, "{kind:?}");
+            assert_eq!(m.facet_sets["left"].len(), 2 * per_face);
+            assert_eq!(m.facet_sets["front"].len(), 4 * per_face);
+            assert_eq!(m.facet_sets["top"].len(), 2 * per_face);
+            assert_eq!(m.node_sets["bottom_front_left"], vec![0]);
+            assert_eq!(m.node_sets["top_back_right"].len(), 1);
+            // every cell has a positive volume
+            for c in 0..m.cell_count() {
+                let pv = crate::fe3d::solid_point_values(kind, &m.cell_coords(c), kind.centre());
+                assert!(pv.det_j > 0.0, "{kind:?} cell {c}: det J = {}", pv.det_j);
+            }
+        }
+        assert!(matches!(
+            block3(SolidKind::Hex8, &[0.0, 1.0], &[0.0], &[0.0, 1.0], &[]),
+            Err(Block3Error::Breaks(BlockError::TooFewBreaks {
+                axis: 'y',
+                ..
+            }))
+        ));
+        assert!(matches!(
+            block3(
+                SolidKind::Hex8,
+                &[0.0, 1.0],
+                &[0.0, 1.0],
+                &[0.0, 1.0],
+                &[([0.5, 0.5, 0.5], [0.0; 3])]
+            ),
+            Err(Block3Error::NoNodeAt { .. })
+        ));
+    }
 
     #[test]
     fn block_counts_and_automatic_sets() {
