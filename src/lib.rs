@@ -52,6 +52,7 @@ pub mod mesh;
 pub mod model;
 pub mod post;
 pub mod run;
+pub mod run3d;
 pub mod solid;
 pub mod solid3d;
 pub mod solid_finite;

@@ -251,3 +251,128 @@ fn every_element_converges_at_its_optimal_rates_on_a_smooth_solution() {
         }
     }
 }
+
+/// The example case `cases/3d/patch-hex8.json` with `edit` applied, written to a temporary
+/// folder; returns the folder (kept alive by the caller) and the file.
+fn edited_case(
+    edit: impl FnOnce(&mut serde_json::Value),
+) -> (tempfile::TempDir, std::path::PathBuf) {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("cases/3d/patch-hex8.json")).unwrap();
+    let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
+    edit(&mut case);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&case).unwrap()).unwrap();
+    (dir, path)
+}
+
+fn run_binary(path: &std::path::Path, out: &std::path::Path) -> (i32, String, String) {
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .arg("run")
+        .arg(path)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    (
+        output.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn the_3d_example_runs_and_writes_a_3d_vtu_with_six_stress_components() {
+    let (dir, path) = edited_case(|_| {});
+    let out = dir.path().join("out");
+    let (code, stdout, stderr) = run_binary(&path, &out);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    assert!(stdout.contains("pass uniform stress"), "{stdout}");
+    let vtu = std::fs::read_to_string(out.join("block.vtu")).unwrap();
+    assert!(
+        vtu.contains("Name=\"stress\" NumberOfComponents=\"6\""),
+        "{vtu:.400}"
+    );
+    assert!(vtu.contains("Name=\"displacement\" NumberOfComponents=\"3\""));
+    // 18 Hex8 cells: VTK type 12 each
+    let types = vtu.split("Name=\"types\"").nth(1).unwrap();
+    let types = &types[types.find('>').unwrap() + 1..types.find("</DataArray>").unwrap()];
+    let ids: Vec<&str> = types.split_whitespace().collect();
+    assert_eq!(ids, vec!["12"; 18]);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["dimension"], 3);
+    assert_eq!(summary["passed"], true);
+}
+
+#[test]
+fn a_3d_case_with_a_contact_pair_is_refused_with_the_reason() {
+    let (dir, path) = edited_case(|case| {
+        case["contact"] = serde_json::json!([{
+            "name": "ground",
+            "slave": {"body": "block", "set": "bottom"},
+            "master": {"rigid": {"kind": "line", "point": [0, 0], "normal": [0, 1]}},
+            "discretization": {"kind": "node_to_surface", "passes": 1},
+            "enforcement": {"kind": "lagrange"}
+        }]);
+    });
+    let out = dir.path().join("out");
+    let (code, _, stderr) = run_binary(&path, &out);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("contact in 3D is not built yet"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("contact[0] 'ground'"), "{stderr}");
+    assert!(!out.exists(), "nothing is written for a refused case");
+}
+
+#[test]
+fn what_3d_does_not_have_yet_is_refused_and_2d_cases_refuse_3d_fields() {
+    for (edit, expected) in [
+        (
+            Box::new(|c: &mut serde_json::Value| {
+                c["physics"] = serde_json::json!({"kinematics": "finite"})
+            }) as Box<dyn Fn(&mut serde_json::Value)>,
+            "finite strain in 3D is not built yet",
+        ),
+        (
+            Box::new(|c: &mut serde_json::Value| {
+                c["loads"] =
+                    serde_json::json!([{"body": "block", "set": "top", "traction": [1, 0]}])
+            }),
+            "in 3D is not built yet",
+        ),
+        (
+            Box::new(|c: &mut serde_json::Value| {
+                c["supports"] = serde_json::json!([{"body": "block", "set": "bottom", "z": 0.0}])
+            }),
+            "the stiffness cannot be factored",
+        ),
+    ] {
+        let (dir, path) = edited_case(|c| edit(c));
+        let (code, _, stderr) = run_binary(&path, &dir.path().join("out"));
+        assert_eq!(code, 2, "{stderr}");
+        assert!(stderr.contains(expected), "{expected}: {stderr}");
+    }
+    // the 2D model refuses a 3D body (through a command that is 2D only) and a z support
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let err = contact_patch::model::admit::load(&root.join("cases/3d/patch-hex8.json"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("3D cases run with `contact-patch run` only"),
+        "{err}"
+    );
+    let text = std::fs::read_to_string(root.join("cases/patch-single/q4-distorted.json")).unwrap();
+    let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
+    case["supports"][0]["z"] = serde_json::json!(0.0);
+    let err = contact_patch::model::Model::build(
+        &contact_patch::model::parse(&case.to_string(), "q4-with-z").unwrap(),
+        "q4-with-z",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("but body 'patch' is 2D"), "{err}");
+}
