@@ -333,7 +333,7 @@ pub fn evaluate_with(
                     (format!("uniform stress {stress:?}{on}{against}{stated}"), error, tol)
                 }
                 Check::UniformStress3d { tol, .. } => (
-                    "uniform_stress_3d: a 3D check, judged by the 3D run (crate::run3d) only".to_string(),
+                    "uniform_stress_3d: a 3D check, judged by the run of a 3D case only".to_string(),
                     f64::INFINITY,
                     *tol,
                 ),
