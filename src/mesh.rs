@@ -481,7 +481,7 @@ const KUHN_TETRAHEDRA: [[[usize; 3]; 4]; 6] = [
 /// edge midpoints, Hex27 face and body centres at the mean of their corners, so every element
 /// keeps straight edges), then moves of single higher-order nodes as in [`block`].
 /// Hexahedra are the grid cells; tetrahedra split each cell into six (see
-/// [`KUHN_TETRAHEDRA`]), conformingly.
+/// `KUHN_TETRAHEDRA`), conformingly.
 pub fn block3(
     kind: SolidKind,
     xs: &[f64],
