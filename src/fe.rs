@@ -17,6 +17,14 @@
 //!
 //! Edges (facets) are `Line2` (nodes at s = -1, +1) or `Line3` (nodes at s = -1, +1, 0), ordered
 //! counter-clockwise around their element, so the outward normal is the tangent turned clockwise.
+//!
+//! **Dimension seam.** [`ReferenceCell<D>`] is what meshes, named sets and output need of a
+//! reference cell in `D` dimensions (node count, corners, facets as local node lists, natural
+//! node coordinates, shape functions, VTK type); [`QuadPoint<D>`] is a quadrature point in `D`
+//! natural coordinates (`D = 2` by default, so the 2D code reads as before). The 2D kinds here
+//! implement it for `D = 2` and the solid kinds of [`crate::fe3d`] for `D = 3`; the 2D facets
+//! of a solid (Quad4, Quad9, Tri3, Tri6) are the 2D reference elements Q4, Q9, T3, T6 of this
+//! module. Code written against the trait (e.g. [`crate::mesh::Mesh`]) serves both dimensions.
 
 use serde::{Deserialize, Serialize};
 
@@ -38,9 +46,57 @@ pub enum EdgeKind {
 
 /// A quadrature point on a reference cell: natural coordinates and weight.
 #[derive(Copy, Clone, Debug)]
-pub struct QuadPoint {
-    pub xi: [f64; 2],
+pub struct QuadPoint<const D: usize = 2> {
+    pub xi: [f64; D],
     pub weight: f64,
+}
+
+/// The dimension seam (see the module docs): a reference cell in `D` natural coordinates.
+pub trait ReferenceCell<const D: usize>: Copy + std::fmt::Debug + PartialEq {
+    /// Number of nodes.
+    fn node_count(self) -> usize;
+    /// Number of corner (vertex) nodes; they come first in the node list.
+    fn corner_count(self) -> usize;
+    /// Whether the cell's shape functions are quadratic.
+    fn is_quadratic(self) -> bool;
+    /// Local nodes of each facet, corners first, ordered so that the facet's own
+    /// parametrisation gives the outward normal (counter-clockwise seen from outside).
+    fn facets(self) -> &'static [&'static [usize]];
+    /// Number of corners of facet `k`; its first nodes, which identify it.
+    fn facet_corner_count(self, k: usize) -> usize;
+    /// Natural coordinates of the nodes, in node order.
+    fn node_coordinates(self) -> &'static [[f64; D]];
+    /// Shape functions `n[a]` and their natural derivatives `dn[a][k] = dN_a/dxi_k` at `xi`.
+    fn shape(self, xi: [f64; D], n: &mut [f64], dn: &mut [[f64; D]]);
+    /// VTK cell type id.
+    fn vtk_cell_type(self) -> u8;
+}
+
+impl ReferenceCell<2> for ElementKind {
+    fn node_count(self) -> usize {
+        ElementKind::node_count(self)
+    }
+    fn corner_count(self) -> usize {
+        ElementKind::corner_count(self)
+    }
+    fn is_quadratic(self) -> bool {
+        ElementKind::is_quadratic(self)
+    }
+    fn facets(self) -> &'static [&'static [usize]] {
+        self.edges()
+    }
+    fn facet_corner_count(self, _k: usize) -> usize {
+        2
+    }
+    fn node_coordinates(self) -> &'static [[f64; 2]] {
+        ElementKind::node_coordinates(self)
+    }
+    fn shape(self, xi: [f64; 2], n: &mut [f64], dn: &mut [[f64; 2]]) {
+        ElementKind::shape(self, xi, n, dn)
+    }
+    fn vtk_cell_type(self) -> u8 {
+        ElementKind::vtk_cell_type(self)
+    }
 }
 
 const Q4_EDGES: [&[usize]; 4] = [&[0, 1], &[1, 2], &[2, 3], &[3, 0]];
@@ -267,7 +323,7 @@ impl EdgeKind {
 }
 
 /// Value and derivative of the 1D quadratic Lagrange polynomial that is 1 at `node` (-1, 0 or 1).
-fn lagrange_1d_quadratic(node: f64, s: f64) -> (f64, f64) {
+pub(crate) fn lagrange_1d_quadratic(node: f64, s: f64) -> (f64, f64) {
     if node < -0.5 {
         (0.5 * s * (s - 1.0), s - 0.5)
     } else if node > 0.5 {

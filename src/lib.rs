@@ -45,13 +45,16 @@
 pub mod contact;
 pub mod error;
 pub mod fe;
+pub mod fe3d;
 pub mod harness;
 pub mod io;
-pub(crate) mod mesh;
+pub mod mesh;
 pub mod model;
 pub mod post;
 pub mod run;
+pub mod run3d;
 pub mod solid;
+pub mod solid3d;
 pub mod solid_finite;
 pub mod solver;
 

@@ -377,6 +377,9 @@ fn run(case: &Path, out: Option<PathBuf>) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let Some(case3) = contact_patch::run3d::read_3d_case(case) {
+        return run3(case, &case3, given);
+    }
     let bar = spinner();
     let mut progress = |stage: &str| {
         if let Some(b) = &bar {
@@ -408,6 +411,57 @@ fn run(case: &Path, out: Option<PathBuf>) -> ExitCode {
             print_outcome(&outcome);
             println!("output: {}", folder.path().display());
             if outcome.passed() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }
+    }
+}
+
+/// `run` for a 3D case (see `contact_patch::run3d`).
+fn run3(
+    path: &Path,
+    case: &contact_patch::io::scene::Case,
+    given: Option<OutputFolder>,
+) -> ExitCode {
+    let source = path.display().to_string();
+    let result = contact_patch::run3d::run_case3(case, &source).and_then(|outcome| {
+        let folder = match given {
+            Some(folder) => folder,
+            None => OutputFolder::new(&Path::new("out").join(file_name(
+                "case name",
+                &outcome.name,
+                "",
+            )?))?,
+        };
+        contact_patch::run3d::write_run3(&folder, &outcome)?;
+        Ok((outcome, folder))
+    });
+    match result {
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+        Ok((o, folder)) => {
+            println!(
+                "{}: 3D, {} dofs ({} {:?} cells)",
+                o.name,
+                o.solid.dof_count(),
+                o.solid.mesh.cell_count(),
+                o.solid.mesh.kind
+            );
+            for c in &o.checks {
+                println!(
+                    "  {} {} (error {:.3e}, tol {:.1e})",
+                    if c.passed { "pass" } else { "FAIL" },
+                    c.check,
+                    c.error,
+                    c.tol
+                );
+            }
+            println!("output: {}", folder.path().display());
+            if o.passed() {
                 ExitCode::SUCCESS
             } else {
                 ExitCode::from(1)

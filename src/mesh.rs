@@ -13,29 +13,48 @@
 //! the sides of its bounding box), the corner node sets `bottom_left`, `bottom_right`,
 //! `top_left`, `top_right`, and `all` (nodes).
 
-use crate::fe::ElementKind;
+use crate::fe::{ElementKind, ReferenceCell};
+use crate::fe3d::SolidKind;
 use std::collections::{BTreeMap, HashMap};
 
-/// A facet: a cell and one of its local edges.
+/// A facet: a cell and one of its local facets (an edge in 2D, a face in 3D; the field keeps
+/// the 2D name `edge`), numbered as in [`ReferenceCell::facets`].
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Facet {
     pub cell: usize,
     pub edge: usize,
 }
 
+/// A mesh in `D` dimensions of cells of one kind `K`; `Mesh` alone is the 2D mesh of
+/// [`ElementKind`] cells, [`Mesh3`] the 3D mesh of [`SolidKind`] cells.
 #[derive(Clone, Debug)]
-pub struct Mesh {
-    pub kind: ElementKind,
-    pub nodes: Vec<[f64; 2]>,
+pub struct Mesh<const D: usize = 2, K = ElementKind> {
+    pub kind: K,
+    pub nodes: Vec<[f64; D]>,
     /// Flat connectivity, `kind.node_count()` entries per cell.
     pub connectivity: Vec<usize>,
     pub node_sets: BTreeMap<String, Vec<usize>>,
     pub facet_sets: BTreeMap<String, Vec<Facet>>,
 }
 
-impl Mesh {
+/// A 3D mesh of solid cells.
+pub type Mesh3 = Mesh<3, SolidKind>;
+
+/// Names of the two sides of the bounding box along each axis, `[low, high]`: x left/right and
+/// y bottom/top in 2D; x left/right, y front/back and z bottom/top in 3D.
+fn side_names(dim: usize) -> &'static [[&'static str; 2]] {
+    const PLANE: [[&str; 2]; 2] = [["left", "right"], ["bottom", "top"]];
+    const SOLID: [[&str; 2]; 3] = [["left", "right"], ["front", "back"], ["bottom", "top"]];
+    if dim == 2 {
+        &PLANE
+    } else {
+        &SOLID
+    }
+}
+
+impl<const D: usize, K: ReferenceCell<D>> Mesh<D, K> {
     /// Build a mesh from explicit data and add the automatic sets.
-    pub fn new(kind: ElementKind, nodes: Vec<[f64; 2]>, connectivity: Vec<usize>) -> Self {
+    pub fn new(kind: K, nodes: Vec<[f64; D]>, connectivity: Vec<usize>) -> Self {
         let mut mesh = Mesh {
             kind,
             nodes,
@@ -57,22 +76,25 @@ impl Mesh {
     }
 
     /// Coordinates of the nodes of cell `c`, in element order.
-    pub fn cell_coords(&self, c: usize) -> Vec<[f64; 2]> {
+    pub fn cell_coords(&self, c: usize) -> Vec<[f64; D]> {
         self.cell(c).iter().map(|&n| self.nodes[n]).collect()
     }
 
-    /// Global node ids of a facet, in edge order `[start, end(, mid)]`.
+    /// Global node ids of a facet, in facet order (2D: `[start, end(, mid)]`).
     pub fn facet_nodes(&self, f: Facet) -> Vec<usize> {
         let cell = self.cell(f.cell);
-        self.kind.edges()[f.edge].iter().map(|&l| cell[l]).collect()
+        self.kind.facets()[f.edge]
+            .iter()
+            .map(|&l| cell[l])
+            .collect()
     }
 
     /// Axis-aligned bounding box `[min, max]`.
-    pub fn bounding_box(&self) -> [[f64; 2]; 2] {
-        let mut lo = [f64::INFINITY; 2];
-        let mut hi = [f64::NEG_INFINITY; 2];
+    pub fn bounding_box(&self) -> [[f64; D]; 2] {
+        let mut lo = [f64::INFINITY; D];
+        let mut hi = [f64::NEG_INFINITY; D];
         for p in &self.nodes {
-            for i in 0..2 {
+            for i in 0..D {
                 lo[i] = lo[i].min(p[i]);
                 hi[i] = hi[i].max(p[i]);
             }
@@ -80,29 +102,44 @@ impl Mesh {
         [lo, hi]
     }
 
-    /// A length scale for geometric tolerances.
+    /// A length scale for geometric tolerances: the largest side of the bounding box.
     pub fn size(&self) -> f64 {
         let [lo, hi] = self.bounding_box();
-        (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE)
+        (0..D)
+            .map(|i| hi[i] - lo[i])
+            .fold(f64::NEG_INFINITY, f64::max)
+            .max(f64::MIN_POSITIVE)
+    }
+
+    /// The sorted corner nodes of facet `k` of cell `c` (unused entries `usize::MAX`): a key
+    /// that two cells sharing the facet give alike.
+    fn facet_key(&self, c: usize, k: usize) -> [usize; 4] {
+        let cell = self.cell(c);
+        let local = self.kind.facets()[k];
+        let mut key = [usize::MAX; 4];
+        for (slot, &l) in key
+            .iter_mut()
+            .zip(&local[..self.kind.facet_corner_count(k)])
+        {
+            *slot = cell[l];
+        }
+        key.sort_unstable();
+        key
     }
 
     /// Facets that belong to exactly one cell, in cell order.
     pub fn boundary_facets(&self) -> Vec<Facet> {
-        let mut count: HashMap<(usize, usize), usize> = HashMap::new();
-        let edges = self.kind.edges();
+        let mut count: HashMap<[usize; 4], usize> = HashMap::new();
+        let facet_count = self.kind.facets().len();
         for c in 0..self.cell_count() {
-            let cell = self.cell(c);
-            for e in edges {
-                let (a, b) = (cell[e[0]], cell[e[1]]);
-                *count.entry((a.min(b), a.max(b))).or_default() += 1;
+            for k in 0..facet_count {
+                *count.entry(self.facet_key(c, k)).or_default() += 1;
             }
         }
         let mut out = Vec::new();
         for c in 0..self.cell_count() {
-            let cell = self.cell(c);
-            for (k, e) in edges.iter().enumerate() {
-                let (a, b) = (cell[e[0]], cell[e[1]]);
-                if count[&(a.min(b), a.max(b))] == 1 {
+            for k in 0..facet_count {
+                if count[&self.facet_key(c, k)] == 1 {
                     out.push(Facet { cell: c, edge: k });
                 }
             }
@@ -111,14 +148,14 @@ impl Mesh {
     }
 
     /// Nodes inside the closed box `[lo, hi]` (with tolerance `tol`).
-    pub fn nodes_in_box(&self, lo: [f64; 2], hi: [f64; 2], tol: f64) -> Vec<usize> {
+    pub fn nodes_in_box(&self, lo: [f64; D], hi: [f64; D], tol: f64) -> Vec<usize> {
         (0..self.nodes.len())
             .filter(|&n| inside(self.nodes[n], lo, hi, tol))
             .collect()
     }
 
     /// Boundary facets whose nodes all lie in the closed box `[lo, hi]`.
-    pub fn facets_in_box(&self, lo: [f64; 2], hi: [f64; 2], tol: f64) -> Vec<Facet> {
+    pub fn facets_in_box(&self, lo: [f64; D], hi: [f64; D], tol: f64) -> Vec<Facet> {
         self.select_facets(&self.boundary_facets(), lo, hi, tol)
     }
 
@@ -126,17 +163,17 @@ impl Mesh {
     fn select_facets(
         &self,
         candidates: &[Facet],
-        lo: [f64; 2],
-        hi: [f64; 2],
+        lo: [f64; D],
+        hi: [f64; D],
         tol: f64,
     ) -> Vec<Facet> {
-        let edges = self.kind.edges();
+        let facets = self.kind.facets();
         candidates
             .iter()
             .copied()
             .filter(|f| {
                 let cell = self.cell(f.cell);
-                edges[f.edge]
+                facets[f.edge]
                     .iter()
                     .all(|&l| inside(self.nodes[cell[l]], lo, hi, tol))
             })
@@ -144,11 +181,14 @@ impl Mesh {
     }
 
     /// The node closest to `p`, with its distance.
-    pub fn nearest_node(&self, p: [f64; 2]) -> Option<(usize, f64)> {
+    pub fn nearest_node(&self, p: [f64; D]) -> Option<(usize, f64)> {
         self.nodes
             .iter()
             .enumerate()
-            .map(|(i, q)| (i, ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2)).sqrt()))
+            .map(|(i, q)| {
+                let d2 = (1..D).fold((q[0] - p[0]).powi(2), |s, k| s + (q[k] - p[k]).powi(2));
+                (i, d2.sqrt())
+            })
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
@@ -157,43 +197,48 @@ impl Mesh {
         1e-9 * self.size()
     }
 
+    /// The sides of the bounding box as node and facet sets (names from [`side_names`]), the
+    /// corners as node sets (side names from the last axis to the first joined by `_`, e.g.
+    /// `bottom_left` in 2D, `bottom_front_left` in 3D), and `all`.
     fn add_automatic_sets(&mut self) {
         if self.nodes.is_empty() {
             return;
         }
         let [lo, hi] = self.bounding_box();
         let tol = self.tolerance();
-        let inf = f64::INFINITY;
         let boundary = self.boundary_facets();
-        let sides = [
-            ("left", [lo[0], -inf], [lo[0], inf]),
-            ("right", [hi[0], -inf], [hi[0], inf]),
-            ("bottom", [-inf, lo[1]], [inf, lo[1]]),
-            ("top", [-inf, hi[1]], [inf, hi[1]]),
-        ];
-        for (name, a, b) in sides {
-            let nodes = self.nodes_in_box(a, b, tol);
-            let facets = self.select_facets(&boundary, a, b, tol);
-            self.node_sets.insert(name.to_string(), nodes);
-            self.facet_sets.insert(name.to_string(), facets);
+        let names = side_names(D);
+        for axis in 0..D {
+            for (side, name) in names[axis].iter().enumerate() {
+                let mut a = [f64::NEG_INFINITY; D];
+                let mut b = [f64::INFINITY; D];
+                let at = if side == 0 { lo[axis] } else { hi[axis] };
+                a[axis] = at;
+                b[axis] = at;
+                let nodes = self.nodes_in_box(a, b, tol);
+                let facets = self.select_facets(&boundary, a, b, tol);
+                self.node_sets.insert(name.to_string(), nodes);
+                self.facet_sets.insert(name.to_string(), facets);
+            }
         }
-        let corners = [
-            ("bottom_left", [lo[0], lo[1]]),
-            ("bottom_right", [hi[0], lo[1]]),
-            ("top_left", [lo[0], hi[1]]),
-            ("top_right", [hi[0], hi[1]]),
-        ];
-        for (name, p) in corners {
+        for corner in 0..(1usize << D) {
+            let mut p = [0.0; D];
+            let mut parts = Vec::with_capacity(D);
+            for axis in (0..D).rev() {
+                let side = (corner >> axis) & 1;
+                p[axis] = if side == 0 { lo[axis] } else { hi[axis] };
+                parts.push(names[axis][side]);
+            }
             let nodes = self.nodes_in_box(p, p, tol);
-            self.node_sets.insert(name.to_string(), nodes);
+            self.node_sets.insert(parts.join("_"), nodes);
         }
         self.node_sets
             .insert("all".to_string(), (0..self.nodes.len()).collect());
     }
 }
 
-fn inside(p: [f64; 2], lo: [f64; 2], hi: [f64; 2], tol: f64) -> bool {
-    (0..2).all(|i| p[i] >= lo[i] - tol && p[i] <= hi[i] + tol)
+fn inside<const D: usize>(p: [f64; D], lo: [f64; D], hi: [f64; D], tol: f64) -> bool {
+    (0..D).all(|i| p[i] >= lo[i] - tol && p[i] <= hi[i] + tol)
 }
 
 /// Problems found while generating a block mesh.
@@ -375,9 +420,243 @@ pub fn block(
     Ok(Mesh::new(kind, nodes, conn))
 }
 
+/// Problems found while generating a 3D block mesh: those of the 2D block, or a move from
+/// a point where the block has no node.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Block3Error {
+    Breaks(BlockError),
+    NoNodeAt { from: [f64; 3] },
+}
+
+impl std::fmt::Display for Block3Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Block3Error::Breaks(e) => e.fmt(f),
+            Block3Error::NoNodeAt { from } => write!(
+                f,
+                "a move starts at ({}, {}, {}), where the block has no node; use the coordinates of a grid vertex, or of a mid-edge, face or centre node as the vertex moves leave it",
+                from[0], from[1], from[2]
+            ),
+        }
+    }
+}
+
+/// The breaks of one axis checked: at least two, strictly increasing.
+fn check_breaks(axis: char, b: &[f64]) -> Result<(), BlockError> {
+    if b.len() < 2 {
+        return Err(BlockError::TooFewBreaks {
+            axis,
+            count: b.len(),
+        });
+    }
+    for i in 1..b.len() {
+        if b[i].partial_cmp(&b[i - 1]) != Some(std::cmp::Ordering::Greater) {
+            return Err(BlockError::NotIncreasing {
+                axis,
+                index: i,
+                value: b[i],
+                previous: b[i - 1],
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The six tetrahedra of the Kuhn (Freudenthal) split of the unit cube, as vertex offsets:
+/// one tetrahedron per order of the axes, along the path `(0,0,0) -> e_p -> e_p + e_q ->
+/// (1,1,1)`. Every cube is split alike, so each cube face is cut along the same diagonal
+/// from both sides and the split is conforming. The vertices of each are ordered for a
+/// positive volume.
+const KUHN_TETRAHEDRA: [[[usize; 3]; 4]; 6] = [
+    [[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 1, 1]],
+    [[0, 0, 0], [1, 0, 1], [1, 0, 0], [1, 1, 1]],
+    [[0, 0, 0], [1, 1, 0], [0, 1, 0], [1, 1, 1]],
+    [[0, 0, 0], [0, 1, 0], [0, 1, 1], [1, 1, 1]],
+    [[0, 0, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1]],
+    [[0, 0, 0], [0, 1, 1], [0, 0, 1], [1, 1, 1]],
+];
+
+/// Generate a structured 3D block mesh: vertices at the breaks `xs x ys x zs`, moved by the
+/// vertex moves, the higher-order nodes placed from the moved vertices (mid-edge nodes at
+/// edge midpoints, Hex27 face and body centres at the mean of their corners, so every element
+/// keeps straight edges), then moves of single higher-order nodes as in [`block`].
+/// Hexahedra are the grid cells; tetrahedra split each cell into six (see
+/// `KUHN_TETRAHEDRA`), conformingly.
+pub fn block3(
+    kind: SolidKind,
+    xs: &[f64],
+    ys: &[f64],
+    zs: &[f64],
+    moves: &[([f64; 3], [f64; 3])],
+) -> Result<Mesh3, Block3Error> {
+    for (axis, b) in [('x', xs), ('y', ys), ('z', zs)] {
+        check_breaks(axis, b).map_err(Block3Error::Breaks)?;
+    }
+    let cells = [xs.len() - 1, ys.len() - 1, zs.len() - 1];
+    let vertex_index = |i: usize, j: usize, k: usize| (k * (cells[1] + 1) + j) * (cells[0] + 1) + i;
+    let mut vertex = vec![[0.0; 3]; (cells[0] + 1) * (cells[1] + 1) * (cells[2] + 1)];
+    for k in 0..=cells[2] {
+        for j in 0..=cells[1] {
+            for i in 0..=cells[0] {
+                vertex[vertex_index(i, j, k)] = [xs[i], ys[j], zs[k]];
+            }
+        }
+    }
+    let size = (xs[cells[0]] - xs[0])
+        .max(ys[cells[1]] - ys[0])
+        .max(zs[cells[2]] - zs[0]);
+    let at = |p: [f64; 3], from: [f64; 3]| (0..3).all(|i| (p[i] - from[i]).abs() <= 1e-9 * size);
+    let mut node_moves = Vec::new();
+    for &(from, to) in moves {
+        match vertex.iter().position(|&v| at(v, from)) {
+            Some(k) => vertex[k] = to,
+            None => node_moves.push((from, to)),
+        }
+    }
+    // Node lattice: step 1 (linear) or 2 (quadratic) per cell. A lattice point is placed at
+    // the mean of the vertices around it (over each odd coordinate, both neighbours), which
+    // is the edge midpoint, face centre or body centre; the Tet10 mid-edge nodes on a face or
+    // body diagonal are placed at that diagonal's midpoint instead.
+    let q = if kind.is_quadratic() { 2 } else { 1 };
+    let lattice = [q * cells[0] + 1, q * cells[1] + 1, q * cells[2] + 1];
+    let mut id = vec![usize::MAX; lattice[0] * lattice[1] * lattice[2]];
+    let mut nodes: Vec<[f64; 3]> = Vec::new();
+    let v = |p: [usize; 3]| vertex[vertex_index(p[0], p[1], p[2])];
+    let mut node_at = |l: [usize; 3], place: &dyn Fn() -> [f64; 3], nodes: &mut Vec<[f64; 3]>| {
+        let k = (l[2] * lattice[1] + l[1]) * lattice[0] + l[0];
+        if id[k] == usize::MAX {
+            id[k] = nodes.len();
+            nodes.push(place());
+        }
+        id[k]
+    };
+    let mean_around = |l: [usize; 3]| -> [f64; 3] {
+        if q == 1 {
+            return v(l);
+        }
+        let mut sum = [0.0; 3];
+        let mut count = 0.0;
+        for corner in 0..8usize {
+            let mut p = [0; 3];
+            let mut skip = false;
+            for axis in 0..3 {
+                let bit = (corner >> axis) & 1;
+                if l[axis].is_multiple_of(2) {
+                    if bit == 1 {
+                        skip = true;
+                    }
+                    p[axis] = l[axis] / 2;
+                } else {
+                    p[axis] = l[axis] / 2 + bit;
+                }
+            }
+            if skip {
+                continue;
+            }
+            let x = v(p);
+            for i in 0..3 {
+                sum[i] += x[i];
+            }
+            count += 1.0;
+        }
+        sum.map(|s| s / count)
+    };
+    let mut conn = Vec::new();
+    for k in 0..cells[2] {
+        for j in 0..cells[1] {
+            for i in 0..cells[0] {
+                let base = [q * i, q * j, q * k];
+                match kind {
+                    SolidKind::Hex8 | SolidKind::Hex27 => {
+                        for xi in kind.node_coordinates() {
+                            // natural -1, 0, 1 to lattice offsets 0, q/2, q
+                            let l = [0, 1, 2]
+                                .map(|a| base[a] + ((xi[a] + 1.0) * 0.5 * q as f64) as usize);
+                            conn.push(node_at(l, &|| mean_around(l), &mut nodes));
+                        }
+                    }
+                    SolidKind::Tet4 | SolidKind::Tet10 => {
+                        for tet in KUHN_TETRAHEDRA {
+                            let corner = |c: usize| [0, 1, 2].map(|a| base[a] + q * tet[c][a]);
+                            for c in 0..4 {
+                                let l = corner(c);
+                                conn.push(node_at(l, &|| v(l.map(|x| x / q)), &mut nodes));
+                            }
+                            if kind == SolidKind::Tet10 {
+                                for [a, b] in [[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]] {
+                                    let (la, lb) = (corner(a), corner(b));
+                                    let l = [0, 1, 2].map(|x| (la[x] + lb[x]) / 2);
+                                    let place = || {
+                                        let (pa, pb) = (v(la.map(|x| x / 2)), v(lb.map(|x| x / 2)));
+                                        [0, 1, 2].map(|x| 0.5 * (pa[x] + pb[x]))
+                                    };
+                                    conn.push(node_at(l, &place, &mut nodes));
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    for (from, to) in node_moves {
+        let k = nodes
+            .iter()
+            .position(|&p| at(p, from))
+            .ok_or(Block3Error::NoNodeAt { from })?;
+        nodes[k] = to;
+    }
+    Ok(Mesh::new(kind, nodes, conn))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn block3_counts_sets_and_positive_volumes() {
+        let (xs, ys, zs) = ([0.0, 1.0, 3.0], [0.0, 2.0], [0.0, 0.5, 1.0]);
+        for (kind, nodes, cells) in [
+            (SolidKind::Hex8, 3 * 2 * 3, 4),
+            (SolidKind::Hex27, 5 * 3 * 5, 4),
+            (SolidKind::Tet4, 3 * 2 * 3, 24),
+            (SolidKind::Tet10, 5 * 3 * 5, 24),
+        ] {
+            let m = block3(kind, &xs, &ys, &zs, &[([1.0, 2.0, 0.5], [1.1, 2.0, 0.45])]).unwrap();
+            assert_eq!((m.nodes.len(), m.cell_count()), (nodes, cells), "{kind:?}");
+            // boundary faces: 2 (x sides) * 1*2 + 2 (y) * 2*2 + 2 (z) * 2*1 cell faces = 16,
+            // two triangles each for tetrahedra
+            let per_face = if kind.is_hexahedron() { 1 } else { 2 };
+            assert_eq!(m.boundary_facets().len(), 16 * per_face, "{kind:?}");
+            assert_eq!(m.facet_sets["left"].len(), 2 * per_face);
+            assert_eq!(m.facet_sets["front"].len(), 4 * per_face);
+            assert_eq!(m.facet_sets["top"].len(), 2 * per_face);
+            assert_eq!(m.node_sets["bottom_front_left"], vec![0]);
+            assert_eq!(m.node_sets["top_back_right"].len(), 1);
+            // every cell has a positive volume
+            for c in 0..m.cell_count() {
+                let pv = crate::fe3d::solid_point_values(kind, &m.cell_coords(c), kind.centre());
+                assert!(pv.det_j > 0.0, "{kind:?} cell {c}: det J = {}", pv.det_j);
+            }
+        }
+        assert!(matches!(
+            block3(SolidKind::Hex8, &[0.0, 1.0], &[0.0], &[0.0, 1.0], &[]),
+            Err(Block3Error::Breaks(BlockError::TooFewBreaks {
+                axis: 'y',
+                ..
+            }))
+        ));
+        assert!(matches!(
+            block3(
+                SolidKind::Hex8,
+                &[0.0, 1.0],
+                &[0.0, 1.0],
+                &[0.0, 1.0],
+                &[([0.5, 0.5, 0.5], [0.0; 3])]
+            ),
+            Err(Block3Error::NoNodeAt { .. })
+        ));
+    }
 
     #[test]
     fn block_counts_and_automatic_sets() {

@@ -332,6 +332,11 @@ pub fn evaluate_with(
                     let on = body.as_deref().map(|b| format!(" in body '{b}'")).unwrap_or_default();
                     (format!("uniform stress {stress:?}{on}{against}{stated}"), error, tol)
                 }
+                Check::UniformStress3d { tol, .. } => (
+                    "uniform_stress_3d: a 3D check, judged by the run of a 3D case only".to_string(),
+                    f64::INFINITY,
+                    *tol,
+                ),
                 Check::ExactDisplacement { tol } => {
                     let exact = model.exact.as_ref().expect("resolved when the model was built");
                     (

@@ -90,7 +90,7 @@ pub fn refined(case: &Case, refinement: Refinement, level: usize, source: &str) 
                         "give the axis as {\"from\": .., \"to\": .., \"divisions\": N}",
                     )),
                 },
-                MeshSpec::Explicit(_) | MeshSpec::Gmsh(_) => {
+                MeshSpec::Explicit(_) | MeshSpec::Gmsh(_) | MeshSpec::Block3d(_) => {
                     return Err(Error::invalid(
                         source,
                         format!("bodies[{k}].mesh"),

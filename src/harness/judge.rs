@@ -102,6 +102,9 @@ fn unjudgeable(check: &Check) -> Option<&'static str> {
         | Check::MaxContactPressure { .. }
         | Check::MaxPenetration { .. }
         | Check::ForceBalance { .. } => None,
+        Check::UniformStress3d { .. } => {
+            Some("it is a check of 3D cases, which are not judged here yet")
+        }
         Check::TerminatesWith { .. }
         | Check::Equilibrium { .. }
         | Check::StatusChanges { .. }

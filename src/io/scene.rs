@@ -652,6 +652,32 @@ pub enum MeshSpec {
     /// A Gmsh `.msh` file (MSH 4.1 ASCII or binary, MSH 2.2 ASCII): the 2D elements of one
     /// physical surface; the file's other physical groups become node and facet sets.
     Gmsh(GmshMeshSpec),
+    /// A 3D structured block from element breaks along x, y and z (Hex8, Hex27, Tet4,
+    /// Tet10; tetrahedra split each grid cell into six). A case with a 3D body is a 3D case:
+    /// one body, supports with x, y, z, pressure loads, `uniform_stress_3d` checks; contact,
+    /// dynamics, finite strain and sweeps are not built in 3D yet and are refused.
+    Block3d(Block3dSpec),
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Block3dSpec {
+    pub element: crate::fe3d::SolidKind,
+    pub x: Breaks,
+    pub y: Breaks,
+    pub z: Breaks,
+    /// Nodes moved after generation (as for the 2D block): a grid vertex with the
+    /// higher-order nodes following it, or a single higher-order node.
+    #[serde(default)]
+    pub moves: Vec<Move3d>,
+}
+
+/// A move of one node of a 3D block.
+#[derive(Copy, Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Move3d {
+    pub from: [f64; 3],
+    pub to: [f64; 3],
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
@@ -825,6 +851,9 @@ pub struct Support {
     pub x: Option<Prescribed>,
     #[serde(default)]
     pub y: Option<Prescribed>,
+    /// The z component, for a 3D body only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub z: Option<Prescribed>,
     /// The factor of the prescribed values at each load step (one per step of
     /// `solver.load_steps`; default: proportional, `k / n` at step `k`): a load path, e.g.
     /// `[0, 1]` for "not in the first step, fully in the second".
@@ -1045,6 +1074,10 @@ pub enum Check {
         #[serde(default)]
         per_condition: Option<f64>,
     },
+    /// 3D cases: max over the quadrature points of |sigma - stress| / max|stress| over the
+    /// six components `[xx, yy, zz, yz, xz, xy]`.
+    #[serde(rename = "uniform_stress_3d")]
+    UniformStress3d { stress: [f64; 6], tol: f64 },
     /// Relative L2 error of the displacement against the case's exact solution.
     ExactDisplacement { tol: f64 },
     /// Sum of the reactions on a supported node set, one component.

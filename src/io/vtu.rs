@@ -6,7 +6,9 @@
 //! `<PointData>` with one `<DataArray>` per field. Numbers are written in Rust's shortest
 //! round-trip form, so a reader gets back the very `f64` the solver computed. Cell types used:
 //! 3 (`VTK_LINE`) for Line2 facets and 21 (`VTK_QUADRATIC_EDGE`, end, end, middle) for Line3
-//! facets, whose node order is ours.
+//! facets, whose node order is ours; for 3D bodies 12 (`VTK_HEXAHEDRON`), 29
+//! (`VTK_TRIQUADRATIC_HEXAHEDRON`), 10 (`VTK_TETRA`) and 24 (`VTK_QUADRATIC_TETRA`), in the
+//! node order of [`crate::fe3d`], which is VTK's.
 
 use crate::error::Result;
 use std::fmt::Write as _;
@@ -69,11 +71,11 @@ impl PointArray {
     }
 }
 
-/// Write an unstructured grid of `points` (2D, z = 0) and `cells` (VTK cell type, point
-/// indices) with `arrays` as point data.
-pub fn write_grid(
+/// Write an unstructured grid of `points` (2D with z = 0, or 3D) and `cells` (VTK cell type,
+/// point indices) with `arrays` as point data.
+pub fn write_grid<const D: usize>(
     path: &Path,
-    points: &[[f64; 2]],
+    points: &[[f64; D]],
     cells: &[(u8, Vec<usize>)],
     arrays: &[PointArray],
 ) -> Result<()> {
@@ -95,7 +97,8 @@ pub fn write_grid(
         "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
     );
     for p in points {
-        let _ = writeln!(text, "{} {} 0", number(p[0]), number(p[1]));
+        let z = if D > 2 { number(p[2]) } else { "0".to_string() };
+        let _ = writeln!(text, "{} {} {z}", number(p[0]), number(p[1]));
     }
     let _ = writeln!(text, "</DataArray></Points>");
     let _ = writeln!(

@@ -729,6 +729,17 @@ impl Model {
             if !self.support_sets.contains(&entry) {
                 self.support_sets.push(entry);
             }
+            if s.z.is_some() {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    format!(
+                        "the support gives a z component, but body '{}' is 2D",
+                        s.body
+                    ),
+                    "remove \"z\" (a 2D body has the components x and y)",
+                ));
+            }
             if s.x.is_none() && s.y.is_none() {
                 return Err(Error::invalid(
                     &self.source,
@@ -1272,6 +1283,14 @@ impl Model {
                     self.require_exact(&at)?;
                     *tol
                 }
+                Check::UniformStress3d { .. } => {
+                    return Err(Error::invalid(
+                        &self.source,
+                        &at,
+                        "uniform_stress_3d is a check of 3D cases, and this case's bodies are 2D",
+                        "use \"uniform_stress\" with the components [xx, yy, xy]",
+                    ));
+                }
                 Check::Reaction { body, set, tol, .. } => {
                     let b = self.find_body(body, &at)?;
                     self.find_node_set(b, set, &at)?;
@@ -1530,6 +1549,12 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str, notes: &mut Vec<String>) 
             }
             Ok(mesh)
         }
+        MeshSpec::Block3d(_) => Err(Error::invalid(
+            source,
+            format!("{at}.mesh.block3d"),
+            "a 3D body in a case that goes through the 2D model: 3D cases run with `contact-patch run` only, alone (one 3D body, no 2D bodies beside it); tables, sweeps, studies, exports and the other commands are 2D for now",
+            "run the case with `contact-patch run CASE`, or give the body a 2D mesh",
+        )),
         MeshSpec::Block(b) => {
             let xs = b.x.values();
             let ys = b.y.values();
@@ -1653,7 +1678,7 @@ fn check_read_size(case: &Case, built: &[Body], mesh: &Mesh, source: &str, at: &
 
 /// The node count of every mesh, from the spec alone (nothing is allocated), against
 /// `limits.nodes`.
-fn check_size(case: &Case, source: &str) -> Result<()> {
+pub(crate) fn check_size(case: &Case, source: &str) -> Result<()> {
     for (field, value) in [
         ("factor_gigabytes", case.limits.factor_gigabytes),
         ("factor_operations", case.limits.factor_operations),
@@ -1675,6 +1700,17 @@ fn check_size(case: &Case, source: &str) -> Result<()> {
                 let order = if b.element.is_quadratic() { 2 } else { 1 };
                 let along = |n: usize| order * n as u128 + 1;
                 along(b.x.intervals()) * along(b.y.intervals())
+            }
+            MeshSpec::Block3d(b) => {
+                let order = if crate::fe::ReferenceCell::is_quadratic(b.element) {
+                    2
+                } else {
+                    1
+                };
+                let along = |n: usize| order * n as u128 + 1;
+                along(b.x.intervals())
+                    .saturating_mul(along(b.y.intervals()))
+                    .saturating_mul(along(b.z.intervals()))
             }
             MeshSpec::Explicit(e) => e.nodes.len() as u128,
             // counted once read (check_read_size)

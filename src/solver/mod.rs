@@ -11,6 +11,7 @@ pub mod constraints;
 pub mod contact_newton;
 pub(crate) mod dense;
 pub mod dynamics;
+pub mod elastic3d;
 pub mod finite;
 pub mod finite_assembly;
 pub mod history;

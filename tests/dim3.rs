@@ -1,0 +1,378 @@
+//! 3D single-body small-strain elasticity against closed forms: the displacement and the
+//! traction patch tests on distorted meshes (the exact uniform stress to 1e-10), and the
+//! convergence rates of every element on a smooth manufactured solution (L2 and energy
+//! norms: 2 and 1 for Hex8 and Tet4, 3 and 2 for Hex27 and Tet10).
+
+use contact_patch::fe3d::SolidKind;
+use contact_patch::mesh::{block3, Mesh3};
+use contact_patch::solid3d::Elasticity3;
+use contact_patch::solver::elastic3d::Solid3;
+use contact_patch::solver::sparse::WorkLimit;
+use nalgebra::Matrix3;
+
+const LIMIT: WorkLimit = WorkLimit {
+    gigabytes: 4.0,
+    operations: 1e12,
+};
+
+/// The box [0, 1] x [0, 0.8] x [0, 1.2] on uneven breaks, every interior vertex moved by a
+/// fixed, different offset (a distorted mesh whose cells stay valid).
+fn distorted_box(kind: SolidKind) -> Mesh3 {
+    let xs = [0.0, 0.3, 0.65, 1.0];
+    let ys = [0.0, 0.35, 0.8];
+    let zs = [0.0, 0.25, 0.7, 1.2];
+    let mut moves = Vec::new();
+    let mut k = 0;
+    for &z in &zs[1..zs.len() - 1] {
+        for &y in &ys[1..ys.len() - 1] {
+            for &x in &xs[1..xs.len() - 1] {
+                k += 1;
+                let s = 0.04 * (k as f64);
+                moves.push((
+                    [x, y, z],
+                    [x + 0.6 * s - 0.05, y - 0.5 * s + 0.03, z + 0.3 * s - 0.04],
+                ));
+            }
+        }
+    }
+    block3(kind, &xs, &ys, &zs, &moves).expect("a valid block")
+}
+
+/// A general (full) displacement gradient: strain and a small rotation.
+fn gradient() -> Matrix3<f64> {
+    Matrix3::new(1e-3, 4e-4, -2e-4, -1e-4, -5e-4, 3e-4, 6e-4, 2e-4, 8e-4)
+}
+
+fn strain_of(h: &Matrix3<f64>) -> [f64; 6] {
+    contact_patch::solid3d::voigt_strain(h)
+}
+
+fn largest_stress_error(solid: &Solid3, u: &[f64], exact: [f64; 6]) -> f64 {
+    let scale = exact.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    solid
+        .stresses(u)
+        .iter()
+        .flat_map(|(_, s)| (0..6).map(move |i| (s[i] - exact[i]).abs()))
+        .fold(0.0, f64::max)
+        / scale
+}
+
+#[test]
+fn displacement_patch_test_on_distorted_meshes_gives_the_exact_uniform_stress() {
+    let material = Elasticity3::new(200.0, 0.3);
+    let h = gradient();
+    let sigma = material.stress(strain_of(&h));
+    for kind in SolidKind::ALL {
+        let mesh = distorted_box(kind);
+        let boundary: Vec<usize> = ["left", "right", "front", "back", "bottom", "top"]
+            .iter()
+            .flat_map(|s| mesh.node_sets[*s].clone())
+            .collect();
+        let mut solid = Solid3::new(mesh, material);
+        let field = |x: [f64; 3]| {
+            let v = h * nalgebra::Vector3::from(x);
+            [v[0], v[1], v[2]]
+        };
+        solid.prescribe(&boundary, |x| field(x).map(Some));
+        let free = solid.prescribed.iter().filter(|p| p.is_none()).count();
+        assert!(free > 0, "{kind:?}: the patch has interior nodes");
+        let u = solid.solve(&LIMIT).expect("solvable");
+        let stress_error = largest_stress_error(&solid, &u, sigma);
+        let displacement_error = solid
+            .mesh
+            .nodes
+            .iter()
+            .enumerate()
+            .flat_map(|(n, x)| {
+                let e = field(*x);
+                let u = &u;
+                (0..3).map(move |i| (u[3 * n + i] - e[i]).abs())
+            })
+            .fold(0.0, f64::max);
+        println!("{kind:?}: free dofs {free}, stress error {stress_error:.2e} (relative), displacement error {displacement_error:.2e}");
+        assert!(
+            stress_error < 1e-10,
+            "{kind:?}: stress error {stress_error:e}"
+        );
+        assert!(
+            displacement_error < 1e-12,
+            "{kind:?}: displacement error {displacement_error:e}"
+        );
+    }
+}
+
+#[test]
+fn traction_patch_test_with_minimal_supports_gives_the_exact_uniform_stress() {
+    // t = sigma n on every face of the box; six dofs fixed at three corners at the values of
+    // the exact field u = eps x (no rotation), which removes the six rigid motions only
+    let material = Elasticity3::new(200.0, 0.3);
+    let eps_tensor = {
+        let h = gradient();
+        (h + h.transpose()) * 0.5
+    };
+    let sigma = material.stress(strain_of(&eps_tensor));
+    let s = Matrix3::new(
+        sigma[0], sigma[5], sigma[4], sigma[5], sigma[1], sigma[3], sigma[4], sigma[3], sigma[2],
+    );
+    for kind in SolidKind::ALL {
+        let mesh = distorted_box(kind);
+        let origin = mesh.node_sets["bottom_front_left"].clone();
+        let x_corner = mesh.node_sets["bottom_front_right"].clone();
+        let y_corner = mesh.node_sets["bottom_back_left"].clone();
+        let faces: Vec<_> = ["left", "right", "front", "back", "bottom", "top"]
+            .iter()
+            .flat_map(|f| mesh.facet_sets[*f].clone())
+            .collect();
+        let mut solid = Solid3::new(mesh, material);
+        let field = |x: [f64; 3]| {
+            let v = eps_tensor * nalgebra::Vector3::from(x);
+            [v[0], v[1], v[2]]
+        };
+        solid.prescribe(&origin, |x| field(x).map(Some));
+        solid.prescribe(&x_corner, |x| {
+            let v = field(x);
+            [None, Some(v[1]), Some(v[2])]
+        });
+        solid.prescribe(&y_corner, |x| [None, None, Some(field(x)[2])]);
+        assert_eq!(solid.prescribed.iter().flatten().count(), 6);
+        solid.add_traction(&faces, &|_, n| {
+            let t = s * nalgebra::Vector3::from(n);
+            [t[0], t[1], t[2]]
+        });
+        let u = solid.solve(&LIMIT).expect("solvable");
+        let stress_error = largest_stress_error(&solid, &u, sigma);
+        println!("{kind:?}: stress error {stress_error:.2e} (relative)");
+        assert!(
+            stress_error < 1e-10,
+            "{kind:?}: stress error {stress_error:e}"
+        );
+    }
+}
+
+/// The manufactured field `u_i = sin(a_i . x + c_i)` and its body force
+/// `b = -div sigma = -(lambda + mu) grad div u - mu lap u`.
+struct Manufactured {
+    a: [[f64; 3]; 3],
+    c: [f64; 3],
+}
+
+impl Manufactured {
+    fn new() -> Self {
+        Manufactured {
+            a: [[1.1, 0.4, -0.3], [0.2, -0.9, 0.5], [-0.4, 0.3, 1.2]],
+            c: [0.1, 0.7, -0.3],
+        }
+    }
+    fn theta(&self, i: usize, x: [f64; 3]) -> f64 {
+        (0..3).map(|j| self.a[i][j] * x[j]).sum::<f64>() + self.c[i]
+    }
+    fn u(&self, x: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|i| self.theta(i, x).sin())
+    }
+    fn gradient(&self, x: [f64; 3]) -> Matrix3<f64> {
+        Matrix3::from_fn(|i, j| self.a[i][j] * self.theta(i, x).cos())
+    }
+    fn body_force(&self, m: &Elasticity3, x: [f64; 3]) -> [f64; 3] {
+        let (lambda, mu) = (m.lambda(), m.mu());
+        let s = [0, 1, 2].map(|i| self.theta(i, x).sin());
+        [0, 1, 2].map(|k| {
+            let grad_div: f64 = (0..3).map(|i| -self.a[i][i] * self.a[i][k] * s[i]).sum();
+            let lap = -(0..3).map(|j| self.a[k][j].powi(2)).sum::<f64>() * s[k];
+            -(lambda + mu) * grad_div - mu * lap
+        })
+    }
+}
+
+/// The unit cube on `n` cells a side, its vertices moved by the smooth map
+/// `x + 0.03 sin(pi x) sin(pi y) sin(pi z) [1, -1, 1]` (a distortion that stays smooth under
+/// refinement, so the rates are the asymptotic ones).
+fn smooth_cube(kind: SolidKind, n: usize) -> Mesh3 {
+    let breaks: Vec<f64> = (0..=n).map(|i| i as f64 / n as f64).collect();
+    let pi = std::f64::consts::PI;
+    let mut moves = Vec::new();
+    for &z in &breaks {
+        for &y in &breaks {
+            for &x in &breaks {
+                let d = 0.03 * (pi * x).sin() * (pi * y).sin() * (pi * z).sin();
+                if d != 0.0 {
+                    moves.push(([x, y, z], [x + d, y - d, z + d]));
+                }
+            }
+        }
+    }
+    block3(kind, &breaks, &breaks, &breaks, &moves).expect("a valid block")
+}
+
+#[test]
+fn every_element_converges_at_its_optimal_rates_on_a_smooth_solution() {
+    let material = Elasticity3::new(1.0, 0.3);
+    let field = Manufactured::new();
+    for (kind, levels, l2_rate, energy_rate) in [
+        (SolidKind::Hex8, [2, 4, 8, 16], 2.0, 1.0),
+        (SolidKind::Tet4, [2, 4, 8, 16], 2.0, 1.0),
+        (SolidKind::Hex27, [1, 2, 4, 8], 3.0, 2.0),
+        (SolidKind::Tet10, [1, 2, 4, 8], 3.0, 2.0),
+    ] {
+        let mut errors = Vec::new();
+        for n in levels {
+            let mesh = smooth_cube(kind, n);
+            let boundary: Vec<usize> = ["left", "right", "front", "back", "bottom", "top"]
+                .iter()
+                .flat_map(|s| mesh.node_sets[*s].clone())
+                .collect();
+            let mut solid = Solid3::new(mesh, material);
+            solid.prescribe(&boundary, |x| field.u(x).map(Some));
+            solid.add_body_force(&|x| field.body_force(&material, x));
+            let u = solid.solve(&LIMIT).expect("solvable");
+            errors.push(solid.error_norms(&u, &|x| field.u(x), &|x| field.gradient(x)));
+        }
+        let rates: Vec<(f64, f64)> = errors
+            .windows(2)
+            .map(|w| ((w[0].0 / w[1].0).log2(), (w[0].1 / w[1].1).log2()))
+            .collect();
+        println!(
+            "{kind:?}: levels {levels:?}, errors (L2, energy) {errors:.3?}, rates {rates:.3?}"
+        );
+        let (l2, energy) = *rates.last().expect("three levels or more");
+        assert!(
+            (l2 - l2_rate).abs() < 0.15,
+            "{kind:?}: L2 rate {l2}, expected {l2_rate}"
+        );
+        assert!(
+            (energy - energy_rate).abs() < 0.15,
+            "{kind:?}: energy rate {energy}, expected {energy_rate}"
+        );
+        // the rates rise towards their asymptotic values: every step gains at least 80 %
+        for (l2, energy) in &rates[1..] {
+            assert!(
+                *l2 > 0.8 * l2_rate && *energy > 0.8 * energy_rate,
+                "{kind:?}: {rates:?}"
+            );
+        }
+    }
+}
+
+/// The example case `cases/3d/patch-hex8.json` with `edit` applied, written to a temporary
+/// folder; returns the folder (kept alive by the caller) and the file.
+fn edited_case(
+    edit: impl FnOnce(&mut serde_json::Value),
+) -> (tempfile::TempDir, std::path::PathBuf) {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("cases/3d/patch-hex8.json")).unwrap();
+    let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
+    edit(&mut case);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&case).unwrap()).unwrap();
+    (dir, path)
+}
+
+fn run_binary(path: &std::path::Path, out: &std::path::Path) -> (i32, String, String) {
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .arg("run")
+        .arg(path)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    (
+        output.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn the_3d_example_runs_and_writes_a_3d_vtu_with_six_stress_components() {
+    let (dir, path) = edited_case(|_| {});
+    let out = dir.path().join("out");
+    let (code, stdout, stderr) = run_binary(&path, &out);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    assert!(stdout.contains("pass uniform stress"), "{stdout}");
+    let vtu = std::fs::read_to_string(out.join("block.vtu")).unwrap();
+    assert!(
+        vtu.contains("Name=\"stress\" NumberOfComponents=\"6\""),
+        "{vtu:.400}"
+    );
+    assert!(vtu.contains("Name=\"displacement\" NumberOfComponents=\"3\""));
+    // 18 Hex8 cells: VTK type 12 each
+    let types = vtu.split("Name=\"types\"").nth(1).unwrap();
+    let types = &types[types.find('>').unwrap() + 1..types.find("</DataArray>").unwrap()];
+    let ids: Vec<&str> = types.split_whitespace().collect();
+    assert_eq!(ids, vec!["12"; 18]);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["dimension"], 3);
+    assert_eq!(summary["passed"], true);
+}
+
+#[test]
+fn a_3d_case_with_a_contact_pair_is_refused_with_the_reason() {
+    let (dir, path) = edited_case(|case| {
+        case["contact"] = serde_json::json!([{
+            "name": "ground",
+            "slave": {"body": "block", "set": "bottom"},
+            "master": {"rigid": {"kind": "line", "point": [0, 0], "normal": [0, 1]}},
+            "discretization": {"kind": "node_to_surface", "passes": 1},
+            "enforcement": {"kind": "lagrange"}
+        }]);
+    });
+    let out = dir.path().join("out");
+    let (code, _, stderr) = run_binary(&path, &out);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("contact in 3D is not built yet"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("contact[0] 'ground'"), "{stderr}");
+    assert!(!out.exists(), "nothing is written for a refused case");
+}
+
+#[test]
+fn what_3d_does_not_have_yet_is_refused_and_2d_cases_refuse_3d_fields() {
+    for (edit, expected) in [
+        (
+            Box::new(|c: &mut serde_json::Value| {
+                c["physics"] = serde_json::json!({"kinematics": "finite"})
+            }) as Box<dyn Fn(&mut serde_json::Value)>,
+            "finite strain in 3D is not built yet",
+        ),
+        (
+            Box::new(|c: &mut serde_json::Value| {
+                c["loads"] =
+                    serde_json::json!([{"body": "block", "set": "top", "traction": [1, 0]}])
+            }),
+            "in 3D is not built yet",
+        ),
+        (
+            Box::new(|c: &mut serde_json::Value| {
+                c["supports"] = serde_json::json!([{"body": "block", "set": "bottom", "z": 0.0}])
+            }),
+            "the stiffness cannot be factored",
+        ),
+    ] {
+        let (dir, path) = edited_case(|c| edit(c));
+        let (code, _, stderr) = run_binary(&path, &dir.path().join("out"));
+        assert_eq!(code, 2, "{stderr}");
+        assert!(stderr.contains(expected), "{expected}: {stderr}");
+    }
+    // the 2D model refuses a 3D body (through a command that is 2D only) and a z support
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let err = contact_patch::model::admit::load(&root.join("cases/3d/patch-hex8.json"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("3D cases run with `contact-patch run` only"),
+        "{err}"
+    );
+    let text = std::fs::read_to_string(root.join("cases/patch-single/q4-distorted.json")).unwrap();
+    let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
+    case["supports"][0]["z"] = serde_json::json!(0.0);
+    let err = contact_patch::model::Model::build(
+        &contact_patch::model::parse(&case.to_string(), "q4-with-z").unwrap(),
+        "q4-with-z",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("but body 'patch' is 2D"), "{err}");
+}
