@@ -99,22 +99,12 @@ fn discretization(c: &mut Criterion) {
 }
 
 /// The active-set loop of a penalty contact solve that changes many rows and then few: the
-/// cross-check's block on a rigid line refined to 240 x 40 Q4 (19,762 dofs, penalty 1e5; about
-/// 100 rows change in its first iteration, then 14, 8, 5, 3, 1), factoring every matrix anew
-/// against updating the last factorization by low rank (`solver.factor_update`).
+/// cross-check's block on a rigid line refined to 240 x 40 Q4 (19,762 dofs, penalty 1e5,
+/// `tests/data/block-on-rigid-line-240x40.json`; about 100 rows change in its first iteration,
+/// then 14, 8, 5, 3, 1), factoring every matrix anew against updating the last factorization
+/// by low rank (`solver.factor_update`).
 fn factor_update(c: &mut Criterion) {
-    let json = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("crosscheck/cases/contact/signorini-flat-penalty-q4.json"),
-    )
-    .unwrap()
-    .replace("\"divisions\": 60", "\"divisions\": 240")
-    .replace("\"divisions\": 10", "\"divisions\": 40");
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("block-240x40.json");
-    std::fs::write(&path, json).unwrap();
-    let mut base = load(&path).unwrap();
-    base.contact[0].enforcement = EnforcementSpec::Penalty { kappa: 1e5 };
+    let base = case("tests/data/block-on-rigid-line-240x40.json");
     let mut group = c.benchmark_group("block_on_rigid_line_factor_update");
     group.sample_size(10);
     for (name, mode) in [

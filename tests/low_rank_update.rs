@@ -7,7 +7,7 @@
 //! (so the loop falls back to factoring and then updates again), and on the default `"auto"`
 //! mode, which below 20,000 equations must stay bit-identical to refactoring.
 
-use contact_patch::io::scene::{EnforcementSpec, FactorUpdate};
+use contact_patch::io::scene::FactorUpdate;
 use contact_patch::model::admit::load;
 use contact_patch::model::Model;
 use contact_patch::solver::linear::Solution;
@@ -120,22 +120,12 @@ fn the_update_gives_the_refactored_answer_on_the_contact_cases() {
 }
 
 /// The cross-check's block on a rigid line refined to 240 x 40 Q4 (19,762 dofs) with a penalty
-/// of 1e5: its first iterations change more rows than an update may take (64), so the loop
-/// factors, and then updates while few rows change; the answer is the refactored one.
+/// of 1e5 (`tests/data/block-on-rigid-line-240x40.json`): its first iterations change more rows
+/// than an update may take (64), so the loop factors, and then updates while few rows change;
+/// the answer is the refactored one.
 #[test]
 fn many_changed_rows_fall_back_to_a_factorization() {
-    let json = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("crosscheck/cases/contact/signorini-flat-penalty-q4.json"),
-    )
-    .unwrap()
-    .replace("\"divisions\": 60", "\"divisions\": 240")
-    .replace("\"divisions\": 10", "\"divisions\": 40");
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("block-240x40.json");
-    std::fs::write(&path, json).unwrap();
-    let mut model = load(&path).unwrap();
-    model.contact[0].enforcement = EnforcementSpec::Penalty { kappa: 1e5 };
+    let model = case("tests/data/block-on-rigid-line-240x40.json");
     assert_eq!(model.dof_count, 2 * 241 * 41);
     let updated = solve(&model, FactorUpdate::LowRank);
     let history = &updated.contact.as_ref().unwrap().history;
