@@ -1,11 +1,13 @@
 //! Criterion benchmarks of the contact solve: what each enforcement method costs on one
 //! representative nonlinear problem (a Q4 block, 6,642 dofs, pressed on a rigid cylinder; 81
-//! candidate rows, 11 active at the solution), and what each discretization costs on the Q9
-//! patch mesh E. Read the figures as ratios within one run (e.g. augmented Lagrangian vs
+//! candidate rows, 11 active at the solution), what each discretization costs on the Q9
+//! patch mesh E, and what the low-rank update of the factorization saves in the active-set loop
+//! of a 19,762-dof block on a rigid line (src/solver/low_rank.rs). Read the figures as ratios within one run (e.g. augmented Lagrangian vs
 //! Lagrange), never as absolute times across machines.
 
 use contact_patch::io::scene::{
-    DiscretizationSpec, EnforcementSpec, MultiplierSpace, MultiplierUpdate, NormalChoice,
+    DiscretizationSpec, EnforcementSpec, FactorUpdate, MultiplierSpace, MultiplierUpdate,
+    NormalChoice,
 };
 use contact_patch::model::admit::load;
 use contact_patch::model::Model;
@@ -96,5 +98,27 @@ fn discretization(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, enforcement, discretization);
+/// The active-set loop of a penalty contact solve that changes many rows and then few: the
+/// cross-check's block on a rigid line refined to 240 x 40 Q4 (19,762 dofs, penalty 1e5,
+/// `tests/data/block-on-rigid-line-240x40.json`; about 100 rows change in its first iteration,
+/// then 14, 8, 5, 3, 1), factoring every matrix anew against updating the last factorization
+/// by low rank (`solver.factor_update`).
+fn factor_update(c: &mut Criterion) {
+    let base = case("tests/data/block-on-rigid-line-240x40.json");
+    let mut group = c.benchmark_group("block_on_rigid_line_factor_update");
+    group.sample_size(10);
+    for (name, mode) in [
+        ("refactor", FactorUpdate::Refactor),
+        ("low_rank", FactorUpdate::LowRank),
+    ] {
+        let mut model = base.clone();
+        model.solver.factor_update = mode;
+        group.bench_function(name, |b| {
+            b.iter(|| solve_static(black_box(&model), &mut |_| {}).unwrap())
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, enforcement, discretization, factor_update);
 criterion_main!(benches);

@@ -92,6 +92,27 @@ pub struct SolverSpec {
     /// `active_set_cycling` and the points named).
     #[serde(default)]
     pub cycling_remedy: CyclingRemedy,
+    /// How an active-set iteration of the penalty family gets the solver of its matrix when
+    /// few rows changed: `"auto"` (default: a low-rank update of the last factorization on
+    /// systems of at least 20,000 equations, else a new factorization), `"refactor"` (always
+    /// factor anew) or `"low_rank"` (the update on every size, to compare);
+    /// see `src/solver/low_rank.rs`.
+    #[serde(default)]
+    pub factor_update: FactorUpdate,
+}
+
+/// Whether the active-set iterations reuse the last factorization with a low-rank
+/// (Woodbury) update instead of factoring anew ([`crate::solver::low_rank`]).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum FactorUpdate {
+    /// The update on large systems (at least 20,000 equations), a new factorization else.
+    #[default]
+    Auto,
+    /// A new factorization whenever the matrix changes.
+    Refactor,
+    /// The update whenever few enough rows changed, whatever the size.
+    LowRank,
 }
 
 /// The remedy of the active-set scheme for a cycling active set
@@ -151,6 +172,7 @@ impl Default for SolverSpec {
             scheme: Scheme::ActiveSet,
             friction_tangent: FrictionTangent::Consistent,
             cycling_remedy: CyclingRemedy::Hold,
+            factor_update: FactorUpdate::Auto,
         }
     }
 }

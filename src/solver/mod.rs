@@ -16,6 +16,7 @@ pub mod finite;
 pub mod finite_assembly;
 pub mod history;
 pub mod linear;
+pub mod low_rank;
 pub mod newton;
 pub mod sparse;
 

@@ -405,6 +405,11 @@ impl Cholesky {
         })
     }
 
+    /// The size of the factorization ([`FactorWork`]).
+    pub fn work(&self) -> FactorWork {
+        FactorWork::of(&self.symbolic)
+    }
+
     /// Whether the numeric factorization works on supernodes (dense blocks) rather than
     /// column by column; faer decides from the pattern.
     pub fn is_supernodal(&self) -> bool {
@@ -494,6 +499,21 @@ impl Factor {
         for (i, v) in b.iter_mut().enumerate() {
             *v = rhs[(i, 0)];
         }
+    }
+
+    /// Solve `A X = B` in place for every column of `b` at once (one pass over the factor).
+    pub fn solve_columns_in_place(&self, b: &mut Mat<f64>) {
+        let par = faer::get_global_parallelism();
+        let mut mem = MemBuffer::new(
+            self.symbolic
+                .solve_in_place_scratch::<f64>(b.ncols().max(1), par),
+        );
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            b.as_mut(),
+            par,
+            MemStack::new(&mut mem),
+        );
     }
 }
 

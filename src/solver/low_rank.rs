@@ -1,0 +1,333 @@
+//! Solving with a factored matrix after a low-rank change, by the Sherman-Morrison-Woodbury
+//! identity, so that an active-set iteration that changes few contact rows needs no new
+//! factorization.
+//!
+//! The base `A = L L^T` is factored ([`crate::solver::sparse::Factor`]). The matrix of a later
+//! iteration is `M = A + U W U^T`: `U = [u_1 .. u_r]` are the gradients `b_i` of the `r` rows
+//! whose weight changed (sparse, a few entries each) and `W = diag(dw_i)` the changes of weight,
+//! of either sign (a row that closed adds `+w_i`, one that opened `-w_i`). Woodbury's identity
+//! (W. W. Hager, "Updating the inverse of a matrix", SIAM Review 31 (1989) 221-239; Golub & Van
+//! Loan, *Matrix Computations*, 4th ed., 2013, sec. 2.1.4):
+//!
+//! ```text
+//! M^-1 = A^-1 - Z C^-1 Z^T,   Z = A^-1 U (n x r),   C = W^-1 + U^T Z (r x r, symmetric)
+//! ```
+//!
+//! and `det M = det A det W det C`, so `C` is nonsingular exactly when `M` is. `C` is indefinite
+//! when rows open, so it is factored by dense LU with partial pivoting (faer). A solve with `M`
+//! costs one solve with `L`, `2 n r` multiply-adds and an `r x r` solve; building the update
+//! costs one solve with `r` right-hand sides at once for the columns of `Z` not already known
+//! (they depend on the base and the row alone, so [`LowRankBase`] keeps them across
+//! iterations), and `n r` values of memory.
+//!
+//! Accuracy: the identity is exact; in floating point its error grows with `cond(C)` (Yip,
+//! "A note on the stability of solving a rank-p modification of a linear system by the
+//! Sherman-Morrison-Woodbury formula", SIAM J. Sci. Stat. Comput. 7 (1986) 507-513). The callers
+//! therefore judge every answer by the residual of `M` itself and refine it (iterative
+//! refinement with `M`'s own residual converges to round-off when `||I - M M~^-1|| < 1`), and
+//! refactor `M` when the update's answer does not reach round-off (the fallback), when `C` is
+//! singular to working precision, or when more rows changed than the update allows.
+
+use crate::solver::sparse::Factor;
+use faer::linalg::solvers::{PartialPivLu, Solve};
+use faer::Mat;
+use std::collections::HashMap;
+use std::rc::Rc;
+
+/// A pivot of the capacitance `C` below this share of its largest entry counts as zero: the
+/// update is refused and the caller refactors.
+pub const CAPACITANCE_TINY_PIVOT: f64 = 1e-13;
+
+/// Either a factorization of `M` itself or the base factorization with a Woodbury update.
+pub enum Operator {
+    Factored(Rc<Factor>),
+    Updated(LowRankUpdate),
+}
+
+impl Operator {
+    /// `b <- M^-1 b`.
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        match self {
+            Operator::Factored(f) => f.solve_in_place(b),
+            Operator::Updated(u) => u.solve_in_place(b),
+        }
+    }
+
+    /// The rank of the update (0 for a factorization of `M` itself).
+    pub fn rank(&self) -> usize {
+        match self {
+            Operator::Factored(_) => 0,
+            Operator::Updated(u) => u.columns.len(),
+        }
+    }
+}
+
+/// A sparse vector: equations and values.
+pub type SparseColumn = (Vec<usize>, Vec<f64>);
+
+/// `M^-1` as the base factor's inverse minus `Z C^-1 Z^T`.
+pub struct LowRankUpdate {
+    base: Rc<Factor>,
+    /// The columns `u_a` of `U`.
+    columns: Vec<SparseColumn>,
+    /// `z_a = A^-1 u_a`.
+    z: Vec<Rc<Vec<f64>>>,
+    capacitance: PartialPivLu<f64>,
+}
+
+fn sparse_dot((eqs, values): &SparseColumn, x: &[f64]) -> f64 {
+    eqs.iter().zip(values).map(|(&e, v)| v * x[e]).sum()
+}
+
+impl LowRankUpdate {
+    /// `b <- M^-1 b = A^-1 b - Z C^-1 (Z^T b)`; `Z^T b = U^T (A^-1 b)` by symmetry of `A`.
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        self.base.solve_in_place(b);
+        let r = self.columns.len();
+        let t = Mat::<f64>::from_fn(r, 1, |a, _| sparse_dot(&self.columns[a], b));
+        let s = self.capacitance.solve(&t);
+        for (a, z) in self.z.iter().enumerate() {
+            let sa = s[(a, 0)];
+            if sa != 0.0 {
+                b.iter_mut().zip(z.iter()).for_each(|(x, zj)| *x -= sa * zj);
+            }
+        }
+    }
+}
+
+/// The factored base matrix `A = K + sum_i w_i b_i b_i^T` (the weights `w_i`, zero for an
+/// inactive row, of the set it was factored for) and the columns `A^-1 b_i` computed so far.
+pub struct LowRankBase {
+    factor: Rc<Factor>,
+    weights: Vec<f64>,
+    known: HashMap<usize, Rc<Vec<f64>>>,
+}
+
+impl LowRankBase {
+    pub fn new(factor: Rc<Factor>, weights: Vec<f64>) -> Self {
+        LowRankBase {
+            factor,
+            weights,
+            known: HashMap::new(),
+        }
+    }
+
+    /// The rows whose weight differs from the base's.
+    pub fn changed(&self, weights: &[f64]) -> Vec<usize> {
+        (0..weights.len())
+            .filter(|&i| weights[i] != self.weights[i])
+            .collect()
+    }
+
+    /// The update to `M = A + sum_i (weights_i - base_i) b_i b_i^T`, with `row(i)` the sparse
+    /// gradient `b_i`; `None` when more than `max_rank` rows changed, more than `max_new` of
+    /// them need a new column `A^-1 b_i`, or the capacitance is singular to working precision
+    /// (the caller then refactors).
+    pub fn update<'a>(
+        &mut self,
+        weights: &[f64],
+        row: impl Fn(usize) -> (&'a [usize], &'a [f64]),
+        n: usize,
+        max_rank: usize,
+        max_new: usize,
+    ) -> Option<LowRankUpdate> {
+        let changed = self.changed(weights);
+        if changed.is_empty() || changed.len() > max_rank {
+            return None;
+        }
+        let columns: Vec<SparseColumn> = changed
+            .iter()
+            .map(|&i| {
+                let (e, c) = row(i);
+                (e.to_vec(), c.to_vec())
+            })
+            .collect();
+        // the columns of Z not known yet, in one solve with several right-hand sides
+        let missing: Vec<usize> = (0..changed.len())
+            .filter(|&a| !self.known.contains_key(&changed[a]))
+            .collect();
+        if missing.len() > max_new {
+            return None;
+        }
+        // keep the memory of the known columns within twice the rank bound
+        if self.known.len() + missing.len() > 2 * max_rank {
+            self.known.retain(|i, _| changed.contains(i));
+        }
+        if !missing.is_empty() {
+            let mut rhs = Mat::<f64>::zeros(n, missing.len());
+            for (k, &a) in missing.iter().enumerate() {
+                let (eqs, values) = &columns[a];
+                for (&e, &v) in eqs.iter().zip(values) {
+                    rhs[(e, k)] += v;
+                }
+            }
+            self.factor.solve_columns_in_place(&mut rhs);
+            for (k, &a) in missing.iter().enumerate() {
+                let z: Vec<f64> = (0..n).map(|j| rhs[(j, k)]).collect();
+                self.known.insert(changed[a], Rc::new(z));
+            }
+        }
+        let z: Vec<Rc<Vec<f64>>> = changed.iter().map(|i| self.known[i].clone()).collect();
+        let r = changed.len();
+        let mut c = Mat::<f64>::zeros(r, r);
+        for a in 0..r {
+            for b in 0..r {
+                c[(a, b)] = sparse_dot(&columns[a], &z[b]);
+            }
+        }
+        for a in 0..r {
+            for b in 0..a {
+                let v = 0.5 * (c[(a, b)] + c[(b, a)]);
+                c[(a, b)] = v;
+                c[(b, a)] = v;
+            }
+        }
+        // the scale of C's terms before they cancel: its entries U^T Z and the 1 / dw_i
+        let mut scale = (0..r)
+            .flat_map(|a| (0..r).map(move |b| (a, b)))
+            .fold(0.0f64, |m, (a, b)| m.max(c[(a, b)].abs()));
+        for a in 0..r {
+            let inverse = 1.0 / (weights[changed[a]] - self.weights[changed[a]]);
+            scale = scale.max(inverse.abs());
+            c[(a, a)] += inverse;
+        }
+        let lu = c.partial_piv_lu();
+        let u = lu.U();
+        let singular = !scale.is_finite()
+            || (0..r).any(|k| {
+                let p = u[(k, k)];
+                !p.is_finite() || p.abs() <= CAPACITANCE_TINY_PIVOT * scale
+            });
+        if singular {
+            return None;
+        }
+        Some(LowRankUpdate {
+            base: self.factor.clone(),
+            columns,
+            z,
+            capacitance: lu,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::sparse::{Cholesky, PatternBuilder, SymmetricPattern, UNLIMITED};
+
+    /// The 1D Laplacian with a spring at the left end, `n` equations, plus the pattern.
+    fn laplacian(n: usize) -> (SymmetricPattern, Vec<f64>) {
+        let mut builder = PatternBuilder::new(n);
+        for j in 1..n {
+            builder.add_block(&[j - 1, j]);
+        }
+        let pattern = builder.build();
+        let mut values = vec![0.0; pattern.nnz()];
+        for j in 0..n {
+            values[pattern.position(j, j).unwrap()] = if j + 1 == n { 1.0 } else { 2.0 };
+            if j > 0 {
+                values[pattern.position(j - 1, j).unwrap()] = -1.0;
+            }
+        }
+        (pattern, values)
+    }
+
+    fn rows(n: usize) -> Vec<SparseColumn> {
+        // rows on one equation and on two (a row of a node-to-surface segment)
+        (0..n)
+            .map(|i| {
+                if i % 3 == 0 && i + 1 < n {
+                    (vec![i, i + 1], vec![0.6, -0.8])
+                } else {
+                    (vec![i], vec![1.0])
+                }
+            })
+            .collect()
+    }
+
+    /// `A + sum_i w_i b_i b_i^T` factored from scratch.
+    fn factored(pattern: &SymmetricPattern, k: &[f64], rows: &[SparseColumn], w: &[f64]) -> Factor {
+        let mut values = k.to_vec();
+        for ((eqs, c), &wi) in rows.iter().zip(w) {
+            if wi == 0.0 {
+                continue;
+            }
+            let m = eqs.len();
+            let block: Vec<f64> = (0..m * m).map(|q| wi * c[q / m] * c[q % m]).collect();
+            pattern.scatter(eqs, &block, &mut values);
+        }
+        Cholesky::analyse(pattern, &UNLIMITED)
+            .unwrap()
+            .factor(pattern, &values)
+            .unwrap()
+    }
+
+    /// Rows that close and rows that open (weights up and down, many at once) give the
+    /// solution of the refactored matrix to round-off; a known column is reused.
+    #[test]
+    fn a_woodbury_update_solves_like_a_new_factorization() {
+        let n = 60;
+        let (pattern, k) = laplacian(n);
+        let rows = rows(n);
+        let base_w: Vec<f64> = (0..n).map(|i| if i < 30 { 1e3 } else { 0.0 }).collect();
+        let mut base = LowRankBase::new(Rc::new(factored(&pattern, &k, &rows, &base_w)), base_w);
+        let b: Vec<f64> = (0..n).map(|i| ((i * 7) % 11) as f64 - 5.0).collect();
+        // 25 to 35 open (weight 0 below 30) or close (above 30); then a second set over the
+        // same base that shares rows with the first
+        for (lo, hi) in [(25, 35), (20, 40)] {
+            let w: Vec<f64> = (0..n)
+                .map(|i| {
+                    if (i < 30) != (lo <= i && i < hi) {
+                        1e3
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            let update = base
+                .update(&w, |i| (&rows[i].0, &rows[i].1), n, 64, 64)
+                .expect("rank below the limit");
+            assert_eq!(Operator::Updated(update).rank(), hi - lo);
+            let update = base
+                .update(&w, |i| (&rows[i].0, &rows[i].1), n, 64, 64)
+                .unwrap();
+            let mut x = b.clone();
+            update.solve_in_place(&mut x);
+            let mut exact = b.clone();
+            factored(&pattern, &k, &rows, &w).solve_in_place(&mut exact);
+            let scale = exact.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let err = x
+                .iter()
+                .zip(&exact)
+                .fold(0.0f64, |m, (a, e)| m.max((a - e).abs()))
+                / scale;
+            assert!(err < 1e-12, "({lo}, {hi}): relative difference {err:.2e}");
+        }
+    }
+
+    /// More changed rows than allowed, no change, or an update that makes `M` singular: no
+    /// update (the caller refactors).
+    #[test]
+    fn no_update_beyond_the_rank_limit_or_for_a_singular_matrix() {
+        let n = 12;
+        let (pattern, k) = laplacian(n);
+        let rows = rows(n);
+        let base_w = vec![0.0; n];
+        let mut base = LowRankBase::new(
+            Rc::new(factored(&pattern, &k, &rows, &base_w)),
+            base_w.clone(),
+        );
+        let row = |i: usize| (&rows[i].0[..], &rows[i].1[..]);
+        assert!(base.update(&base_w, row, n, 4, 4).is_none());
+        let many: Vec<f64> = (0..n).map(|i| if i < 5 { 1.0 } else { 0.0 }).collect();
+        assert!(base.update(&many, row, n, 4, 4).is_none());
+        assert!(base.update(&many, row, n, 5, 5).is_some());
+        // a negative spring -1 / (e^T A^-1 e) on the last equation makes M singular
+        let mut e = vec![0.0; n];
+        e[n - 1] = 1.0;
+        base.factor.solve_in_place(&mut e);
+        let mut singular = base_w.clone();
+        singular[n - 1] = -1.0 / e[n - 1];
+        assert!(base.update(&singular, row, n, 4, 4).is_none());
+    }
+}
