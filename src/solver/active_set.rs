@@ -2242,6 +2242,10 @@ impl Kernel<'_> {
         let mut kappa = modulus / self.model.size();
         for _level in 0..PREDICTOR_LEVELS {
             let w: Vec<f64> = rows.iter().map(|r| kappa * r.area).collect();
+            // the sets this level has solved: one that comes back would cycle to the level's
+            // iteration cap (measured: a support moved by 1e12 cycled with period 6 through
+            // 90 predictor iterations), so the level ends there and the next one goes on
+            let mut seen: Vec<Vec<bool>> = Vec::new();
             for _ in 0..PREDICTOR_LEVEL_ITERATIONS {
                 if after + used >= max_iterations {
                     return (active, used);
@@ -2278,7 +2282,10 @@ impl Kernel<'_> {
                     cycling_remedy: false,
                 });
                 previous_forces = forces;
-                active = next;
+                seen.push(std::mem::replace(&mut active, next));
+                if changes > 0 && seen.contains(&active) {
+                    break;
+                }
                 let last_level = w.iter().fold(0.0f64, |m, &v| m.max(v)) >= rho;
                 let settled = if last_level {
                     changes == 0
@@ -2298,7 +2305,6 @@ impl Kernel<'_> {
     }
 }
 
-/// The largest penetration `-g` over the contact rows (ties excluded) of an iteration.
 /// Systems of at least this many equations update the last factorization by low rank in the
 /// `auto` mode; below it a factorization costs about as much as the update's solves.
 pub const LOW_RANK_MIN_EQUATIONS: usize = 20_000;
@@ -2336,6 +2342,7 @@ fn effective_weights(active: &[bool], w: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// The largest penetration `-g` over the contact rows (ties excluded) of an iteration.
 fn largest_penetration(rows: &[Constraint], gaps: &[f64]) -> f64 {
     rows.iter()
         .zip(gaps)
