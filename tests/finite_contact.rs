@@ -181,7 +181,7 @@ fn quadratic_ratios(o: &Outcome) -> (usize, f64) {
 /// rows measured afresh in the deformed configuration, no node penetrates (Lagrange: below
 /// 1e-10 of the size) and every node carrying force has zero gap (Lagrange); the contact
 /// force balances the top's reaction. Penalty and Lagrange multipliers, Q4 and Q9; the
-/// augmented Lagrangian (Uzawa update per iteration) converges to the Lagrange state.
+/// augmented Lagrangian (Uzawa update per iteration) converges too, its rate printed.
 #[test]
 fn a_block_slid_over_a_deformable_base_converges_quadratically() {
     for element in ["Q4", "Q9"] {
@@ -349,13 +349,13 @@ fn judged(v: Value, check: &str) -> f64 {
 /// at its top-left corner where that state puts it (`u_x = 4 (a - 1)`); Newton in 4 load
 /// steps along the homogeneous states of 5, 10, 15 and 20 %. Returns the Cauchy stress
 /// error of the uniform-stress check (exact `[0, sigma_yy, 0]`), the spread of `F` over every
-/// quadrature point of both bodies, and the largest `r_{k+1} / r_k^2` of its Newton history.
+/// quadrature point of both bodies.
 fn finite_patch(
     mesh: &str,
     discretization: &Value,
     slave: &str,
     enforcement: &Value,
-) -> Result<(f64, f64, f64), String> {
+) -> Result<(f64, f64), String> {
     // the homogeneous state after each load step k of STEPS: F = diag(a_k, 1 - 0.2 k / STEPS),
     // the nominal pressure p_k = -a_k sigma_yy, the punch's top-left corner at 4 (a_k - 1) in
     // x and its top at -7 (0.2 k / STEPS) - p_k / (passes kappa) in y (the penalty's uniform
@@ -439,18 +439,7 @@ fn finite_patch(
             }
         });
     }
-    let history = &o.solution.finite.as_ref().unwrap().history;
-    let largest = history
-        .windows(2)
-        .filter(|w| {
-            w[0].step == w[1].step
-                && w[0].residual < 1e-3
-                && w[0].residual > 1e-12
-                && w[1].residual > 1e-12
-        })
-        .map(|w| w[1].residual / (w[0].residual * w[0].residual))
-        .fold(0.0f64, f64::max);
-    Ok((error.max(worst), spread, largest))
+    Ok((error.max(worst), spread))
 }
 
 /// The contact patch test at finite strain, meshes A-E: both bodies compressed by 20 % with a
@@ -486,12 +475,8 @@ fn the_finite_strain_patch_test_passes_where_the_small_strain_one_does() {
                 let small = small_strain_error(mesh, &discretization, slave, &enforcement);
                 let small_pass = small <= 1e-10;
                 let verdict = |pass: bool| if pass { "pass" } else { "fail" };
-                let (error, spread, ratio) = match finite_patch(
-                    mesh,
-                    &discretization,
-                    slave,
-                    &enforcement,
-                ) {
+                let (error, spread) = match finite_patch(mesh, &discretization, slave, &enforcement)
+                {
                     Ok(measured) => measured,
                     Err(why) => {
                         table.push(format!(
@@ -504,7 +489,7 @@ fn the_finite_strain_patch_test_passes_where_the_small_strain_one_does() {
                 };
                 let finite_pass = error <= 1e-10 && spread <= 1e-10;
                 table.push(format!(
-                    "| {mesh} | {label} | {kind} | {small:.1e} | {error:.1e} | {spread:.1e} | {} / {} (r_k+1/r_k^2 <= {ratio:.1e}) |",
+                    "| {mesh} | {label} | {kind} | {small:.1e} | {error:.1e} | {spread:.1e} | {} / {} |",
                     verdict(small_pass),
                     verdict(finite_pass),
                 ));
