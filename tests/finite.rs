@@ -368,8 +368,38 @@ fn combinations_not_built_are_refused_with_the_reason() {
         {"name": "base", "material": "m", "mesh": {"block": {"element": "Q4", "x": [-1, 3], "y": [-1, 0]}}}
     ]);
     d["contact"][0]["master"] = json!({"body": "base", "set": "top"});
-    d["supports"] = json!([{"body": "base", "set": "bottom", "x": 0.0, "y": 0.0}]);
-    expect(&d, "master", "only rigid masters");
+    d["supports"] = json!([
+        {"body": "base", "set": "bottom", "x": 0.0, "y": 0.0},
+        {"body": "block", "set": "left", "x": 0.0}
+    ]);
+    // between deformable bodies: node-to-surface with master normals is built
+    // (tests/finite_contact.rs); the other discretizations and ties are refused
+    let mut e = d.clone();
+    e["contact"][0]["discretization"] = json!({"kind": "mortar"});
+    expect(
+        &e,
+        "discretization",
+        "mortar contact between deformable bodies is not built yet",
+    );
+    e["contact"][0]["discretization"] = json!({"kind": "node_to_node"});
+    expect(
+        &e,
+        "discretization",
+        "node-to-node contact between deformable bodies is not built yet",
+    );
+    e["contact"][0]["discretization"] = json!({"kind": "node_to_surface", "normal": "slave"});
+    expect(
+        &e,
+        "discretization.normal",
+        "slave normals between deformable bodies is not built yet",
+    );
+    e["contact"][0]["discretization"] = json!({"kind": "node_to_surface"});
+    e["contact"][0]["interaction"] = json!("tied");
+    expect(
+        &e,
+        "interaction",
+        "tied pair between deformable bodies is not built yet",
+    );
 }
 
 /// A block between a rigid plane `y = 0` (frictionless contact of its bottom, node-to-surface

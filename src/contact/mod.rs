@@ -82,6 +82,10 @@ pub struct Constraint {
     /// The tangential slip measure of a frictional (Coulomb) pair, `None` elsewhere: physics
     /// is opt-in, a frictionless scene builds no tangential row.
     pub tangent: Option<TangentRow>,
+    /// Finite kinematics, node-to-surface with master normals between deformable bodies: the
+    /// row's nodes and positions for the second derivative of its gap
+    /// ([`discretization::node_to_segment`]); `None` elsewhere (small strain builds none).
+    pub segment: Option<discretization::node_to_segment::SegmentLinearization>,
 }
 
 /// The tangential slip of a contact point, `g_t(u) = sum_k c_ik u_{d_ik}` (zero at `u = 0`):
@@ -135,11 +139,19 @@ impl Constraint {
             .chain(self.tangent.as_ref().map(|t| (&t.dofs[..], &t.coeffs[..])))
     }
 
-    /// Every dof of the row's normal and tangential gradients (each once).
+    /// Every dof of the row's normal and tangential gradients and of its second derivative
+    /// (each once).
     pub fn all_dofs(&self) -> Vec<usize> {
         let mut d = self.dofs.clone();
         if let Some(t) = &self.tangent {
             d.extend(t.dofs.iter().filter(|x| !self.dofs.contains(x)));
+        }
+        if let Some(s) = &self.segment {
+            for &x in &s.dofs {
+                if !d.contains(&x) {
+                    d.push(x);
+                }
+            }
         }
         d
     }

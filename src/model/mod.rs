@@ -30,8 +30,9 @@ use crate::harness::exact::ExactField;
 use crate::io::paths::{name_problem, NAME_RULE};
 use crate::io::scene::{
     Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, GmshMeshSpec,
-    Interaction, Kinematics, MaterialModel, MeshSpec, MultiplierSpace, NodeSetSpec, Physics, Plane,
-    Prescribed, RigidSurface, SolverSpec, SweepSpec, TractionSpec, MAX_SOLVER_COUNT,
+    Interaction, Kinematics, MaterialModel, MeshSpec, MultiplierSpace, NodeSetSpec, NormalChoice,
+    Physics, Plane, Prescribed, RigidSurface, SolverSpec, SweepSpec, TractionSpec,
+    MAX_SOLVER_COUNT,
 };
 use crate::mesh::{block, Facet, Mesh};
 use crate::solid::{check_geometry, Elasticity};
@@ -613,11 +614,40 @@ impl Model {
                 );
             }
             if let MasterSide::Body { .. } = pair.master {
-                return invalid(
-                    format!("{at}.master"),
-                    "finite kinematics with contact between deformable bodies (node-to-node, node-to-surface, mortar) is not built yet: only rigid masters".into(),
-                    "use a rigid master surface (plane or circle), or small-strain kinematics",
-                );
+                // between deformable bodies: node-to-surface with master normals, whose gap
+                // has its full second derivative (contact::discretization::node_to_segment)
+                let refused = match pair.discretization {
+                    _ if pair.interaction == Interaction::Tied => Some((
+                        format!("{at}.interaction"),
+                        "finite kinematics with a tied pair between deformable bodies is not built yet (a tie holds the reference offsets, which rotate with the bodies)",
+                        "use a frictionless pair, or small-strain kinematics",
+                    )),
+                    DiscretizationSpec::NodeToSurface {
+                        normal: NormalChoice::Master,
+                        ..
+                    } => None,
+                    DiscretizationSpec::NodeToSurface {
+                        normal: NormalChoice::Slave,
+                        ..
+                    } => Some((
+                        format!("{at}.discretization.normal"),
+                        "finite kinematics with slave normals between deformable bodies is not built yet (the slave normal's variation is not linearized)",
+                        "use master normals (\"normal\": \"master\"), or small-strain kinematics",
+                    )),
+                    DiscretizationSpec::NodeToNode => Some((
+                        format!("{at}.discretization"),
+                        "finite kinematics with node-to-node contact between deformable bodies is not built yet (the nodal normal's variation is not linearized)",
+                        "use node-to-surface with master normals, or small-strain kinematics",
+                    )),
+                    DiscretizationSpec::Mortar { .. } => Some((
+                        format!("{at}.discretization"),
+                        "finite kinematics with mortar contact between deformable bodies is not built yet (the variation of the segments, normals and projections is not linearized)",
+                        "use node-to-surface with master normals, or small-strain kinematics",
+                    )),
+                };
+                if let Some((location, problem, hint)) = refused {
+                    return invalid(location, problem.into(), hint);
+                }
             }
         }
         if !self.contact.is_empty() {

@@ -18,9 +18,14 @@
 //! with `H_i` the second derivative of the gap where the row provides it (rigid circles in the
 //! current geometry, [`gap_second_derivative`]). In the current geometry the rows are searched
 //! again at every iterate (`x = X + u`), so the geometry updates and the active-set iterations of
-//! the active-set scheme are one Newton loop here. Rows whose gradient lacks its own variation
-//! (node-to-surface and mortar against deformable masters: no `delta xi` and normal terms yet)
-//! give a tangent that is not exact, and Newton converges linearly on them; the history shows it.
+//! the active-set scheme are one Newton loop here. Under finite kinematics node-to-surface rows
+//! between deformable bodies (master normals) carry the second derivative of their gap over
+//! the slave node and the master facet's nodes
+//! ([`crate::contact::discretization::node_to_segment`]: the `delta xi` and normal-rotation
+//! terms), and the tangent gains `-force H` (`force = lambda - rho g` for a multiplier row, the
+//! derivative of its force term). Small-strain rows whose gradient lacks its own variation
+//! (node-to-surface and mortar against deformable masters in the current geometry) give a
+//! tangent that is not exact, and Newton converges linearly on them; the history shows it.
 //!
 //! The augmented Lagrangian updates `lambda_bar_i <- max(0, lambda_bar_i - w_i g_i)` after every
 //! iteration or, in an outer loop, after Newton has converged ([`MultiplierUpdate`]), until
@@ -199,8 +204,9 @@ pub(crate) struct ContactSystem<'a> {
     /// and the frictional status of the last evaluation (with the direction of a slip).
     committed: HashMap<RowKey, Committed>,
     status: HashMap<RowKey, (Status, bool)>,
-    /// Finite kinematics: the element found inverted at the last evaluation (its residual is
-    /// then NaN, which ends the Newton solve; the load step is cut).
+    /// Finite kinematics: the element found inverted at the last evaluation, or the pair found
+    /// without rows there (its residual is then NaN, which ends the Newton solve; the load step
+    /// is cut).
     inverted: Option<String>,
     /// Augmented-Lagrangian Coulomb pairs: the tangential Uzawa multiplier `lambda_bar_t` by
     /// point (carried from the last load step, updated with the normal one).
@@ -906,7 +912,20 @@ impl System for ContactSystem<'_> {
         let current = self.model.physics.contact_geometry == ContactGeometry::Current;
         if current && self.evaluations > 0 {
             let t = Instant::now();
-            self.rows = rows_at(self.model, Some((&u, &self.reference_areas)))?;
+            self.rows = match rows_at(self.model, Some((&u, &self.reference_areas))) {
+                Ok(rows) => rows,
+                // finite kinematics: an iterate that carried a pair off its master (a Newton
+                // step far from the solution) fails the step, which is then cut
+                Err(e) if self.model.physics.kinematics == Kinematics::Finite => {
+                    self.inverted = Some(format!("at a Newton iterate, {e}"));
+                    residual.iter_mut().for_each(|v| *v = f64::NAN);
+                    return Ok(Evaluation {
+                        force_scale: 1.0,
+                        ..Evaluation::default()
+                    });
+                }
+                Err(e) => return Err(e),
+            };
             self.search_seconds += t.elapsed().as_secs_f64();
             self.record_departures(&u);
             let version = self.version;
@@ -1182,6 +1201,25 @@ impl System for ContactSystem<'_> {
                                     .position(ea.min(ec), ea.max(ec))
                                     .expect("node block")] -= lambda * h[2 * a + c];
                             }
+                        }
+                    }
+                }
+            }
+            if let (true, Some(segment)) = (geometric, &r.segment) {
+                // finite kinematics between deformable bodies: -force H over the row's nodes,
+                // the delta xi and normal-rotation terms (force = lambda_bar - w g for penalty
+                // rows, lambda - rho g for multiplier rows: the derivative of -force b)
+                let (_, h) = segment.gap_and_hessian();
+                let m = segment.dofs.len();
+                let eqs: Vec<usize> = segment.dofs.iter().map(|&d| self.sys.eq(d)).collect();
+                for a in 0..m {
+                    for c in a..m {
+                        let (ea, ec) = (eqs[a], eqs[c]);
+                        if ea != NO_EQUATION && ec != NO_EQUATION {
+                            upper[self
+                                .pattern
+                                .position(ea.min(ec), ea.max(ec))
+                                .expect("the row's nodes are covered")] -= force * h[a * m + c];
                         }
                     }
                 }
@@ -1485,10 +1523,17 @@ impl<'a> Probe<'a> {
                 )
             })
             .collect();
-        // past the first evaluation, which closes rows to hold free bodies
+        // past the first evaluation, which closes rows to hold free bodies (and numbers the
+        // multipliers: a search at another state keeps them)
         system.evaluations = 1;
+        system.remember_multipliers();
         let general = GeneralPattern::from_symmetric(&system.pattern);
         Ok(Probe { system, general })
+    }
+
+    /// How many unknowns the system has: the free displacements, then the multipliers.
+    pub fn unknown_count(&self) -> usize {
+        self.general.n
     }
 
     /// The free unknowns of the global displacement `u`.
@@ -1554,8 +1599,17 @@ impl<'a> Probe<'a> {
             scale: 1.0,
             elimination: None,
         };
+        let version = self.system.version;
         self.system
             .evaluate(x, &self.general, &mut residual, &mut tangent)?;
+        if self.system.version != version {
+            // the rows at x couple new equations (a slave node slid onto another facet): the
+            // evaluation stopped at the new pattern; evaluate again on it
+            self.general = GeneralPattern::from_symmetric(&self.system.pattern);
+            tangent.values = vec![0.0; self.general.nnz()];
+            self.system
+                .evaluate(x, &self.general, &mut residual, &mut tangent)?;
+        }
         let g = &self.general;
         let mut dense = vec![vec![0.0; n]; n];
         for j in 0..n {

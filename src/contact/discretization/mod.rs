@@ -37,12 +37,14 @@
 
 pub(crate) mod geometry;
 pub(crate) mod mortar;
+pub mod node_to_segment;
 pub(crate) mod search;
 
 use crate::contact::Constraint;
-use crate::io::scene::{DiscretizationSpec, Interaction, NormalChoice, RigidSurface};
+use crate::io::scene::{DiscretizationSpec, Interaction, Kinematics, NormalChoice, RigidSurface};
 use crate::model::{ContactPair, MasterSide, Model};
 use geometry::{closest_point, edge_shape, facet_point, ray_point, unit_normal, Surface};
+use node_to_segment::{MasterPoint, SegmentLinearization};
 use search::BucketGrid;
 
 /// Tolerance on the facet parameter for "inside the facet".
@@ -298,6 +300,7 @@ pub(crate) fn weighted_row(
         bilateral,
         mass: Vec::new(),
         tangent: None,
+        segment: None,
     }
 }
 
@@ -353,6 +356,9 @@ fn node_to_surface(
     let radius = rows.search_distance.unwrap_or_else(|| master.facet_size());
     let tol = 1e-12 * mb.mesh.size();
     let kind = master.kind;
+    // finite kinematics: the rows carry what their gap's second derivative needs (frictionless
+    // pairs; the model refuses the others there)
+    let linearize = model.physics.kinematics == Kinematics::Finite && !rows.tied;
     // how many master facets end at each vertex (a corner needs two)
     let mut facets_at: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
     for f in &master.facets {
@@ -424,6 +430,16 @@ fn node_to_surface(
                 Some((master, &master.facets[f], &n[..k])),
                 pass,
             );
+            if linearize && normal == NormalChoice::Master {
+                attach_segment(
+                    rows,
+                    slave,
+                    s,
+                    master,
+                    &master.facets[f],
+                    MasterPoint::Facet { kind, xi },
+                );
+            }
             continue;
         }
         // corner condition: the nearest vertex shared by two candidate facets (a slave node
@@ -450,8 +466,41 @@ fn node_to_surface(
             };
             let g0 = nu[0] * d[0] + nu[1] * d[1];
             rows.node(slave, s, nu, g0, Some((master, &[v], &[1.0])), pass);
+            if linearize {
+                attach_segment(rows, slave, s, master, &[v], MasterPoint::Vertex);
+            }
         }
     }
+}
+
+/// Give the row just pushed for slave node `node` what its second derivative needs (finite
+/// kinematics between deformable bodies, [`node_to_segment`]): its nodes' dofs and positions
+/// (the configuration the rows are built in).
+fn attach_segment(
+    rows: &mut Rows,
+    slave: &Surface,
+    node: usize,
+    master: &Surface,
+    master_nodes: &[usize],
+    point: MasterPoint,
+) {
+    let (sb, mb) = (
+        &rows.model.bodies[slave.body],
+        &rows.model.bodies[master.body],
+    );
+    let mut dofs = vec![sb.dof(node, 0), sb.dof(node, 1)];
+    let mut positions = vec![sb.mesh.nodes[node]];
+    for &m in master_nodes {
+        dofs.extend([mb.dof(m, 0), mb.dof(m, 1)]);
+        positions.push(mb.mesh.nodes[m]);
+    }
+    let row = rows.out.last_mut().expect("the row was just pushed");
+    debug_assert_eq!(row.slave_node, node);
+    row.segment = Some(SegmentLinearization {
+        dofs,
+        positions,
+        point,
+    });
 }
 
 /// The second derivative of a row's gap with respect to its slave node's displacement
