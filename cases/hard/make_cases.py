@@ -599,6 +599,40 @@ for kappa, label in [(1e4, "1e4"), (1e6, "1e6")]:
     )
 
 
+# 16. finite-strain sliding off an edge: a neo-Hookean block pressed onto a neo-Hookean base
+# and slid past its right end (node-to-surface between deformable bodies, current geometry)
+c = {
+    "analysis": {"plane": "strain", "thickness": 1.0},
+    "materials": {"m": {"E": 1000.0, "nu": 0.3, "model": "neo_hookean"}},
+    "bodies": [
+        {"name": "base", "material": "m", "mesh": {"block": {
+            "element": "Q4", "x": [0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0], "y": [0, 0.5, 1]}}},
+        {"name": "top", "material": "m", "mesh": {"block": {
+            "element": "Q4", "x": [0.5, 0.9, 1.3, 1.7], "y": [1, 1.4, 1.8]}}},
+    ],
+    "physics": {"kinematics": "finite", "contact_geometry": "current"},
+    "solver": {"scheme": "newton", "load_steps": 10},
+    "supports": [
+        {"body": "base", "set": "bottom", "x": 0.0, "y": 0.0},
+        {"body": "top", "set": "top", "x": 1.6, "y": -0.1},
+    ],
+    "loads": [],
+    "contact": [{
+        "name": "interface",
+        "slave": {"body": "top", "set": "bottom"},
+        "master": {"body": "base", "set": "top"},
+        "discretization": {"kind": "node_to_surface", "passes": 1},
+        "enforcement": enforcement("penalty", 1e5),
+    }],
+}
+case(
+    "finite-strain-sliding-off-an-edge",
+    "Two neo-Hookean blocks (E = 1000, nu = 0.3, finite kinematics, contact searched again at every Newton iteration): the top block (width 1.2) pressed down 0.1 and slid 1.6 to the right over the base (width 3), so its right end leaves the base's top: the slave nodes that pass the master's end open, the load steps cut themselves where Newton fails, and the run converges with the forces in balance and a penalty-sized penetration (kappa = 1e5).",
+    c,
+    [converged(), {"check": "force_balance", "tol": 1e-9}, {"check": "max_penetration", "share": 0.01}],
+)
+
+
 def main():
     for name, c in CASES.items():
         ordered = {"$schema": c.pop("$schema"), "name": c.pop("name"), "description": c.pop("description")}
