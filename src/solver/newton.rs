@@ -141,7 +141,7 @@ pub trait System {
     fn augment(&mut self, _x: &[f64], _converged: bool) -> bool {
         false
     }
-    /// When the iteration cycles ([`cycle_period`]): change what steers the path without
+    /// When the iteration cycles (`cycle_period`): change what steers the path without
     /// changing the solution, and say what was changed (`None`: nothing left to change; the
     /// solve then stops with [`Termination::ActiveSetCycling`]).
     fn remedy_cycle(&mut self) -> Option<String> {
