@@ -1247,10 +1247,11 @@ impl System for ContactSystem<'_> {
                 let (Some(j), true) = (self.multiplier[i], active[&row_key(r)]) else {
                     continue;
                 };
-                let [(o, _)] = self.free_of(&[r.owner], &[1.0])[..] else {
-                    unreachable!("an elimination row owns a free dof (its obstacle check)")
-                };
-                owned.push((j, o));
+                // the obstacle check gave every row a free owned dof; one without would reach
+                // the solve as an unowned active row, which it refuses with the reason
+                if let Some(&(o, _)) = self.free_of(&[r.owner], &[1.0]).first() {
+                    owned.push((j, o));
+                }
             }
             tangent.elimination = Some(owned);
         }

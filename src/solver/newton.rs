@@ -515,7 +515,7 @@ impl LinearSolver {
                         .any(|k| p.row_idx[k] != j && upper[k] != 0.0);
                     if diagonal == 0.0 || coupled {
                         return Err(cannot(format!(
-                            "the inactive multiplier {j} is coupled to other unknowns"
+                            "the multiplier {j} is coupled to other unknowns but has no owned dof to be solved for"
                         )));
                     }
                     b[j] / diagonal
