@@ -20,12 +20,15 @@
 //! them together; it runs at `kappa = E / L` (the largest Young's modulus over the model size)
 //! and then at 100 times as much per level up to the stiffness scale, each level from the set of
 //! the one before, and the multiplier loop resumes from its set (`Kernel::penalty_predictor`).
-//! Its iterations are in the history and count against the iteration limits. A penalty
-//! iterate is never the answer: the loop ends only on a multiplier iterate whose set is stable.
+//! Its iterations are in the history and count against the iteration limits. A level whose
+//! set comes back (the penalty iteration cycles) ends there. A penalty iterate is never the
+//! answer: the loop ends only on a multiplier iterate whose set is stable.
 //!
-//! Work limit: a loop takes at most `limits.iteration_dofs / dofs` iterations (at least one);
-//! when that is below `solver.max_iterations` and reached, the loop ends with
-//! [`Termination::WorkLimit`], saying how far the set got and how to raise the limit.
+//! Work limit: a loop takes at most `limits.iteration_dofs / dofs` iterations (at least one),
+//! and an iteration of the minimum-norm Schur path (dependent Lagrange rows), which solves once
+//! per active row, counts those solves too; when the limit is below `solver.max_iterations`
+//! and reached, the loop ends with [`Termination::WorkLimit`], saying how far the set got and
+//! how to raise the limit.
 //!
 //! Cycling: for the methods without a multiplier iteration of their own (Lagrange,
 //! elimination, penalty, perturbed Lagrangian) the set alone determines the iterate, so a set
@@ -562,6 +565,7 @@ fn solve_at(
         },
         perturbation,
         linear_solver: "cholesky",
+        extra_solves: 0,
         cache: None,
         low_rank: None,
         update_rank: update_rank(model.solver.factor_update, sys.n),
@@ -790,6 +794,9 @@ struct Kernel<'a> {
     /// The perturbed Lagrangian's consistent perturbation `C` (see [`perturbation`]).
     perturbation: Vec<Vec<(usize, f64)>>,
     linear_solver: &'static str,
+    /// Solves of the last iteration beyond its one solve (the minimum-norm Schur path solves
+    /// once per active row), counted against the work limit.
+    extra_solves: usize,
     /// The last operator (a factorization or a low-rank update of one) with its active set
     /// and weights.
     cache: Option<(Vec<bool>, Vec<f64>, Rc<Operator>)>,
@@ -1454,6 +1461,7 @@ impl Kernel<'_> {
             self.rows[i].add_to(-rho * self.rows[i].g0, &mut z0);
         }
         f.solve_in_place(&mut z0);
+        self.extra_solves += idx.len();
         let mut zs: Vec<Vec<f64>> = Vec::with_capacity(idx.len());
         for &i in &idx {
             let mut z = vec![0.0; n];
@@ -1916,7 +1924,10 @@ impl Kernel<'_> {
         let dofs = self.sys.n.max(1);
         let affordable = (self.model.iteration_dofs / dofs as u64).max(1) as usize;
         let max_iterations = self.model.solver.max_iterations.min(affordable);
-        let work_bound = affordable < self.model.solver.max_iterations;
+        let mut work_bound = affordable < self.model.solver.max_iterations;
+        // the work done: dofs per solve (an iteration of the minimum-norm Schur path solves
+        // once per active row, so a long loop of those reaches the limit sooner)
+        let mut work: u64 = 0;
         // the penalty predictor of the set (Lagrange and elimination), used once
         let mut predicted = false;
         let mut it = 0;
@@ -2170,17 +2181,23 @@ impl Kernel<'_> {
             }
             seen.insert(new_active.clone());
             active = new_active;
+            work += dofs as u64 * (1 + std::mem::take(&mut self.extra_solves) as u64);
+            if work >= self.model.iteration_dofs && it < max_iterations {
+                work_bound = true;
+                break;
+            }
         }
         let termination = if work_bound {
             let changes = self.history.last().map_or(0, |h| h.status_changes);
             Termination::WorkLimit(format!(
-                "the active set had not settled after {max_iterations} iterations ({changes} rows still changing status): {max_iterations} iterations of {dofs} dofs reach the work limit of {} iteration-dofs (limits.iteration_dofs); raise \"limits\": {{\"iteration_dofs\": N}} if the machine has the time, use a coarser mesh, or apply the load in more load steps (solver.load_steps) so that each step changes the set less",
+                "the active set had not settled after {it} iterations ({changes} rows still changing status): {it} iterations ({} solves) of {dofs} dofs reach the work limit of {} iteration-dofs (limits.iteration_dofs); raise \"limits\": {{\"iteration_dofs\": N}} if the machine has the time, use a coarser mesh, or apply the load in more load steps (solver.load_steps) so that each step changes the set less",
+                work.max(it as u64 * dofs as u64) / dofs as u64,
                 self.model.iteration_dofs
             ))
         } else {
             Termination::IterationLimit
         };
-        Ok((x, forces, active, termination, max_iterations))
+        Ok((x, forces, active, termination, it))
     }
 
     /// The penalty predictor of the active set of a set-determined method (Lagrange
