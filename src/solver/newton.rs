@@ -45,7 +45,7 @@ pub struct Tangent {
     pub scale: f64,
     /// Constraint elimination: the saddle-point matrix is not factored; each active multiplier
     /// row `(j, o)` is solved for its owned unknown `o` instead (see
-    /// [`LinearSolver::solve_eliminating`]). `None`: factor the matrix.
+    /// `LinearSolver::solve_eliminating`). `None`: factor the matrix.
     pub elimination: Option<Vec<(usize, usize)>>,
 }
 
