@@ -72,7 +72,11 @@
 //! the displacement block definite for bodies held only by contact (the augmentation of the
 //! active-set scheme). Dependent active rows (a two-pass discretization) make the matrix
 //! singular: the step ends `Singular` with the reason, where the active-set scheme picks the
-//! minimum-norm multipliers.
+//! minimum-norm multipliers. Under finite kinematics the displacement block also carries
+//! `-force H` of the rows' gaps, which makes it indefinite where the forces are large of either
+//! sign (a slave node leaving the master's free end, issue 12): pivots of the wrong sign are
+//! then not a dependence of rows, and such a tangent is factored by LU
+//! ([`Tangent::indefinite_block`]).
 //!
 //! **Coulomb friction** (pairs with `interaction: {"coulomb": ..}`) with the penalty or the
 //! perturbed Lagrangian as normal law:
