@@ -631,6 +631,16 @@ case(
     c,
     [converged(), {"check": "force_balance", "tol": 1e-9}, {"check": "max_penetration", "share": 0.01}],
 )
+# the same slide with Lagrange multipliers (issue 12: it ended at load factor 0.87 with a zero
+# pivot at a multiplier, the -force H of the remaining rows making the displacement block
+# indefinite once the end node left the base)
+c["contact"][0]["enforcement"] = enforcement("lagrange")
+case(
+    "finite-strain-sliding-off-an-edge-lagrange",
+    "The slide of finite-strain-sliding-off-an-edge with Lagrange multipliers: two neo-Hookean blocks, the top one pressed down 0.1 and slid 1.6 to the right, past the end of the base; once its end node leaves the master, the remaining rows' -force H makes the displacement block of the saddle-point tangent indefinite, which is factored by LU (L D L^T with expected pivot signs refuses it). The run converges with the forces in balance and no penetration beyond round-off.",
+    c,
+    [converged(), {"check": "force_balance", "tol": 1e-9}, {"check": "max_penetration", "share": 1e-8}],
+)
 
 
 def main():

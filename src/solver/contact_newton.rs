@@ -72,7 +72,11 @@
 //! the displacement block definite for bodies held only by contact (the augmentation of the
 //! active-set scheme). Dependent active rows (a two-pass discretization) make the matrix
 //! singular: the step ends `Singular` with the reason, where the active-set scheme picks the
-//! minimum-norm multipliers.
+//! minimum-norm multipliers. Under finite kinematics the displacement block also carries
+//! `-force H` of the rows' gaps, which makes it indefinite where the forces are large of either
+//! sign (a slave node leaving the master's free end, issue 12): pivots of the wrong sign are
+//! then not a dependence of rows, and such a tangent is factored by LU
+//! ([`Tangent::indefinite_block`]).
 //!
 //! **Coulomb friction** (pairs with `interaction: {"coulomb": ..}`) with the penalty or the
 //! perturbed Lagrangian as normal law:
@@ -1000,6 +1004,8 @@ impl System for ContactSystem<'_> {
         let mut active = HashMap::with_capacity(self.rows.len());
         let mut forces = HashMap::with_capacity(self.rows.len());
         let mut terms: Vec<(usize, f64)> = Vec::new();
+        // an active row added the second derivative of its gap to the displacement block
+        let mut second_derivatives = false;
         for i in 0..self.rows.len() {
             let r = &self.rows[i];
             let key = row_key(r);
@@ -1210,6 +1216,7 @@ impl System for ContactSystem<'_> {
                 // the delta xi and normal-rotation terms (force = lambda_bar - w g for penalty
                 // rows, lambda - rho g for multiplier rows: the derivative of -force b)
                 let (_, h) = segment.gap_and_hessian();
+                second_derivatives = true;
                 let m = segment.dofs.len();
                 let eqs: Vec<usize> = segment.dofs.iter().map(|&d| self.sys.eq(d)).collect();
                 for a in 0..m {
@@ -1239,6 +1246,11 @@ impl System for ContactSystem<'_> {
         }
         tangent.multipliers = self.pattern.n - n;
         tangent.scale = rho;
+        // finite kinematics: -force H makes the displacement block indefinite where the force
+        // is large against the stiffness (a slave node leaving the master's free end puts the
+        // remaining rows under a large force of either sign): the saddle-point matrix has
+        // pivots of the wrong sign that are not a dependence of rows
+        tangent.indefinite_block = second_derivatives;
         // constraint elimination (the model admits it only on its own): each active row is
         // solved for its owned dof
         if self.rows.iter().any(|r| self.eliminated(r)) {
@@ -1599,6 +1611,7 @@ impl<'a> Probe<'a> {
             multipliers: 0,
             scale: 1.0,
             elimination: None,
+            indefinite_block: false,
         };
         let version = self.system.version;
         self.system

@@ -401,6 +401,7 @@ impl<'a> Integrator<'a> {
             multipliers: 0,
             scale: 1.0,
             elimination: None,
+            indefinite_block: false,
         };
         self.system
             .evaluate(&self.x, &general, &mut residual, &mut tangent)?;
@@ -995,6 +996,7 @@ pub fn probe_first_step(model: &Model, x: &[f64]) -> Result<(Vec<f64>, Vec<Vec<f
         multipliers: 0,
         scale: 1.0,
         elimination: None,
+        indefinite_block: false,
     };
     integrator
         .system

@@ -47,6 +47,11 @@ pub struct Tangent {
     /// row `(j, o)` is solved for its owned unknown `o` instead (see
     /// `LinearSolver::solve_eliminating`). `None`: factor the matrix.
     pub elimination: Option<Vec<(usize, usize)>>,
+    /// The displacement block carries second derivatives of contact gaps (`-force H`, finite
+    /// kinematics) and may be indefinite: a saddle-point matrix whose `L D L^T` meets a pivot
+    /// of the wrong sign is then factored by LU, as an indefinite symmetric matrix without
+    /// multipliers is. `false`: such a pivot means dependent rows, and the solve ends there.
+    pub indefinite_block: bool,
 }
 
 /// What an evaluation reports besides the residual and the tangent.
@@ -225,6 +230,7 @@ pub fn solve_with(
             multipliers: 0,
             scale: 1.0,
             elimination: None,
+            indefinite_block: false,
         };
         let eval = system.evaluate(x, &linear.general, &mut residual, &mut tangent)?;
         if system.pattern_version() != version {
@@ -551,6 +557,11 @@ impl LinearSolver {
                         }));
                     return Ok(Factorization::Ldlt(f));
                 }
+                // an indefinite displacement block (finite kinematics: the gap's second
+                // derivative times a contact force) gives pivots of the wrong sign, and
+                // regularizing them may overflow the factor; LU below, which has no expected
+                // inertia
+                Err(FactorError::ZeroPivot { .. }) if tangent.indefinite_block => {}
                 // singular: dependent rows (two passes), a body the active rows leave free
                 Err(e @ FactorError::ZeroPivot { .. }) => return Err(e),
                 // LU below
@@ -763,6 +774,7 @@ mod tests {
                 multipliers: 0,
                 scale: 1.0,
                 elimination: None,
+                indefinite_block: false,
             };
             s.evaluate(&x, &general, &mut res, &mut t).unwrap();
             assert!(res.iter().all(|v| v.abs() < 1e-12), "{res:?}");
@@ -790,6 +802,7 @@ mod tests {
             multipliers: 0,
             scale: 1.0,
             elimination: None,
+            indefinite_block: false,
         };
         let mut r = vec![0.0; 10];
         s.evaluate(&x, &general, &mut r, &mut t).unwrap();
