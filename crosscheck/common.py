@@ -21,7 +21,9 @@ Each solver receives supports as (node coordinates, component, values) and loads
 Contact (src/contact/): a single-body case may declare frictionless pairs of the body against a
 rigid line or circle with node-to-surface rows and a penalty (`RigidContact`), or Coulomb pairs
 against a rigid line (penalty return map of src/contact/friction.rs, load-stepped along the
-supports' and loads' `path` factors, `Problem.factor`); a two-body case
+supports' and loads' `path` factors, `Problem.factor`); under finite kinematics
+(`physics.kinematics: "finite"`, `Problem.finite`, the material's `model`,
+`Problem.hyperelastic`) a single hyperelastic body, alone or against a rigid line; a two-body case
 may tie its bodies with a mortar pair (`TiedCase`). `Sampler` evaluates a nodal field of one of
 our .vtu meshes at arbitrary points (as `src/post.rs::CellLocator`), for the distances of the
 tied-layer and two-block studies.
@@ -164,8 +166,16 @@ class Problem:
         if self.dynamics is not None and not dynamic:
             raise Unsupported("physics.dynamics (a time history; DOLFINx steps it, "
                               "ref_dolfinx.solve_wave)")
-        if any(k != "kinematics" or v != "small_strain" for k, v in physics.items()):
-            raise Unsupported(f"physics {physics}")
+        # finite kinematics (src/solid_finite.rs, ref_dolfinx.solve_finite): a hyperelastic
+        # body, alone or with frictionless penalty contact against a rigid line, whose gap
+        # n . (X + u - p) is the same in the reference and the current geometry
+        kinematics = physics.pop("kinematics", "small_strain")
+        if kinematics not in ("small_strain", "finite"):
+            raise Unsupported(f"physics.kinematics {kinematics!r}")
+        self.finite = kinematics == "finite"
+        geometry = physics.pop("contact_geometry", "reference")
+        if physics or (geometry != "reference" and not (self.finite and geometry == "current")):
+            raise Unsupported(f"physics {c.get('physics')}")
         if body is None:
             body = bodies[0]
         else:
@@ -178,6 +188,11 @@ class Problem:
         self.thickness = float(an.get("thickness", 1.0))
         m = c["materials"][body["material"]]
         self.material = Material(m["E"], m["nu"], an["plane"])
+        # the hyperelastic energy under finite kinematics (src/io/scene.rs MaterialModel)
+        self.hyperelastic = m.get("model", "linear_elastic")
+        if self.finite != (self.hyperelastic != "linear_elastic"):
+            raise Unsupported(f"material model {self.hyperelastic!r} with "
+                              f"{'finite' if self.finite else 'small-strain'} kinematics")
         self.exact = Exact(c["exact"]) if c.get("exact") else None
 
         self.vtu = Path(out_dir) / f"{self.body}.vtu"
@@ -213,6 +228,9 @@ class Problem:
                               if s["body"] == self.body for k in ("x", "y") if s.get(k) is not None]
         self.load_paths = [ld.get("path") for ld in c.get("loads", []) if ld["body"] == self.body]
         self.frictional = any(pair.mu is not None for pair in self.contact)
+        if self.finite and (self.frictional or any(p.kind != "line" for p in self.contact)):
+            raise Unsupported("finite kinematics with friction or a rigid circle (the "
+                              "cross-check's finite cases press against a rigid line)")
         if not self.frictional and any(self.factor(pth, self.load_steps) != 1.0
                                        for pth in self.support_paths + self.load_paths):
             raise Unsupported("a load path that does not end at 1 without friction")

@@ -42,6 +42,17 @@ free dofs (SuperLU), `d~ = d_n + dt v_n + dt^2 (1/2 - beta) a_n`,
 from `d_0 = 0`, the case's initial velocities and `a_0 = M^-1 (f - K d_0)`. The reference keeps
 the displacement at every step and the kinetic, strain and load energies.
 
+Finite kinematics (`physics.kinematics: "finite"`, `solve_finite`; src/solid_finite.rs, Bonet
+& Wood, *Nonlinear Continuum Mechanics for Finite Element Analysis*, 2nd ed., eqs. 6.28 and
+6.6 for plane strain): the residual is UFL's derivative of the stored energy
+`int t W(F) dX` (`hyperelastic_energy`: neo-Hookean `W = mu/2 (tr C + 1 - 3 - 2 ln J) +
+lambda/2 (ln J)^2` or St. Venant-Kirchhoff `W = lambda/2 (tr E)^2 + mu E:E`, `F = I + grad u`,
+`F_33 = 1`) with our stiffness quadrature, minus the dead loads times the load factor, minus,
+against a rigid line, the penalty term above with the current gap `g = n . (X + u - p)`; UFL
+derives the tangent; Newton's method in numpy/scipy per load step (the case's factors), from
+the last step's state, to a relative residual of 1e-14 or its round-off floor (at most 1e-12).
+No .vtu is written for these cases.
+
 The solution is also written by DOLFINx itself (`dolfinx.io.VTKFile`, ASCII) as
 OUT_ROOT/<case>/dolfinx.pvd + dolfinx_p0_000000.vtu, with the point fields `displacement` and
 `stress` (xx, yy, xy of sigma(u_h) interpolated at the nodes of a Lagrange space of the same
@@ -241,7 +252,10 @@ def solve(pb: Problem, vtu_path=None):
     extra = {"match_distance": dist, "dofs": 2 * X.shape[0],
              "stiffness_quadrature_degree": STIFFNESS_DEGREE[pb.element],
              "load_quadrature_degree": LOAD_DEGREE}
-    if pb.frictional:
+    if pb.finite:
+        uh, finite = solve_finite(pb, msh, V, load_terms, mt, contact_terms, th, ids)
+        extra.update(finite)
+    elif pb.frictional:
         uh, contact = solve_friction(pb, msh, V, a, load_terms, mt, contact_terms, th, ids)
         extra["contact"] = contact
     elif pb.contact:
@@ -259,7 +273,7 @@ def solve(pb: Problem, vtu_path=None):
         if reason <= 0:
             raise RuntimeError(f"{pb.name}: PETSc solve did not converge (reason {reason})")
 
-    if vtu_path is not None and not pb.frictional:
+    if vtu_path is not None and not pb.frictional and not pb.finite:
         fields = contact_point_fields(msh, degree, V, uh, pb, extra["contact"]) \
             if pb.contact else ()
         write_vtu(vtu_path, msh, degree, uh, sigma, fields)
@@ -674,6 +688,149 @@ def solve_friction(pb, msh, V, a, load_terms, mt, contact_terms, th, ids):
     return uh, {"pairs": out_pairs, "newton": history, "steps": steps,
                 "iterations": len(history), "relative_residual": res,
                 "contact_quadrature": f"GLL degree {CONTACT_RULE[pb.element]}"}
+
+
+def hyperelastic_energy(model, lam, mu, uh):
+    """The stored energy per reference volume of src/solid_finite.rs in UFL, plane strain
+    (F_33 = 1): F = I + grad u (2x2), C = F^T F, J = det F;
+    neo-Hookean W = mu/2 (I_1 - 3 - 2 ln J) + lambda/2 (ln J)^2 with I_1 = tr C + 1 (the
+    three-dimensional trace, C_33 = 1); St. Venant-Kirchhoff W = lambda/2 (tr E)^2 + mu E:E,
+    E = (C - I)/2 (E_33 = 0)."""
+    identity = ufl.Identity(2)
+    F = identity + ufl.grad(uh)
+    C = F.T * F
+    if model == "neo_hookean":
+        ln_j = ufl.ln(ufl.det(F))
+        return 0.5 * mu * (ufl.tr(C) + 1.0 - 3.0 - 2.0 * ln_j) + 0.5 * lam * ln_j**2
+    if model == "saint_venant_kirchhoff":
+        E = 0.5 * (C - identity)
+        return 0.5 * lam * ufl.tr(E)**2 + mu * ufl.inner(E, E)
+    raise Unsupported(f"material model {model!r}")
+
+
+def solve_finite(pb, msh, V, load_terms, mt, contact_terms, th, ids):
+    """Finite kinematics (total Lagrangian), optionally with frictionless penalty contact
+    against a rigid line: the residual is the derivative of the stored energy
+    `int t W(F) dX` (hyperelastic_energy, quadrature of our stiffness rule) minus the dead
+    loads times their load factors minus the penalty term `int t kappa (g)_- (n . v) dS` over
+    the reference slave facets with the Gauss-Lobatto rule of our nodal weights, `g = n . (X +
+    u - p)` the gap in the current configuration (for a line it is affine in u, and our rows
+    take the reference nodal weights A_a as this rule does). UFL derives the tangent. Per load
+    step (the case's `path` factors or k/n) the supports take their values times the factor
+    and Newton's method runs in numpy/scipy on the free dofs (SuperLU) from the last step's
+    solution until the relative residual (max over free dofs of |R| over the larger of the
+    largest load and the largest internal force) reaches 1e-14, or stops falling below 1e-12
+    (round-off); a step that ends above 1e-12 is an error."""
+    v, du = ufl.TestFunction(V), ufl.TrialFunction(V)
+    uh = fem.Function(V)
+    x = ufl.SpatialCoordinate(msh)
+    mat = pb.material
+    lam, mu = fem.Constant(msh, mat.lam), fem.Constant(msh, mat.mu)
+    dx = ufl.Measure("dx", domain=msh,
+                     metadata={"quadrature_degree": STIFFNESS_DEGREE[pb.element]})
+    internal = ufl.derivative(th * hyperelastic_energy(pb.hyperelastic, lam, mu, uh) * dx, uh, v)
+    factors = {k: fem.Constant(msh, 0.0) for k in load_terms}
+    external = None
+    for k, terms in load_terms.items():
+        term = factors[k] * sum(terms[1:], terms[0])
+        external = term if external is None else external + term
+    contact_forms = []
+    if pb.contact:
+        dsc = ufl.Measure("ds", domain=msh, subdomain_data=mt,
+                          metadata={"quadrature_rule": "GLL",
+                                    "quadrature_degree": CONTACT_RULE[pb.element]})
+        for k, pair in enumerate(pb.contact):
+            g, nx, ny = pair.gap(x[0], x[1], uh[0], uh[1], ufl.sqrt)
+            pos = ufl.conditional(ufl.le(g, 0.0), -g, 0.0)
+            terms = [th * pair.kappa * pos * (nx * v[0] + ny * v[1]) * dsc(tag)
+                     for kk, tag in contact_terms if kk == k]
+            contact_forms.append(sum(terms[1:], terms[0]))
+    F = internal
+    if external is not None:
+        F = F - external
+    for cf in contact_forms:
+        F = F - cf
+    F_form, J_form = fem.form(F), fem.form(ufl.derivative(F, uh, du))
+    internal_form = fem.form(internal)
+    external_form = fem.form(external) if external is not None else None
+
+    X = V.tabulate_dof_coordinates()[:, :2]          # one row per node; dof = 2 node + comp
+    ndof = 2 * X.shape[0]
+    tree = cKDTree(X)
+    fixed = {}
+    for (coords, comp, values), path in zip(pb.supports, pb.support_paths):
+        d, idx = tree.query(coords)
+        if d.max() > pb.tol:
+            raise RuntimeError(f"{pb.name}: support node not found (distance {d.max():.3e})")
+        for node, val in zip(idx, values):
+            fixed[2 * int(node) + comp] = (float(val), path)   # later supports win
+    free = np.setdiff1d(np.arange(ndof), np.array(sorted(fixed), dtype=np.int64))
+
+    def vector(form):
+        return dolfinx.fem.petsc.assemble_vector(form).array.copy()
+
+    def jacobian():
+        A = dolfinx.fem.petsc.assemble_matrix(J_form)
+        A.assemble()
+        ip, jp, vals = A.getValuesCSR()
+        return scipy.sparse.csr_matrix((vals, jp, ip), shape=(ndof, ndof))
+
+    def relative_residual():
+        r = vector(F_form)
+        f_ext = np.abs(vector(external_form)).max() if external_form is not None else 0.0
+        scale = max(f_ext, float(np.abs(vector(internal_form)).max()), np.finfo(float).tiny)
+        return r, float(np.abs(r[free]).max()) / scale
+
+    history, steps = [], []
+    for step in range(1, pb.load_steps + 1):
+        for k, c in factors.items():
+            c.value = pb.factor(pb.load_paths[k], step)
+        # the supports' increment enters the first iteration through the tangent at the last
+        # step's state (J_ff du_f = -r_f - J_fc du_c), so the first iterate is the linearized
+        # step and not a mesh with its supported nodes alone moved
+        dofs = np.array(sorted(fixed), dtype=np.int64)
+        target = np.array([pb.factor(fixed[d][1], step) * fixed[d][0] for d in dofs])
+        lift = np.zeros(ndof)
+        lift[dofs] = target - uh.x.array[dofs]
+        r, res = relative_residual()
+        it = 0
+        while (res > 1e-14 or it == 0) and it < 50:
+            it += 1
+            J = jacobian()
+            rhs = -r[free] - (J[free] @ lift) if it == 1 else -r[free]
+            delta = scipy.sparse.linalg.spsolve(J[free][:, free].tocsc(), rhs)
+            if it == 1:
+                uh.x.array[dofs] = target
+            if not np.all(np.isfinite(delta)):
+                raise RuntimeError(f"{pb.name}: step {step}, iteration {it}: singular tangent")
+            uh.x.array[free] += delta
+            previous = res
+            r, res = relative_residual()
+            history.append({"step": step, "iteration": it, "relative_residual": res})
+            if res <= 1e-12 and res > 0.5 * previous:   # stalled at round-off
+                break
+        if not res <= 1e-12:
+            raise RuntimeError(f"{pb.name}: step {step}: Newton ended at relative residual "
+                               f"{res:.2e} after {it} iterations")
+        steps.append({"step": step, "iterations": it, "relative_residual": res})
+
+    pairs = []
+    inv = np.empty(len(ids), dtype=np.int64)
+    inv[ids] = np.arange(len(ids))                   # .vtu point -> DOLFINx dof node
+    U = uh.x.array.reshape(-1, 2)
+    for pair, cf in zip(pb.contact, contact_forms):
+        f = vector(fem.form(cf)).reshape(-1, 2)
+        vn = np.array(sorted({nd for fc in facets_in_box(pb, pair.box) for nd in fc}))
+        dn = inv[vn]
+        P = pb.points[vn]
+        g, _, _ = pair.gap(P[:, 0], P[:, 1], U[dn, 0], U[dn, 1], np.sqrt)
+        pairs.append({"name": pair.name, "total_force": f.sum(axis=0).tolist(),
+                      "nodes": vn.tolist(), "slave_force": f[dn].tolist(),
+                      "gap": np.asarray(g).tolist(), "active": [bool(t) for t in g < 0.0]})
+    return uh, {"finite": {"material": pb.hyperelastic, "steps": steps, "newton": history,
+                           "relative_residual": max(s["relative_residual"] for s in steps)},
+                "contact": {"pairs": pairs,
+                            "contact_quadrature": f"GLL degree {CONTACT_RULE[pb.element]}"}}
 
 
 def main(argv):

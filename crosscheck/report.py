@@ -24,6 +24,11 @@ contact results or the tie solutions; see ref_dolfinx.py and ref_skfem.py). Quan
   steps): the field, the total contact force (x, y), the nodal contact force at every slave
   node (ours: `<pair>.contact.csv`), each node's last status (equal); TOL_FRICTION = 1e-10
   (both Newton solves end below 1e-12). scikit-fem: not applicable.
+* finite kinematics (a hyperelastic body, neo-Hookean or St. Venant-Kirchhoff, alone or with
+  frictionless penalty contact against a rigid line; ref_dolfinx.solve_finite, DOLFINx only;
+  the same load steps): the field, and with contact the total contact force (x, y), the nodal
+  contact force at every slave node (ours: `<pair>.contact.csv`) and the number of closed
+  nodes (equal); TOL_FINITE = 1e-10 (both Newton solves end below 1e-12). scikit-fem: n/a.
 * two bodies tied by a mortar pair: scikit-fem's mortar tie with the same multipliers; the
   field over both bodies (and per body), tolerance 1e-10. DOLFINx: not applicable (n/a).
 * elastic waves (physics.dynamics, no contact): DOLFINx only (ref_dolfinx.solve_wave, the
@@ -64,6 +69,7 @@ from common import (ELEMENT_OF_MESHIO, Exact, Material, Problem, Sampler,  # noq
 TOL = 1e-10            # same discrete linear problem: round-off
 TOL_CONTACT = 1e-8     # penalty contact: the references' Newton residuals are <= 1e-9
 TOL_FRICTION = 1e-10   # penalty Coulomb (DOLFINx only): both Newton solves end below 1e-12
+TOL_FINITE = 1e-10     # finite kinematics (DOLFINx only): both Newton solves end below 1e-12
 TOL_DU = 1e-8          # tied-layer du: absolute, between codes and against tied-layer.json
 HERTZ_PEAK = 0.03      # peak nodal pressure within 3% of Hertz's p0
 EXACT_MARGIN = 10.0    # the two-block reference must be this much closer to the exact field
@@ -259,7 +265,8 @@ def case_entry(case_path, root, repo):
             kind = "wave"
         else:
             pb = Problem(case_path, out)
-            kind = "friction" if pb.frictional else "contact" if pb.contact else "elasticity"
+            kind = ("finite" if pb.finite else "friction" if pb.frictional
+                    else "contact" if pb.contact else "elasticity")
     except Exception as e:  # noqa: BLE001  (any failure here is a failed verdict, with its text)
         entry.update({"kind": "?", "error": f"cannot read the case or our output: "
                       f"{type(e).__name__}: {e}", "verdict": "fail", "quantities": []})
@@ -286,12 +293,13 @@ def case_entry(case_path, root, repo):
     try:
         if kind == "tie":
             rows = tie_rows(entry, tc, datas, errors, na)
-        elif kind in ("wave", "friction"):
-            if "dolfinx" in na:   # DOLFINx must solve every wave and friction case
-                errors["dolfinx"] = f"not applicable to a wave case: {na.pop('dolfinx')}"
+        elif kind in ("wave", "friction", "finite"):
+            if "dolfinx" in na:   # DOLFINx must solve every wave, friction and finite case
+                errors["dolfinx"] = f"not applicable to a {kind} case: {na.pop('dolfinx')}"
                 entry["errors"] = errors
             rows = (wave_rows(entry, pb, out, datas, errors, na) if kind == "wave"
-                    else friction_rows(entry, pb, out, summary, datas, errors, na))
+                    else friction_rows(entry, pb, out, summary, datas, errors, na)
+                    if kind == "friction" else finite_rows(entry, pb, out, summary, datas, errors, na))
         else:
             if na:   # a one-body case must be solved by both references
                 for s, why in na.items():
@@ -447,6 +455,72 @@ def friction_rows(entry, pb, out, summary, datas, errors, na):
     counts = {st: sum(v == st for v in ours_status.values()) for st in ("open", "stick", "slip")}
     rows.add(f"nodes with another status (ours: {counts['open']} open, {counts['stick']} stick, "
              f"{counts['slip']} slip)", 0, {s: int(v) for s, v in sdiff.items()}, sdiff,
+             0.0, "equal", kind="equal", fmt="int")
+    return rows
+
+
+def our_slave_forces(pb, out):
+    """Our nodal contact force and status at every slave node (`<pair>.contact.csv`), by .vtu
+    point id (checked by coordinates)."""
+    force, status = {}, {}
+    for pair in pb.contact:
+        with open(out / f"{pair.name}.contact.csv", newline="") as f:
+            for r in csv.DictReader(f):
+                if r["side"] != "slave":
+                    continue
+                node = int(r["node"])
+                if np.abs(pb.points[node] - [float(r["x"]), float(r["y"])]).max() > pb.tol:
+                    raise RuntimeError(f"{pair.name}.contact.csv node {node} is not .vtu point {node}")
+                force[node] = np.array([float(r["force_x"]), float(r["force_y"])])
+                status[node] = r["status"]
+    return force, status
+
+
+def finite_rows(entry, pb, out, summary, datas, errors, na):
+    """Finite kinematics (ref_dolfinx.solve_finite: the same stored energy in UFL, the same
+    quadrature, load steps and, with contact, the same penalty rows): the field and, with
+    contact, the total contact force, the nodal contact forces and the closed nodes."""
+    entry.update({"element": pb.element, "plane": pb.material.plane, "nodes": len(pb.points),
+                  "cells": len(pb.cells), "material": pb.hyperelastic,
+                  "load_steps": pb.load_steps})
+    entry["newton_relative_residual"] = {"ours": summary.get("relative_residual"),
+                                         **{s: d["finite"]["relative_residual"]
+                                            for s, d in datas.items()}}
+    refs = {s: np.asarray(d["u"], dtype=float) for s, d in datas.items()}
+    rows = Rows(refs, errors, na)
+    tol, txt = TOL_FINITE, tol_text(TOL_FINITE)
+    corner = pb.node_set("top_right")
+    field_rows(rows, pb.u_ours, refs, tol, txt, int(corner[0]) if len(corner) == 1 else None)
+    if not pb.contact:
+        return rows
+    c = summary.get("contact")
+    if c is None:
+        raise RuntimeError("our summary.json has no contact section")
+    F = np.asarray(c["total_force"], dtype=float)
+    fn = float(np.linalg.norm(F)) or 1.0
+    totals = {s: np.sum([p["total_force"] for p in d["contact"]["pairs"]], axis=0)
+              for s, d in datas.items()}
+    for k, xy in ((0, "x"), (1, "y")):
+        rows.add(f"total contact force {xy} (rel. to |F|)", float(F[k]),
+                 {s: float(t[k]) for s, t in totals.items()},
+                 {s: abs(float(t[k]) - F[k]) / fn for s, t in totals.items()}, tol, txt,
+                 fmt="signed")
+    ours_force, ours_status = our_slave_forces(pb, out)
+    scale = max(float(np.abs(v).max()) for v in ours_force.values()) or 1.0
+    fdiff, fref, cdiff, cref = {}, {}, {}, {}
+    for s, d in datas.items():
+        ref_force = {n: np.asarray(f) for p in d["contact"]["pairs"]
+                     for n, f in zip(p["nodes"], p["slave_force"])}
+        ref_active = {n: a for p in d["contact"]["pairs"] for n, a in zip(p["nodes"], p["active"])}
+        if sorted(ref_force) != sorted(ours_force):
+            raise RuntimeError(f"{NAMES[s]}'s slave nodes differ from ours")
+        fdiff[s] = max(float(np.abs(ref_force[n] - ours_force[n]).max()) for n in ours_force) / scale
+        fref[s] = max(float(np.abs(v).max()) for v in ref_force.values())
+        cdiff[s] = float(sum(ref_active[n] != (ours_status[n] != "open") for n in ours_status))
+        cref[s] = int(sum(ref_active.values()))
+    rows.add("nodal contact forces (max abs)", scale, fref, fdiff, tol, txt)
+    closed = sum(st != "open" for st in ours_status.values())
+    rows.add("closed slave nodes (nodes with another status)", closed, cref, cdiff,
              0.0, "equal", kind="equal", fmt="int")
     return rows
 
@@ -828,7 +902,14 @@ def write_md(path, report):
         "ref_dolfinx.py runs the same return map per slave node with the plastic slip committed "
         "per step; the field, the total contact force, the nodal contact forces (max abs "
         "difference over the largest nodal force) and each node's last status (equal) are "
-        "compared, tolerance 1e-10; scikit-fem: n/a.",
+        "compared, tolerance 1e-10; scikit-fem: n/a. Finite kinematics (`neo-hookean-*`, "
+        "`svk-*`: a hyperelastic body, alone or pressed onto a rigid line with a penalty): "
+        "DOLFINx solves the same total-Lagrangian problem, the stored energy written in UFL "
+        "and differentiated by UFL, with the same quadrature and load steps and, with "
+        "contact, the same penalty rows (the current gap at the slave nodes, our nodal "
+        "weights); the field, the total and nodal contact forces and the closed nodes (equal) "
+        "are compared, tolerance 1e-10 (both Newton solves end below a relative residual of "
+        "1e-12); scikit-fem: n/a.",
         "",
         "| case | element | plane | nodes | quantity | ours | DOLFINx | scikit-fem "
         "| rel. diff DOLFINx | rel. diff scikit-fem | tol | verdict |",
@@ -1103,6 +1184,7 @@ def main(argv):
         "versions": versions,
         "tolerances": {"linear": TOL, "linear_rule": "max(1e-10, kappa_1 eps) with kappa_1 "
                        "scikit-fem's cond1_estimate", "contact": TOL_CONTACT, "friction": TOL_FRICTION,
+                       "finite": TOL_FINITE,
                        "tie": TOL, "tied_layer_du": TOL_DU, "hertz_peak": HERTZ_PEAK,
                        "hertz_half_width": "one node spacing",
                        "two_block_exact_margin": EXACT_MARGIN},

@@ -18,7 +18,9 @@
 # crosscheck/cases (cross-check-only elasticity cases), crosscheck/cases/contact (penalty
 # contact with rigid surfaces), crosscheck/cases/friction (penalty Coulomb contact on a rigid
 # line in two load steps, DOLFINx only), crosscheck/cases/dynamics (elastic waves in a bar, stepped by
-# DOLFINx with the same mesh, mass and Newmark parameters), and the studies that crosscheck/studies.py generates into the
+# DOLFINx with the same mesh, mass and Newmark parameters), crosscheck/cases/finite (finite
+# kinematics: hyperelastic cantilevers and a neo-Hookean block pressed onto a rigid line with a
+# penalty, DOLFINx only, the same load steps), and the studies that crosscheck/studies.py generates into the
 # run folder: the tied layer (cases/tied-layer at levels 1, 2, 4, 8) and the two blocks
 # (crosscheck/cases/two-block at levels 1, 2, 4, and its fine one-body reference). With CASE
 # arguments only those cases run (no studies).
@@ -87,7 +89,7 @@ if [ "$#" -gt 0 ]; then
 else
     CASES=(cases/patch-single/*.json cases/convergence/*.json crosscheck/cases/*.json
            crosscheck/cases/contact/*.json crosscheck/cases/friction/*.json
-           crosscheck/cases/dynamics/*.json)
+           crosscheck/cases/dynamics/*.json crosscheck/cases/finite/*.json)
     "$PY" crosscheck/studies.py "$OUT" > "$OUT/study-cases.txt"
     mapfile -t STUDY_CASES < "$OUT/study-cases.txt"
     CASES+=("${STUDY_CASES[@]}")
