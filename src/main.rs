@@ -180,6 +180,18 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// The contact patch test at finite strain: meshes A-E of cases/patch with neo-Hookean
+    /// bodies compressed by 20 %, each node-to-surface cell against its small-strain verdict;
+    /// writes reports/finite-patch-table.md and .json (run from the repository's root).
+    #[command(
+        name = "finite-patch",
+        after_help = "Example:\n  contact-patch finite-patch\n  contact-patch finite-patch --out /tmp/reports"
+    )]
+    FinitePatch {
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
     /// The impact studies: `impact` (default), the dynamic cases with every impact treatment
     /// and mass against the 1D wave solutions (reports/impact.md, .json); `block-drop`, a block
     /// dropped on a foundation under time-step refinement (reports/block-drop.md, .json, .svg);
@@ -330,6 +342,7 @@ fn main() -> ExitCode {
         Command::Hard { paths, out } => hard(&paths, &out),
         Command::ImpactReport { paths, out, study } => impact_report(&paths, &out, study),
         Command::FrictionConvergence { out } => friction_convergence(&out),
+        Command::FinitePatch { out } => finite_patch(&out),
         Command::Profile { case, pair, out } => profile(&case, &pair, &out),
         Command::Report { reports } => report_page(&reports),
         Command::Cattaneo { paths, pair, out } => cattaneo(&paths, &pair, &out),
@@ -1259,6 +1272,46 @@ fn cattaneo(paths: &[PathBuf], pair: &str, out: &Path) -> ExitCode {
 }
 
 /// `contact-patch friction-convergence`: the residual histories of the friction tangents.
+fn finite_patch(out: &Path) -> ExitCode {
+    let folder = match ReportFolder::new(out) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let bar = progress_bar(contact_patch::harness::finite_patch::cell_count());
+    let result = (|| -> contact_patch::Result<()> {
+        use contact_patch::harness::finite_patch;
+        let cells = finite_patch::run(Path::new("."), &mut |name| {
+            if let Some(b) = &bar {
+                b.set_message(name.to_string());
+                b.inc(1);
+            }
+        })?;
+        folder.write_file("finite-patch-table.md", &finite_patch::report(&cells))?;
+        let json = serde_json::to_string_pretty(&cells).expect("cells serialize") + "\n";
+        folder.write_file("finite-patch-table.json", &json)
+    })();
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    match result {
+        Ok(()) => {
+            println!(
+                "wrote {} and {}",
+                folder.shown("finite-patch-table.md").display(),
+                folder.shown("finite-patch-table.json").display()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
 fn friction_convergence(out: &Path) -> ExitCode {
     let folder = match ReportFolder::new(out) {
         Ok(f) => f,

@@ -53,6 +53,11 @@ pub const KNOWN_REPORTS: &[KnownReport] = &[
         command: "contact-patch table",
     },
     KnownReport {
+        stem: "finite-patch-table",
+        title: "Contact patch test at finite strain (meshes A-E compressed 20 %)",
+        command: "contact-patch finite-patch",
+    },
+    KnownReport {
         stem: "hard-cases",
         title: "Stability suite (hard cases)",
         command: "contact-patch hard",

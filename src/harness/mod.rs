@@ -34,6 +34,7 @@ pub mod block_drop;
 pub mod cattaneo;
 pub mod checks;
 pub(crate) mod exact;
+pub mod finite_patch;
 pub mod friction;
 pub mod friction_convergence;
 pub mod hard;
