@@ -294,6 +294,10 @@ fn the_finite_patch_test_s_exact_state_is_uniaxial_stress() {
 ///   equilibrium of the discrete system (residual below 1e-12 of the internal force), and a
 ///   cell is exact exactly when its tangent there is positive definite (a cell that stops
 ///   without converging has an unstable exact state);
+/// - for Lagrange multipliers the exact state is an equilibrium too; its stability (a penalty
+///   of 1e8 standing for the constraint) does not decide the verdict: measured, D converges to
+///   an exact state with one unstable direction, and A with the foundation as slave stops
+///   although its exact state is stable (reports/finite-patch-table.md);
 /// - the cells of mesh A and B with the punch as slave, A with two passes, and D with the
 ///   punch as slave and Lagrange multipliers are exact (measured: 0 to 2.3e-12).
 ///
@@ -313,23 +317,29 @@ fn the_finite_strain_patch_test_passes_where_the_small_strain_one_does() {
             "{name}: exact at finite strain, failing at small strain ({:e})",
             c.small_strain_error
         );
-        if c.enforcement == "penalty" && c.small_strain_pass {
-            let s = c.exact_state.expect("measured for every such penalty cell");
-            assert!(s.residual < 1e-12, "{name}: residual {:e}", s.residual);
-            match &c.finite {
-                finite_patch::FiniteOutcome::Converged { .. } => assert_eq!(
-                    c.finite_pass,
-                    s.unstable_directions == 0,
-                    "{name}: {} unstable directions",
-                    s.unstable_directions
-                ),
-                finite_patch::FiniteOutcome::Stopped { reason } => assert!(
-                    s.unstable_directions > 0,
-                    "{name}: stable exact state, yet {reason}"
-                ),
+        match (c.enforcement.as_str(), c.small_strain_pass, c.exact_state) {
+            ("penalty", true, Some(s)) => {
+                assert!(s.residual < 1e-12, "{name}: residual {:e}", s.residual);
+                match &c.finite {
+                    finite_patch::FiniteOutcome::Converged { .. } => assert_eq!(
+                        c.finite_pass,
+                        s.unstable_directions == 0,
+                        "{name}: {} unstable directions",
+                        s.unstable_directions
+                    ),
+                    finite_patch::FiniteOutcome::Stopped { reason } => assert!(
+                        s.unstable_directions > 0,
+                        "{name}: stable exact state, yet {reason}"
+                    ),
+                }
             }
-        } else {
-            assert!(c.exact_state.is_none(), "{name}");
+            // a penalty of 1e8 (= 1e5 E) standing for the constraint: its residual at the
+            // exact state is kappa times the round-off of the gaps
+            ("lagrange", true, Some(s)) => {
+                assert!(s.residual < 1e-9, "{name}: residual {:e}", s.residual)
+            }
+            (_, false, None) => {}
+            (_, pass, state) => panic!("{name}: small strain {pass}, exact state {state:?}"),
         }
     }
     for (mesh, label, enforcement) in [
