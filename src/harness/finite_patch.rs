@@ -342,6 +342,17 @@ fn finite_case(
     })
 }
 
+/// The finite-strain case file of a cell (to run it alone: `contact-patch run`).
+pub fn case(
+    root: &Path,
+    mesh: &str,
+    discretization: &PatchDiscretization,
+    enforcement: &Value,
+) -> Result<Value> {
+    let small_case = catalogue_case(root, mesh, discretization, enforcement)?;
+    Ok(finite_case(&small_case, discretization, enforcement)?.case)
+}
+
 /// One cell: the small-strain verdict, the finite-strain solve and, for penalty cells, the
 /// discrete system at the exact state.
 pub fn cell(
