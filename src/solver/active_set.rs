@@ -449,7 +449,7 @@ fn solve_at(
     let t = Instant::now();
     // each pair is enforced by its own method; the pairs of one solve share a family
     // (validated in the model), whose first member drives the loop
-    crate::contact::enforcement::refuse_obstacles(model, &rows)?;
+    crate::solver::refuse_obstacles(model, &rows)?;
     let method = method(&model.contact[0].enforcement).kernel();
     progress("assembling");
     let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.dofs.clone()).collect();

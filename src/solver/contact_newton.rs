@@ -244,7 +244,7 @@ impl<'a> ContactSystem<'a> {
         };
         let start = vec![0.0; model.dof_count];
         let rows = rows_at(model, current.then(|| (u.unwrap_or(&start), &areas)))?;
-        crate::contact::enforcement::refuse_obstacles(model, &rows)?;
+        crate::solver::refuse_obstacles(model, &rows)?;
         let search_seconds = t.elapsed().as_secs_f64();
         let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.all_dofs()).collect();
         let sys = assemble(model, &blocks);

@@ -36,3 +36,25 @@ pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Sol
         crate::solver::active_set::solve(model, progress)
     }
 }
+
+/// Refuse rows that a pair's method cannot treat ([`crate::contact::enforcement::Enforcement::obstacle`]): constraint
+/// elimination needs every row to own a free slave dof no other row touches.
+pub(crate) fn refuse_obstacles(
+    model: &crate::model::Model,
+    rows: &[crate::contact::Constraint],
+) -> crate::error::Result<()> {
+    for (k, pair) in model.contact.iter().enumerate() {
+        let enforcement = crate::contact::enforcement::method(&pair.enforcement);
+        let of_pair: Vec<crate::contact::Constraint> =
+            rows.iter().filter(|r| r.pair == k).cloned().collect();
+        if let Some(why) = enforcement.obstacle(&of_pair, &model.prescribed) {
+            return Err(crate::error::Error::invalid(
+                &model.source,
+                format!("contact '{}'", pair.name),
+                format!("{} does not apply: {why}", enforcement.title()),
+                "use another enforcement method for this pair",
+            ));
+        }
+    }
+    Ok(())
+}

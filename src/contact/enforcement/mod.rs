@@ -92,27 +92,6 @@ pub fn method(spec: &EnforcementSpec) -> Box<dyn Enforcement> {
     }
 }
 
-/// Refuse rows that a pair's method cannot treat ([`Enforcement::obstacle`]): constraint
-/// elimination needs every row to own a free slave dof no other row touches.
-pub fn refuse_obstacles(
-    model: &crate::model::Model,
-    rows: &[Constraint],
-) -> crate::error::Result<()> {
-    for (k, pair) in model.contact.iter().enumerate() {
-        let enforcement = method(&pair.enforcement);
-        let of_pair: Vec<Constraint> = rows.iter().filter(|r| r.pair == k).cloned().collect();
-        if let Some(why) = enforcement.obstacle(&of_pair, &model.prescribed) {
-            return Err(crate::error::Error::invalid(
-                &model.source,
-                format!("contact '{}'", pair.name),
-                format!("{} does not apply: {why}", enforcement.title()),
-                "use another enforcement method for this pair",
-            ));
-        }
-    }
-    Ok(())
-}
-
 /// Which enforcement methods one contact solve can combine, a method per pair: the loop is
 /// driven by one family. Penalty, perturbed Lagrangian and augmented Lagrangian rows (any
 /// kappa, either Uzawa update) share the penalty-regularized loop (whose linear solve becomes
