@@ -4,8 +4,9 @@
 //! support and no contact can hold against a rigid motion (`crate::model::rigid`), which would
 //! otherwise surface as a singular matrix.
 
-use crate::contact::discretization::constraints;
+use crate::contact::discretization::{check_matched_nodes, constraints};
 use crate::error::{Error, Result};
+use crate::io::scene::{DiscretizationSpec, Kinematics};
 use crate::model::{parse, MasterSide, Model};
 use std::path::Path;
 
@@ -20,6 +21,22 @@ pub fn load(path: &Path) -> Result<Model> {
 
 /// `model`, when it passes the checks of this module.
 pub fn admit(model: Model) -> Result<Model> {
+    // finite kinematics pairs node-to-node contact by proximity in the current configuration:
+    // the reference configuration must match node for node
+    if model.physics.kinematics == Kinematics::Finite {
+        for pair in &model.contact {
+            if pair.discretization == DiscretizationSpec::NodeToNode {
+                check_matched_nodes(&model, pair).map_err(|reason| {
+                    Error::invalid(
+                        &model.source,
+                        format!("contact '{}'", pair.name),
+                        format!("the discretization does not apply: {reason}"),
+                        "choose another discretization for this pair",
+                    )
+                })?;
+            }
+        }
+    }
     // in a dynamic run the mass holds every rigid motion
     if model.dynamics.is_none() {
         check_rigid_modes(&model)?;
