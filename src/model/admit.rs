@@ -2,7 +2,9 @@
 //! any solve. [`Model::build`] resolves names, meshes and numbers; here the contact rows of
 //! every pair are built (with every candidate row counted as closed) to find a body that no
 //! support and no contact can hold against a rigid motion (`crate::model::rigid`), which would
-//! otherwise surface as a singular matrix.
+//! otherwise surface as a singular matrix. Under finite kinematics a node-to-node pair's
+//! reference interface must also match node for node (its nodes are then paired by proximity
+//! in the current configuration, `crate::contact::discretization::nodal_normal`).
 
 use crate::contact::discretization::{check_matched_nodes, constraints};
 use crate::error::{Error, Result};

@@ -320,8 +320,7 @@ pub(crate) fn weighted_row(
 
 /// Whether the node-to-node pair `pair` between bodies matches node for node in `model`'s
 /// configuration (to `1e-9` of the model's size), the reason where it does not: finite
-/// kinematics pairs nodes in the current configuration by proximity
-/// ([`node_to_node_current`]), so the reference configuration is held to the exact match here.
+/// kinematics pairs nodes in the current configuration by proximity, so the reference configuration is held to the exact match here.
 pub fn check_matched_nodes(model: &Model, pair: &ContactPair) -> Result<(), String> {
     let MasterSide::Body { body, facets } = &pair.master else {
         return Ok(());

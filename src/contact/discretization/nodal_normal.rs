@@ -3,7 +3,7 @@
 //! normals, in two forms, and node-to-node. The row's force direction `f` (its `coeffs`), the
 //! gap's gradient and the derivative `df/dx` the Newton tangent needs.
 //!
-//! **The nodal normal** (the same one [`super::geometry::Surface`] gives): the normalized sum
+//! **The nodal normal** (the same one the `geometry` module's surfaces give): the normalized sum
 //! over the surface facets at node `a` of `m_a = int N_a n |x'| ds = int N_a [x'_y, -x'_x] ds`
 //! (the facet's Gauss rule), so `n_a = m_a / |m_a|` depends on the node and its neighbours along
 //! the surface (a Line2 surface: the two adjacent facets' nodes).
