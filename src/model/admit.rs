@@ -9,7 +9,7 @@
 use crate::contact::discretization::{check_matched_nodes, constraints};
 use crate::error::{Error, Result};
 use crate::io::scene::{DiscretizationSpec, Kinematics};
-use crate::model::{parse, MasterSide, Model};
+use crate::model::{parse, ContactPair, MasterSide, Model};
 use std::path::Path;
 
 /// Read, parse, build and admit a case file.
@@ -28,14 +28,8 @@ pub fn admit(model: Model) -> Result<Model> {
     if model.physics.kinematics == Kinematics::Finite {
         for pair in &model.contact {
             if pair.discretization == DiscretizationSpec::NodeToNode {
-                check_matched_nodes(&model, pair).map_err(|reason| {
-                    Error::invalid(
-                        &model.source,
-                        format!("contact '{}'", pair.name),
-                        format!("the discretization does not apply: {reason}"),
-                        "choose another discretization for this pair",
-                    )
-                })?;
+                check_matched_nodes(&model, pair)
+                    .map_err(|reason| not_applicable(&model, pair, reason))?;
             }
         }
     }
@@ -46,19 +40,24 @@ pub fn admit(model: Model) -> Result<Model> {
     Ok(model)
 }
 
+/// The error of a pair whose discretization does not apply, for `reason`.
+fn not_applicable(model: &Model, pair: &ContactPair, reason: String) -> Error {
+    Error::invalid(
+        &model.source,
+        format!("contact '{}'", pair.name),
+        format!("the discretization does not apply: {reason}"),
+        "choose another discretization for this pair",
+    )
+}
+
 /// Every rigid mode of every body must be held by the prescribed dofs and the contact rows
 /// together, every candidate row counted as closed (see `crate::model::rigid`).
 pub fn check_rigid_modes(model: &Model) -> Result<()> {
     let mut rows = Vec::new();
     for pair in &model.contact {
-        rows.extend(constraints(model, pair).map_err(|reason| {
-            Error::invalid(
-                &model.source,
-                format!("contact '{}'", pair.name),
-                format!("the discretization does not apply: {reason}"),
-                "choose another discretization for this pair",
-            )
-        })?);
+        rows.extend(
+            constraints(model, pair).map_err(|reason| not_applicable(model, pair, reason))?,
+        );
     }
     let rows: Vec<&crate::contact::Constraint> = rows.iter().collect();
     let Some(free) = crate::model::rigid::free_rigid_mode(model, &rows) else {

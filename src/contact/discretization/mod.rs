@@ -352,13 +352,7 @@ fn node_to_node_current(rows: &mut Rows, slave: &Surface, master: &Surface) -> R
     let model = rows.model;
     let mb = &model.bodies[master.body];
     let sb = &model.bodies[slave.body];
-    let master_nodes: Vec<usize> = master.nodes.keys().copied().collect();
-    let grid = BucketGrid::new(
-        master_nodes
-            .iter()
-            .map(|&n| [mb.mesh.nodes[n], mb.mesh.nodes[n]])
-            .collect(),
-    );
+    let (master_nodes, grid) = node_grid(model, master);
     let radius = master.facet_size();
     let mut used = vec![None; master_nodes.len()];
     for &s in slave.nodes.keys() {
@@ -432,18 +426,25 @@ fn node_to_node_current(rows: &mut Rows, slave: &Surface, master: &Surface) -> R
     Ok(())
 }
 
+/// The nodes of surface `master` and a search grid over their positions.
+fn node_grid(model: &Model, master: &Surface) -> (Vec<usize>, BucketGrid) {
+    let mb = &model.bodies[master.body];
+    let nodes: Vec<usize> = master.nodes.keys().copied().collect();
+    let grid = BucketGrid::new(
+        nodes
+            .iter()
+            .map(|&n| [mb.mesh.nodes[n], mb.mesh.nodes[n]])
+            .collect(),
+    );
+    (nodes, grid)
+}
+
 fn node_to_node(rows: &mut Rows, slave: &Surface, master: &Surface) -> Result<(), String> {
     let model = rows.model;
     let mb = &model.bodies[master.body];
     let sb = &model.bodies[slave.body];
     let tol = 1e-9 * mb.mesh.size();
-    let master_nodes: Vec<usize> = master.nodes.keys().copied().collect();
-    let grid = BucketGrid::new(
-        master_nodes
-            .iter()
-            .map(|&n| [mb.mesh.nodes[n], mb.mesh.nodes[n]])
-            .collect(),
-    );
+    let (master_nodes, grid) = node_grid(model, master);
     let mut used = vec![false; master_nodes.len()];
     for &s in slave.nodes.keys() {
         let p = sb.mesh.nodes[s];
