@@ -66,6 +66,7 @@ fn discretization(c: &mut Criterion) {
             DiscretizationSpec::NodeToSurface {
                 passes: 1,
                 normal: NormalChoice::Master,
+                slave_normal_variation: None,
             },
         ),
         (
@@ -73,6 +74,7 @@ fn discretization(c: &mut Criterion) {
             DiscretizationSpec::NodeToSurface {
                 passes: 2,
                 normal: NormalChoice::Master,
+                slave_normal_variation: None,
             },
         ),
         (

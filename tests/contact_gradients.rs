@@ -115,11 +115,13 @@ fn node_to_surface_master_normal_rows_are_gap_gradients() {
         let disc = DiscretizationSpec::NodeToSurface {
             passes: 1,
             normal: NormalChoice::Master,
+            slave_normal_variation: None,
         };
         assert!(check(&m, disc.clone(), 1e-6, 1e-7, false) >= 2);
         let two = DiscretizationSpec::NodeToSurface {
             passes: 2,
             normal: NormalChoice::Master,
+            slave_normal_variation: None,
         };
         assert!(
             check(&m, two, 1e-6, 1e-7, false) >= 4,
@@ -136,6 +138,7 @@ fn node_to_surface_slave_normal_rows_are_gap_gradients_on_tilted_faces() {
             let disc = DiscretizationSpec::NodeToSurface {
                 passes,
                 normal: NormalChoice::Slave,
+                slave_normal_variation: None,
             };
             assert!(
                 check_dofs(&m, disc, 1e-6, 1e-7, false, true) >= 2 * passes as usize,
@@ -157,6 +160,7 @@ fn node_to_surface_slave_normal_rows_are_gap_gradients_where_closed() {
     let disc = DiscretizationSpec::NodeToSurface {
         passes: 1,
         normal: NormalChoice::Slave,
+        slave_normal_variation: None,
     };
     assert_eq!(check(&m, disc, 1e-6, 1e-7, true), 2);
     let text = std::fs::read_to_string(format!(
@@ -168,6 +172,7 @@ fn node_to_surface_slave_normal_rows_are_gap_gradients_where_closed() {
     let disc = DiscretizationSpec::NodeToSurface {
         passes: 2,
         normal: NormalChoice::Slave,
+        slave_normal_variation: None,
     };
     assert!(check(&m, disc, 1e-6, 1e-7, true) >= 8);
 }
@@ -204,6 +209,7 @@ fn rigid_surface_rows_are_gap_gradients() {
         let disc = DiscretizationSpec::NodeToSurface {
             passes: 1,
             normal: NormalChoice::Master,
+            slave_normal_variation: None,
         };
         assert_eq!(check(&m, disc, 1e-6, 1e-7, false), 3, "{rigid}");
     }

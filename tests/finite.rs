@@ -372,8 +372,9 @@ fn combinations_not_built_are_refused_with_the_reason() {
         {"body": "base", "set": "bottom", "x": 0.0, "y": 0.0},
         {"body": "block", "set": "left", "x": 0.0}
     ]);
-    // between deformable bodies: node-to-surface with master normals is built
-    // (tests/finite_contact.rs); the other discretizations and ties are refused
+    // between deformable bodies: node-to-surface with master normals (tests/finite_contact.rs)
+    // and with slave normals, and node-to-node where the nodes match
+    // (tests/finite_slave_normals.rs) are built; mortar and ties are refused
     let mut e = d.clone();
     e["contact"][0]["discretization"] = json!({"kind": "mortar"});
     expect(
@@ -381,17 +382,36 @@ fn combinations_not_built_are_refused_with_the_reason() {
         "discretization",
         "mortar contact between deformable bodies is not built yet",
     );
+    // node-to-node on this non-matching interface: refused with the reason before any solve
     e["contact"][0]["discretization"] = json!({"kind": "node_to_node"});
+    expect(&e, "contact 'ground'", "the interface nodes do not match");
+    // the slave normals' linearization is chosen where it means something only
+    e["contact"][0]["discretization"] = json!({"kind": "node_to_surface", "normal": "master", "slave_normal_variation": "smooth_sliding"});
     expect(
         &e,
-        "discretization",
-        "node-to-node contact between deformable bodies is not built yet",
+        "discretization.slave_normal_variation",
+        "this pair takes master normals",
     );
-    e["contact"][0]["discretization"] = json!({"kind": "node_to_surface", "normal": "slave"});
+    let mut small = e.clone();
+    small["contact"][0]["discretization"] = json!({"kind": "node_to_surface", "normal": "slave", "slave_normal_variation": "consistent"});
+    small["physics"] = json!({"contact_geometry": "current"});
+    small["materials"]["m"]["model"] = json!("linear_elastic");
     expect(
-        &e,
-        "discretization.normal",
-        "slave normals between deformable bodies is not built yet",
+        &small,
+        "discretization.slave_normal_variation",
+        "this case is small strain",
+    );
+    let mut against_rigid = c.clone();
+    against_rigid["contact"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("interaction");
+    against_rigid["physics"]["contact_geometry"] = json!("current");
+    against_rigid["contact"][0]["discretization"] = json!({"kind": "node_to_surface", "normal": "slave", "slave_normal_variation": "consistent"});
+    expect(
+        &against_rigid,
+        "discretization.slave_normal_variation",
+        "this pair's master is rigid",
     );
     e["contact"][0]["discretization"] = json!({"kind": "node_to_surface"});
     e["contact"][0]["interaction"] = json!("tied");

@@ -41,6 +41,7 @@ fn patch_b_passes_at_every_scale() {
                 DiscretizationSpec::NodeToSurface {
                     passes: 1,
                     normal: Default::default(),
+                    slave_normal_variation: None,
                 },
                 EnforcementSpec::Lagrange,
             ),
@@ -54,6 +55,7 @@ fn patch_b_passes_at_every_scale() {
                 DiscretizationSpec::NodeToSurface {
                     passes: 1,
                     normal: Default::default(),
+                    slave_normal_variation: None,
                 },
                 EnforcementSpec::Penalty { kappa: 10.0 * e },
             ),

@@ -86,6 +86,10 @@ pub struct Constraint {
     /// row's nodes and positions for the second derivative of its gap
     /// ([`discretization::node_to_segment`]); `None` elsewhere (small strain builds none).
     pub segment: Option<discretization::node_to_segment::SegmentLinearization>,
+    /// Finite kinematics, node-to-surface with slave normals and node-to-node between
+    /// deformable bodies: the row's nodes (the normal's surface neighbours included) for the
+    /// variation of its nodal normal ([`discretization::nodal_normal`]); `None` elsewhere.
+    pub nodal_normal: Option<discretization::nodal_normal::NodalNormalLinearization>,
 }
 
 /// The tangential slip of a contact point, `g_t(u) = sum_k c_ik u_{d_ik}` (zero at `u = 0`):
@@ -146,8 +150,14 @@ impl Constraint {
         if let Some(t) = &self.tangent {
             d.extend(t.dofs.iter().filter(|x| !self.dofs.contains(x)));
         }
-        if let Some(s) = &self.segment {
-            for &x in &s.dofs {
+        let curvature_dofs = self
+            .segment
+            .as_ref()
+            .map(|s| &s.dofs)
+            .into_iter()
+            .chain(self.nodal_normal.as_ref().map(|n| &n.dofs));
+        for dofs in curvature_dofs {
+            for &x in dofs {
                 if !d.contains(&x) {
                     d.push(x);
                 }

@@ -33,6 +33,7 @@ pub fn variants() -> Vec<(&'static str, DiscretizationSpec)> {
             DiscretizationSpec::NodeToSurface {
                 passes: 1,
                 normal: NormalChoice::Master,
+                slave_normal_variation: None,
             },
         ),
         (

@@ -446,6 +446,30 @@ pub enum NormalChoice {
     Slave,
 }
 
+/// How a node-to-surface row with slave normals is linearized under finite kinematics between
+/// deformable bodies (`contact::discretization::nodal_normal`).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum SlaveNormalVariation {
+    /// The force along the gap's full gradient (the slave node, its surface neighbours and the
+    /// master facet's nodes) and the gap's second derivative in the tangent.
+    #[default]
+    Consistent,
+    /// The seed's smooth-sliding form: the `delta xi` term ignored, the force on the slave node
+    /// and the master facet's nodes only; its tangent is unsymmetric (solved by LU).
+    SmoothSliding,
+}
+
+impl SlaveNormalVariation {
+    /// The name the case format gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            SlaveNormalVariation::Consistent => "consistent",
+            SlaveNormalVariation::SmoothSliding => "smooth_sliding",
+        }
+    }
+}
+
 fn one_pass() -> u8 {
     1
 }
@@ -463,6 +487,10 @@ pub enum DiscretizationSpec {
         passes: u8,
         #[serde(default)]
         normal: NormalChoice,
+        /// Finite kinematics with slave normals only: `"consistent"` (default) or
+        /// `"smooth_sliding"`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        slave_normal_variation: Option<SlaveNormalVariation>,
     },
     /// Segment-based mortar: weighted gaps `D x_s - M x_m` per slave node.
     Mortar {

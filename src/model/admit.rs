@@ -2,11 +2,14 @@
 //! any solve. [`Model::build`] resolves names, meshes and numbers; here the contact rows of
 //! every pair are built (with every candidate row counted as closed) to find a body that no
 //! support and no contact can hold against a rigid motion (`crate::model::rigid`), which would
-//! otherwise surface as a singular matrix.
+//! otherwise surface as a singular matrix. Under finite kinematics a node-to-node pair's
+//! reference interface must also match node for node (its nodes are then paired by proximity
+//! in the current configuration, `crate::contact::discretization::nodal_normal`).
 
-use crate::contact::discretization::constraints;
+use crate::contact::discretization::{check_matched_nodes, constraints};
 use crate::error::{Error, Result};
-use crate::model::{parse, MasterSide, Model};
+use crate::io::scene::{DiscretizationSpec, Kinematics};
+use crate::model::{parse, ContactPair, MasterSide, Model};
 use std::path::Path;
 
 /// Read, parse, build and admit a case file.
@@ -20,6 +23,16 @@ pub fn load(path: &Path) -> Result<Model> {
 
 /// `model`, when it passes the checks of this module.
 pub fn admit(model: Model) -> Result<Model> {
+    // finite kinematics pairs node-to-node contact by proximity in the current configuration:
+    // the reference configuration must match node for node
+    if model.physics.kinematics == Kinematics::Finite {
+        for pair in &model.contact {
+            if pair.discretization == DiscretizationSpec::NodeToNode {
+                check_matched_nodes(&model, pair)
+                    .map_err(|reason| not_applicable(&model, pair, reason))?;
+            }
+        }
+    }
     // in a dynamic run the mass holds every rigid motion
     if model.dynamics.is_none() {
         check_rigid_modes(&model)?;
@@ -27,19 +40,24 @@ pub fn admit(model: Model) -> Result<Model> {
     Ok(model)
 }
 
+/// The error of a pair whose discretization does not apply, for `reason`.
+fn not_applicable(model: &Model, pair: &ContactPair, reason: String) -> Error {
+    Error::invalid(
+        &model.source,
+        format!("contact '{}'", pair.name),
+        format!("the discretization does not apply: {reason}"),
+        "choose another discretization for this pair",
+    )
+}
+
 /// Every rigid mode of every body must be held by the prescribed dofs and the contact rows
 /// together, every candidate row counted as closed (see `crate::model::rigid`).
 pub fn check_rigid_modes(model: &Model) -> Result<()> {
     let mut rows = Vec::new();
     for pair in &model.contact {
-        rows.extend(constraints(model, pair).map_err(|reason| {
-            Error::invalid(
-                &model.source,
-                format!("contact '{}'", pair.name),
-                format!("the discretization does not apply: {reason}"),
-                "choose another discretization for this pair",
-            )
-        })?);
+        rows.extend(
+            constraints(model, pair).map_err(|reason| not_applicable(model, pair, reason))?,
+        );
     }
     let rows: Vec<&crate::contact::Constraint> = rows.iter().collect();
     let Some(free) = crate::model::rigid::free_rigid_mode(model, &rows) else {

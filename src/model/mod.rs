@@ -556,6 +556,7 @@ impl Model {
             Err(Error::invalid(&self.source, location, problem, hint))
         };
         let finite = case.physics.kinematics == Kinematics::Finite;
+        self.check_slave_normal_variation(finite)?;
         if !finite {
             for (name, m) in &case.materials {
                 if !m.model.is_linear() {
@@ -622,23 +623,11 @@ impl Model {
                         "finite kinematics with a tied pair between deformable bodies is not built yet (a tie holds the reference offsets, which rotate with the bodies)",
                         "use a frictionless pair, or small-strain kinematics",
                     )),
-                    DiscretizationSpec::NodeToSurface {
-                        normal: NormalChoice::Master,
-                        ..
-                    } => None,
-                    DiscretizationSpec::NodeToSurface {
-                        normal: NormalChoice::Slave,
-                        ..
-                    } => Some((
-                        format!("{at}.discretization.normal"),
-                        "finite kinematics with slave normals between deformable bodies is not built yet (the slave normal's variation is not linearized)",
-                        "use master normals (\"normal\": \"master\"), or small-strain kinematics",
-                    )),
-                    DiscretizationSpec::NodeToNode => Some((
-                        format!("{at}.discretization"),
-                        "finite kinematics with node-to-node contact between deformable bodies is not built yet (the nodal normal's variation is not linearized)",
-                        "use node-to-surface with master normals, or small-strain kinematics",
-                    )),
+                    // node-to-surface with either normal (nodal_normal.rs for slave normals),
+                    // node-to-node where the nodes stay matched
+                    DiscretizationSpec::NodeToSurface { .. } | DiscretizationSpec::NodeToNode => {
+                        None
+                    }
                     DiscretizationSpec::Mortar { .. } => Some((
                         format!("{at}.discretization"),
                         "finite kinematics with mortar contact between deformable bodies is not built yet (the variation of the segments, normals and projections is not linearized)",
@@ -673,6 +662,40 @@ impl Model {
                     "remove \"geometric_stiffness\": false",
                 );
             }
+        }
+        Ok(())
+    }
+
+    /// `slave_normal_variation` selects how slave normals are linearized at finite strain
+    /// between deformable bodies: given anywhere else it means nothing, and is refused.
+    fn check_slave_normal_variation(&self, finite: bool) -> Result<()> {
+        for (k, pair) in self.contact.iter().enumerate() {
+            let DiscretizationSpec::NodeToSurface {
+                normal,
+                slave_normal_variation: Some(variation),
+                ..
+            } = pair.discretization
+            else {
+                continue;
+            };
+            let why = if normal != NormalChoice::Slave {
+                "it selects how slave normals are linearized, and this pair takes master normals"
+            } else if !finite {
+                "it selects the linearization of slave normals under finite kinematics, and this case is small strain (its rows are linear)"
+            } else if matches!(pair.master, MasterSide::Rigid(_)) {
+                "it selects the linearization of slave normals between deformable bodies, and this pair's master is rigid"
+            } else {
+                continue;
+            };
+            return Err(Error::invalid(
+                &self.source,
+                format!(
+                    "contact[{k}] '{}'.discretization.slave_normal_variation",
+                    pair.name
+                ),
+                format!("\"{}\" means nothing here: {why}", variation.name()),
+                "remove \"slave_normal_variation\", or use \"normal\": \"slave\" with \"physics\": {\"kinematics\": \"finite\"} between deformable bodies",
+            ));
         }
         Ok(())
     }

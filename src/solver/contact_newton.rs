@@ -119,7 +119,8 @@ use super::finite_assembly::tangent_and_residual;
 use super::linear::{assemble, finish, max_abs, LinearSystem, Solution, Timings, NO_EQUATION};
 use super::newton::{self, Evaluation, System, Tangent};
 use super::sparse::{GeneralPattern, PatternBuilder, SymmetricPattern};
-use crate::contact::discretization::gap_second_derivative;
+use crate::contact::discretization::nodal_normal::RowCurvature;
+use crate::contact::discretization::{gap_second_derivative, row_curvature};
 use crate::contact::enforcement::{method, Method};
 use crate::contact::friction::{
     augmented_return_map, multiplier_status, return_map, Committed, FrictionPoint, ReturnMap,
@@ -551,6 +552,15 @@ impl<'a> ContactSystem<'a> {
         {
             if let Some(j) = mult {
                 let mut block: Vec<usize> = self.free_terms(r).iter().map(|&(e, _)| e).collect();
+                // a nodal-normal row's multiplier equation reaches every node of its
+                // linearization (smooth sliding: beyond the force direction's nodes)
+                if let Some(lin) = &r.nodal_normal {
+                    for e in lin.dofs.iter().map(|&d| self.sys.eq(d)) {
+                        if e != NO_EQUATION && !block.contains(&e) {
+                            block.push(e);
+                        }
+                    }
+                }
                 block.push(*j);
                 if let (Some(jt), Some(t)) = (tangential, &r.tangent) {
                     block.extend(self.free_of(&t.dofs, &t.coeffs).iter().map(|&(e, _)| e));
@@ -1006,6 +1016,9 @@ impl System for ContactSystem<'_> {
         let mut terms: Vec<(usize, f64)> = Vec::new();
         // an active row added the second derivative of its gap to the displacement block
         let mut second_derivatives = false;
+        // the unsymmetric entries of rows whose force direction is not their gap's gradient
+        // (smooth-sliding slave normals)
+        let mut curvature_entries: Vec<(usize, usize, f64)> = Vec::new();
         for i in 0..self.rows.len() {
             let r = &self.rows[i];
             let key = row_key(r);
@@ -1211,37 +1224,34 @@ impl System for ContactSystem<'_> {
                     }
                 }
             }
-            if let (true, Some(segment)) = (geometric, &r.segment) {
-                // finite kinematics between deformable bodies: -force H over the row's nodes,
-                // the delta xi and normal-rotation terms (force = lambda_bar - w g for penalty
-                // rows, lambda - rho g for multiplier rows: the derivative of -force b)
-                let (_, h) = segment.gap_and_hessian();
+            if let (true, Some(curvature)) = (geometric, row_curvature(r)) {
+                // finite kinematics between deformable bodies: the second-order part of the
+                // row's linearization over its nodes (force = lambda_bar - w g for penalty
+                // rows, lambda - rho g for multiplier rows: the derivative of -force f)
                 second_derivatives = true;
-                let m = segment.dofs.len();
-                let eqs: Vec<usize> = segment.dofs.iter().map(|&d| self.sys.eq(d)).collect();
-                for a in 0..m {
-                    for c in a..m {
-                        let (ea, ec) = (eqs[a], eqs[c]);
-                        if ea != NO_EQUATION && ec != NO_EQUATION {
-                            upper[self
-                                .pattern
-                                .position(ea.min(ec), ea.max(ec))
-                                .expect("the row's nodes are covered")] -= force * h[a * m + c];
-                        }
-                    }
-                }
+                add_row_curvature(
+                    &curvature,
+                    r,
+                    |d| self.sys.eq(d),
+                    (w, force, self.multiplier[i]),
+                    &self.pattern,
+                    &mut upper,
+                    &mut curvature_entries,
+                );
             }
         }
         tangent.values = general.symmetric_values(&upper);
         // the symmetrized tangent drops the slip coupling (its symmetric part would make the
         // matrix indefinite and Newton diverge)
-        tangent.symmetric = (coupling.is_empty() || symmetrized) && slip_rows.is_empty();
+        tangent.symmetric = (coupling.is_empty() || symmetrized)
+            && slip_rows.is_empty()
+            && curvature_entries.is_empty();
         if !symmetrized {
             for (a, b, v) in coupling {
                 tangent.values[general.position(a, b).expect("covered")] += v;
             }
         }
-        for (a, b, v) in slip_rows {
+        for (a, b, v) in slip_rows.into_iter().chain(curvature_entries) {
             tangent.values[general.position(a, b).expect("covered")] += v;
         }
         tangent.multipliers = self.pattern.n - n;
@@ -1495,6 +1505,72 @@ pub(crate) fn solve_step(
         friction,
     });
     Ok(solution)
+}
+
+/// Add the second-order part of active row `row`'s linearization ([`RowCurvature`]) to the
+/// tangent: with the row's force `force` along its force direction `f` (the row's `coeffs`) and
+/// the weight `w` of `f f^T` already in the displacement block (`law = (w, force, multiplier)`),
+/// `-force df/dx` and, where `f` is not the gap's gradient, `w f (grad g - f)^T` (and in the
+/// multiplier's equation `-rho (grad g - f)^T`, `rho = w`), so that the block is
+/// `w f (grad g)^T - force df/dx`. Symmetric contributions go into the upper triangle `upper` of
+/// `pattern`, the others into `unsymmetric` as (row equation, column equation, value).
+fn add_row_curvature(
+    curvature: &RowCurvature,
+    row: &Constraint,
+    eq: impl Fn(usize) -> usize,
+    (w, force, multiplier): (f64, f64, Option<usize>),
+    pattern: &SymmetricPattern,
+    upper: &mut [f64],
+    unsymmetric: &mut Vec<(usize, usize, f64)>,
+) {
+    let m = curvature.dofs.len();
+    let eqs: Vec<usize> = curvature.dofs.iter().map(|&d| eq(d)).collect();
+    let d = &curvature.direction_derivative;
+    let Some(gradient) = &curvature.gap_gradient else {
+        for a in 0..m {
+            for c in a..m {
+                let (ea, ec) = (eqs[a], eqs[c]);
+                if ea != NO_EQUATION && ec != NO_EQUATION {
+                    upper[pattern
+                        .position(ea.min(ec), ea.max(ec))
+                        .expect("the row's nodes are covered")] -= force * d[a * m + c];
+                }
+            }
+        }
+        return;
+    };
+    // the force direction over the curvature's dofs
+    let f: Vec<f64> = curvature
+        .dofs
+        .iter()
+        .map(|dof| {
+            row.dofs
+                .iter()
+                .position(|x| x == dof)
+                .map_or(0.0, |k| row.coeffs[k])
+        })
+        .collect();
+    for a in 0..m {
+        if eqs[a] == NO_EQUATION {
+            continue;
+        }
+        for c in 0..m {
+            if eqs[c] == NO_EQUATION {
+                continue;
+            }
+            let v = -force * d[a * m + c] + w * f[a] * (gradient[c] - f[c]);
+            if v != 0.0 {
+                unsymmetric.push((eqs[a], eqs[c], v));
+            }
+        }
+    }
+    if let Some(j) = multiplier {
+        for c in 0..m {
+            if eqs[c] != NO_EQUATION && gradient[c] != f[c] {
+                unsymmetric.push((j, eqs[c], -w * (gradient[c] - f[c])));
+            }
+        }
+    }
 }
 
 /// The residual and the tangent of the Newton scheme's contact system, one evaluation at a time,

@@ -37,13 +37,17 @@
 
 pub(crate) mod geometry;
 pub(crate) mod mortar;
+pub mod nodal_normal;
 pub mod node_to_segment;
 pub(crate) mod search;
 
 use crate::contact::Constraint;
-use crate::io::scene::{DiscretizationSpec, Interaction, Kinematics, NormalChoice, RigidSurface};
+use crate::io::scene::{
+    DiscretizationSpec, Interaction, Kinematics, NormalChoice, RigidSurface, SlaveNormalVariation,
+};
 use crate::model::{ContactPair, MasterSide, Model};
 use geometry::{closest_point, edge_shape, facet_point, ray_point, unit_normal, Surface};
+use nodal_normal::{NodalNormalLinearization, NormalTarget, RowCurvature};
 use node_to_segment::{MasterPoint, SegmentLinearization};
 use search::BucketGrid;
 
@@ -197,16 +201,25 @@ pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>,
         },
         (DiscretizationSpec::NodeToNode, MasterSide::Body { body, facets }) => {
             let master = Surface::new(*body, &model.bodies[*body], facets, model.thickness);
-            node_to_node(&mut rows, &slave, &master)?;
+            if model.physics.kinematics == Kinematics::Finite && !rows.tied {
+                node_to_node_current(&mut rows, &slave, &master)?;
+            } else {
+                node_to_node(&mut rows, &slave, &master)?;
+            }
         }
         (
-            DiscretizationSpec::NodeToSurface { passes, normal },
+            DiscretizationSpec::NodeToSurface {
+                passes,
+                normal,
+                slave_normal_variation,
+            },
             MasterSide::Body { body, facets },
         ) => {
             let master = Surface::new(*body, &model.bodies[*body], facets, model.thickness);
-            node_to_surface(&mut rows, &slave, &master, *normal, 1);
+            let variation = slave_normal_variation.unwrap_or_default();
+            node_to_surface(&mut rows, &slave, &master, *normal, variation, 1);
             if *passes == 2 {
-                node_to_surface(&mut rows, &master, &slave, *normal, 2);
+                node_to_surface(&mut rows, &master, &slave, *normal, variation, 2);
             }
         }
         (DiscretizationSpec::Mortar { multiplier }, MasterSide::Body { body, facets }) => {
@@ -301,7 +314,129 @@ pub(crate) fn weighted_row(
         mass: Vec::new(),
         tangent: None,
         segment: None,
+        nodal_normal: None,
     }
+}
+
+/// Whether the node-to-node pair `pair` between bodies matches node for node in `model`'s
+/// configuration (to `1e-9` of the model's size), the reason where it does not: finite
+/// kinematics pairs nodes in the current configuration by proximity, so the reference configuration is held to the exact match here.
+pub fn check_matched_nodes(model: &Model, pair: &ContactPair) -> Result<(), String> {
+    let MasterSide::Body { body, facets } = &pair.master else {
+        return Ok(());
+    };
+    let slave = Surface::new(
+        pair.slave.0,
+        &model.bodies[pair.slave.0],
+        &pair.slave.1,
+        model.thickness,
+    );
+    let master = Surface::new(*body, &model.bodies[*body], facets, model.thickness);
+    let mut rows = Rows {
+        model,
+        tied: false,
+        friction: false,
+        search_distance: None,
+        out: Vec::new(),
+    };
+    node_to_node(&mut rows, &slave, &master)
+}
+
+/// Node-to-node in the current configuration (finite kinematics): each slave node against the
+/// nearest master node, `g = n_m . (x_s - x_m)` with the master's nodal normal, linearized
+/// with the normal's variation ([`nodal_normal`]). The nodes must stay matched: a slave node
+/// that has slid along the master surface by more than half the shorter master facet at its
+/// master node faces another master node, and the pair is refused with that reason (so is a
+/// master node left without a slave node, or one claimed twice).
+fn node_to_node_current(rows: &mut Rows, slave: &Surface, master: &Surface) -> Result<(), String> {
+    let model = rows.model;
+    let mb = &model.bodies[master.body];
+    let sb = &model.bodies[slave.body];
+    let (master_nodes, grid) = node_grid(model, master);
+    let radius = master.facet_size();
+    let mut used = vec![None; master_nodes.len()];
+    for &s in slave.nodes.keys() {
+        let p = sb.mesh.nodes[s];
+        let distance = |k: usize| {
+            let x = mb.mesh.nodes[master_nodes[k]];
+            (p[0] - x[0]).powi(2) + (p[1] - x[1]).powi(2)
+        };
+        let Some(k) = grid
+            .query(p, radius)
+            .into_iter()
+            .min_by(|&a, &b| distance(a).total_cmp(&distance(b)))
+        else {
+            return Err(format!(
+                "the interface nodes no longer match: the slave node at ({}, {}) (current configuration) has no master node within a facet ({radius}); node-to-node needs nodes that stay matched, use node_to_surface where they slide",
+                p[0], p[1]
+            ));
+        };
+        let m = master_nodes[k];
+        let x = mb.mesh.nodes[m];
+        let n = master.nodes[&m].normal;
+        let d = [p[0] - x[0], p[1] - x[1]];
+        let along = (d[0] * n[1] - d[1] * n[0]).abs();
+        let half = 0.5
+            * master
+                .coords
+                .iter()
+                .zip(&master.facets)
+                .filter(|(_, f)| f.contains(&m))
+                .map(|(c, _)| ((c[1][0] - c[0][0]).powi(2) + (c[1][1] - c[0][1]).powi(2)).sqrt())
+                .fold(f64::INFINITY, f64::min);
+        if along > half {
+            return Err(format!(
+                "the interface nodes no longer match: the slave node at ({}, {}) (current configuration) has slid {along:.3e} along the master surface from its master node at ({}, {}), more than half the master facet ({half:.3e}); node-to-node needs nodes that stay matched, use node_to_surface where they slide",
+                p[0], p[1], x[0], x[1]
+            ));
+        }
+        if let Some(other) = used[k].replace(s) {
+            let q = sb.mesh.nodes[other];
+            return Err(format!(
+                "the interface nodes no longer match: the slave nodes at ({}, {}) and ({}, {}) (current configuration) both face the master node at ({}, {}); node-to-node needs nodes that stay matched, use node_to_surface where they slide",
+                q[0], q[1], p[0], p[1], x[0], x[1]
+            ));
+        }
+        let g0 = n[0] * d[0] + n[1] * d[1];
+        rows.node(slave, s, n, g0, Some((master, &[m], &[1.0])), 1);
+        // the slave node first, then the master node and its surface neighbours
+        let (mut dofs, mut positions, facets) = nodes_around(model, master, m, slave, &[s]);
+        dofs.rotate_right(2);
+        positions.rotate_right(1);
+        let lin = NodalNormalLinearization {
+            dofs,
+            positions,
+            normal_kind: master.kind,
+            normal_node: 1,
+            normal_facets: facets
+                .into_iter()
+                .map(|f| f.into_iter().map(|i| i + 1).collect())
+                .collect(),
+            target: NormalTarget::MasterNode { master: 1 },
+        };
+        attach_nodal_normal(rows, s, lin);
+    }
+    if let Some(k) = used.iter().position(|u| u.is_none()) {
+        let x = mb.mesh.nodes[master_nodes[k]];
+        return Err(format!(
+            "the interface nodes no longer match: the master node at ({}, {}) (current configuration) has no slave node; node-to-node needs nodes that stay matched",
+            x[0], x[1]
+        ));
+    }
+    Ok(())
+}
+
+/// The nodes of surface `master` and a search grid over their positions.
+fn node_grid(model: &Model, master: &Surface) -> (Vec<usize>, BucketGrid) {
+    let mb = &model.bodies[master.body];
+    let nodes: Vec<usize> = master.nodes.keys().copied().collect();
+    let grid = BucketGrid::new(
+        nodes
+            .iter()
+            .map(|&n| [mb.mesh.nodes[n], mb.mesh.nodes[n]])
+            .collect(),
+    );
+    (nodes, grid)
 }
 
 fn node_to_node(rows: &mut Rows, slave: &Surface, master: &Surface) -> Result<(), String> {
@@ -309,13 +444,7 @@ fn node_to_node(rows: &mut Rows, slave: &Surface, master: &Surface) -> Result<()
     let mb = &model.bodies[master.body];
     let sb = &model.bodies[slave.body];
     let tol = 1e-9 * mb.mesh.size();
-    let master_nodes: Vec<usize> = master.nodes.keys().copied().collect();
-    let grid = BucketGrid::new(
-        master_nodes
-            .iter()
-            .map(|&n| [mb.mesh.nodes[n], mb.mesh.nodes[n]])
-            .collect(),
-    );
+    let (master_nodes, grid) = node_grid(model, master);
     let mut used = vec![false; master_nodes.len()];
     for &s in slave.nodes.keys() {
         let p = sb.mesh.nodes[s];
@@ -347,6 +476,7 @@ fn node_to_surface(
     slave: &Surface,
     master: &Surface,
     normal: NormalChoice,
+    variation: SlaveNormalVariation,
     pass: u8,
 ) {
     let model = rows.model;
@@ -430,15 +560,36 @@ fn node_to_surface(
                 Some((master, &master.facets[f], &n[..k])),
                 pass,
             );
-            if linearize && normal == NormalChoice::Master {
-                attach_segment(
-                    rows,
-                    slave,
-                    s,
-                    master,
-                    &master.facets[f],
-                    MasterPoint::Facet { kind, xi },
-                );
+            if linearize {
+                match normal {
+                    NormalChoice::Master => attach_segment(
+                        rows,
+                        slave,
+                        s,
+                        master,
+                        &master.facets[f],
+                        MasterPoint::Facet { kind, xi },
+                    ),
+                    NormalChoice::Slave => {
+                        let (dofs, positions, normal_facets) =
+                            nodes_around(rows.model, slave, s, master, &master.facets[f]);
+                        let start = positions.len() - master.facets[f].len();
+                        let lin = NodalNormalLinearization {
+                            dofs,
+                            positions,
+                            normal_kind: slave.kind,
+                            normal_node: 0,
+                            normal_facets,
+                            target: NormalTarget::SlaveRay {
+                                master_kind: kind,
+                                start,
+                                xi,
+                                variation,
+                            },
+                        };
+                        attach_nodal_normal(rows, s, lin);
+                    }
+                }
             }
             continue;
         }
@@ -471,6 +622,82 @@ fn node_to_surface(
             }
         }
     }
+}
+
+/// The nodes of a nodal-normal row (finite kinematics): the row's own node `node` of surface
+/// `own` first, then the other nodes of `own`'s facets at `node` (whose normal the gap may
+/// take), then `others` of surface `other` (each node once); their global dofs and
+/// positions, and those facets as indices into the list.
+fn nodes_around(
+    model: &Model,
+    own: &Surface,
+    node: usize,
+    other: &Surface,
+    others: &[usize],
+) -> (Vec<usize>, Vec<[f64; 2]>, Vec<Vec<usize>>) {
+    let (ob, tb) = (&model.bodies[own.body], &model.bodies[other.body]);
+    let mut local = vec![node];
+    let mut facets = Vec::new();
+    for f in own.facets.iter().filter(|f| f.contains(&node)) {
+        let mut indices = Vec::with_capacity(f.len());
+        for &n in f {
+            let k = match local.iter().position(|&m| m == n) {
+                Some(k) => k,
+                None => {
+                    local.push(n);
+                    local.len() - 1
+                }
+            };
+            indices.push(k);
+        }
+        facets.push(indices);
+    }
+    let mut dofs: Vec<usize> = local
+        .iter()
+        .flat_map(|&n| [ob.dof(n, 0), ob.dof(n, 1)])
+        .collect();
+    let mut positions: Vec<[f64; 2]> = local.iter().map(|&n| ob.mesh.nodes[n]).collect();
+    for &m in others {
+        dofs.extend([tb.dof(m, 0), tb.dof(m, 1)]);
+        positions.push(tb.mesh.nodes[m]);
+    }
+    (dofs, positions, facets)
+}
+
+/// Replace the force direction and gap of the row just pushed for slave node `node` by those
+/// of its nodal-normal linearization (finite kinematics, [`nodal_normal`]) and attach it. Exact
+/// zeros of the direction (the smooth-sliding form on the neighbours) are dropped from the row.
+fn attach_nodal_normal(rows: &mut Rows, node: usize, lin: NodalNormalLinearization) {
+    let (g, direction) = lin.gap_and_direction();
+    let row = rows.out.last_mut().expect("the row was just pushed");
+    debug_assert_eq!(row.slave_node, node);
+    row.g0 = g;
+    row.normal = [direction[0], direction[1]];
+    row.dofs.clear();
+    row.coeffs.clear();
+    for (&d, &c) in lin.dofs.iter().zip(&direction) {
+        if c != 0.0 {
+            row.dofs.push(d);
+            row.coeffs.push(c);
+        }
+    }
+    row.owner = lin.dofs[usize::from(direction[1].abs() >= direction[0].abs())];
+    row.nodal_normal = Some(lin);
+}
+
+/// The second-order part of row `row`'s linearization in the current configuration (finite
+/// kinematics between deformable bodies), in the one form the Newton tangent consumes for every
+/// row type (see [`RowCurvature`]); `None` for rows that have none.
+pub fn row_curvature(row: &Constraint) -> Option<RowCurvature> {
+    if let Some(segment) = &row.segment {
+        let (_, hessian) = segment.gap_and_hessian();
+        return Some(RowCurvature {
+            dofs: segment.dofs.clone(),
+            direction_derivative: hessian,
+            gap_gradient: None,
+        });
+    }
+    row.nodal_normal.as_ref().map(|lin| lin.curvature())
 }
 
 /// Give the row just pushed for slave node `node` what its second derivative needs (finite
