@@ -372,15 +372,16 @@ fn combinations_not_built_are_refused_with_the_reason() {
         {"body": "base", "set": "bottom", "x": 0.0, "y": 0.0},
         {"body": "block", "set": "left", "x": 0.0}
     ]);
-    // between deformable bodies: node-to-surface with master normals is built
-    // (tests/finite_contact.rs); the other discretizations and ties are refused
+    // between deformable bodies: node-to-surface with master normals (tests/finite_contact.rs)
+    // and standard and dual mortar (tests/finite_mortar.rs) are built; the other
+    // discretizations and ties are refused
     let mut e = d.clone();
-    e["contact"][0]["discretization"] = json!({"kind": "mortar"});
-    expect(
-        &e,
-        "discretization",
-        "mortar contact between deformable bodies is not built yet",
-    );
+    for multiplier in ["standard", "dual"] {
+        e["contact"][0]["discretization"] = json!({"kind": "mortar", "multiplier": multiplier});
+        let case = contact_patch::model::parse(&e.to_string(), "mortar").unwrap();
+        contact_patch::model::Model::build(&case, "mortar")
+            .unwrap_or_else(|err| panic!("{multiplier} mortar is admitted: {err}"));
+    }
     e["contact"][0]["discretization"] = json!({"kind": "node_to_node"});
     expect(
         &e,

@@ -86,6 +86,18 @@ pub struct Constraint {
     /// row's nodes and positions for the second derivative of its gap
     /// ([`discretization::node_to_segment`]); `None` elsewhere (small strain builds none).
     pub segment: Option<discretization::node_to_segment::SegmentLinearization>,
+    /// Finite kinematics, mortar between deformable bodies: the second derivative of the row's
+    /// gap, computed with the row (`contact::discretization::mortar_linearization`); `None`
+    /// elsewhere (small strain builds none).
+    pub hessian: Option<GapHessian>,
+}
+
+/// The second derivative of a row's gap over the dofs it depends on, evaluated where the row
+/// was built: `values[a * dofs.len() + b] = d2 g / du_{dofs[a]} du_{dofs[b]}` (symmetric).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GapHessian {
+    pub dofs: Vec<usize>,
+    pub values: Vec<f64>,
 }
 
 /// The tangential slip of a contact point, `g_t(u) = sum_k c_ik u_{d_ik}` (zero at `u = 0`):
@@ -148,6 +160,13 @@ impl Constraint {
         }
         if let Some(s) = &self.segment {
             for &x in &s.dofs {
+                if !d.contains(&x) {
+                    d.push(x);
+                }
+            }
+        }
+        if let Some(h) = &self.hessian {
+            for &x in &h.dofs {
                 if !d.contains(&x) {
                     d.push(x);
                 }

@@ -615,7 +615,8 @@ impl Model {
             }
             if let MasterSide::Body { .. } = pair.master {
                 // between deformable bodies: node-to-surface with master normals, whose gap
-                // has its full second derivative (contact::discretization::node_to_segment)
+                // has its full second derivative (contact::discretization::node_to_segment),
+                // and mortar
                 let refused = match pair.discretization {
                     _ if pair.interaction == Interaction::Tied => Some((
                         format!("{at}.interaction"),
@@ -639,11 +640,9 @@ impl Model {
                         "finite kinematics with node-to-node contact between deformable bodies is not built yet (the nodal normal's variation is not linearized)",
                         "use node-to-surface with master normals, or small-strain kinematics",
                     )),
-                    DiscretizationSpec::Mortar { .. } => Some((
-                        format!("{at}.discretization"),
-                        "finite kinematics with mortar contact between deformable bodies is not built yet (the variation of the segments, normals and projections is not linearized)",
-                        "use node-to-surface with master normals, or small-strain kinematics",
-                    )),
+                    // standard and dual mortar: the gap's exact gradient and second
+                    // derivative (contact::discretization::mortar_linearization)
+                    DiscretizationSpec::Mortar { .. } => None,
                 };
                 if let Some((location, problem, hint)) = refused {
                     return invalid(location, problem.into(), hint);

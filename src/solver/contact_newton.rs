@@ -126,7 +126,7 @@ use crate::contact::friction::{
     Status,
 };
 use crate::contact::state::{ContactState, Departure, Termination};
-use crate::contact::Constraint;
+use crate::contact::{Constraint, GapHessian};
 use crate::error::Result;
 use crate::io::scene::{
     ContactGeometry, FrictionTangent, Interaction, Kinematics, MultiplierUpdate,
@@ -1231,6 +1231,12 @@ impl System for ContactSystem<'_> {
                     }
                 }
             }
+            if let (true, Some(hessian)) = (geometric, &r.hessian) {
+                // finite kinematics, mortar between deformable bodies: -force H_j of the
+                // weighted gap (segments, projections and nodal normal varied)
+                second_derivatives = true;
+                add_gap_hessian(&mut upper, &self.pattern, &self.sys, hessian, force);
+            }
         }
         tangent.values = general.symmetric_values(&upper);
         // the symmetrized tangent drops the slip coupling (its symmetric part would make the
@@ -1377,6 +1383,29 @@ impl System for ContactSystem<'_> {
         self.augmentation.extend(updates);
         self.tangential_augmentation.extend(tangential_updates);
         moved
+    }
+}
+
+/// Add `-force H` of a row's gap Hessian ([`GapHessian`], computed with the row) to the upper
+/// triangle `upper` of the tangent over `pattern` (dofs without an equation skipped).
+fn add_gap_hessian(
+    upper: &mut [f64],
+    pattern: &SymmetricPattern,
+    sys: &LinearSystem,
+    hessian: &GapHessian,
+    force: f64,
+) {
+    let m = hessian.dofs.len();
+    let eqs: Vec<usize> = hessian.dofs.iter().map(|&d| sys.eq(d)).collect();
+    for a in 0..m {
+        for c in a..m {
+            let (ea, ec) = (eqs[a], eqs[c]);
+            if ea != NO_EQUATION && ec != NO_EQUATION {
+                upper[pattern
+                    .position(ea.min(ec), ea.max(ec))
+                    .expect("the row's dofs are covered")] -= force * hessian.values[a * m + c];
+            }
+        }
     }
 }
 

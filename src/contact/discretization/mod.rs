@@ -37,6 +37,7 @@
 
 pub(crate) mod geometry;
 pub(crate) mod mortar;
+pub(crate) mod mortar_linearization;
 pub mod node_to_segment;
 pub(crate) mod search;
 
@@ -301,6 +302,7 @@ pub(crate) fn weighted_row(
         mass: Vec::new(),
         tangent: None,
         segment: None,
+        hessian: None,
     }
 }
 
