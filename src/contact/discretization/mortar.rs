@@ -64,12 +64,16 @@ pub fn multiplier(kind: EdgeKind, space: MultiplierSpace, s: f64) -> [f64; 3] {
     }
 }
 
+/// A break point on a slave facet: its parameter `s`, and the master node (id, position) whose
+/// projection it is (`None` at a facet end).
+pub(crate) type BreakPoint = (f64, Option<(usize, [f64; 2])>);
+
 /// A piece of a slave facet between two break points, integrated against one master facet.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct SubSegment {
     /// The ends in the slave facet's parameter `s`: a facet end (`None`) or the projection of
     /// a master node (its id and position).
-    pub ends: [(f64, Option<(usize, [f64; 2])>); 2],
+    pub ends: [BreakPoint; 2],
     /// The master facet over the piece (an index into the master surface's facets).
     pub master_facet: usize,
 }
@@ -103,7 +107,7 @@ pub(crate) fn mortar_integrals(
         let reach = 0.5 * ((hi[0] - lo[0]).hypot(hi[1] - lo[1])) + radius;
         let candidates = grid.query(centre, reach);
         // break points: facet ends and the projections of master facet end nodes
-        let mut breaks = vec![(-1.0, None), (1.0, None)];
+        let mut breaks: Vec<BreakPoint> = vec![(-1.0, None), (1.0, None)];
         for &c in &candidates {
             for (&p, &node) in master.coords[c][..2].iter().zip(&master.facets[c][..2]) {
                 let s = closest_point(ks, coords, p);

@@ -314,7 +314,7 @@ mod tests {
         fn facets(&self, points: usize, reverse: bool) -> Vec<Vec<usize>> {
             let vertices = match self.kind {
                 EdgeKind::Line2 => points,
-                EdgeKind::Line3 => (points + 1) / 2,
+                EdgeKind::Line3 => points.div_ceil(2),
             };
             (0..vertices - 1)
                 .map(|f| {
