@@ -550,7 +550,8 @@ impl Model {
 
     /// What finite kinematics solves so far, refused otherwise with the reason: hyperelastic
     /// materials exactly when `physics.kinematics` is `"finite"`, plane strain, static, and
-    /// frictionless contact against rigid masters in the current geometry (Newton scheme).
+    /// frictionless contact in the current geometry (Newton scheme) against rigid masters or,
+    /// between deformable bodies, node-to-surface with master normals and mortar.
     fn check_kinematics(&self, case: &Case) -> Result<()> {
         let invalid = |location: String, problem: String, hint: &str| {
             Err(Error::invalid(&self.source, location, problem, hint))

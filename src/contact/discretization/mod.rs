@@ -510,8 +510,9 @@ fn attach_segment(
 /// `g = |x_s - c| - R` gives `d2g/dx_s2 = (I - n n^T) / |x_s - c|` at the slave position `x_s`
 /// (in the configuration the row is linearized in), for node-to-surface rows. Rigid lines and
 /// ties are affine (`None`); mortar rows against a rigid circle do not provide theirs (`None`);
-/// node-to-surface and mortar rows against deformable masters do not provide theirs yet (their
-/// geometry is then updated by a fixed point, see [`crate::solver::active_set`]).
+/// small-strain node-to-surface and mortar rows against deformable masters do not provide theirs
+/// (their geometry is then updated by a fixed point, see [`crate::solver::active_set`]); under
+/// finite kinematics those rows carry theirs (`Constraint::segment`, `Constraint::hessian`).
 pub fn gap_second_derivative(model: &Model, row: &Constraint, x_s: [f64; 2]) -> Option<[f64; 4]> {
     let pair = &model.contact[row.pair];
     let MasterSide::Rigid(RigidSurface::Circle { centre, .. }) = pair.master else {

@@ -36,6 +36,12 @@
 //!   dual rows carry none. (The Galerkin pairing `int psi_j psi_k` of two dual functions is not
 //!   diagonal, e.g. `h [[1, -1/2], [-1/2, 1]]` on one Line2 facet; we pair the dual multiplier
 //!   with the trace space, the choice that keeps dual mortar local.)
+//! * **Finite kinematics** (between deformable bodies, frictionless): the same integrals in the
+//!   current configuration, and each row's gradient replaced by the exact one of its weighted
+//!   gap, with the gap's second derivative attached ([`crate::contact::GapHessian`]): the
+//!   segment ends, the projections of the Gauss points and the nodal normal all move with the
+//!   nodes (`mortar_linearization`). The pieces found by [`mortar_integrals`] fix which master
+//!   facet covers which piece.
 
 use super::geometry::{closest_point, edge_shape, facet_point, Surface};
 use super::mortar_linearization::linearize_row;
