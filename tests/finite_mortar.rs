@@ -222,7 +222,8 @@ fn deformed(o: &Outcome) -> contact_patch::model::Model {
 /// is negative (below 1e-10 of the size) and every row carrying force has zero weighted gap;
 /// the contact force balances the top's reaction. The penalty (`kappa = 1e4`) converges too,
 /// its rate judged the same way (at `kappa = 1e5` a Q9 step cycled between open and closed
-/// points and its cuts were spent).
+/// points and its cuts were spent); the augmented Lagrangian (Uzawa update per iteration)
+/// converges, its rate printed.
 #[test]
 fn a_block_slid_over_a_deformable_base_with_mortar_converges_quadratically() {
     for element in ["Q4", "Q9"] {
@@ -230,13 +231,20 @@ fn a_block_slid_over_a_deformable_base_with_mortar_converges_quadratically() {
             for enforcement in [
                 json!({"kind": "lagrange"}),
                 json!({"kind": "penalty", "kappa": 1e4}),
+                json!({"kind": "augmented_lagrange", "kappa": 1e4, "update": "per_iteration"}),
             ] {
                 let kind = enforcement["kind"].as_str().unwrap();
                 let case = two_blocks(element, multiplier, enforcement.clone(), 0.9, -0.1, 6);
                 let (_dir, path) = write(&case);
                 let o = run_case(&path, &mut |_| {}).unwrap();
                 assert!(o.passed(), "{element} {multiplier} {kind}: {:?}", o.checks);
-                let (seen, largest) = quadratic_ratios(&o);
+                // the augmented Lagrangian's Uzawa update after every iteration moves the
+                // residual itself: its rate is printed, not judged
+                let (seen, largest) = if kind == "augmented_lagrange" {
+                    (0, f64::NAN)
+                } else {
+                    quadratic_ratios(&o)
+                };
                 let history = o.solution.finite.as_ref().unwrap();
                 println!(
                     "{element} {multiplier} {kind}: {} attempts, {} cuts, largest r_k+1 / r_k^2 {largest:.2e} over {seen} pairs, residuals {:?}",
@@ -244,7 +252,7 @@ fn a_block_slid_over_a_deformable_base_with_mortar_converges_quadratically() {
                     history.cuts,
                     history.history.iter().map(|h| format!("{}:{:.1e}", h.step, h.residual)).collect::<Vec<_>>()
                 );
-                {
+                if kind != "augmented_lagrange" {
                     assert!(
                         seen >= 6,
                         "{element} {multiplier}: too few iterations to judge"
