@@ -373,15 +373,16 @@ fn combinations_not_built_are_refused_with_the_reason() {
         {"body": "block", "set": "left", "x": 0.0}
     ]);
     // between deformable bodies: node-to-surface with master normals (tests/finite_contact.rs)
-    // and with slave normals, and node-to-node where the nodes match
-    // (tests/finite_slave_normals.rs) are built; mortar and ties are refused
+    // and with slave normals, node-to-node where the nodes match
+    // (tests/finite_slave_normals.rs), and standard and dual mortar (tests/finite_mortar.rs)
+    // are built; ties are refused
     let mut e = d.clone();
-    e["contact"][0]["discretization"] = json!({"kind": "mortar"});
-    expect(
-        &e,
-        "discretization",
-        "mortar contact between deformable bodies is not built yet",
-    );
+    for multiplier in ["standard", "dual"] {
+        e["contact"][0]["discretization"] = json!({"kind": "mortar", "multiplier": multiplier});
+        let case = contact_patch::model::parse(&e.to_string(), "mortar").unwrap();
+        contact_patch::model::Model::build(&case, "mortar")
+            .unwrap_or_else(|err| panic!("{multiplier} mortar is admitted: {err}"));
+    }
     // node-to-node on this non-matching interface: refused with the reason before any solve
     e["contact"][0]["discretization"] = json!({"kind": "node_to_node"});
     expect(&e, "contact 'ground'", "the interface nodes do not match");

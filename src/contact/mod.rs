@@ -90,6 +90,18 @@ pub struct Constraint {
     /// deformable bodies: the row's nodes (the normal's surface neighbours included) for the
     /// variation of its nodal normal ([`discretization::nodal_normal`]); `None` elsewhere.
     pub nodal_normal: Option<discretization::nodal_normal::NodalNormalLinearization>,
+    /// Finite kinematics, mortar between deformable bodies: the second derivative of the row's
+    /// gap, computed with the row (`contact::discretization::mortar_linearization`); `None`
+    /// elsewhere (small strain builds none).
+    pub hessian: Option<GapHessian>,
+}
+
+/// The second derivative of a row's gap over the dofs it depends on, evaluated where the row
+/// was built: `values[a * dofs.len() + b] = d2 g / du_{dofs[a]} du_{dofs[b]}` (symmetric).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GapHessian {
+    pub dofs: Vec<usize>,
+    pub values: Vec<f64>,
 }
 
 /// The tangential slip of a contact point, `g_t(u) = sum_k c_ik u_{d_ik}` (zero at `u = 0`):
@@ -155,7 +167,8 @@ impl Constraint {
             .as_ref()
             .map(|s| &s.dofs)
             .into_iter()
-            .chain(self.nodal_normal.as_ref().map(|n| &n.dofs));
+            .chain(self.nodal_normal.as_ref().map(|n| &n.dofs))
+            .chain(self.hessian.as_ref().map(|h| &h.dofs));
         for dofs in curvature_dofs {
             for &x in dofs {
                 if !d.contains(&x) {

@@ -550,7 +550,8 @@ impl Model {
 
     /// What finite kinematics solves so far, refused otherwise with the reason: hyperelastic
     /// materials exactly when `physics.kinematics` is `"finite"`, plane strain, static, and
-    /// frictionless contact against rigid masters in the current geometry (Newton scheme).
+    /// frictionless contact in the current geometry (Newton scheme) against rigid masters or,
+    /// between deformable bodies, node-to-surface with master normals and mortar.
     fn check_kinematics(&self, case: &Case) -> Result<()> {
         let invalid = |location: String, problem: String, hint: &str| {
             Err(Error::invalid(&self.source, location, problem, hint))
@@ -616,7 +617,8 @@ impl Model {
             }
             if let MasterSide::Body { .. } = pair.master {
                 // between deformable bodies: node-to-surface with master normals, whose gap
-                // has its full second derivative (contact::discretization::node_to_segment)
+                // has its full second derivative (contact::discretization::node_to_segment),
+                // and mortar
                 let refused = match pair.discretization {
                     _ if pair.interaction == Interaction::Tied => Some((
                         format!("{at}.interaction"),
@@ -624,15 +626,11 @@ impl Model {
                         "use a frictionless pair, or small-strain kinematics",
                     )),
                     // node-to-surface with either normal (nodal_normal.rs for slave normals),
-                    // node-to-node where the nodes stay matched
-                    DiscretizationSpec::NodeToSurface { .. } | DiscretizationSpec::NodeToNode => {
-                        None
-                    }
-                    DiscretizationSpec::Mortar { .. } => Some((
-                        format!("{at}.discretization"),
-                        "finite kinematics with mortar contact between deformable bodies is not built yet (the variation of the segments, normals and projections is not linearized)",
-                        "use node-to-surface with master normals, or small-strain kinematics",
-                    )),
+                    // node-to-node where the nodes stay matched, standard and dual mortar (the
+                    // gap's exact gradient and second derivative, mortar_linearization.rs)
+                    DiscretizationSpec::NodeToSurface { .. }
+                    | DiscretizationSpec::NodeToNode
+                    | DiscretizationSpec::Mortar { .. } => None,
                 };
                 if let Some((location, problem, hint)) = refused {
                     return invalid(location, problem.into(), hint);

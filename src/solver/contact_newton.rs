@@ -23,7 +23,9 @@
 //! the slave node and the master facet's nodes
 //! ([`crate::contact::discretization::node_to_segment`]: the `delta xi` and normal-rotation
 //! terms), and the tangent gains `-force H` (`force = lambda - rho g` for a multiplier row, the
-//! derivative of its force term). Small-strain rows whose gradient lacks its own variation
+//! derivative of its force term). Mortar rows between deformable bodies carry theirs computed
+//! with the row ([`crate::contact::GapHessian`], consumed as a `RowCurvature`: the segments, projections
+//! and nodal normal varied). Small-strain rows whose gradient lacks its own variation
 //! (node-to-surface and mortar against deformable masters in the current geometry) give a
 //! tangent that is not exact, and Newton converges linearly on them; the history shows it.
 //!

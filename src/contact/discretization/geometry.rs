@@ -113,6 +113,26 @@ impl Surface {
     /// The surface of facet set `facets` of `body` (index `body_index`), thickness `t`.
     pub fn new(body_index: usize, body: &Body, facets: &[Facet], thickness: f64) -> Surface {
         let kind = body.mesh.kind.edge_kind();
+        let (nodes, coords) = facets
+            .iter()
+            .map(|&f| {
+                let nodes = body.mesh.facet_nodes(f);
+                let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| body.mesh.nodes[n]).collect();
+                (nodes, coords)
+            })
+            .unzip();
+        Surface::from_facets(body_index, kind, nodes, coords, thickness)
+    }
+
+    /// The surface of facets given by their node ids and positions (edge order), with the
+    /// nodal weights and normals computed from them.
+    pub fn from_facets(
+        body_index: usize,
+        kind: EdgeKind,
+        facet_nodes: Vec<Vec<usize>>,
+        facet_coords: Vec<Vec<[f64; 2]>>,
+        thickness: f64,
+    ) -> Surface {
         let mut out = Surface {
             body: body_index,
             kind,
@@ -122,9 +142,7 @@ impl Surface {
         };
         let mut sums: BTreeMap<usize, (f64, [f64; 2])> = BTreeMap::new();
         let k = kind.node_count();
-        for &f in facets {
-            let nodes = body.mesh.facet_nodes(f);
-            let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| body.mesh.nodes[n]).collect();
+        for (nodes, coords) in facet_nodes.into_iter().zip(facet_coords) {
             for (s, w) in kind.load_rule() {
                 let (n, _) = edge_shape(kind, s);
                 let (_, t) = facet_point(kind, &coords, s);

@@ -37,6 +37,7 @@
 
 pub(crate) mod geometry;
 pub(crate) mod mortar;
+pub(crate) mod mortar_linearization;
 pub mod nodal_normal;
 pub mod node_to_segment;
 pub(crate) mod search;
@@ -315,6 +316,7 @@ pub(crate) fn weighted_row(
         tangent: None,
         segment: None,
         nodal_normal: None,
+        hessian: None,
     }
 }
 
@@ -697,6 +699,14 @@ pub fn row_curvature(row: &Constraint) -> Option<RowCurvature> {
             gap_gradient: None,
         });
     }
+    if let Some(hessian) = &row.hessian {
+        // mortar: the weighted gap's second derivative, computed with the row
+        return Some(RowCurvature {
+            dofs: hessian.dofs.clone(),
+            direction_derivative: hessian.values.clone(),
+            gap_gradient: None,
+        });
+    }
     row.nodal_normal.as_ref().map(|lin| lin.curvature())
 }
 
@@ -735,8 +745,9 @@ fn attach_segment(
 /// `g = |x_s - c| - R` gives `d2g/dx_s2 = (I - n n^T) / |x_s - c|` at the slave position `x_s`
 /// (in the configuration the row is linearized in), for node-to-surface rows. Rigid lines and
 /// ties are affine (`None`); mortar rows against a rigid circle do not provide theirs (`None`);
-/// node-to-surface and mortar rows against deformable masters do not provide theirs yet (their
-/// geometry is then updated by a fixed point, see [`crate::solver::active_set`]).
+/// small-strain node-to-surface and mortar rows against deformable masters do not provide theirs
+/// (their geometry is then updated by a fixed point, see [`crate::solver::active_set`]); under
+/// finite kinematics those rows carry theirs (`Constraint::segment`, `Constraint::hessian`).
 pub fn gap_second_derivative(model: &Model, row: &Constraint, x_s: [f64; 2]) -> Option<[f64; 4]> {
     let pair = &model.contact[row.pair];
     let MasterSide::Rigid(RigidSurface::Circle { centre, .. }) = pair.master else {

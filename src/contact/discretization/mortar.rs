@@ -36,12 +36,20 @@
 //!   dual rows carry none. (The Galerkin pairing `int psi_j psi_k` of two dual functions is not
 //!   diagonal, e.g. `h [[1, -1/2], [-1/2, 1]]` on one Line2 facet; we pair the dual multiplier
 //!   with the trace space, the choice that keeps dual mortar local.)
+//! * **Finite kinematics** (between deformable bodies, frictionless): the same integrals in the
+//!   current configuration, and each row's gradient replaced by the exact one of its weighted
+//!   gap, with the gap's second derivative attached ([`crate::contact::GapHessian`]): the
+//!   segment ends, the projections of the Gauss points and the nodal normal all move with the
+//!   nodes (`mortar_linearization`). The pieces found by [`mortar_integrals`] fix which master
+//!   facet covers which piece.
 
 use super::geometry::{closest_point, edge_shape, facet_point, Surface};
+use super::mortar_linearization::linearize_row;
 use super::search::BucketGrid;
 use super::Rows;
+use crate::contact::GapHessian;
 use crate::fe::{gauss_legendre, EdgeKind};
-use crate::io::scene::{MultiplierSpace, RigidSurface};
+use crate::io::scene::{Kinematics, MultiplierSpace, RigidSurface};
 use std::collections::BTreeMap;
 
 /// Multiplier function values at `s` on a slave facet.
@@ -62,49 +70,62 @@ pub fn multiplier(kind: EdgeKind, space: MultiplierSpace, s: f64) -> [f64; 3] {
     }
 }
 
-/// Mortar rows of `slave` against `master`.
-pub(crate) fn mortar_rows(
-    rows: &mut Rows,
+/// A break point on a slave facet: its parameter `s`, and the master node (id, position) whose
+/// projection it is (`None` at a facet end).
+pub(crate) type BreakPoint = (f64, Option<(usize, [f64; 2])>);
+
+/// A piece of a slave facet between two break points, integrated against one master facet.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct SubSegment {
+    /// The ends in the slave facet's parameter `s`: a facet end (`None`) or the projection of
+    /// a master node (its id and position).
+    pub ends: [BreakPoint; 2],
+    /// The master facet over the piece (an index into the master surface's facets).
+    pub master_facet: usize,
+}
+
+/// `D_jk` and `M_jl` by slave node `j` (over slave nodes `k`, master nodes `l`).
+pub(crate) type MortarMatrix = BTreeMap<usize, BTreeMap<usize, f64>>;
+
+/// The segment-based mortar integrals of `slave` against `master` (see the module notes):
+/// `D`, `M`, and each slave facet's pieces.
+pub(crate) fn mortar_integrals(
     slave: &Surface,
     master: &Surface,
     space: MultiplierSpace,
-) -> Result<(), String> {
-    let model = rows.model;
-    let sb = &model.bodies[slave.body];
-    let mb = &model.bodies[master.body];
+    radius: f64,
+    thickness: f64,
+) -> (MortarMatrix, MortarMatrix, Vec<Vec<SubSegment>>) {
     let (ks, km) = (slave.kind, master.kind);
     let (ns, nm) = (ks.node_count(), km.node_count());
     let grid = BucketGrid::new(master.boxes());
-    let radius = rows.search_distance.unwrap_or_else(|| master.facet_size());
-    let gauss = gauss_legendre(if ks == EdgeKind::Line3 || km == EdgeKind::Line3 {
-        4
-    } else {
-        3
-    });
+    let gauss = gauss_rule(ks, km);
     let tol = 1e-12;
     // D[j][k] over slave nodes, M[j][l] over master nodes
-    let mut d: BTreeMap<usize, BTreeMap<usize, f64>> = BTreeMap::new();
-    let mut m: BTreeMap<usize, BTreeMap<usize, f64>> = BTreeMap::new();
+    let mut d: MortarMatrix = BTreeMap::new();
+    let mut m: MortarMatrix = BTreeMap::new();
+    let mut pieces = Vec::with_capacity(slave.coords.len());
     let slave_boxes = slave.boxes();
     for (f, coords) in slave.coords.iter().enumerate() {
+        let mut facet_pieces = Vec::new();
         let [lo, hi] = slave_boxes[f];
         let centre = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
         let reach = 0.5 * ((hi[0] - lo[0]).hypot(hi[1] - lo[1])) + radius;
         let candidates = grid.query(centre, reach);
         // break points: facet ends and the projections of master facet end nodes
-        let mut breaks = vec![-1.0, 1.0];
+        let mut breaks: Vec<BreakPoint> = vec![(-1.0, None), (1.0, None)];
         for &c in &candidates {
-            for &p in &master.coords[c][..2] {
+            for (&p, &node) in master.coords[c][..2].iter().zip(&master.facets[c][..2]) {
                 let s = closest_point(ks, coords, p);
                 if s.abs() < 1.0 - tol {
-                    breaks.push(s);
+                    breaks.push((s, Some((node, p))));
                 }
             }
         }
-        breaks.sort_by(f64::total_cmp);
-        breaks.dedup_by(|a, b| (*a - *b).abs() < tol);
+        breaks.sort_by(|a, b| a.0.total_cmp(&b.0));
+        breaks.dedup_by(|a, b| (a.0 - b.0).abs() < tol);
         for w in breaks.windows(2) {
-            let (a, b) = (w[0], w[1]);
+            let (a, b) = (w[0].0, w[1].0);
             let (xm, _) = facet_point(ks, coords, 0.5 * (a + b));
             // the master facet over this sub-segment: the nearest one whose projection is inside
             let mut best: Option<(f64, usize)> = None;
@@ -120,10 +141,14 @@ pub(crate) fn mortar_rows(
                 }
             }
             let Some((_, c)) = best else { continue };
+            facet_pieces.push(SubSegment {
+                ends: [w[0], w[1]],
+                master_facet: c,
+            });
             for &(eta, wq) in &gauss {
                 let s = a + 0.5 * (b - a) * (eta + 1.0);
                 let (x, t) = facet_point(ks, coords, s);
-                let jac = t[0].hypot(t[1]) * 0.5 * (b - a) * model.thickness;
+                let jac = t[0].hypot(t[1]) * 0.5 * (b - a) * thickness;
                 let xi = closest_point(km, &master.coords[c], x);
                 let (n_s, _) = edge_shape(ks, s);
                 let (n_m, _) = edge_shape(km, xi);
@@ -140,7 +165,35 @@ pub(crate) fn mortar_rows(
                 }
             }
         }
+        pieces.push(facet_pieces);
     }
+    (d, m, pieces)
+}
+
+/// Gauss points per sub-segment: 3 between Line2 facets, 4 where either is Line3.
+pub(crate) fn gauss_rule(slave: EdgeKind, master: EdgeKind) -> Vec<(f64, f64)> {
+    gauss_legendre(if slave == EdgeKind::Line3 || master == EdgeKind::Line3 {
+        4
+    } else {
+        3
+    })
+}
+
+/// Mortar rows of `slave` against `master`. Under finite kinematics (frictionless, not tied)
+/// each row's gradient is the exact one and the row carries its gap's second derivative
+/// ([`super::mortar_linearization`]).
+pub(crate) fn mortar_rows(
+    rows: &mut Rows,
+    slave: &Surface,
+    master: &Surface,
+    space: MultiplierSpace,
+) -> Result<(), String> {
+    let model = rows.model;
+    let sb = &model.bodies[slave.body];
+    let mb = &model.bodies[master.body];
+    let radius = rows.search_distance.unwrap_or_else(|| master.facet_size());
+    let (d, m, pieces) = mortar_integrals(slave, master, space, radius, model.thickness);
+    let linearize = model.physics.kinematics == Kinematics::Finite && !rows.tied;
     for (&j, dj) in &d {
         let area: f64 = dj.values().sum();
         if area <= 1e-12 * radius * model.thickness {
@@ -176,6 +229,24 @@ pub(crate) fn mortar_rows(
             area,
             1,
         );
+        if linearize {
+            let row = rows.out.last_mut().expect("the row was just pushed");
+            let dof = |master: bool, node: usize, i: usize| {
+                if master {
+                    mb.dof(node, i)
+                } else {
+                    sb.dof(node, i)
+                }
+            };
+            let lin = linearize_row(slave, master, &pieces, space, model.thickness, j, dof);
+            row.g0 = lin.gap;
+            row.dofs = lin.dofs.clone();
+            row.coeffs = lin.gradient;
+            row.hessian = Some(GapHessian {
+                dofs: lin.dofs,
+                values: lin.hessian,
+            });
+        }
         if space == MultiplierSpace::Standard {
             // the multiplier mass M_jk = int N_j N_k = D_jk (Phi = N), in area units
             let mass: Vec<(usize, f64)> = std::iter::once(j)
