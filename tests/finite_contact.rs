@@ -287,54 +287,59 @@ fn the_finite_patch_test_s_exact_state_is_uniaxial_stress() {
 /// The contact patch test at finite strain (`contact-patch finite-patch`,
 /// `src/harness/finite_patch.rs`), meshes A-E: both bodies compressed by 20 % with a
 /// frictionless flat interface, where the homogeneous deformation `F = diag(a, 0.8)` is exact.
-/// Every node-to-surface discretization (one pass with either body as slave, two passes) with
-/// Lagrange multipliers and the penalty (two passes: penalty only). Asserted, cell by cell:
+/// Every discretization built at finite strain (node-to-surface with master normals and with
+/// slave normals in both forms, one pass with either body as slave and two passes;
+/// node-to-node; standard and dual mortar) with Lagrange multipliers and the penalty (two
+/// passes: penalty only). Asserted, cell by cell:
 /// - no cell is exact where the small-strain test of the same cell fails;
-/// - for the penalty, wherever the small-strain test passes, the exact state is an
-///   equilibrium of the discrete system (residual below 1e-12 of the internal force), and a
-///   cell is exact exactly when its tangent there is positive definite (a cell that stops
-///   without converging has an unstable exact state);
-/// - for Lagrange multipliers the exact state is an equilibrium too; its stability (a penalty
-///   of 1e8 standing for the constraint) does not decide the verdict: measured, D converges to
-///   an exact state with one unstable direction, and A with the foundation as slave stops
-///   although its exact state is stable (reports/finite-patch-table.md);
-/// - the cells of mesh A and B with the punch as slave, A with two passes, and D with the
-///   punch as slave and Lagrange multipliers are exact (measured: 0 to 2.3e-12).
+/// - node-to-node applies where the interface nodes match (A, D) and is refused elsewhere;
+/// - wherever the small-strain test passes, the exact state is an equilibrium of the discrete
+///   system (penalty: residual below 1e-12 of the internal force; Lagrange, probed with a
+///   penalty of 1e8: below 1e-9, kappa times the round-off of the gaps);
+/// - every penalty cell of a variational form (all but the smooth-sliding slave normals, whose
+///   residual is not the gradient of an energy) that passes at small strain and not at finite
+///   strain has a direction of decreasing energy at or beside its exact state (measured: 13
+///   such cells; the converse does not hold: Newton follows the homogeneous path onto unstable
+///   exact states too, e.g. mortar on the Q9 meshes D and E);
+/// - mortar with Lagrange multipliers, standard and dual, is exact on every mesh; master and
+///   slave normals with the punch as slave are exact on A, B and D with Lagrange multipliers.
 ///
 /// The verdicts are the snapshot `finite_patch_verdicts` (a contract: a changed verdict is
-/// reviewed, not accepted blindly). The cells that stop (the foundation as slave, the penalty
-/// on the Q9 meshes D and E) are listed with their reasons in reports/finite-patch-table.md.
+/// reviewed, not accepted blindly); the numbers and the reasons of the cells that stop are in
+/// reports/finite-patch-table.md.
 #[test]
 fn the_finite_strain_patch_test_passes_where_the_small_strain_one_does() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let cells = finite_patch::run(root, &mut |_| {}).unwrap();
-    assert_eq!(cells.len(), 25);
     assert_eq!(cells.len(), finite_patch::cell_count());
+    assert_eq!(cells.len(), 105);
     for c in &cells {
         let name = format!("{} {} {}", c.mesh, c.discretization, c.enforcement);
+        if let Some(why) = &c.not_applicable {
+            assert!(
+                c.discretization == "node-to-node" && ["B", "C", "E"].contains(&c.mesh.as_str()),
+                "{name}: {why}"
+            );
+            assert!(why.contains("do not match"), "{name}: {why}");
+            continue;
+        }
         assert!(
             c.small_strain_pass || !c.finite_pass,
-            "{name}: exact at finite strain, failing at small strain ({:e})",
+            "{name}: exact at finite strain, failing at small strain ({:?})",
             c.small_strain_error
         );
         match (c.enforcement.as_str(), c.small_strain_pass, c.exact_state) {
             ("penalty", true, Some(s)) => {
                 assert!(s.residual < 1e-12, "{name}: residual {:e}", s.residual);
-                match &c.finite {
-                    finite_patch::FiniteOutcome::Converged { .. } => assert_eq!(
-                        c.finite_pass,
-                        s.unstable_directions == 0,
-                        "{name}: {} unstable directions",
-                        s.unstable_directions
-                    ),
-                    finite_patch::FiniteOutcome::Stopped { reason } => assert!(
-                        s.unstable_directions > 0,
-                        "{name}: stable exact state, yet {reason}"
-                    ),
+                let variational = !c.discretization.contains("smooth sliding");
+                if variational && !c.finite_pass {
+                    assert!(
+                        s.unstable_directions + s.unstable_directions_beside > 0,
+                        "{name}: stable at and beside the exact state, yet {:?}",
+                        c.finite
+                    );
                 }
             }
-            // a penalty of 1e8 (= 1e5 E) standing for the constraint: its residual at the
-            // exact state is kappa times the round-off of the gaps
             ("lagrange", true, Some(s)) => {
                 assert!(s.residual < 1e-9, "{name}: residual {:e}", s.residual)
             }
@@ -342,14 +347,7 @@ fn the_finite_strain_patch_test_passes_where_the_small_strain_one_does() {
             (_, pass, state) => panic!("{name}: small strain {pass}, exact state {state:?}"),
         }
     }
-    for (mesh, label, enforcement) in [
-        ("A", "node-to-surface 1p, punch slave", "lagrange"),
-        ("A", "node-to-surface 1p, punch slave", "penalty"),
-        ("B", "node-to-surface 1p, punch slave", "lagrange"),
-        ("B", "node-to-surface 1p, punch slave", "penalty"),
-        ("A", "node-to-surface 2p", "penalty"),
-        ("D", "node-to-surface 1p, punch slave", "lagrange"),
-    ] {
+    let exact = |mesh: &str, label: &str, enforcement: &str| {
         let c = cells
             .iter()
             .find(|c| c.mesh == mesh && c.discretization == label && c.enforcement == enforcement)
@@ -359,11 +357,34 @@ fn the_finite_strain_patch_test_passes_where_the_small_strain_one_does() {
             "{mesh} {label} {enforcement}: {:?}",
             c.finite
         );
+    };
+    for mesh in finite_patch::MESHES {
+        exact(mesh, "mortar standard", "lagrange");
+        exact(mesh, "mortar dual", "lagrange");
+    }
+    for mesh in ["A", "B", "D"] {
+        exact(mesh, "node-to-surface 1p, punch slave", "lagrange");
+        exact(mesh, "slave normals 1p, punch slave", "lagrange");
+        exact(
+            mesh,
+            "slave normals smooth sliding 1p, punch slave",
+            "lagrange",
+        );
+    }
+    for (mesh, label, enforcement) in [
+        ("A", "node-to-surface 1p, punch slave", "penalty"),
+        ("B", "node-to-surface 1p, punch slave", "penalty"),
+        ("A", "node-to-surface 2p", "penalty"),
+        ("A", "node-to-node", "lagrange"),
+        ("D", "node-to-node", "lagrange"),
+    ] {
+        exact(mesh, label, enforcement);
     }
     let verdicts: Vec<String> = cells
         .iter()
         .map(|c| {
             let finite = match (&c.finite, c.finite_pass) {
+                _ if c.not_applicable.is_some() => "does not apply",
                 (_, true) => "pass",
                 (finite_patch::FiniteOutcome::Converged { .. }, false) => "fail",
                 (finite_patch::FiniteOutcome::Stopped { .. }, _) => "stops",
@@ -373,7 +394,11 @@ fn the_finite_strain_patch_test_passes_where_the_small_strain_one_does() {
                 c.mesh,
                 c.discretization,
                 c.enforcement,
-                if c.small_strain_pass { "pass" } else { "fail" }
+                match (&c.not_applicable, c.small_strain_pass) {
+                    (Some(_), _) => "does not apply",
+                    (None, true) => "pass",
+                    (None, false) => "fail",
+                }
             )
         })
         .collect();

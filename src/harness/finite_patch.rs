@@ -74,25 +74,67 @@ pub struct PatchDiscretization {
     pub slave: &'static str,
 }
 
-/// The discretizations of the table. A discretization the model does not admit at finite
-/// strain is still listed: its cells carry the model's reason.
+/// The discretizations of the table: node-to-surface with master normals (`node_to_segment`),
+/// with slave normals in the consistent and the smooth-sliding form and node-to-node
+/// (`nodal_normal`), standard and dual mortar (`mortar_linearization`). A discretization that
+/// does not apply to a mesh (node-to-node on non-matching interfaces) is listed with the
+/// model's reason.
 pub fn discretizations() -> Vec<PatchDiscretization> {
+    let nts = |label, spec, slave| PatchDiscretization { label, spec, slave };
+    let slave_normals = |passes: u8, form: &str| json!({"kind": "node_to_surface", "passes": passes, "normal": "slave", "slave_normal_variation": form});
     vec![
-        PatchDiscretization {
-            label: "node-to-surface 1p, punch slave",
-            spec: json!({"kind": "node_to_surface", "passes": 1}),
-            slave: "punch",
-        },
-        PatchDiscretization {
-            label: "node-to-surface 1p, foundation slave",
-            spec: json!({"kind": "node_to_surface", "passes": 1}),
-            slave: "foundation",
-        },
-        PatchDiscretization {
-            label: "node-to-surface 2p",
-            spec: json!({"kind": "node_to_surface", "passes": 2}),
-            slave: "punch",
-        },
+        nts(
+            "node-to-surface 1p, punch slave",
+            json!({"kind": "node_to_surface", "passes": 1}),
+            "punch",
+        ),
+        nts(
+            "node-to-surface 1p, foundation slave",
+            json!({"kind": "node_to_surface", "passes": 1}),
+            "foundation",
+        ),
+        nts(
+            "node-to-surface 2p",
+            json!({"kind": "node_to_surface", "passes": 2}),
+            "punch",
+        ),
+        nts(
+            "slave normals 1p, punch slave",
+            slave_normals(1, "consistent"),
+            "punch",
+        ),
+        nts(
+            "slave normals 1p, foundation slave",
+            slave_normals(1, "consistent"),
+            "foundation",
+        ),
+        nts("slave normals 2p", slave_normals(2, "consistent"), "punch"),
+        nts(
+            "slave normals smooth sliding 1p, punch slave",
+            slave_normals(1, "smooth_sliding"),
+            "punch",
+        ),
+        nts(
+            "slave normals smooth sliding 1p, foundation slave",
+            slave_normals(1, "smooth_sliding"),
+            "foundation",
+        ),
+        nts(
+            "slave normals smooth sliding 2p",
+            slave_normals(2, "smooth_sliding"),
+            "punch",
+        ),
+        nts("node-to-node", json!({"kind": "node_to_node"}), "punch"),
+        nts(
+            "mortar standard",
+            json!({"kind": "mortar", "multiplier": "standard"}),
+            "punch",
+        ),
+        nts(
+            "mortar dual",
+            json!({"kind": "mortar", "multiplier": "dual"}),
+            "punch",
+        ),
     ]
 }
 
@@ -133,9 +175,12 @@ pub struct FinitePatchCell {
     pub discretization: String,
     pub slave: String,
     pub enforcement: String,
-    /// The small-strain stress error of the same cell (relative to the load).
-    pub small_strain_error: f64,
+    /// The small-strain stress error of the same cell (relative to the load); `None` where
+    /// the discretization does not apply to the mesh (see `not_applicable`).
+    pub small_strain_error: Option<f64>,
     pub small_strain_pass: bool,
+    /// Why the discretization does not apply to the mesh (the model's message), if it does not.
+    pub not_applicable: Option<String>,
     pub finite: FiniteOutcome,
     pub finite_pass: bool,
     /// Penalty cells whose small-strain test passes: the residual of the discrete system at
@@ -151,6 +196,25 @@ pub struct FinitePatchCell {
 pub struct ExactState {
     pub residual: f64,
     pub unstable_directions: usize,
+    /// The most negative pivots of the tangent with the punch moved `SIDEWAYS` to either side
+    /// of the exact state (not an equilibrium there): where the gap's second derivative jumps
+    /// at the exact state (a slave node on a master node), its inertia on either side.
+    pub unstable_directions_beside: usize,
+}
+
+/// How far the punch is moved sideways to probe the tangent beside the exact state.
+pub const SIDEWAYS: f64 = 1e-7;
+
+/// The exact state's residual and the inertia of the tangent at it and beside it.
+fn stability(model: &Model, a: f64, shift: f64) -> Result<ExactState> {
+    let (residual, unstable_directions) = inertia(model, a, shift, 0.0)?;
+    let left = inertia(model, a, shift, -SIDEWAYS)?.1;
+    let right = inertia(model, a, shift, SIDEWAYS)?.1;
+    Ok(ExactState {
+        residual,
+        unstable_directions,
+        unstable_directions_beside: left.max(right),
+    })
 }
 
 /// `a` with `sigma_xx = 0` for `F = diag(a, stretch)` of the neo-Hookean law with Lamé
@@ -198,7 +262,12 @@ fn catalogue_case(
         o.remove("sweep");
     }
     let pair = &mut v["contact"][0];
+    // the small-strain rows have one linearization: the choice of the finite-strain form of
+    // slave normals is refused there
     pair["discretization"] = discretization.spec.clone();
+    if let Some(d) = pair["discretization"].as_object_mut() {
+        d.remove("slave_normal_variation");
+    }
     pair["enforcement"] = enforcement.clone();
     if discretization.slave == "foundation" {
         let (s, m) = (pair["slave"].clone(), pair["master"].clone());
@@ -313,6 +382,7 @@ fn finite_case(
     };
     let mut v = small_case.clone();
     v["contact"][0]["enforcement"] = enforcement.clone();
+    v["contact"][0]["discretization"] = discretization.spec.clone();
     v["materials"]["m"]["model"] = json!("neo_hookean");
     v["physics"] = json!({"kinematics": "finite", "contact_geometry": "current"});
     v["solver"] = json!({"scheme": "newton", "load_steps": STEPS});
@@ -362,7 +432,28 @@ pub fn cell(
     enforcement: &Value,
 ) -> Result<FinitePatchCell> {
     let small_case = catalogue_case(root, mesh, discretization, enforcement)?;
-    let small_strain_error = small_strain_error(&small_case)?;
+    let small_strain_error = match small_strain_error(&small_case) {
+        Ok(error) => error,
+        // the discretization does not apply to this mesh (node-to-node on non-matching nodes)
+        Err(e @ Error::Invalid { .. }) => {
+            return Ok(FinitePatchCell {
+                mesh: mesh.into(),
+                discretization: discretization.label.into(),
+                slave: discretization.slave.into(),
+                enforcement: enforcement["kind"].as_str().unwrap_or("?").into(),
+                small_strain_error: None,
+                small_strain_pass: false,
+                not_applicable: Some(e.to_string()),
+                finite: FiniteOutcome::Stopped {
+                    reason: "the discretization does not apply".into(),
+                },
+                finite_pass: false,
+                exact_state: None,
+                seconds: 0.0,
+            })
+        }
+        Err(e) => return Err(e),
+    };
     let small_strain_pass = small_strain_error <= TOLERANCE;
     let FiniteCase {
         case,
@@ -377,12 +468,12 @@ pub fn cell(
     let exact_state = if !small_strain_pass {
         None
     } else if enforcement["kind"] == "penalty" {
-        Some(exact_state(&model, a, -penetration)?)
+        Some(stability(&model, a, -penetration)?)
     } else {
         let stiff = json!({"kind": "penalty", "kappa": STIFF_PENALTY});
         let probe = finite_case(&small_case, discretization, &stiff)?;
         let model = Model::build(&parse(&probe.case.to_string(), "patch")?, "patch")?;
-        Some(exact_state(&model, a, -probe.penetration)?)
+        Some(stability(&model, a, -probe.penetration)?)
     };
     let start = Instant::now();
     let solved = run_model(model, 0.0, start, &mut |_| {});
@@ -446,8 +537,9 @@ pub fn cell(
         discretization: discretization.label.into(),
         slave: discretization.slave.into(),
         enforcement: enforcement["kind"].as_str().unwrap_or("?").into(),
-        small_strain_error,
+        small_strain_error: Some(small_strain_error),
         small_strain_pass,
+        not_applicable: None,
         finite,
         finite_pass,
         exact_state,
@@ -456,15 +548,19 @@ pub fn cell(
 }
 
 /// The penalty system at the exact homogeneous state (`u = ((a - 1) X, -0.2 Y)`, the punch
-/// lowered by `shift`, its penetration): the largest residual relative to the largest
-/// internal force there, and the number of negative pivots of `L D L^T` (no pivoting) of its
-/// symmetric part.
-fn exact_state(model: &Model, a: f64, shift: f64) -> Result<ExactState> {
+/// lowered by `shift`, its penetration, and moved sideways by `slide`): the largest residual
+/// relative to the largest internal force there, and the number of negative pivots of
+/// `L D L^T` (no pivoting) of its symmetric part.
+fn inertia(model: &Model, a: f64, shift: f64, slide: f64) -> Result<(f64, usize)> {
     let mut u = vec![0.0; model.dof_count];
     for body in &model.bodies {
-        let lowered = if body.name == "punch" { shift } else { 0.0 };
+        let (lowered, slid) = if body.name == "punch" {
+            (shift, slide)
+        } else {
+            (0.0, 0.0)
+        };
         for (n, x) in body.mesh.nodes.iter().enumerate() {
-            u[body.dof(n, 0)] = (a - 1.0) * x[0];
+            u[body.dof(n, 0)] = (a - 1.0) * x[0] + slid;
             u[body.dof(n, 1)] = -COMPRESSION * x[1] + lowered;
         }
     }
@@ -502,14 +598,14 @@ fn exact_state(model: &Model, a: f64, shift: f64) -> Result<ExactState> {
             }
         }
     }
-    Ok(ExactState {
-        residual,
-        unstable_directions,
-    })
+    Ok((residual, unstable_directions))
 }
 
-/// A verdict letter: `p` pass, `f` fail, `nc` not converged.
+/// A verdict letter: `p` pass, `f` fail, `nc` not converged, `n/a` does not apply.
 fn letter(cell: &FinitePatchCell) -> &'static str {
+    if cell.not_applicable.is_some() {
+        return "n/a";
+    }
     match (&cell.finite, cell.finite_pass) {
         (_, true) => "p",
         (FiniteOutcome::Converged { .. }, false) => "f",
@@ -518,7 +614,9 @@ fn letter(cell: &FinitePatchCell) -> &'static str {
 }
 
 fn small_letter(cell: &FinitePatchCell) -> &'static str {
-    if cell.small_strain_pass {
+    if cell.not_applicable.is_some() {
+        "n/a"
+    } else if cell.small_strain_pass {
         "p"
     } else {
         "f"
@@ -578,15 +676,21 @@ pub fn report(cells: &[FinitePatchCell]) -> String {
             out.push('\n');
         }
     }
-    let passed = cells.iter().filter(|c| c.finite_pass).count();
-    let small = cells.iter().filter(|c| c.small_strain_pass).count();
-    let stopped = cells
+    let applies: Vec<&FinitePatchCell> = cells
+        .iter()
+        .filter(|c| c.not_applicable.is_none())
+        .collect();
+    let passed = applies.iter().filter(|c| c.finite_pass).count();
+    let small = applies.iter().filter(|c| c.small_strain_pass).count();
+    let stopped = applies
         .iter()
         .filter(|c| matches!(c.finite, FiniteOutcome::Stopped { .. }))
         .count();
     out.push_str(&format!(
-        "\n{passed} of {} cells pass at finite strain ({small} at small strain); {stopped} stop before 20 %.\n",
-        cells.len()
+        "\n{passed} of the {} cells that apply pass at finite strain ({small} at small strain); {stopped} stop \
+         before 20 %; {} do not apply (node-to-node where the interface nodes do not match).\n",
+        applies.len(),
+        cells.len() - applies.len()
     ));
     for (enforcement, title, what) in [
         (
@@ -610,14 +714,18 @@ pub fn report(cells: &[FinitePatchCell]) -> String {
         let count = |unstable: bool, pass: bool| {
             probed
                 .iter()
-                .filter(|(c, s)| (s.unstable_directions > 0) == unstable && c.finite_pass == pass)
+                .filter(|(c, s)| {
+                    (s.unstable_directions + s.unstable_directions_beside > 0) == unstable
+                        && c.finite_pass == pass
+                })
                 .count()
         };
         out.push_str(&format!(
             "\n**{title}** For each of the {} {enforcement} cells whose small-strain test passes, the exact state \
              is an equilibrium of the discrete system (largest residual {:.1e}, relative to the largest internal \
-             force), and the inertia of {what} there counts its directions of decreasing energy. Stable: {} pass, \
-             {} do not; unstable: {} pass, {} do not.\n",
+             force), and the inertia of {what} there, and with the punch moved 1e-7 to either side, counts its \
+             directions of decreasing energy. Stable at and beside the exact state: {} pass, {} do not; \
+             unstable at or beside it: {} pass, {} do not.\n",
             probed.len(),
             probed.iter().map(|(_, s)| s.residual).fold(0.0f64, f64::max),
             count(false, true),
@@ -627,7 +735,7 @@ pub fn report(cells: &[FinitePatchCell]) -> String {
         ));
     }
     out.push_str(
-        "\n## Every cell\n\n| mesh | discretization | enforcement | small strain | finite strain: stress | F | iterations per step | verdicts (small / finite) | unstable directions at the exact state | time ms | reason it stopped |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "\n## Every cell\n\n| mesh | discretization | enforcement | small strain | finite strain: stress | F | iterations per step | verdicts (small / finite) | unstable directions at / beside the exact state | time ms | reason it stopped |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for c in cells {
         let (stress, f, iterations, reason) = match &c.finite {
@@ -645,7 +753,13 @@ pub fn report(cells: &[FinitePatchCell]) -> String {
                 "-".into(),
                 "-".into(),
                 "-".into(),
-                reason.lines().next().unwrap_or("").replace('|', "/"),
+                c.not_applicable
+                    .as_deref()
+                    .unwrap_or(reason)
+                    .lines()
+                    .next()
+                    .unwrap_or("")
+                    .replace('|', "/"),
             ),
         };
         out.push_str(&format!(
@@ -653,11 +767,13 @@ pub fn report(cells: &[FinitePatchCell]) -> String {
             c.mesh,
             c.discretization,
             c.enforcement,
-            number(c.small_strain_error),
+            c.small_strain_error.map_or("-".into(), number),
             small_letter(c),
             letter(c),
-            c.exact_state
-                .map_or("-".into(), |s| s.unstable_directions.to_string()),
+            c.exact_state.map_or("-".into(), |s| format!(
+                "{} / {}",
+                s.unstable_directions, s.unstable_directions_beside
+            )),
             1e3 * c.seconds,
         ));
     }
