@@ -180,10 +180,10 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
-    /// Hertz at loads where geometric nonlinearity matters: a block on a rigid cylinder with
-    /// small-strain and finite-strain (neo-Hookean) kinematics over loads P = 0.5 to 64, and the
-    /// finite-strain result at P = 64 on four meshes; writes reports/hertz-finite.md, .json and
-    /// two SVG plots.
+    /// Hertz at loads where geometric nonlinearity matters: a block pressed onto a rigid
+    /// cylinder with small-strain and finite-strain (neo-Hookean) kinematics over approaches
+    /// 0.005 to 0.32 of its top, and the finite-strain result at the largest on four meshes;
+    /// writes reports/hertz-finite.md, .json and two SVG plots.
     #[command(
         name = "hertz-finite",
         after_help = "Example:\n  contact-patch hertz-finite\n  contact-patch hertz-finite --out /tmp/reports\n\nThe problem and the measures: src/harness/hertz_finite.rs."
