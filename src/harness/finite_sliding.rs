@@ -64,6 +64,7 @@ pub struct Entry {
 pub fn entries() -> Vec<Entry> {
     let lagrange = json!({"kind": "lagrange"});
     let penalty = json!({"kind": "penalty", "kappa": 1e5});
+    let soft = json!({"kind": "penalty", "kappa": 1e4});
     vec![
         Entry {
             label: "node-to-surface, master normals, 1 pass, Lagrange",
@@ -79,6 +80,16 @@ pub fn entries() -> Vec<Entry> {
             label: "node-to-surface, master normals, 2 passes, penalty 1e5",
             discretization: json!({"kind": "node_to_surface", "passes": 2}),
             enforcement: penalty.clone(),
+        },
+        Entry {
+            label: "node-to-surface, master normals, 1 pass, penalty 1e4",
+            discretization: json!({"kind": "node_to_surface", "passes": 1}),
+            enforcement: soft.clone(),
+        },
+        Entry {
+            label: "node-to-surface, master normals, 2 passes, penalty 1e4",
+            discretization: json!({"kind": "node_to_surface", "passes": 2}),
+            enforcement: soft,
         },
         Entry {
             label: "node-to-surface, master normals, 2 passes, Lagrange",
