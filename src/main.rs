@@ -181,13 +181,41 @@ enum Command {
         out: PathBuf,
     },
     /// The contact patch test at finite strain: meshes A-E of cases/patch with neo-Hookean
-    /// bodies compressed by 20 %, each node-to-surface cell against its small-strain verdict;
+    /// bodies compressed by 20 %, every discretization built at finite strain, each cell
+    /// against its small-strain verdict;
     /// writes reports/finite-patch-table.md and .json (run from the repository's root).
     #[command(
         name = "finite-patch",
         after_help = "Example:\n  contact-patch finite-patch\n  contact-patch finite-patch --out /tmp/reports"
     )]
     FinitePatch {
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
+    /// Hertz at loads where geometric nonlinearity matters: a block pressed onto a rigid
+    /// cylinder with small-strain and finite-strain (neo-Hookean) kinematics over approaches
+    /// 0.005 to 0.32 of its top, and the finite-strain result at the largest on four meshes;
+    /// writes reports/hertz-finite.md, .json and two SVG plots.
+    #[command(
+        name = "hertz-finite",
+        after_help = "Example:\n  contact-patch hertz-finite\n  contact-patch hertz-finite --out /tmp/reports\n\nThe problem and the measures: src/harness/hertz_finite.rs."
+    )]
+    HertzFinite {
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
+    /// Large sliding at finite strain: a neo-Hookean block pressed and slid by six facet
+    /// lengths over a non-matching neo-Hookean foundation, per contact discretization (those
+    /// finite strain refuses are listed with the reason); the oscillation of the contact forces
+    /// along the path and Newton's residual histories; writes reports/finite-sliding.md, .json
+    /// and two SVG plots.
+    #[command(
+        name = "finite-sliding",
+        after_help = "Example:\n  contact-patch finite-sliding\n  contact-patch finite-sliding --out /tmp/reports\n\nThe problem and the measures: src/harness/finite_sliding.rs."
+    )]
+    FiniteSliding {
         /// Output folder.
         #[arg(long, default_value = "reports")]
         out: PathBuf,
@@ -343,6 +371,8 @@ fn main() -> ExitCode {
         Command::ImpactReport { paths, out, study } => impact_report(&paths, &out, study),
         Command::FrictionConvergence { out } => friction_convergence(&out),
         Command::FinitePatch { out } => finite_patch(&out),
+        Command::HertzFinite { out } => hertz_finite(&out),
+        Command::FiniteSliding { out } => finite_sliding(&out),
         Command::Profile { case, pair, out } => profile(&case, &pair, &out),
         Command::Report { reports } => report_page(&reports),
         Command::Cattaneo { paths, pair, out } => cattaneo(&paths, &pair, &out),
@@ -1343,6 +1373,74 @@ fn friction_convergence(out: &Path) -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// Write `files` (name, text) into the report folder `out`, printing what was written; exit 2
+/// with the message on a bad folder or a failed study.
+fn write_study(
+    out: &Path,
+    files: impl FnOnce() -> contact_patch::Result<Vec<(String, String)>>,
+) -> ExitCode {
+    let folder = match ReportFolder::new(out) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let result = files().and_then(|files| {
+        for (name, text) in &files {
+            folder.write_file(name, text)?;
+        }
+        Ok(files)
+    });
+    match result {
+        Ok(files) => {
+            for (name, _) in &files {
+                println!("wrote {}", folder.shown(name).display());
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn hertz_finite(out: &Path) -> ExitCode {
+    use contact_patch::harness::hertz_finite;
+    write_study(out, || {
+        let study = hertz_finite::study()?;
+        let mut files = vec![
+            ("hertz-finite.md".to_string(), hertz_finite::report(&study)),
+            (
+                "hertz-finite.json".to_string(),
+                serde_json::to_string_pretty(&study).expect("the study serializes") + "\n",
+            ),
+        ];
+        files.extend(hertz_finite::plots(&study));
+        Ok(files)
+    })
+}
+
+fn finite_sliding(out: &Path) -> ExitCode {
+    use contact_patch::harness::finite_sliding;
+    write_study(out, || {
+        let runs = finite_sliding::study();
+        let mut files = vec![
+            (
+                "finite-sliding.md".to_string(),
+                finite_sliding::report(&runs),
+            ),
+            (
+                "finite-sliding.json".to_string(),
+                serde_json::to_string_pretty(&runs).expect("the runs serialize") + "\n",
+            ),
+        ];
+        files.extend(finite_sliding::plots(&runs));
+        Ok(files)
+    })
 }
 
 /// The cases of `contact-patch impact-report` when none are given.

@@ -78,6 +78,16 @@ pub const KNOWN_REPORTS: &[KnownReport] = &[
         command: "contact-patch profile cases/contact/hertz-profile.json --pair cylinder",
     },
     KnownReport {
+        stem: "hertz-finite",
+        title: "Hertz at finite strain: small against finite kinematics",
+        command: "contact-patch hertz-finite",
+    },
+    KnownReport {
+        stem: "finite-sliding",
+        title: "Large sliding at finite strain",
+        command: "contact-patch finite-sliding",
+    },
+    KnownReport {
         stem: "crosscheck",
         title: "Cross-check against DOLFINx and scikit-fem",
         command: "bash crosscheck/run.sh",

@@ -39,6 +39,18 @@ pub const MAX_STEP_CUTS: usize = 10;
 
 /// Solve `model` (finite kinematics) in load steps with automatic cuts.
 pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+    solve_observed(model, progress, &mut |_, _| {})
+}
+
+/// [`solve`], calling `on_step(load_factor, solution)` after every accepted load step with the
+/// state it converged to (displacements, reactions, the contact rows and forces of that step,
+/// and its Newton residual history in `contact.history`), for studies that follow a load path
+/// (`harness::finite_sliding`, `tests/finite_objectivity.rs`).
+pub fn solve_observed(
+    model: &Model,
+    progress: &mut dyn FnMut(&str),
+    on_step: &mut dyn FnMut(f64, &Solution),
+) -> Result<Solution> {
     let n = model.solver.load_steps;
     let nominal = 1.0;
     let (mut done, mut increment) = (0.0f64, nominal);
@@ -104,6 +116,8 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
             increment *= 0.5;
             continue;
         }
+        on_step(to, &solution);
+        let state = solution.contact.as_mut().expect("a Newton solve");
         records.push(StepRecord {
             step: records.len() + 1,
             load_factor: to,
