@@ -1,0 +1,94 @@
+//! Helpers shared by the finite-strain contact tests (tests/finite_contact.rs,
+//! tests/finite_mortar.rs, tests/finite_slave_normals.rs): the two-block scene they slide, a
+//! scratch folder for its case file, and the check of the gaps measured afresh after a slide.
+
+#![allow(dead_code)] // not every test binary that includes this module uses every helper
+
+use contact_patch::contact::Constraint;
+use contact_patch::run::Outcome;
+use serde_json::{json, Value};
+
+pub const E: f64 = 1000.0;
+pub const NU: f64 = 0.3;
+
+/// The Lamé constants `(lambda, mu)` of `E`, `NU` (plane strain).
+pub fn lame() -> (f64, f64) {
+    (
+        E * NU / ((1.0 + NU) * (1.0 - 2.0 * NU)),
+        E / (2.0 * (1.0 + NU)),
+    )
+}
+
+/// Write `case` as `case.json` in a fresh scratch folder (kept alive by the returned guard).
+pub fn write(case: &Value) -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.json");
+    std::fs::write(&path, serde_json::to_string_pretty(case).unwrap()).unwrap();
+    (dir, path)
+}
+
+/// The top block's nodes: non-matching (master facets 0.5 long, slave nodes 0.4 apart).
+pub const NON_MATCHING: [f64; 4] = [0.5, 0.9, 1.3, 1.7];
+/// The top block as wide as the base, its bottom nodes on the base's top nodes (node-to-node
+/// pairs every node of both surfaces).
+pub const MATCHING: [f64; 7] = [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0];
+
+/// A base block `[0, 3] x [0, 1]` and a top block over `top_x` x `[1, 1.8]` of `element`,
+/// neo-Hookean; the base's bottom clamped, the top block's top moved by `(slide, press)` in
+/// `steps` load steps; the top block's bottom (slave) against the base's top (master) with
+/// `discretization` and `enforcement`, in the current configuration, Newton.
+pub fn two_blocks(
+    element: &str,
+    top_x: &[f64],
+    discretization: Value,
+    enforcement: Value,
+    (slide, press): (f64, f64),
+    steps: usize,
+) -> Value {
+    json!({
+        "name": "two-blocks",
+        "description": "two neo-Hookean blocks in frictionless contact, finite kinematics",
+        "analysis": {"plane": "strain", "thickness": 1.0},
+        "materials": {"m": {"E": E, "nu": NU, "model": "neo_hookean"}},
+        "bodies": [
+            {"name": "base", "material": "m", "mesh": {"block": {
+                "element": element, "x": [0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0], "y": [0, 0.5, 1]}}},
+            {"name": "top", "material": "m", "mesh": {"block": {
+                "element": element, "x": top_x, "y": [1, 1.4, 1.8]}}}
+        ],
+        "physics": {"kinematics": "finite", "contact_geometry": "current"},
+        "solver": {"scheme": "newton", "load_steps": steps},
+        "supports": [
+            {"body": "base", "set": "bottom", "x": 0.0, "y": 0.0},
+            {"body": "top", "set": "top", "x": slide, "y": press}
+        ],
+        "loads": [],
+        "contact": [{
+            "name": "interface",
+            "slave": {"body": "top", "set": "bottom"},
+            "master": {"body": "base", "set": "top"},
+            "discretization": discretization,
+            "enforcement": enforcement
+        }],
+        "checks": [{"check": "force_balance", "tol": 1e-9}]
+    })
+}
+
+/// The rows `rows`, built afresh in the deformed configuration of the solved `o` (Lagrange
+/// multipliers): no gap below `-1e-10` of the model's size (no penetration), and every row
+/// whose slave node carries a force has a zero gap to `1e-10` of the size.
+pub fn assert_closed_where_pressed(o: &Outcome, rows: &[Constraint]) {
+    let state = o.solution.contact.as_ref().unwrap();
+    let size = o.model.size();
+    for r in rows {
+        assert!(r.g0 >= -1e-10 * size, "penetration {}", r.g0);
+        let k = state
+            .rows
+            .iter()
+            .position(|q| q.slave_node == r.slave_node)
+            .unwrap();
+        if state.forces[k] > 1e-12 {
+            assert!(r.g0.abs() <= 1e-10 * size, "gap {} under force", r.g0);
+        }
+    }
+}
