@@ -9,6 +9,7 @@
 //! rigid plane and a prescribed top with free sides (`sigma_xx = 0` solved for the lateral
 //! stretch by bisection), and the small-strain solution of the same scene at a small load.
 
+mod finite_common;
 use contact_patch::post::{cell_displacements, for_each_quadrature_stress};
 use contact_patch::run::{run_case, Outcome};
 use contact_patch::solid_finite::deformation_gradient_at;
@@ -544,27 +545,7 @@ fn the_newton_tangent_with_a_rigid_circle_is_the_difference_of_the_residual() {
         *v += 1e-3 * (0.7 * i as f64).sin() - 5e-3 * (i % 2) as f64;
     }
     let at = probe.evaluate(&x).unwrap();
-    let n = x.len();
-    let scale = at
-        .tangent
-        .iter()
-        .flatten()
-        .fold(0.0f64, |m, v| m.max(v.abs()));
-    let h = 1e-7;
-    let mut worst = 0.0f64;
-    for j in 0..n {
-        let (mut xp, mut xm) = (x.clone(), x.clone());
-        xp[j] += h;
-        xm[j] -= h;
-        let (rp, rm) = (
-            probe.evaluate(&xp).unwrap().residual,
-            probe.evaluate(&xm).unwrap().residual,
-        );
-        for i in 0..n {
-            let fd = (rp[i] - rm[i]) / (2.0 * h);
-            worst = worst.max((fd - at.tangent[i][j]).abs() / scale);
-        }
-    }
+    let (worst, scale) = finite_common::tangent_difference(&mut probe, &x, &at);
     println!("Newton tangent vs central difference: {worst:.1e} of {scale:.3e}");
     assert!(worst < 1e-6, "{worst:e}");
 }

@@ -80,26 +80,7 @@ fn the_newton_tangent_between_deformable_bodies_is_the_difference_of_the_residua
             let n = probe.evaluate(&x).unwrap().residual.len();
             assert_eq!(n, x.len());
             let at = probe.evaluate(&x).unwrap();
-            let scale = at
-                .tangent
-                .iter()
-                .flatten()
-                .fold(0.0f64, |m, v| m.max(v.abs()));
-            let h = 1e-7;
-            let mut worst = 0.0f64;
-            for j in 0..n {
-                let (mut xp, mut xm) = (x.clone(), x.clone());
-                xp[j] += h;
-                xm[j] -= h;
-                let (rp, rm) = (
-                    probe.evaluate(&xp).unwrap().residual,
-                    probe.evaluate(&xm).unwrap().residual,
-                );
-                for i in 0..n {
-                    let fd = (rp[i] - rm[i]) / (2.0 * h);
-                    worst = worst.max((fd - at.tangent[i][j]).abs() / scale);
-                }
-            }
+            let (worst, scale) = finite_common::tangent_difference(&mut probe, &x, &at);
             println!(
                 "{element} {}: {n} unknowns, tangent vs central difference {worst:.1e} of {scale:.3e}",
                 enforcement["kind"]

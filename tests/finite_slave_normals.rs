@@ -56,26 +56,7 @@ fn tangent_error(case: &Value, rigid: [f64; 2], wave_size: f64) -> (f64, f64, us
     let n = probe.evaluate(&x).unwrap().residual.len();
     assert_eq!(n, x.len());
     let at = probe.evaluate(&x).unwrap();
-    let scale = at
-        .tangent
-        .iter()
-        .flatten()
-        .fold(0.0f64, |m, v| m.max(v.abs()));
-    let h = 1e-7;
-    let mut worst = 0.0f64;
-    for j in 0..n {
-        let (mut xp, mut xm) = (x.clone(), x.clone());
-        xp[j] += h;
-        xm[j] -= h;
-        let (rp, rm) = (
-            probe.evaluate(&xp).unwrap().residual,
-            probe.evaluate(&xm).unwrap().residual,
-        );
-        for i in 0..n {
-            let fd = (rp[i] - rm[i]) / (2.0 * h);
-            worst = worst.max((fd - at.tangent[i][j]).abs() / scale);
-        }
-    }
+    let (worst, scale) = finite_common::tangent_difference(&mut probe, &x, &at);
     (worst, scale, n, at.symmetric)
 }
 

@@ -92,3 +92,35 @@ pub fn assert_closed_where_pressed(o: &Outcome, rows: &[Constraint]) {
         }
     }
 }
+
+/// The Newton tangent of `probe` at `x` (its evaluation `at`) against central differences of
+/// the residual (step `1e-7`): the largest difference relative to the largest tangent entry,
+/// and that entry.
+pub fn tangent_difference(
+    probe: &mut contact_patch::solver::contact_newton::Probe,
+    x: &[f64],
+    at: &contact_patch::solver::contact_newton::ProbeEvaluation,
+) -> (f64, f64) {
+    let n = x.len();
+    let scale = at
+        .tangent
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let h = 1e-7;
+    let mut worst = 0.0f64;
+    for j in 0..n {
+        let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+        xp[j] += h;
+        xm[j] -= h;
+        let (rp, rm) = (
+            probe.evaluate(&xp).unwrap().residual,
+            probe.evaluate(&xm).unwrap().residual,
+        );
+        for i in 0..n {
+            let fd = (rp[i] - rm[i]) / (2.0 * h);
+            worst = worst.max((fd - at.tangent[i][j]).abs() / scale);
+        }
+    }
+    (worst, scale)
+}
