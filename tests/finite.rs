@@ -517,35 +517,45 @@ fn a_block_compressed_by_twenty_percent_on_a_rigid_plane_deforms_homogeneously()
 /// The tangent of the whole Newton system (hyperelastic solid plus penalty rows against a
 /// rigid circle, with the second derivative of the circle's gap) is the central difference of
 /// its residual at a deformed, penetrating state off equilibrium, to 1e-6 of its largest
-/// entry.
+/// entry: node-to-surface rows, and standard and dual mortar rows (the weighted gap's second
+/// derivative, `mortar_linearization::linearize_rigid_row`: the length element and the
+/// distance at every Gauss point vary with the positions).
 #[test]
 fn the_newton_tangent_with_a_rigid_circle_is_the_difference_of_the_residual() {
     use contact_patch::solver::contact_newton::Probe;
-    let mut case = scene("neo_hookean", distorted_block("Q4"), 1);
-    case["physics"]["contact_geometry"] = json!("current");
-    case["solver"]["scheme"] = json!("newton");
-    case["supports"] = json!([{"body": "block", "set": "top", "x": 0.1, "y": -0.3}]);
-    case["contact"] = json!([{
-        "name": "roller", "slave": {"body": "block", "set": "bottom"},
-        "master": {"rigid": {"kind": "circle", "centre": [1.0, -3.0], "radius": 3.0}},
-        "discretization": {"kind": "node_to_surface", "passes": 1},
-        "enforcement": {"kind": "penalty", "kappa": 1e4}
-    }]);
-    case["checks"] = json!([{"check": "force_balance", "tol": 1e-8}]);
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("case.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&case).unwrap()).unwrap();
-    let o = run_case(&path, &mut |_| {}).unwrap();
-    assert!(o.passed(), "{:?}", o.checks);
-    let model = contact_patch::model::admit::load(&path).unwrap();
-    let mut probe = Probe::new(&model, 0.0).unwrap();
-    // off equilibrium: the solution pushed further down by a nonuniform amount
-    let mut x = probe.unknowns(&o.solution.u);
-    for (i, v) in x.iter_mut().enumerate() {
-        *v += 1e-3 * (0.7 * i as f64).sin() - 5e-3 * (i % 2) as f64;
+    for discretization in [
+        json!({"kind": "node_to_surface", "passes": 1}),
+        json!({"kind": "mortar", "multiplier": "standard"}),
+        json!({"kind": "mortar", "multiplier": "dual"}),
+    ] {
+        let mut case = scene("neo_hookean", distorted_block("Q4"), 1);
+        case["physics"]["contact_geometry"] = json!("current");
+        case["solver"]["scheme"] = json!("newton");
+        case["supports"] = json!([{"body": "block", "set": "top", "x": 0.1, "y": -0.3}]);
+        case["contact"] = json!([{
+            "name": "roller", "slave": {"body": "block", "set": "bottom"},
+            "master": {"rigid": {"kind": "circle", "centre": [1.0, -3.0], "radius": 3.0}},
+            "discretization": discretization,
+            "enforcement": {"kind": "penalty", "kappa": 1e4}
+        }]);
+        case["checks"] = json!([{"check": "force_balance", "tol": 1e-8}]);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("case.json");
+        std::fs::write(&path, serde_json::to_string_pretty(&case).unwrap()).unwrap();
+        let o = run_case(&path, &mut |_| {}).unwrap();
+        assert!(o.passed(), "{:?}", o.checks);
+        let model = contact_patch::model::admit::load(&path).unwrap();
+        let mut probe = Probe::new(&model, 0.0).unwrap();
+        // off equilibrium: the solution pushed further down by a nonuniform amount
+        let mut x = probe.unknowns(&o.solution.u);
+        for (i, v) in x.iter_mut().enumerate() {
+            *v += 1e-3 * (0.7 * i as f64).sin() - 5e-3 * (i % 2) as f64;
+        }
+        let at = probe.evaluate(&x).unwrap();
+        let (worst, scale) = finite_common::tangent_difference(&mut probe, &x, &at);
+        println!(
+            "{discretization}: Newton tangent vs central difference: {worst:.1e} of {scale:.3e}"
+        );
+        assert!(worst < 1e-6, "{discretization}: {worst:e}");
     }
-    let at = probe.evaluate(&x).unwrap();
-    let (worst, scale) = finite_common::tangent_difference(&mut probe, &x, &at);
-    println!("Newton tangent vs central difference: {worst:.1e} of {scale:.3e}");
-    assert!(worst < 1e-6, "{worst:e}");
 }

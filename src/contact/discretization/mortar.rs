@@ -44,7 +44,7 @@
 //!   facet covers which piece.
 
 use super::geometry::{closest_point, edge_shape, facet_point, Surface};
-use super::mortar_linearization::linearize_row;
+use super::mortar_linearization::{linearize_rigid_row, linearize_row};
 use super::search::BucketGrid;
 use super::Rows;
 use crate::contact::GapHessian;
@@ -392,6 +392,27 @@ pub(crate) fn rigid_mortar_rows(
                     }
                 }
             }
+        }
+        if model.physics.kinematics == Kinematics::Finite && !rows.tied {
+            // finite kinematics: the gap's second derivative too (the length element and the
+            // distance vary with the positions), by hyper-dual numbers
+            let lin = linearize_rigid_row(
+                slave,
+                rigid,
+                space,
+                model.thickness,
+                j,
+                &gauss,
+                |node, i| sb.dof(node, i),
+            );
+            let row = &mut rows.out[before];
+            row.g0 = lin.gap;
+            row.dofs = lin.dofs.clone();
+            row.coeffs = lin.gradient;
+            row.hessian = Some(GapHessian {
+                dofs: lin.dofs,
+                values: lin.hessian,
+            });
         }
         if space == MultiplierSpace::Standard {
             let mass: Vec<(usize, f64)> = order.iter().map(|&k| (k, dj[&k])).collect();

@@ -296,6 +296,104 @@ pub(crate) fn linearize_row(
     }
 }
 
+/// The exact gradient and second derivative of the mortar row of slave node `node` against a
+/// rigid surface (`mortar::rigid_mortar_rows`): `g_j = int Phi_j g(x) dGamma / int Phi_j dGamma`
+/// over the slave facets that hold `node`, with `g` the rigid surface's signed distance
+/// (`mortar::rigid_gap`: `n . (x - p)` for a line, `|x - c| - R` for a circle) at the Gauss
+/// points `gauss` of each facet, every quantity in the current positions (the length element
+/// `|x'|` varies with them). `dof(node, i)` numbers component `i` of a slave node.
+pub(crate) fn linearize_rigid_row(
+    slave: &Surface,
+    rigid: &crate::io::scene::RigidSurface,
+    space: MultiplierSpace,
+    thickness: f64,
+    node: usize,
+    gauss: &[(f64, f64)],
+    dof: impl Fn(usize, usize) -> usize,
+) -> LinearizedGap {
+    use crate::io::scene::RigidSurface;
+    let ks = slave.kind;
+    let facets: Vec<usize> = (0..slave.facets.len())
+        .filter(|&f| slave.facets[f].contains(&node))
+        .collect();
+    let mut nodes: Vec<(usize, [f64; 2])> = Vec::new();
+    let mut local: Vec<Vec<usize>> = Vec::new();
+    for &f in &facets {
+        local.push(
+            (0..ks.node_count())
+                .map(|a| {
+                    let id = slave.facets[f][a];
+                    match nodes.iter().position(|n| n.0 == id) {
+                        Some(k) => k,
+                        None => {
+                            nodes.push((id, slave.coords[f][a]));
+                            nodes.len() - 1
+                        }
+                    }
+                })
+                .collect(),
+        );
+    }
+    let variables = 2 * nodes.len();
+    let x: Vec<Point> = nodes
+        .iter()
+        .enumerate()
+        .map(|(k, n)| {
+            [
+                Ad::from_re(n.1[0]).derivative(variables, 2 * k),
+                Ad::from_re(n.1[1]).derivative(variables, 2 * k + 1),
+            ]
+        })
+        .collect();
+    let distance = |p: &Point| -> Ad {
+        match *rigid {
+            RigidSurface::Line { point, normal } => {
+                let l = normal[0].hypot(normal[1]);
+                (p[0].clone() - point[0]) * (normal[0] / l)
+                    + (p[1].clone() - point[1]) * (normal[1] / l)
+            }
+            RigidSurface::Circle { centre, radius } => {
+                let d = [p[0].clone() - centre[0], p[1].clone() - centre[1]];
+                dot2(&d, &d).sqrt() - radius
+            }
+        }
+    };
+    let (mut area, mut weighted) = (constant(0.0), constant(0.0));
+    for (e, &f) in facets.iter().enumerate() {
+        let j = slave.facets[f]
+            .iter()
+            .position(|&n| n == node)
+            .expect("the facet holds the node");
+        let xs: Vec<Point> = local[e].iter().map(|&k| x[k].clone()).collect();
+        for &(s, wq) in gauss {
+            let s = constant(s);
+            let (xg, t) = facet_point(ks, &xs, &s);
+            let w = dot2(&t, &t).sqrt() * thickness * &multiplier(ks, space, &s)[j] * wq;
+            area += w.clone();
+            weighted += w * &distance(&xg);
+        }
+    }
+    let g = weighted / area;
+    let gradient = g.v1.unwrap_generic(nalgebra::U1, nalgebra::Dyn(variables));
+    let hessian =
+        g.v2.unwrap_generic(nalgebra::Dyn(variables), nalgebra::Dyn(variables));
+    let mut values = vec![0.0; variables * variables];
+    for a in 0..variables {
+        for c in 0..variables {
+            values[a * variables + c] = 0.5 * (hessian[(a, c)] + hessian[(c, a)]);
+        }
+    }
+    LinearizedGap {
+        gap: g.re,
+        dofs: nodes
+            .iter()
+            .flat_map(|n| [dof(n.0, 0), dof(n.0, 1)])
+            .collect(),
+        gradient: gradient.iter().copied().collect(),
+        hessian: values,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::mortar::mortar_integrals;
@@ -549,6 +647,123 @@ mod tests {
                 jump < 1e-3 && gradient_jump < 1e-2,
                 "{jump:e} {gradient_jump:e}"
             );
+        }
+    }
+    /// The rigid-surface mortar gap of `node` in `f64` (`mortar::multiplier`,
+    /// `mortar::rigid_gap`, `geometry::facet_point`: another code path).
+    fn rigid_reference(
+        slave: &Surface,
+        rigid: &crate::io::scene::RigidSurface,
+        space: MultiplierSpace,
+        node: usize,
+        gauss: &[(f64, f64)],
+    ) -> f64 {
+        use super::super::geometry::facet_point as point_f64;
+        use super::super::mortar::{multiplier as phi_f64, rigid_gap};
+        let (mut weighted, mut area) = (0.0, 0.0);
+        for (f, nodes) in slave.facets.iter().enumerate() {
+            let Some(j) = nodes.iter().position(|&n| n == node) else {
+                continue;
+            };
+            for &(s, wq) in gauss {
+                let (x, t) = point_f64(slave.kind, &slave.coords[f], s);
+                let w = t[0].hypot(t[1]) * phi_f64(slave.kind, space, s)[j] * wq;
+                weighted += w * rigid_gap(rigid, x).unwrap().0;
+                area += w;
+            }
+        }
+        weighted / area
+    }
+
+    /// The mortar gap against a rigid line and a rigid circle (`linearize_rigid_row`): its
+    /// value against the `f64` integration, its gradient against central differences of that
+    /// gap, its second derivative against central differences of the gradient, on straight and
+    /// curved (Line3) slave facets at a deformed state, standard and dual multipliers.
+    #[test]
+    fn the_rigid_mortar_gap_s_derivatives_are_its_differences() {
+        use crate::io::scene::RigidSurface;
+        let gauss = crate::fe::gauss_legendre(8);
+        for rigid in [
+            RigidSurface::Line {
+                point: [0.0, 0.9],
+                normal: [0.1, 1.0],
+            },
+            RigidSurface::Circle {
+                centre: [1.0, -2.0],
+                radius: 2.9,
+            },
+        ] {
+            for kind in [EdgeKind::Line2, EdgeKind::Line3] {
+                for space in [MultiplierSpace::Standard, MultiplierSpace::Dual] {
+                    let base = pair(kind, &[0.1, 0.6, 1.1, 1.6]);
+                    let surface = |p: &Pair| p.surfaces().0;
+                    let n = 2 * base.slave.len();
+                    for node in 0..base.slave.len() {
+                        let lin = linearize_rigid_row(
+                            &surface(&base),
+                            &rigid,
+                            space,
+                            1.0,
+                            node,
+                            &gauss,
+                            |k, i| 2 * k + i,
+                        );
+                        let reference =
+                            rigid_reference(&surface(&base), &rigid, space, node, &gauss);
+                        assert!(
+                            (lin.gap - reference).abs() < 1e-13,
+                            "{kind:?} {space:?} {node}"
+                        );
+                        let m = lin.dofs.len();
+                        let (mut b, mut hess) = (vec![0.0; n], vec![0.0; n * n]);
+                        for a in 0..m {
+                            b[lin.dofs[a]] = lin.gradient[a];
+                            for c in 0..m {
+                                hess[lin.dofs[a] * n + lin.dofs[c]] = lin.hessian[a * m + c];
+                            }
+                        }
+                        let h = 1e-6;
+                        let scale_b = b.iter().fold(0.0f64, |x, v| x.max(v.abs()));
+                        // against a line with a single straight facet the length element cancels
+                        // and H vanishes: measured against the gradient's scale then (the facets
+                        // are about 0.5 long)
+                        let scale_h = hess.iter().fold(0.0f64, |x, v| x.max(v.abs())).max(scale_b);
+                        let (mut worst_b, mut worst_h) = (0.0f64, 0.0f64);
+                        for k in 0..n {
+                            let (p, q) = (base.perturbed(k, h), base.perturbed(k, -h));
+                            let fd = (rigid_reference(&surface(&p), &rigid, space, node, &gauss)
+                                - rigid_reference(&surface(&q), &rigid, space, node, &gauss))
+                                / (2.0 * h);
+                            worst_b = worst_b.max((fd - b[k]).abs() / scale_b);
+                            let gradient = |p: &Pair| {
+                                let lin = linearize_rigid_row(
+                                    &surface(p),
+                                    &rigid,
+                                    space,
+                                    1.0,
+                                    node,
+                                    &gauss,
+                                    |k, i| 2 * k + i,
+                                );
+                                let mut b = vec![0.0; n];
+                                for (a, &d) in lin.dofs.iter().enumerate() {
+                                    b[d] = lin.gradient[a];
+                                }
+                                b
+                            };
+                            let (bp, bq) = (gradient(&p), gradient(&q));
+                            for a in 0..n {
+                                let fd = (bp[a] - bq[a]) / (2.0 * h);
+                                worst_h = worst_h.max((fd - hess[a * n + k]).abs() / scale_h);
+                            }
+                        }
+                        assert!(
+                            worst_b < 1e-8 && worst_h < 1e-7,
+                            "{kind:?} {space:?} node {node}: gradient {worst_b:e}, second derivative {worst_h:e}"
+                        );
+                    }
+                }
+            }
         }
     }
 }
