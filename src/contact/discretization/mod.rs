@@ -744,7 +744,8 @@ fn attach_segment(
 /// (`2 x 2`, row-major), where the row's master makes it non-zero: against a rigid circle,
 /// `g = |x_s - c| - R` gives `d2g/dx_s2 = (I - n n^T) / |x_s - c|` at the slave position `x_s`
 /// (in the configuration the row is linearized in), for node-to-surface rows. Rigid lines and
-/// ties are affine (`None`); mortar rows against a rigid circle do not provide theirs (`None`);
+/// ties are affine (`None`); mortar rows against a rigid circle do not provide a nodal one here
+/// (`None`; under finite kinematics they carry their weighted gap's, `Constraint::hessian`);
 /// small-strain node-to-surface and mortar rows against deformable masters do not provide theirs
 /// (their geometry is then updated by a fixed point, see [`crate::solver::active_set`]); under
 /// finite kinematics those rows carry theirs (`Constraint::segment`, `Constraint::hessian`).

@@ -37,6 +37,12 @@
 //! second derivatives (implicit function theorem), and a third is taken for safety. Line2
 //! projections are in closed form.
 //!
+//! **Against a rigid surface** (`linearize_rigid_row`): `g_j = int Phi_j g(x_s) dGamma /
+//! int Phi_j dGamma` with `g` the rigid surface's signed distance, every Gauss point's position
+//! and length element in the current positions of the slave facets that hold node `j`; the same
+//! hyper-dual evaluation gives its gradient and second derivative (on a straight facet against
+//! a line the length element cancels and the second derivative vanishes).
+//!
 //! The unit tests check `b_j` against central differences of the gap computed afresh by the
 //! `f64` segmentation and integration of the `mortar` module (another code path), and `H_j`
 //! against central differences of `b_j`, on straight (Line2) and curved (Line3) facets at a
