@@ -220,6 +220,20 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// The ironing problem at finite strain, frictionless: a stiff neo-Hookean die with a
+    /// circular bottom pressed into a soft neo-Hookean slab and slid by 2.5 die widths, on three
+    /// meshes, per contact discretization; the forces on the die along the path, their
+    /// differences between successive refinements and their oscillation; writes
+    /// reports/ironing.md, .json and .svg.
+    #[command(
+        name = "ironing",
+        after_help = "Example:\n  contact-patch ironing\n  contact-patch ironing --out /tmp/reports\n\nThe problem and the measures: src/harness/ironing.rs."
+    )]
+    Ironing {
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
     /// The impact studies: `impact` (default), the dynamic cases with every impact treatment
     /// and mass against the 1D wave solutions (reports/impact.md, .json); `block-drop`, a block
     /// dropped on a foundation under time-step refinement (reports/block-drop.md, .json, .svg);
@@ -373,6 +387,7 @@ fn main() -> ExitCode {
         Command::FinitePatch { out } => finite_patch(&out),
         Command::HertzFinite { out } => hertz_finite(&out),
         Command::FiniteSliding { out } => finite_sliding(&out),
+        Command::Ironing { out } => ironing(&out),
         Command::Profile { case, pair, out } => profile(&case, &pair, &out),
         Command::Report { reports } => report_page(&reports),
         Command::Cattaneo { paths, pair, out } => cattaneo(&paths, &pair, &out),
@@ -1439,6 +1454,22 @@ fn finite_sliding(out: &Path) -> ExitCode {
             ),
         ];
         files.extend(finite_sliding::plots(&runs));
+        Ok(files)
+    })
+}
+
+fn ironing(out: &Path) -> ExitCode {
+    use contact_patch::harness::ironing;
+    write_study(out, || {
+        let studies = ironing::study();
+        let mut files = vec![
+            ("ironing.md".to_string(), ironing::report(&studies)),
+            (
+                "ironing.json".to_string(),
+                serde_json::to_string_pretty(&studies).expect("the study serializes") + "\n",
+            ),
+        ];
+        files.extend(ironing::plots(&studies));
         Ok(files)
     })
 }

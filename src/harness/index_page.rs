@@ -88,6 +88,11 @@ pub const KNOWN_REPORTS: &[KnownReport] = &[
         command: "contact-patch finite-sliding",
     },
     KnownReport {
+        stem: "ironing",
+        title: "The ironing problem at finite strain (frictionless)",
+        command: "contact-patch ironing",
+    },
+    KnownReport {
         stem: "crosscheck",
         title: "Cross-check against DOLFINx and scikit-fem",
         command: "bash crosscheck/run.sh",

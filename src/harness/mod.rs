@@ -43,6 +43,7 @@ pub mod hertz_finite;
 pub mod impact;
 pub mod impact_cost;
 pub mod index_page;
+pub mod ironing;
 pub mod judge;
 pub mod junit;
 pub mod layer;
