@@ -297,7 +297,7 @@ fn not_run(entry: &Entry, outcome: String) -> SlidingRun {
 }
 
 /// The first line of an error's message.
-fn first_line(e: &crate::error::Error) -> String {
+pub(crate) fn first_line(e: &crate::error::Error) -> String {
     e.to_string().lines().next().unwrap_or_default().to_string()
 }
 
@@ -356,9 +356,28 @@ fn forces_on_block(model: &crate::model::Model, pair: usize, block: usize) -> bo
     model.contact[pair].slave.0 == block
 }
 
-/// The measures of a completed path.
-fn measured(entry: &Entry, path: Vec<PathPoint>, residuals: Vec<(f64, Vec<f64>)>) -> SlidingRun {
-    let steady: Vec<&PathPoint> = path.iter().filter(|p| p.slide >= STEADY_FROM).collect();
+/// What the path studies (this one and [`super::ironing`]) measure on a completed path: the
+/// mean normal (vertical) contact force over the steady part (`slide >= steady_from`), the
+/// oscillation of both components there relative to it, the balance of the contact force
+/// with the driven support's reaction, the residual histories of the first, middle and last
+/// sliding step, and Newton's rate over every step.
+pub(crate) struct PathMeasures {
+    pub mean_normal: f64,
+    pub normal: Oscillation,
+    pub tangential: Oscillation,
+    pub balance: f64,
+    pub histories: Vec<StepResiduals>,
+    pub quadratic_pairs: usize,
+    pub quadratic_ratio: f64,
+}
+
+/// The [`PathMeasures`] of `path` with the residual histories `residuals` (slide, residuals).
+pub(crate) fn path_measures(
+    path: &[PathPoint],
+    residuals: &[(f64, Vec<f64>)],
+    steady_from: f64,
+) -> PathMeasures {
+    let steady: Vec<&PathPoint> = path.iter().filter(|p| p.slide >= steady_from).collect();
     let mean_normal =
         steady.iter().map(|p| p.contact_force[1]).sum::<f64>() / steady.len().max(1) as f64;
     let component = |i: usize| -> Vec<(f64, f64)> {
@@ -395,24 +414,39 @@ fn measured(entry: &Entry, path: Vec<PathPoint>, residuals: Vec<(f64, Vec<f64>)>
             .collect()
     };
     let (mut pairs, mut ratio) = (0, 0.0f64);
-    for (_, r) in &residuals {
+    for (_, r) in residuals {
         let (n, largest) = quadratic_ratio(r, FINITE_RESIDUAL_TOLERANCE);
         pairs += n;
         ratio = ratio.max(largest);
     }
+    let oscillation_scale = mean_normal.abs().max(f64::MIN_POSITIVE);
+    PathMeasures {
+        mean_normal,
+        normal: oscillation(&component(1), oscillation_scale),
+        tangential: oscillation(&component(0), oscillation_scale),
+        balance,
+        histories,
+        quadratic_pairs: pairs,
+        quadratic_ratio: ratio,
+    }
+}
+
+/// The measures of a completed path.
+fn measured(entry: &Entry, path: Vec<PathPoint>, residuals: Vec<(f64, Vec<f64>)>) -> SlidingRun {
+    let m = path_measures(&path, &residuals, STEADY_FROM);
     let cuts = path.len().saturating_sub(PRESS_STEPS + SLIDE_STEPS);
     SlidingRun {
         label: entry.label.into(),
         discretization: entry.discretization.clone(),
         enforcement: entry.enforcement.clone(),
         outcome: "ran".into(),
-        normal: Some(oscillation(&component(1), mean_normal)),
-        tangential: Some(oscillation(&component(0), mean_normal)),
-        mean_normal,
-        balance,
-        histories,
-        quadratic_ratio: ratio,
-        quadratic_pairs: pairs,
+        normal: Some(m.normal),
+        tangential: Some(m.tangential),
+        mean_normal: m.mean_normal,
+        balance: m.balance,
+        histories: m.histories,
+        quadratic_ratio: m.quadratic_ratio,
+        quadratic_pairs: m.quadratic_pairs,
         cuts,
         path,
     }
@@ -423,7 +457,7 @@ pub fn study() -> Vec<SlidingRun> {
     entries().iter().map(run).collect()
 }
 
-fn sci(v: f64) -> String {
+pub(crate) fn sci(v: f64) -> String {
     if v.is_finite() {
         format!("{v:.2e}")
     } else {

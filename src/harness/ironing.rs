@@ -44,7 +44,9 @@
 //! translation; the slab's ends make a slow drift): its discrete value measures the error.
 //! **Newton's rate**: `r_{k+1} / r_k^2` over every step ([`super::load_path::quadratic_ratio`]).
 
-use super::finite_sliding::{oscillation, Oscillation, StepResiduals};
+use super::finite_sliding::{
+    first_line, path_measures, sci, Oscillation, PathPoint, StepResiduals,
+};
 use super::load_path::{build, follow, quadratic_ratio};
 use crate::contact::forces::pair_forces;
 use crate::io::svg::{line_plot, Series};
@@ -205,19 +207,6 @@ pub fn case(level: &Level, discretization: &Value, enforcement: &Value) -> Value
     })
 }
 
-/// The state after one accepted load step.
-#[derive(Clone, Debug, Serialize)]
-pub struct PathPoint {
-    pub load_factor: f64,
-    /// The slide of the die's top.
-    pub slide: f64,
-    /// Net contact force on the die `[F_x, F_y]`.
-    pub contact_force: [f64; 2],
-    /// The reaction at the die's driven top (sum over its supported dofs).
-    pub reaction: [f64; 2],
-    pub iterations: usize,
-}
-
 /// One discretization at one level.
 #[derive(Clone, Debug, Serialize)]
 pub struct IroningRun {
@@ -263,10 +252,6 @@ pub struct IroningStudy {
     pub enforcement: Value,
     pub runs: Vec<IroningRun>,
     pub differences: Vec<RefinementDifference>,
-}
-
-fn first_line(e: &crate::error::Error) -> String {
-    e.to_string().lines().next().unwrap_or_default().to_string()
 }
 
 fn not_run(level: Level, outcome: String) -> IroningRun {
@@ -367,61 +352,19 @@ pub fn settled_ratios(history: &[crate::contact::state::IterationRecord]) -> Vec
     ratios
 }
 
-/// The measures of a completed path.
+/// The measures of a completed path ([`super::finite_sliding::path_measures`]).
 fn measured(level: Level, path: Vec<PathPoint>, residuals: Vec<(f64, Vec<f64>)>) -> IroningRun {
-    let steady: Vec<&PathPoint> = path.iter().filter(|p| p.slide >= STEADY_FROM).collect();
-    let mean_vertical =
-        steady.iter().map(|p| p.contact_force[1]).sum::<f64>() / steady.len().max(1) as f64;
-    let component = |i: usize| -> Vec<(f64, f64)> {
-        steady
-            .iter()
-            .map(|p| (p.slide, p.contact_force[i]))
-            .collect()
-    };
-    let scale = path
-        .iter()
-        .flat_map(|p| p.contact_force)
-        .fold(0.0f64, |m, v| m.max(v.abs()))
-        .max(f64::MIN_POSITIVE);
-    let balance = path
-        .iter()
-        .flat_map(|p| {
-            [
-                (p.contact_force[0] + p.reaction[0]).abs(),
-                (p.contact_force[1] + p.reaction[1]).abs(),
-            ]
-        })
-        .fold(0.0f64, f64::max)
-        / scale;
-    let sliding: Vec<&(f64, Vec<f64>)> = residuals.iter().filter(|r| r.0 > 0.0).collect();
-    let histories = if sliding.is_empty() {
-        Vec::new()
-    } else {
-        [0, sliding.len() / 2, sliding.len() - 1]
-            .iter()
-            .map(|&k| StepResiduals {
-                slide: sliding[k].0,
-                residuals: sliding[k].1.clone(),
-            })
-            .collect()
-    };
-    let (mut pairs, mut ratio) = (0, 0.0f64);
-    for (_, r) in &residuals {
-        let (n, largest) = quadratic_ratio(r, FINITE_RESIDUAL_TOLERANCE);
-        pairs += n;
-        ratio = ratio.max(largest);
-    }
-    let scale_vertical = mean_vertical.abs().max(f64::MIN_POSITIVE);
+    let m = path_measures(&path, &residuals, STEADY_FROM);
     IroningRun {
         level,
         outcome: "ran".into(),
-        vertical: Some(oscillation(&component(1), scale_vertical)),
-        horizontal: Some(oscillation(&component(0), scale_vertical)),
-        mean_vertical,
-        balance,
-        histories,
-        quadratic_ratio: ratio,
-        quadratic_pairs: pairs,
+        vertical: Some(m.normal),
+        horizontal: Some(m.tangential),
+        mean_vertical: m.mean_normal,
+        balance: m.balance,
+        histories: m.histories,
+        quadratic_ratio: m.quadratic_ratio,
+        quadratic_pairs: m.quadratic_pairs,
         settled_quadratic_ratio: f64::NAN,
         settled_quadratic_pairs: 0,
         cuts: path.len().saturating_sub(PRESS_STEPS + SLIDE_STEPS),
@@ -492,14 +435,6 @@ pub fn study_of(entry: &Entry) -> IroningStudy {
 /// Every entry of [`entries`] over every level.
 pub fn study() -> Vec<IroningStudy> {
     entries().iter().map(study_of).collect()
-}
-
-fn sci(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v:.2e}")
-    } else {
-        "-".into()
-    }
 }
 
 fn level_name(level: &Level) -> String {
