@@ -69,6 +69,43 @@ pub(crate) struct LinearizedGap {
     pub hessian: Vec<f64>,
 }
 
+/// The positions `points` as second-order dual numbers, one seed per coordinate (`2 k`, `2 k + 1`
+/// for point `k`).
+fn seeded(points: &[[f64; 2]]) -> Vec<Point> {
+    let variables = 2 * points.len();
+    points
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            [
+                Ad::from_re(p[0]).derivative(variables, 2 * k),
+                Ad::from_re(p[1]).derivative(variables, 2 * k + 1),
+            ]
+        })
+        .collect()
+}
+
+/// The gap `g` evaluated in dual numbers over `dofs` (two per seeded point): its value, gradient
+/// and second derivative, made exactly symmetric (it is to round-off; its mean is exactly).
+fn linearized(g: Ad, dofs: Vec<usize>) -> LinearizedGap {
+    let variables = dofs.len();
+    let gradient = g.v1.unwrap_generic(nalgebra::U1, nalgebra::Dyn(variables));
+    let hessian =
+        g.v2.unwrap_generic(nalgebra::Dyn(variables), nalgebra::Dyn(variables));
+    let mut values = vec![0.0; variables * variables];
+    for a in 0..variables {
+        for c in 0..variables {
+            values[a * variables + c] = 0.5 * (hessian[(a, c)] + hessian[(c, a)]);
+        }
+    }
+    LinearizedGap {
+        gap: g.re,
+        dofs,
+        gradient: gradient.iter().copied().collect(),
+        hessian: values,
+    }
+}
+
 fn constant(v: f64) -> Ad {
     Ad::from_re(v)
 }
@@ -216,17 +253,7 @@ pub(crate) fn linearize_row(
         master_local.push(on_master);
         break_local.push(ends);
     }
-    let variables = 2 * nodes.len();
-    let x: Vec<Point> = nodes
-        .iter()
-        .enumerate()
-        .map(|(k, n)| {
-            [
-                Ad::from_re(n.2[0]).derivative(variables, 2 * k),
-                Ad::from_re(n.2[1]).derivative(variables, 2 * k + 1),
-            ]
-        })
-        .collect();
+    let x = seeded(&nodes.iter().map(|n| n.2).collect::<Vec<_>>());
     let gauss = gauss_rule(ks, km);
     let mut area = constant(0.0);
     let mut weighted = [constant(0.0), constant(0.0)];
@@ -280,26 +307,11 @@ pub(crate) fn linearize_row(
     let length = dot2(&normal, &normal).sqrt();
     // nu_j = -n_j / |n_j|: g_j = -(n_j . S_j) / (|n_j| A_j)
     let g = -dot2(&normal, &weighted) / (length * area);
-    let gradient = g.v1.unwrap_generic(nalgebra::U1, nalgebra::Dyn(variables));
-    let hessian =
-        g.v2.unwrap_generic(nalgebra::Dyn(variables), nalgebra::Dyn(variables));
     let dofs = nodes
         .iter()
         .flat_map(|n| [dof(n.0, n.1, 0), dof(n.0, n.1, 1)])
         .collect();
-    let mut values = vec![0.0; variables * variables];
-    for a in 0..variables {
-        for c in 0..variables {
-            // symmetric to round-off; its mean is exactly symmetric
-            values[a * variables + c] = 0.5 * (hessian[(a, c)] + hessian[(c, a)]);
-        }
-    }
-    LinearizedGap {
-        gap: g.re,
-        dofs,
-        gradient: gradient.iter().copied().collect(),
-        hessian: values,
-    }
+    linearized(g, dofs)
 }
 
 /// The exact gradient and second derivative of the mortar row of slave node `node` against a
@@ -340,17 +352,7 @@ pub(crate) fn linearize_rigid_row(
                 .collect(),
         );
     }
-    let variables = 2 * nodes.len();
-    let x: Vec<Point> = nodes
-        .iter()
-        .enumerate()
-        .map(|(k, n)| {
-            [
-                Ad::from_re(n.1[0]).derivative(variables, 2 * k),
-                Ad::from_re(n.1[1]).derivative(variables, 2 * k + 1),
-            ]
-        })
-        .collect();
+    let x = seeded(&nodes.iter().map(|n| n.1).collect::<Vec<_>>());
     let distance = |p: &Point| -> Ad {
         match *rigid {
             RigidSurface::Line { point, normal } => {
@@ -380,24 +382,11 @@ pub(crate) fn linearize_rigid_row(
         }
     }
     let g = weighted / area;
-    let gradient = g.v1.unwrap_generic(nalgebra::U1, nalgebra::Dyn(variables));
-    let hessian =
-        g.v2.unwrap_generic(nalgebra::Dyn(variables), nalgebra::Dyn(variables));
-    let mut values = vec![0.0; variables * variables];
-    for a in 0..variables {
-        for c in 0..variables {
-            values[a * variables + c] = 0.5 * (hessian[(a, c)] + hessian[(c, a)]);
-        }
-    }
-    LinearizedGap {
-        gap: g.re,
-        dofs: nodes
-            .iter()
-            .flat_map(|n| [dof(n.0, 0), dof(n.0, 1)])
-            .collect(),
-        gradient: gradient.iter().copied().collect(),
-        hessian: values,
-    }
+    let dofs = nodes
+        .iter()
+        .flat_map(|n| [dof(n.0, 0), dof(n.0, 1)])
+        .collect();
+    linearized(g, dofs)
 }
 
 #[cfg(test)]
