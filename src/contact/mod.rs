@@ -41,9 +41,10 @@ pub mod friction;
 pub mod results;
 pub mod state;
 
-/// One linearized contact constraint (a row of `B`).
+/// One linearized contact constraint (a row of `B`) in `D` dimensions (2 unless named: the
+/// normal, the slave normal and the slave point have `D` components; 3 for 3D bodies).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Constraint {
+pub struct Constraint<const D: usize = 2> {
     /// Global dofs of the gradient row.
     pub dofs: Vec<usize>,
     /// `dg/du` for each of `dofs`.
@@ -57,13 +58,13 @@ pub struct Constraint {
     /// master to slave): the unit normal for master normals, rigid surfaces and mortar,
     /// `n_m / (n_m . nu)` for slave normals, `e_x` or `e_y` for tied rows. The row's force on
     /// the slave node is `lambda * normal`.
-    pub normal: [f64; 2],
+    pub normal: [f64; D],
     /// Outward unit normal of the slave surface at the slave node (zero for rigid slaves).
-    pub slave_normal: [f64; 2],
+    pub slave_normal: [f64; D],
     /// Body and local node of the slave node, and its reference position.
     pub slave_body: usize,
     pub slave_node: usize,
-    pub point: [f64; 2],
+    pub point: [f64; D],
     /// 1 for the first pass, 2 for the second pass of a two-pass discretization.
     pub pass: u8,
     /// The slave dof this constraint may be solved for (largest |c| among the slave dofs).
@@ -137,7 +138,7 @@ pub(crate) fn row_key(r: &Constraint) -> RowKey {
     (r.pair, r.pass, r.slave_body, r.slave_node, direction)
 }
 
-impl Constraint {
+impl<const D: usize> Constraint<D> {
     /// Gap for the displacement `u`.
     pub fn gap(&self, u: &[f64]) -> f64 {
         self.g0
