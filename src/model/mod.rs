@@ -21,11 +21,13 @@
 pub mod admit;
 pub mod dynamics;
 pub(crate) mod rigid;
+pub mod space;
 pub mod stable_step;
 
 use crate::contact::enforcement::Family;
 use crate::error::{Error, Result};
 use crate::fe::{point_values, ElementKind};
+use crate::fe3d::SolidKind;
 use crate::harness::exact::ExactField;
 use crate::io::paths::{name_problem, NAME_RULE};
 use crate::io::scene::{
@@ -37,27 +39,32 @@ use crate::io::scene::{
 use crate::mesh::{block, Facet, Mesh};
 use crate::solid::{check_geometry, Elasticity};
 use crate::solid_finite::Hyperelastic;
+use space::SolidCell;
 
-/// One elastic body: its mesh (with named sets), material and first global dof.
+/// One elastic body in `D` dimensions (2 unless named) of cells `K`: its mesh (with named
+/// sets), material and first global dof.
 #[derive(Clone, Debug)]
-pub struct Body {
+pub struct Body<const D: usize = 2, K: SolidCell<D> = ElementKind> {
     pub name: String,
     pub material_name: String,
-    pub material: Elasticity,
+    pub material: K::Material,
     /// The hyperelastic energy under `physics.kinematics: "finite"` (`None` with small strain).
     pub hyperelastic: Option<Hyperelastic>,
-    pub mesh: Mesh,
+    pub mesh: Mesh<D, K>,
     pub dof_offset: usize,
 }
 
-impl Body {
-    /// Global dof of `component` (0 = x, 1 = y) of local node `node`.
+/// A 3D body of solid cells.
+pub type Body3 = Body<3, SolidKind>;
+
+impl<const D: usize, K: SolidCell<D>> Body<D, K> {
+    /// Global dof of `component` (0 = x, 1 = y, 2 = z) of local node `node`.
     pub fn dof(&self, node: usize, component: usize) -> usize {
-        self.dof_offset + 2 * node + component
+        self.dof_offset + D * node + component
     }
 
     pub fn dof_count(&self) -> usize {
-        2 * self.mesh.nodes.len()
+        D * self.mesh.nodes.len()
     }
 
     /// Whether global dof `d` belongs to this body.
@@ -65,12 +72,11 @@ impl Body {
         d >= self.dof_offset && d < self.dof_offset + self.dof_count()
     }
 
-    /// Global dofs of cell `c`, in element dof order `[x0, y0, x1, y1, ...]`.
+    /// Global dofs of cell `c`, in element dof order `[x0, y0(, z0), x1, ...]`.
     pub fn cell_dofs(&self, c: usize, out: &mut Vec<usize>) {
         out.clear();
         for &n in self.mesh.cell(c) {
-            out.push(self.dof(n, 0));
-            out.push(self.dof(n, 1));
+            out.extend((0..D).map(|i| self.dof(n, i)));
         }
     }
 }
@@ -149,14 +155,14 @@ impl ContactPair {
 
 /// A validated scene, ready to solve.
 #[derive(Clone, Debug)]
-pub struct Model {
+pub struct Model<const D: usize = 2, K: SolidCell<D> = ElementKind> {
     pub name: String,
     pub description: String,
     /// Where the case came from (used in every message).
     pub source: String,
     pub plane: Plane,
     pub thickness: f64,
-    pub bodies: Vec<Body>,
+    pub bodies: Vec<Body<D, K>>,
     pub dof_count: usize,
     /// Prescribed value of each global dof, if any.
     pub prescribed: Vec<Option<f64>>,
@@ -257,7 +263,10 @@ pub fn parse(text: &str, source: &str) -> Result<Case> {
     })
 }
 
-impl Model {
+/// A 3D model of solid bodies.
+pub type Model3 = Model<3, SolidKind>;
+
+impl<const D: usize, K: SolidCell<D>> Model<D, K> {
     /// The largest body's size (a length scale for geometric tolerances).
     pub fn size(&self) -> f64 {
         self.bodies
@@ -268,7 +277,7 @@ impl Model {
 
     /// The same model under the load factor `t`: external forces and prescribed values times
     /// `t`.
-    pub fn with_load_factor(&self, t: f64) -> Model {
+    pub fn with_load_factor(&self, t: f64) -> Self {
         let mut m = self.clone();
         for f in &mut m.external_force {
             *f *= t;
@@ -281,7 +290,7 @@ impl Model {
 
     /// The model at load step `k` of `n`: the proportional loads and supports at the factor
     /// `k / n`, those on a load path at their own factor for step `k`.
-    pub fn at_step(&self, k: usize, n: usize) -> Model {
+    pub fn at_step(&self, k: usize, n: usize) -> Self {
         self.at_load(k as f64, n)
     }
 
@@ -289,7 +298,7 @@ impl Model {
     /// proportional loads and supports at `s / n`; those on a load path at their factor
     /// interpolated linearly between the steps `floor(s)` and `ceil(s)` (zero before step 1).
     /// At a whole `s = k` this is [`Model::at_step`]`(k, n)` exactly.
-    pub fn at_load(&self, s: f64, n: usize) -> Model {
+    pub fn at_load(&self, s: f64, n: usize) -> Self {
         let t = s / n as f64;
         if self.load_path.is_empty() {
             return self.with_load_factor(t);
@@ -336,7 +345,7 @@ impl Model {
     }
 
     /// Body, node and component of global dof `d`: the one inverse of the numbering
-    /// `offset_b + 2 node + component` (bodies are numbered in order, so a binary search on
+    /// `offset_b + D node + component` (bodies are numbered in order, so a binary search on
     /// the offsets finds the body). `None` past the last dof.
     pub fn dof_owner(&self, d: usize) -> Option<DofRef> {
         let b = self
@@ -348,8 +357,8 @@ impl Model {
             let local = d - body.dof_offset;
             DofRef {
                 body: b,
-                node: local / 2,
-                component: local % 2,
+                node: local / D,
+                component: local % D,
             }
         })
     }
@@ -358,10 +367,12 @@ impl Model {
         self.bodies.iter().position(|b| b.name == name)
     }
 
-    pub fn body(&self, name: &str) -> Option<&Body> {
+    pub fn body(&self, name: &str) -> Option<&Body<D, K>> {
         self.bodies.iter().find(|b| b.name == name)
     }
+}
 
+impl Model {
     /// Validate `case` and build the model. `source` names the case in messages.
     pub fn build(case: &Case, source: &str) -> Result<Model> {
         let invalid = |location: String, problem: String, hint: &str| {

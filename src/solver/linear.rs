@@ -17,8 +17,9 @@
 //! Maxima propagate NaN (`max_abs`), so that a NaN can never pass as a zero residual.
 
 use crate::error::{Error, Result};
+use crate::model::space::SolidCell;
 use crate::model::Model;
-use crate::solid::{element_internal_force, element_stiffness, Kinematics, MAX_DOFS};
+use crate::solid::MAX_DOFS;
 use crate::solver::constraints::AffineConstraints;
 pub use crate::solver::constraints::NO_EQUATION;
 use crate::solver::sparse::{Cholesky, FactorError, PatternBuilder, SymmetricPattern};
@@ -73,23 +74,20 @@ pub struct Solution {
 }
 
 /// Calls `visit(dofs, ke)` for every cell of every body.
-pub fn for_each_element_stiffness(model: &Model, mut visit: impl FnMut(&[usize], &[f64])) {
+pub fn for_each_element_stiffness<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    mut visit: impl FnMut(&[usize], &[f64]),
+) {
     let mut dofs = Vec::with_capacity(MAX_DOFS);
-    let mut ke = [0.0; MAX_DOFS * MAX_DOFS];
+    let mut ke = Vec::new();
     for body in &model.bodies {
         let kind = body.mesh.kind;
         let rule = kind.stiffness_rule();
-        let nd = 2 * kind.node_count();
+        let nd = D * kind.node_count();
+        ke.resize(nd * nd, 0.0);
         for c in 0..body.mesh.cell_count() {
             let coords = body.mesh.cell_coords(c);
-            element_stiffness(
-                kind,
-                &coords,
-                &body.material,
-                model.thickness,
-                &rule,
-                &mut ke,
-            );
+            kind.element_stiffness(&coords, &body.material, model.thickness, &rule, &mut ke);
             body.cell_dofs(c, &mut dofs);
             visit(&dofs, &ke[..nd * nd]);
         }
@@ -128,7 +126,12 @@ impl LinearSystem {
 
     /// The error for a stiffness that cannot be factored: `equation` is where the first bad
     /// pivot was found (in the caller's numbering), `what` says what was wrong with it.
-    pub fn singular(&self, model: &Model, equation: Option<usize>, what: &str) -> Error {
+    pub fn singular<const D: usize, K: SolidCell<D>>(
+        &self,
+        model: &Model<D, K>,
+        equation: Option<usize>,
+        what: &str,
+    ) -> Error {
         let dof = equation.and_then(|e| self.dof_of(e));
         let where_ = dof
             .map(|d| describe_dof(model, d))
@@ -148,7 +151,11 @@ impl LinearSystem {
         }
     }
 
-    pub fn factor_error(&self, model: &Model, e: FactorError) -> Error {
+    pub fn factor_error<const D: usize, K: SolidCell<D>>(
+        &self,
+        model: &Model<D, K>,
+        e: FactorError,
+    ) -> Error {
         match e {
             FactorError::NotPositiveDefinite { equation } => {
                 self.singular(model, Some(equation), "first bad pivot")
@@ -191,7 +198,13 @@ impl LinearSystem {
 
     /// `Ok` when every entry of `x` (one per equation) is finite, else the error naming the
     /// first non-finite one: `what` names the vector, `stage` when it was computed.
-    pub fn check_finite(&self, model: &Model, x: &[f64], what: &str, stage: &str) -> Result<()> {
+    pub fn check_finite<const D: usize, K: SolidCell<D>>(
+        &self,
+        model: &Model<D, K>,
+        x: &[f64],
+        what: &str,
+        stage: &str,
+    ) -> Result<()> {
         match x.iter().position(|v| !v.is_finite()) {
             None => Ok(()),
             Some(e) => Err(non_finite(model, what, x[e], self.dof_of(e), stage)),
@@ -200,7 +213,10 @@ impl LinearSystem {
 }
 
 /// The body and node of global dof `d` when that node belongs to no cell.
-fn orphan_node(model: &Model, d: usize) -> Option<(String, usize)> {
+fn orphan_node<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    d: usize,
+) -> Option<(String, usize)> {
     let owner = model.dof_owner(d)?;
     let (body, node) = (&model.bodies[owner.body], owner.node);
     let used = (0..body.mesh.cell_count()).any(|c| body.mesh.cell(c).contains(&node));
@@ -219,17 +235,29 @@ pub fn max_abs<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
 }
 
 /// The error for a non-finite `value` of `what` at global dof `dof`, computed at `stage`.
-pub fn non_finite(model: &Model, what: &str, value: f64, dof: Option<usize>, stage: &str) -> Error {
+pub fn non_finite<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    what: &str,
+    value: f64,
+    dof: Option<usize>,
+    stage: &str,
+) -> Error {
     let at = dof.map_or_else(|| "an unknown dof".into(), |d| describe_dof(model, d));
     non_finite_at(model, what, value, &at, stage)
 }
 
 /// The error for a non-finite `value` of `what` at the place `at` (in words).
-pub fn non_finite_at(model: &Model, what: &str, value: f64, at: &str, stage: &str) -> Error {
+pub fn non_finite_at<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    what: &str,
+    value: f64,
+    at: &str,
+    stage: &str,
+) -> Error {
     let moduli = model
         .bodies
         .iter()
-        .map(|b| b.material.youngs_modulus)
+        .map(|b| K::youngs_modulus(&b.material))
         .fold(0.0f64, f64::max);
     let loads = max_abs(&model.external_force);
     Error::Solver {
@@ -245,7 +273,10 @@ pub fn non_finite_at(model: &Model, what: &str, value: f64, at: &str, stage: &st
 
 /// Assemble `K_ff` and the right-hand side. `extra_blocks` (global dofs) are added to the
 /// sparsity pattern, e.g. the dofs coupled by contact constraints.
-pub fn assemble(model: &Model, extra_blocks: &[Vec<usize>]) -> LinearSystem {
+pub fn assemble<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    extra_blocks: &[Vec<usize>],
+) -> LinearSystem {
     let constraints = AffineConstraints::dirichlet(&model.prescribed);
     let n = constraints.free_count();
     let mut local = constraints.local();
@@ -277,7 +308,10 @@ pub fn assemble(model: &Model, extra_blocks: &[Vec<usize>]) -> LinearSystem {
 
 /// Solve the static elastic problem without contact (see [`crate::solver`] for the entry that
 /// adds contact when the scene asks for it). `progress` is told the name of each stage.
-pub fn solve_elastic(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+pub fn solve_elastic<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Solution> {
     let mut timings = Timings::default();
     let t = Instant::now();
     progress("assembling");
@@ -326,7 +360,10 @@ pub fn solve_elastic(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<So
 impl LinearSystem {
     /// `Ok` when the external forces, the assembled stiffness and the right-hand side
     /// `f_f - K_fp u_p` are finite, else the error naming the first dof where they are not.
-    pub fn check_assembled(&self, model: &Model) -> Result<()> {
+    pub fn check_assembled<const D: usize, K: SolidCell<D>>(
+        &self,
+        model: &Model<D, K>,
+    ) -> Result<()> {
         if let Some(d) = model.external_force.iter().position(|v| !v.is_finite()) {
             return Err(non_finite(
                 model,
@@ -360,8 +397,8 @@ impl LinearSystem {
 /// Reactions and the equilibrium residual of `u`, given contact nodal forces `contact_force`
 /// (global, possibly empty). Every one of them must be finite: the error names the first dof
 /// where one is not.
-pub fn finish(
-    model: &Model,
+pub fn finish<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
     sys: &LinearSystem,
     u: Vec<f64>,
     contact_force: &[f64],
@@ -423,31 +460,34 @@ pub fn finish(
 
 /// The internal force `f_int(u)` of every body at the global displacement `u`, element by
 /// element (small strain: `K u`; finite kinematics: [`crate::solver::finite_assembly::internal_force`]).
-pub fn internal_force(model: &Model, u: &[f64]) -> Vec<f64> {
-    if model.physics.kinematics == crate::io::scene::Kinematics::Finite {
-        // an inverted element has no internal force: NaN, which every caller refuses by name
-        return crate::solver::finite_assembly::internal_force(model, u)
-            .unwrap_or_else(|_| vec![f64::NAN; u.len()]);
+pub fn internal_force<const D: usize, K: SolidCell<D>>(model: &Model<D, K>, u: &[f64]) -> Vec<f64> {
+    if let Some(plane) = K::as_plane(model) {
+        if plane.physics.kinematics == crate::io::scene::Kinematics::Finite {
+            // an inverted element has no internal force: NaN, which every caller refuses by name
+            return crate::solver::finite_assembly::internal_force(plane, u)
+                .unwrap_or_else(|_| vec![f64::NAN; u.len()]);
+        }
     }
     let mut f = vec![0.0; u.len()];
     let mut dofs = Vec::with_capacity(MAX_DOFS);
-    let mut ue = [0.0; MAX_DOFS];
+    let mut ue = Vec::new();
+    let mut fe = Vec::new();
     for body in &model.bodies {
         let kind = body.mesh.kind;
         let rule = kind.stiffness_rule();
         for c in 0..body.mesh.cell_count() {
             body.cell_dofs(c, &mut dofs);
-            for (v, &d) in ue.iter_mut().zip(&dofs) {
-                *v = u[d];
-            }
-            let fe = element_internal_force(
-                Kinematics::SmallStrain,
-                kind,
+            ue.clear();
+            ue.extend(dofs.iter().map(|&d| u[d]));
+            fe.clear();
+            fe.resize(dofs.len(), 0.0);
+            kind.add_internal_force(
                 &body.mesh.cell_coords(c),
-                &ue[..dofs.len()],
+                &ue,
                 &body.material,
                 model.thickness,
                 &rule,
+                &mut fe,
             );
             for (a, &d) in dofs.iter().enumerate() {
                 f[d] += fe[a];
@@ -458,7 +498,7 @@ pub fn internal_force(model: &Model, u: &[f64]) -> Vec<f64> {
 }
 
 /// `f_int(u) - f`, element by element.
-pub fn residual(model: &Model, u: &[f64]) -> Vec<f64> {
+pub fn residual<const D: usize, K: SolidCell<D>>(model: &Model<D, K>, u: &[f64]) -> Vec<f64> {
     let mut r = internal_force(model, u);
     for (r, f) in r.iter_mut().zip(&model.external_force) {
         *r -= f;
@@ -467,18 +507,18 @@ pub fn residual(model: &Model, u: &[f64]) -> Vec<f64> {
 }
 
 /// "body 'x', node n at (x, y), u_x" for a global dof.
-pub fn describe_dof(model: &Model, dof: usize) -> String {
+pub fn describe_dof<const D: usize, K: SolidCell<D>>(model: &Model<D, K>, dof: usize) -> String {
     match model.dof_owner(dof) {
         Some(r) => {
             let body = &model.bodies[r.body];
             let p = body.mesh.nodes[r.node];
+            let at: Vec<String> = p.iter().map(|x| x.to_string()).collect();
             format!(
-                "body '{}', node {} at ({}, {}), u_{}",
+                "body '{}', node {} at ({}), u_{}",
                 body.name,
                 r.node,
-                p[0],
-                p[1],
-                ["x", "y"][r.component]
+                at.join(", "),
+                K::axis_name(r.component)
             )
         }
         None => format!("dof {dof}"),

@@ -1,0 +1,156 @@
+//! The dimension seam: what a body's cells supply to the one code path of the model, the
+//! assembly and the contact solve, in `D = 2` (plane cells, [`ElementKind`]) and `D = 3` (solid
+//! cells, [`SolidKind`]).
+//!
+//! Dofs are numbered `offset_b + D node + component` in both; a cell's element stiffness is
+//! `K_e = int_cell B^T C B dV` over its stiffness rule (times the thickness in 2D), with the
+//! plane-strain or plane-stress `C` of [`crate::solid::Elasticity`] in 2D and the isotropic
+//! 6x6 `C` of [`crate::solid3d::Elasticity3`] in 3D (Hughes, *The Finite Element Method*, 2000,
+//! chapters 2-3). Everything that does not depend on the dimension (dof numbering, sparsity,
+//! Dirichlet elimination, the active-set loop and every enforcement method) is written once
+//! against this trait.
+
+use crate::fe::{ElementKind, QuadPoint, ReferenceCell};
+use crate::fe3d::SolidKind;
+use crate::model::Model;
+use crate::solid::{element_internal_force, element_stiffness, Elasticity, Kinematics};
+use crate::solid3d::{element_internal_force3, element_stiffness3, Elasticity3};
+
+/// The cell kinds of a `D`-dimensional elastic body.
+pub trait SolidCell<const D: usize>: ReferenceCell<D> + Send + Sync + 'static {
+    /// The small-strain elastic material of a body of these cells.
+    type Material: Clone + std::fmt::Debug + Send + Sync;
+
+    /// The quadrature rule of the element stiffness.
+    fn stiffness_rule(self) -> Vec<QuadPoint<D>>;
+
+    /// The element stiffness `K_e` (row-major, `D n` square, `n` the cell's node count) of the
+    /// cell at `coords` with the rule `rule` (of [`SolidCell::stiffness_rule`]); `thickness`
+    /// multiplies it in 2D and is 1 in 3D.
+    fn element_stiffness(
+        self,
+        coords: &[[f64; D]],
+        material: &Self::Material,
+        thickness: f64,
+        rule: &[QuadPoint<D>],
+        ke: &mut [f64],
+    );
+
+    /// The small-strain internal force `f_e = int_cell B^T C B u_e dV` of the cell at `coords`
+    /// under the element displacement `u_e`, added to `out` (`D n` entries).
+    fn add_internal_force(
+        self,
+        coords: &[[f64; D]],
+        u_e: &[f64],
+        material: &Self::Material,
+        thickness: f64,
+        rule: &[QuadPoint<D>],
+        out: &mut [f64],
+    );
+
+    /// The model as a 2D model, where the physics built only in 2D (finite strain, dynamics,
+    /// friction, exact fields) lives; `None` in 3D, where the model refuses those scenes.
+    fn as_plane(model: &Model<D, Self>) -> Option<&Model>
+    where
+        Self: Sized;
+
+    /// Young's modulus of `material` (scales, messages).
+    fn youngs_modulus(material: &Self::Material) -> f64;
+
+    /// The axis names of the components, `x, y(, z)`.
+    fn axis_name(component: usize) -> &'static str {
+        ["x", "y", "z"][component]
+    }
+}
+
+impl SolidCell<2> for ElementKind {
+    type Material = Elasticity;
+
+    fn element_stiffness(
+        self,
+        coords: &[[f64; 2]],
+        material: &Elasticity,
+        thickness: f64,
+        rule: &[QuadPoint<2>],
+        ke: &mut [f64],
+    ) {
+        element_stiffness(self, coords, material, thickness, rule, ke);
+    }
+
+    fn stiffness_rule(self) -> Vec<QuadPoint<2>> {
+        ElementKind::stiffness_rule(self)
+    }
+
+    fn add_internal_force(
+        self,
+        coords: &[[f64; 2]],
+        u_e: &[f64],
+        material: &Elasticity,
+        thickness: f64,
+        rule: &[QuadPoint<2>],
+        out: &mut [f64],
+    ) {
+        let fe = element_internal_force(
+            Kinematics::SmallStrain,
+            self,
+            coords,
+            u_e,
+            material,
+            thickness,
+            rule,
+        );
+        for (o, f) in out.iter_mut().zip(fe.iter()) {
+            *o += f;
+        }
+    }
+
+    fn as_plane(model: &Model) -> Option<&Model> {
+        Some(model)
+    }
+
+    fn youngs_modulus(material: &Elasticity) -> f64 {
+        material.youngs_modulus
+    }
+}
+
+impl SolidCell<3> for SolidKind {
+    type Material = Elasticity3;
+
+    fn element_stiffness(
+        self,
+        coords: &[[f64; 3]],
+        material: &Elasticity3,
+        _thickness: f64,
+        rule: &[QuadPoint<3>],
+        ke: &mut [f64],
+    ) {
+        element_stiffness3(self, coords, material, rule, ke);
+    }
+
+    fn stiffness_rule(self) -> Vec<QuadPoint<3>> {
+        SolidKind::stiffness_rule(self)
+    }
+
+    fn add_internal_force(
+        self,
+        coords: &[[f64; 3]],
+        u_e: &[f64],
+        material: &Elasticity3,
+        _thickness: f64,
+        rule: &[QuadPoint<3>],
+        out: &mut [f64],
+    ) {
+        let fe = element_internal_force3(self, coords, u_e, material, rule);
+        for (o, f) in out.iter_mut().zip(&fe) {
+            *o += f;
+        }
+    }
+
+    fn as_plane(_model: &Model<3, SolidKind>) -> Option<&Model> {
+        None
+    }
+
+    fn youngs_modulus(material: &Elasticity3) -> f64 {
+        material.youngs_modulus
+    }
+}
