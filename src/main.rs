@@ -502,13 +502,27 @@ fn run3(
             ExitCode::from(2)
         }
         Ok((o, folder)) => {
+            let cells: Vec<String> = o
+                .model
+                .bodies
+                .iter()
+                .map(|b| format!("{} {:?} cells", b.mesh.cell_count(), b.mesh.kind))
+                .collect();
             println!(
-                "{}: 3D, {} dofs ({} {:?} cells)",
+                "{}: 3D, {} dofs ({})",
                 o.name,
-                o.solid.dof_count(),
-                o.solid.mesh.cell_count(),
-                o.solid.mesh.kind
+                o.model.dof_count,
+                cells.join(", ")
             );
+            if let Some(c) = &o.solution.contact {
+                let active = c.active.iter().filter(|&&a| a).count();
+                println!(
+                    "  contact: {:?} after {} iteration(s), {active} of {} rows active",
+                    c.termination,
+                    c.iterations,
+                    c.rows.len()
+                );
+            }
             for c in &o.checks {
                 println!(
                     "  {} {} (error {:.3e}, tol {:.1e})",

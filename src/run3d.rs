@@ -1,13 +1,18 @@
-//! One run of a 3D case (a body with a `block3d` mesh): validate, solve small-strain
-//! elasticity, judge the checks, write `summary.json` and the body's `.vtu`.
+//! One run of a 3D case (bodies with `block3d` meshes): validate into a [`Model3`], solve
+//! small-strain elasticity, with contact when the case has pairs, judge the checks, write
+//! `summary.json` and one `.vtu` per body.
 //!
-//! The 3D floor of the dimension seam (issue 13): the case format, mesher
-//! ([`crate::mesh::block3`]), kernels ([`crate::solid3d`]) and solve
-//! ([`crate::solver::elastic3d::Solid3`]) work in 3D; what is not built in 3D yet is refused
-//! here with the reason (an invalid-case error, exit 2), never computed wrongly: contact
-//! (`"contact in 3D is not built yet"`), dynamics, finite strain, sweeps, exact solutions,
-//! load paths, user-defined sets, more than one body, loads other than pressure, checks other
-//! than `uniform_stress_3d`.
+//! The 3D side of the dimension seam (issue 13): the case format, mesher
+//! ([`crate::mesh::block3`]) and kernels ([`crate::solid3d`]) are 3D; the model
+//! ([`crate::model::Model`]`<3, SolidKind>`), the assembly and elastic solve
+//! ([`crate::solver::linear`]), the rigid-mode check ([`crate::model::admit::check_rigid_modes`])
+//! and the active-set contact solve with every enforcement method
+//! ([`crate::solver::active_set`]) are the 2D code paths, generic over the dimension. What is
+//! not built in 3D yet is refused here with the reason (an invalid-case error, exit 2), never
+//! computed wrongly: dynamics, finite strain, friction, the Newton scheme and the current
+//! contact geometry, sweeps, exact solutions, load paths, user-defined sets, loads other than
+//! pressure, checks other than `uniform_stress_3d`; the 3D discretizations refuse what they do
+//! not treat ([`crate::contact::discretization::Discretize`]).
 //!
 //! The check `uniform_stress_3d` is the 3D uniform-stress check: the largest difference over
 //! the quadrature points of the stiffness rule and the six components, relative to the
@@ -20,12 +25,12 @@ use crate::fe::ReferenceCell;
 use crate::fe3d::SolidKind;
 use crate::harness::checks::CheckResult;
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
-use crate::io::scene::{Case, Check, Kinematics, MeshSpec, Prescribed};
+use crate::io::scene::{Case, Check, ContactGeometry, Kinematics, MeshSpec, Prescribed, Scheme};
 use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
-use crate::solid3d::{check_geometry3, strain_at3, Elasticity3};
-use crate::solver::elastic3d::Solid3;
-use crate::solver::sparse::WorkLimit;
+use crate::model::{Body3, Model3};
+use crate::solid3d::{check_geometry3, facet_traction_load, strain_at3, Elasticity3};
+use crate::solver::linear::Solution;
 use std::path::Path;
 
 /// Whether the case has a 3D body (and so runs here).
@@ -47,41 +52,35 @@ pub fn read_3d_case(path: &Path) -> Option<Case> {
 #[derive(Clone, Debug)]
 pub struct Outcome3 {
     pub name: String,
-    pub body_name: String,
-    pub solid: Solid3,
-    pub u: Vec<f64>,
+    pub model: Model3,
+    pub solution: Solution<3>,
     pub checks: Vec<CheckResult>,
 }
 
 impl Outcome3 {
+    /// Every check passes and the contact solve (if any) converged.
     pub fn passed(&self) -> bool {
-        self.checks.iter().all(|c| c.passed)
+        self.checks.iter().all(|c| c.passed) && self.converged()
+    }
+
+    /// Whether the contact solve converged (`true` without contact).
+    pub fn converged(&self) -> bool {
+        self.solution
+            .contact
+            .as_ref()
+            .is_none_or(|c| c.termination == crate::contact::state::Termination::Converged)
     }
 }
 
 /// Run the 3D case `case` read from `source`.
 pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
-    let (solid, body_name) = build3(case, source)?;
-    let limit = WorkLimit {
-        gigabytes: case.limits.factor_gigabytes,
-        operations: case.limits.factor_operations,
+    let model = build3(case, source)?;
+    crate::model::admit::check_rigid_modes(&model)?;
+    let solution = if model.contact.is_empty() {
+        crate::solver::linear::solve_elastic(&model, &mut |_| {})?
+    } else {
+        crate::solver::active_set::solve(&model, &mut |_| {})?
     };
-    let u = solid.solve(&limit).map_err(|e| {
-        Error::invalid(
-            source,
-            format!("bodies[0] '{body_name}'"),
-            format!("the stiffness cannot be factored ({e:?})"),
-            "support the body against all six rigid motions (three translations, three rotations), or raise \"limits\" if the factor is too large",
-        )
-    })?;
-    if let Some(d) = u.iter().position(|v| !v.is_finite()) {
-        return Err(Error::invalid(
-            source,
-            format!("bodies[0] '{body_name}'"),
-            format!("the displacement of dof {d} is not finite"),
-            "rescale the loads and moduli (e.g. N and mm)",
-        ));
-    }
     let checks = case
         .checks
         .iter()
@@ -89,9 +88,10 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
             Check::UniformStress3d { stress, tol } => {
                 let largest = stress.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 let scale = if largest > 0.0 { largest } else { 1.0 };
-                let error = solid
-                    .stresses(&u)
+                let error = model
+                    .bodies
                     .iter()
+                    .flat_map(|b| body_stresses(b, &solution.u))
                     .flat_map(|(_, s)| (0..6).map(move |i| (s[i] - stress[i]).abs()))
                     .fold(0.0, f64::max)
                     / scale;
@@ -107,11 +107,29 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
         .collect();
     Ok(Outcome3 {
         name: case.name.clone(),
-        body_name,
-        solid,
-        u,
+        model,
+        solution,
         checks,
     })
+}
+
+/// The stress of the displacement `u` (global) in `body` at every quadrature point of the
+/// stiffness rule, with the point: `(x, sigma)`.
+pub fn body_stresses(body: &Body3, u: &[f64]) -> Vec<([f64; 3], [f64; 6])> {
+    let kind = body.mesh.kind;
+    let rule = kind.stiffness_rule();
+    let mut dofs = Vec::new();
+    let mut out = Vec::new();
+    for c in 0..body.mesh.cell_count() {
+        let coords = body.mesh.cell_coords(c);
+        body.cell_dofs(c, &mut dofs);
+        let u_e: Vec<f64> = dofs.iter().map(|&d| u[d]).collect();
+        for q in &rule {
+            let (eps, x) = strain_at3(kind, &coords, &u_e, q.xi);
+            out.push((x, body.material.stress(eps)));
+        }
+    }
+    out
 }
 
 /// The reason a feature is refused in 3D.
@@ -119,18 +137,10 @@ fn not_built(source: &str, at: impl std::fmt::Display, what: &str, hint: &str) -
     Error::invalid(source, at, format!("{what} in 3D is not built yet"), hint)
 }
 
-/// Validate the 3D case into its body (see the module docs for what is refused).
-pub fn build3(case: &Case, source: &str) -> Result<(Solid3, String)> {
+/// Validate the 3D case into its model (see the module docs for what is refused).
+pub fn build3(case: &Case, source: &str) -> Result<Model3> {
     if let Some(problem) = name_problem(&case.name) {
         return Err(Error::invalid(source, "name", problem, NAME_RULE));
-    }
-    if let Some(pair) = case.contact.first() {
-        return Err(not_built(
-            source,
-            format!("contact[0] '{}'", pair.name),
-            "contact",
-            "3D bodies run without contact for now: remove \"contact\", or give the bodies 2D meshes",
-        ));
     }
     if case.physics.dynamics.is_some() {
         return Err(not_built(
@@ -148,6 +158,22 @@ pub fn build3(case: &Case, source: &str) -> Result<(Solid3, String)> {
             "use small strain (remove physics.kinematics)",
         ));
     }
+    if case.physics.contact_geometry == ContactGeometry::Current {
+        return Err(not_built(
+            source,
+            "physics.contact_geometry",
+            "contact in the current geometry",
+            "remove physics.contact_geometry (contact in the reference geometry)",
+        ));
+    }
+    if case.solver.scheme == Scheme::Newton {
+        return Err(not_built(
+            source,
+            "solver.scheme",
+            "the Newton scheme",
+            "remove solver.scheme (the active-set scheme)",
+        ));
+    }
     if case.sweep.is_some() {
         return Err(not_built(source, "sweep", "a sweep", "remove the sweep"));
     }
@@ -159,245 +185,118 @@ pub fn build3(case: &Case, source: &str) -> Result<(Solid3, String)> {
             "remove \"exact\"; give the supports numbers and judge with uniform_stress_3d",
         ));
     }
-    if case.bodies.len() != 1 {
-        return Err(Error::invalid(
-            source,
-            "bodies",
-            format!(
-                "a 3D case has one body for now (3D bodies do not meet 2D ones), got {}",
-                case.bodies.len()
-            ),
-            "run each 3D body as a case of its own",
-        ));
-    }
-    let spec = &case.bodies[0];
-    let at = format!("bodies[0] '{}'", spec.name);
-    if let Some(problem) = name_problem(&spec.name) {
-        return Err(Error::invalid(
-            source,
-            format!("{at}.name"),
-            problem,
-            NAME_RULE,
-        ));
-    }
-    let MeshSpec::Block3d(block) = &spec.mesh else {
-        unreachable!("a 3D case has a block3d body")
-    };
-    if !spec.node_sets.is_empty() || !spec.facet_sets.is_empty() {
-        return Err(not_built(
-            source,
-            &at,
-            "user-defined node and facet sets",
-            "use the automatic sets: left/right (x), front/back (y), bottom/top (z), the corners such as bottom_front_left, and all",
-        ));
-    }
-    let Some(mat) = case.materials.get(&spec.material) else {
-        let known: Vec<&String> = case.materials.keys().collect();
-        return Err(Error::invalid(
-            source,
-            format!("{at}.material"),
-            format!("material '{}' is not defined", spec.material),
-            format!("define it under \"materials\" or use one of {known:?}"),
-        ));
-    };
-    if !(mat.youngs_modulus.is_finite() && mat.youngs_modulus > 0.0) {
-        return Err(Error::invalid(
-            source,
-            format!("materials.{}.E", spec.material),
-            format!(
-                "Young's modulus must be positive and finite, got {}",
-                mat.youngs_modulus
-            ),
-            "give E > 0",
-        ));
-    }
-    if !(mat.nu.is_finite() && mat.nu > -1.0 && mat.nu < 0.5) {
-        return Err(Error::invalid(
-            source,
-            format!("materials.{}.nu", spec.material),
-            format!("Poisson's ratio must lie in (-1, 0.5), got {}", mat.nu),
-            "nu = 0.5 (incompressible) is not supported by displacement elements; use e.g. 0.499",
-        ));
-    }
-    if !mat.model.is_linear() {
-        return Err(not_built(
-            source,
-            format!("materials.{}.model", spec.material),
-            "a hyperelastic material",
-            "use \"model\": \"linear_elastic\"",
-        ));
-    }
-    crate::model::check_size(case, source)?;
-    let (xs, ys, zs) = (block.x.values(), block.y.values(), block.z.values());
-    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-    if !(finite(&xs) && finite(&ys) && finite(&zs))
-        || block
-            .moves
-            .iter()
-            .any(|m| !(finite(&m.from) && finite(&m.to)))
+    if let Some(k) = case
+        .bodies
+        .iter()
+        .position(|b| !matches!(b.mesh, MeshSpec::Block3d(_)))
     {
         return Err(Error::invalid(
             source,
-            format!("{at}.mesh.block3d"),
-            "a break or a move is not finite",
-            "give finite coordinates",
+            format!("bodies[{k}] '{}'", case.bodies[k].name),
+            "the body is 2D and another body of the case 3D; 2D and 3D bodies do not meet",
+            "give every body a \"block3d\" mesh, or run the 2D bodies as a case of their own",
         ));
     }
-    let moves: Vec<_> = block.moves.iter().map(|m| (m.from, m.to)).collect();
-    let mesh = block3(block.element, &xs, &ys, &zs, &moves).map_err(|e| {
-        Error::invalid(
-            source,
-            format!("{at}.mesh.block3d"),
-            e,
-            "fix the breaks or moves",
-        )
-    })?;
-    for c in 0..mesh.cell_count() {
-        if let Err(bad) = check_geometry3(mesh.kind, &mesh.cell_coords(c)) {
+    crate::model::check_size(case, source)?;
+    let mut bodies: Vec<Body3> = Vec::new();
+    for (bi, spec) in case.bodies.iter().enumerate() {
+        let at = format!("bodies[{bi}] '{}'", spec.name);
+        if let Some(problem) = name_problem(&spec.name) {
             return Err(Error::invalid(
                 source,
-                format!("{at}: element {c} (nodes {:?})", mesh.cell(c)),
-                format!(
-                    "the element is inverted or degenerate: det J = {:.3e} at ({:.6}, {:.6}, {:.6})",
-                    bad.det_j, bad.at[0], bad.at[1], bad.at[2]
-                ),
-                "keep the moves small against the element size",
+                format!("{at}.name"),
+                problem,
+                NAME_RULE,
             ));
         }
-    }
-    let mut solid = Solid3::new(mesh, Elasticity3::new(mat.youngs_modulus, mat.nu));
-    let node_set = |solid: &Solid3, body: &str, set: &str, at: &str| -> Result<Vec<usize>> {
-        if body != spec.name {
+        if bodies.iter().any(|b| b.name == spec.name) {
             return Err(Error::invalid(
                 source,
-                at,
-                format!("body '{body}' does not exist"),
-                format!("use the body '{}'", spec.name),
+                &at,
+                format!("a second body is named '{}'", spec.name),
+                "give every body a unique name",
             ));
         }
-        solid.mesh.node_sets.get(set).cloned().ok_or_else(|| {
-            let known: Vec<&String> = solid.mesh.node_sets.keys().collect();
+        let MeshSpec::Block3d(block) = &spec.mesh else {
+            unreachable!("every body was checked to be 3D above")
+        };
+        if !spec.node_sets.is_empty() || !spec.facet_sets.is_empty() {
+            return Err(not_built(
+                source,
+                &at,
+                "user-defined node and facet sets",
+                "use the automatic sets: left/right (x), front/back (y), bottom/top (z), the corners such as bottom_front_left, and all",
+            ));
+        }
+        let material = material3(case, &spec.material, source, &at)?;
+        let (xs, ys, zs) = (block.x.values(), block.y.values(), block.z.values());
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        if !(finite(&xs) && finite(&ys) && finite(&zs))
+            || block
+                .moves
+                .iter()
+                .any(|m| !(finite(&m.from) && finite(&m.to)))
+        {
+            return Err(Error::invalid(
+                source,
+                format!("{at}.mesh.block3d"),
+                "a break or a move is not finite",
+                "give finite coordinates",
+            ));
+        }
+        let moves: Vec<_> = block.moves.iter().map(|m| (m.from, m.to)).collect();
+        let mesh = block3(block.element, &xs, &ys, &zs, &moves).map_err(|e| {
             Error::invalid(
                 source,
-                at,
-                format!("body '{body}' has no node set '{set}'"),
-                format!("use one of {known:?}"),
+                format!("{at}.mesh.block3d"),
+                e,
+                "fix the breaks or moves",
             )
-        })
-    };
-    for (k, s) in case.supports.iter().enumerate() {
-        let at = format!("supports[{k}]");
-        let nodes = node_set(&solid, &s.body, &s.set, &at)?;
-        if s.path.is_some() {
-            return Err(not_built(
-                source,
-                format!("{at}.path"),
-                "a load path",
-                "remove \"path\"",
-            ));
-        }
-        if s.x.is_none() && s.y.is_none() && s.z.is_none() {
-            return Err(Error::invalid(
-                source,
-                &at,
-                "the support fixes no component",
-                "add \"x\", \"y\" and/or \"z\" (numbers)",
-            ));
-        }
-        for (comp, value) in [(0, s.x), (1, s.y), (2, s.z)] {
-            let v = match value {
-                None => continue,
-                Some(Prescribed::Value(v)) if v.is_finite() => v,
-                Some(Prescribed::Value(_)) => {
-                    return Err(Error::invalid(
-                        source,
-                        &at,
-                        "the prescribed value is not finite",
-                        "give a finite number",
-                    ))
-                }
-                Some(Prescribed::Exact(_)) => {
-                    return Err(not_built(
-                        source,
-                        &at,
-                        "\"exact\" as a prescribed value",
-                        "give a number",
-                    ))
-                }
-            };
-            for &n in &nodes {
-                let dof = solid.dof(n, comp);
-                match solid.prescribed[dof] {
-                    Some(old) if old != v => {
-                        return Err(Error::invalid(
-                            source,
-                            &at,
-                            format!(
-                                "node {n} gets u_{} = {v} here but {old} from an earlier support",
-                                ["x", "y", "z"][comp]
-                            ),
-                            "remove one of the conflicting supports or make their values agree",
-                        ))
-                    }
-                    _ => solid.prescribed[dof] = Some(v),
-                }
+        })?;
+        for c in 0..mesh.cell_count() {
+            if let Err(bad) = check_geometry3(mesh.kind, &mesh.cell_coords(c)) {
+                return Err(Error::invalid(
+                    source,
+                    format!("{at}: element {c} (nodes {:?})", mesh.cell(c)),
+                    format!(
+                        "the element is inverted or degenerate: det J = {:.3e} at ({:.6}, {:.6}, {:.6})",
+                        bad.det_j, bad.at[0], bad.at[1], bad.at[2]
+                    ),
+                    "keep the moves small against the element size",
+                ));
             }
         }
+        bodies.push(Body3 {
+            name: spec.name.clone(),
+            material_name: spec.material.clone(),
+            material,
+            hyperelastic: None,
+            mesh,
+            dof_offset: 0,
+        });
     }
-    for (k, load) in case.loads.iter().enumerate() {
-        let at = format!("loads[{k}]");
-        if load.path.is_some() {
+    let mut model = Model3::with_bodies(&case.name, source, bodies);
+    model.description = case.description.clone();
+    model.plane = case.analysis.plane;
+    model.physics = case.physics.clone();
+    model.solver = case.solver.clone();
+    model.factor_limit = crate::solver::sparse::WorkLimit {
+        gigabytes: case.limits.factor_gigabytes,
+        operations: case.limits.factor_operations,
+    };
+    model.iteration_dofs = case.limits.iteration_dofs;
+    apply_supports3(&mut model, case)?;
+    apply_pressures3(&mut model, case)?;
+    model.resolve_contact(case)?;
+    for (k, pair) in case.contact.iter().enumerate() {
+        if pair.interaction.friction().is_some() {
             return Err(not_built(
                 source,
-                format!("{at}.path"),
-                "a load path",
-                "remove \"path\"",
+                format!("contact[{k}] '{}'.interaction", pair.name),
+                "Coulomb friction",
+                "use a frictionless or tied interaction",
             ));
         }
-        let (Some(p), None, None, None) =
-            (load.pressure, &load.traction, load.body_force, load.force)
-        else {
-            return Err(not_built(
-                source,
-                &at,
-                "a traction, force or body force (their components are 2D in the case format)",
-                "give a \"pressure\" on a facet set",
-            ));
-        };
-        if !p.is_finite() {
-            return Err(Error::invalid(
-                source,
-                &at,
-                "the pressure is not finite",
-                "give a finite number",
-            ));
-        }
-        if load.body != spec.name {
-            return Err(Error::invalid(
-                source,
-                &at,
-                format!("body '{}' does not exist", load.body),
-                format!("use the body '{}'", spec.name),
-            ));
-        }
-        let Some(set) = &load.set else {
-            return Err(Error::invalid(
-                source,
-                &at,
-                "a pressure needs a facet \"set\"",
-                "add \"set\": e.g. \"top\"",
-            ));
-        };
-        let Some(facets) = solid.mesh.facet_sets.get(set).cloned() else {
-            let known: Vec<&String> = solid.mesh.facet_sets.keys().collect();
-            return Err(Error::invalid(
-                source,
-                &at,
-                format!("body '{}' has no facet set '{set}'", spec.name),
-                format!("use one of {known:?}"),
-            ));
-        };
-        solid.add_traction(&facets, &|_, n| n.map(|v| -p * v));
     }
     for (k, check) in case.checks.iter().enumerate() {
         let at = format!("checks[{k}]");
@@ -422,25 +321,193 @@ pub fn build3(case: &Case, source: &str) -> Result<(Solid3, String)> {
             }
         }
     }
-    Ok((solid, spec.name.clone()))
+    model.checks = case.checks.clone();
+    Ok(model)
 }
 
-/// The nodal stress: the mean over the cells around each node of the stress at the cell's
-/// natural centre.
-fn nodal_stress(outcome: &Outcome3) -> Vec<[f64; 6]> {
-    let mesh = &outcome.solid.mesh;
+/// The linear elastic material `name` of the case, validated.
+fn material3(case: &Case, name: &str, source: &str, at: &str) -> Result<Elasticity3> {
+    let Some(mat) = case.materials.get(name) else {
+        let known: Vec<&String> = case.materials.keys().collect();
+        return Err(Error::invalid(
+            source,
+            format!("{at}.material"),
+            format!("material '{name}' is not defined"),
+            format!("define it under \"materials\" or use one of {known:?}"),
+        ));
+    };
+    if !(mat.youngs_modulus.is_finite() && mat.youngs_modulus > 0.0) {
+        return Err(Error::invalid(
+            source,
+            format!("materials.{name}.E"),
+            format!(
+                "Young's modulus must be positive and finite, got {}",
+                mat.youngs_modulus
+            ),
+            "give E > 0",
+        ));
+    }
+    if !(mat.nu.is_finite() && mat.nu > -1.0 && mat.nu < 0.5) {
+        return Err(Error::invalid(
+            source,
+            format!("materials.{name}.nu"),
+            format!("Poisson's ratio must lie in (-1, 0.5), got {}", mat.nu),
+            "nu = 0.5 (incompressible) is not supported by displacement elements; use e.g. 0.499",
+        ));
+    }
+    if !mat.model.is_linear() {
+        return Err(not_built(
+            source,
+            format!("materials.{name}.model"),
+            "a hyperelastic material",
+            "use \"model\": \"linear_elastic\"",
+        ));
+    }
+    Ok(Elasticity3::new(mat.youngs_modulus, mat.nu))
+}
+
+/// The supports of the case: prescribed components of node sets.
+fn apply_supports3(model: &mut Model3, case: &Case) -> Result<()> {
+    let source = model.source.clone();
+    for (k, s) in case.supports.iter().enumerate() {
+        let at = format!("supports[{k}]");
+        let b = model.find_body(&s.body, &at)?;
+        let nodes = model.find_node_set(b, &s.set, &at)?.to_vec();
+        let bi = model.body_index(&s.body).expect("found above");
+        if s.path.is_some() {
+            return Err(not_built(
+                &source,
+                format!("{at}.path"),
+                "a load path",
+                "remove \"path\"",
+            ));
+        }
+        if s.x.is_none() && s.y.is_none() && s.z.is_none() {
+            return Err(Error::invalid(
+                &source,
+                &at,
+                "the support fixes no component",
+                "add \"x\", \"y\" and/or \"z\" (numbers)",
+            ));
+        }
+        for (comp, value) in [(0, s.x), (1, s.y), (2, s.z)] {
+            let v = match value {
+                None => continue,
+                Some(Prescribed::Value(v)) if v.is_finite() => v,
+                Some(Prescribed::Value(_)) => {
+                    return Err(Error::invalid(
+                        &source,
+                        &at,
+                        "the prescribed value is not finite",
+                        "give a finite number",
+                    ))
+                }
+                Some(Prescribed::Exact(_)) => {
+                    return Err(not_built(
+                        &source,
+                        &at,
+                        "\"exact\" as a prescribed value",
+                        "give a number",
+                    ))
+                }
+            };
+            for &n in &nodes {
+                let dof = model.bodies[bi].dof(n, comp);
+                match model.prescribed[dof] {
+                    Some(old) if old != v => {
+                        return Err(Error::invalid(
+                            &source,
+                            &at,
+                            format!(
+                                "node {n} of body '{}' gets u_{} = {v} here but {old} from an earlier support",
+                                s.body,
+                                ["x", "y", "z"][comp]
+                            ),
+                            "remove one of the conflicting supports or make their values agree",
+                        ))
+                    }
+                    _ => model.prescribed[dof] = Some(v),
+                }
+            }
+        }
+        model.support_sets.push((bi, s.set.clone()));
+    }
+    Ok(())
+}
+
+/// The pressures of the case: `t = -p n` on facet sets, as consistent nodal forces.
+fn apply_pressures3(model: &mut Model3, case: &Case) -> Result<()> {
+    let source = model.source.clone();
+    for (k, load) in case.loads.iter().enumerate() {
+        let at = format!("loads[{k}]");
+        if load.path.is_some() {
+            return Err(not_built(
+                &source,
+                format!("{at}.path"),
+                "a load path",
+                "remove \"path\"",
+            ));
+        }
+        let (Some(p), None, None, None) =
+            (load.pressure, &load.traction, load.body_force, load.force)
+        else {
+            return Err(not_built(
+                &source,
+                &at,
+                "a traction, force or body force (their components are 2D in the case format)",
+                "give a \"pressure\" on a facet set",
+            ));
+        };
+        if !p.is_finite() {
+            return Err(Error::invalid(
+                &source,
+                &at,
+                "the pressure is not finite",
+                "give a finite number",
+            ));
+        }
+        let Some(set) = &load.set else {
+            return Err(Error::invalid(
+                &source,
+                &at,
+                "a pressure needs a facet \"set\"",
+                "add \"set\": e.g. \"top\"",
+            ));
+        };
+        let body = model.find_body(&load.body, &at)?;
+        let facets = model.find_facet_set(body, set, &at)?.to_vec();
+        let facet_kind = body.mesh.kind.facet_kind();
+        let mut force = vec![0.0; model.dof_count];
+        for &f in &facets {
+            let nodes = body.mesh.facet_nodes(f);
+            let coords: Vec<[f64; 3]> = nodes.iter().map(|&n| body.mesh.nodes[n]).collect();
+            let fe = facet_traction_load(facet_kind, &coords, &|_, n| n.map(|v| -p * v));
+            for (a, &n) in nodes.iter().enumerate() {
+                for i in 0..3 {
+                    force[body.dof(n, i)] += fe[3 * a + i];
+                }
+            }
+        }
+        for (f, v) in model.external_force.iter_mut().zip(force) {
+            *f += v;
+        }
+    }
+    Ok(())
+}
+
+/// The nodal stress of `body`: the mean over the cells around each node of the stress at the
+/// cell's natural centre.
+fn nodal_stress(body: &Body3, u: &[f64]) -> Vec<[f64; 6]> {
+    let mesh = &body.mesh;
     let kind: SolidKind = mesh.kind;
     let mut sum = vec![[0.0; 6]; mesh.nodes.len()];
     let mut count = vec![0usize; mesh.nodes.len()];
+    let mut dofs = Vec::new();
     for c in 0..mesh.cell_count() {
-        let u_e: Vec<f64> = outcome
-            .solid
-            .cell_dofs(c)
-            .into_iter()
-            .map(|d| outcome.u[d])
-            .collect();
+        body.cell_dofs(c, &mut dofs);
+        let u_e: Vec<f64> = dofs.iter().map(|&d| u[d]).collect();
         let (eps, _) = strain_at3(kind, &mesh.cell_coords(c), &u_e, kind.centre());
-        let sigma = outcome.solid.material.stress(eps);
+        let sigma = body.material.stress(eps);
         for &n in mesh.cell(c) {
             for i in 0..6 {
                 sum[n][i] += sigma[i];
@@ -454,47 +521,80 @@ fn nodal_stress(outcome: &Outcome3) -> Vec<[f64; 6]> {
         .collect()
 }
 
-/// Write `summary.json` and `<body>.vtu` into `folder` (replaced as a whole).
+/// The contact part of the summary: how the solve ended and the rows' totals.
+fn contact_summary(outcome: &Outcome3) -> Option<serde_json::Value> {
+    let state = outcome.solution.contact.as_ref()?;
+    let active = state.active.iter().filter(|&&a| a).count();
+    let mut force = [0.0; 3];
+    for (r, f) in state.rows.iter().zip(&state.forces) {
+        for i in 0..3 {
+            force[i] += f * r.normal[i];
+        }
+    }
+    Some(serde_json::json!({
+        "termination": format!("{:?}", state.termination),
+        "iterations": state.iterations,
+        "rows": state.rows.len(),
+        "active": active,
+        "force_on_slaves": force,
+    }))
+}
+
+/// Write `summary.json` and one `<body>.vtu` per body into `folder` (replaced as a whole).
 pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
-    let mesh = &outcome.solid.mesh;
-    let max_displacement = (0..mesh.nodes.len())
-        .map(|n| {
-            (0..3)
-                .map(|i| outcome.u[3 * n + i].powi(2))
-                .sum::<f64>()
-                .sqrt()
+    let model = &outcome.model;
+    let u = &outcome.solution.u;
+    let bodies: Vec<serde_json::Value> = model
+        .bodies
+        .iter()
+        .map(|b| {
+            let max_displacement = (0..b.mesh.nodes.len())
+                .map(|n| (0..3).map(|i| u[b.dof(n, i)].powi(2)).sum::<f64>().sqrt())
+                .fold(0.0, f64::max);
+            serde_json::json!({
+                "name": b.name,
+                "element": b.mesh.kind,
+                "nodes": b.mesh.nodes.len(),
+                "cells": b.mesh.cell_count(),
+                "max_displacement": max_displacement,
+            })
         })
-        .fold(0.0, f64::max);
+        .collect();
     let summary = serde_json::json!({
         "case": outcome.name,
         "dimension": 3,
-        "body": outcome.body_name,
-        "element": mesh.kind,
-        "nodes": mesh.nodes.len(),
-        "cells": mesh.cell_count(),
-        "dofs": outcome.solid.dof_count(),
-        "max_displacement": max_displacement,
+        "bodies": bodies,
+        "dofs": model.dof_count,
+        "relative_residual": outcome.solution.relative_residual,
+        "contact": contact_summary(outcome),
         "passed": outcome.passed(),
         "checks": outcome.checks.iter().map(|c| serde_json::json!({
             "check": c.check, "error": c.error, "tol": c.tol, "passed": c.passed,
         })).collect::<Vec<_>>(),
     });
-    let stress: Vec<f64> = nodal_stress(outcome).into_iter().flatten().collect();
-    let cells: Vec<(u8, Vec<usize>)> = (0..mesh.cell_count())
-        .map(|c| (mesh.kind.vtk_cell_type(), mesh.cell(c).to_vec()))
-        .collect();
     folder.write(|tmp| {
         let text = serde_json::to_string_pretty(&summary).expect("the summary serializes");
         crate::io::paths::write_new_file(&tmp.join("summary.json"), &(text + "\n"))?;
-        let path = tmp.join(file_name("body name", &outcome.body_name, ".vtu")?);
-        write_grid(
-            &path,
-            &mesh.nodes,
-            &cells,
-            &[
-                PointArray::float("displacement", 3, outcome.u.clone()),
-                PointArray::float("stress", 6, stress),
-            ],
-        )
+        for body in &model.bodies {
+            let mesh = &body.mesh;
+            let stress: Vec<f64> = nodal_stress(body, u).into_iter().flatten().collect();
+            let displacement: Vec<f64> = (0..mesh.nodes.len())
+                .flat_map(|n| (0..3).map(move |i| u[body.dof(n, i)]))
+                .collect();
+            let cells: Vec<(u8, Vec<usize>)> = (0..mesh.cell_count())
+                .map(|c| (mesh.kind.vtk_cell_type(), mesh.cell(c).to_vec()))
+                .collect();
+            let path = tmp.join(file_name("body name", &body.name, ".vtu")?);
+            write_grid(
+                &path,
+                &mesh.nodes,
+                &cells,
+                &[
+                    PointArray::float("displacement", 3, displacement),
+                    PointArray::float("stress", 6, stress),
+                ],
+            )?;
+        }
+        Ok(())
     })
 }

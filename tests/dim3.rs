@@ -307,7 +307,7 @@ fn the_3d_example_runs_and_writes_a_3d_vtu_with_six_stress_components() {
 }
 
 #[test]
-fn a_3d_case_with_a_contact_pair_is_refused_with_the_reason() {
+fn a_3d_body_against_a_2d_rigid_surface_is_refused_with_the_reason() {
     let (dir, path) = edited_case(|case| {
         case["contact"] = serde_json::json!([{
             "name": "ground",
@@ -321,9 +321,10 @@ fn a_3d_case_with_a_contact_pair_is_refused_with_the_reason() {
     let (code, _, stderr) = run_binary(&path, &out);
     assert_eq!(code, 2, "{stderr}");
     assert!(
-        stderr.contains("contact in 3D is not built yet"),
+        stderr.contains("the rigid surface is 2D and the bodies are 3D"),
         "{stderr}"
     );
+    assert!(stderr.contains("\"plane\" or a \"sphere\""), "{stderr}");
     assert!(stderr.contains("contact[0] 'ground'"), "{stderr}");
     assert!(!out.exists(), "nothing is written for a refused case");
 }
@@ -348,7 +349,7 @@ fn what_3d_does_not_have_yet_is_refused_and_2d_cases_refuse_3d_fields() {
             Box::new(|c: &mut serde_json::Value| {
                 c["supports"] = serde_json::json!([{"body": "block", "set": "bottom", "z": 0.0}])
             }),
-            "the stiffness cannot be factored",
+            "the body is not held against rigid motion: it can translate in x",
         ),
     ] {
         let (dir, path) = edited_case(|c| edit(c));

@@ -280,16 +280,24 @@ pub struct FrictionSummary {
 }
 
 /// The frictional totals of all pairs of `state` (`None`: no frictional row).
-pub fn step_summary(state: &super::state::ContactState) -> Option<FrictionSummary> {
+pub fn step_summary<const D: usize>(
+    state: &super::state::ContactState<D>,
+) -> Option<FrictionSummary> {
     summarize(state, None)
 }
 
 /// The frictional totals of pair `pair` of `state` (`None`: no frictional row).
-pub fn pair_summary(state: &super::state::ContactState, pair: usize) -> Option<FrictionSummary> {
+pub fn pair_summary<const D: usize>(
+    state: &super::state::ContactState<D>,
+    pair: usize,
+) -> Option<FrictionSummary> {
     summarize(state, Some(pair))
 }
 
-fn summarize(state: &super::state::ContactState, pair: Option<usize>) -> Option<FrictionSummary> {
+fn summarize<const D: usize>(
+    state: &super::state::ContactState<D>,
+    pair: Option<usize>,
+) -> Option<FrictionSummary> {
     let mut out = FrictionSummary {
         tangential_force: [0.0; 2],
         open: 0,

@@ -97,6 +97,23 @@ pub struct Constraint<const D: usize = 2> {
     pub hessian: Option<GapHessian>,
 }
 
+/// Where a row acts, in any dimension: its dofs, the slave dof it may be solved for and the
+/// slave point (what an enforcement method's applicability depends on).
+#[derive(Clone, Copy, Debug)]
+pub struct RowSite<'a> {
+    pub dofs: &'a [usize],
+    pub owner: usize,
+    pub point: &'a [f64],
+}
+
+impl RowSite<'_> {
+    /// The slave point in words, `(x, y)` or `(x, y, z)`.
+    pub fn at(&self) -> String {
+        let at: Vec<String> = self.point.iter().map(|x| x.to_string()).collect();
+        format!("({})", at.join(", "))
+    }
+}
+
 /// The second derivative of a row's gap over the dofs it depends on, evaluated where the row
 /// was built: `values[a * dofs.len() + b] = d2 g / du_{dofs[a]} du_{dofs[b]}` (symmetric).
 #[derive(Clone, Debug, PartialEq)]
@@ -129,16 +146,36 @@ impl TangentRow {
 }
 
 /// A row's identity across iterations, geometry updates and load steps: pair, pass, slave body
-/// and node, and for ties the direction (0 = x, 1 = y).
+/// and node, and for ties the direction (0 = x, 1 = y, 2 = z: the largest component of the
+/// tie's normal, the first of equal ones).
 pub(crate) type RowKey = (usize, u8, usize, usize, u8);
 
 /// The identity of row `r`.
-pub(crate) fn row_key(r: &Constraint) -> RowKey {
-    let direction = u8::from(r.bilateral && r.normal[1].abs() > r.normal[0].abs());
+pub(crate) fn row_key<const D: usize>(r: &Constraint<D>) -> RowKey {
+    let direction = if r.bilateral {
+        (1..D).fold(0, |best, i| {
+            if r.normal[i].abs() > r.normal[best].abs() {
+                i
+            } else {
+                best
+            }
+        }) as u8
+    } else {
+        0
+    };
     (r.pair, r.pass, r.slave_body, r.slave_node, direction)
 }
 
 impl<const D: usize> Constraint<D> {
+    /// Where the row acts (see [`RowSite`]).
+    pub fn site(&self) -> RowSite<'_> {
+        RowSite {
+            dofs: &self.dofs,
+            owner: self.owner,
+            point: &self.point,
+        }
+    }
+
     /// Gap for the displacement `u`.
     pub fn gap(&self, u: &[f64]) -> f64 {
         self.g0

@@ -23,8 +23,8 @@ pub enum Termination {
 
 /// What the contact solve found.
 #[derive(Clone, Debug)]
-pub struct ContactState {
-    pub rows: Vec<Constraint>,
+pub struct ContactState<const D: usize = 2> {
+    pub rows: Vec<Constraint<D>>,
     pub active: Vec<bool>,
     /// Contact force of each row (zero when inactive).
     pub forces: Vec<f64>,
@@ -59,7 +59,7 @@ pub struct ContactState {
     pub friction: Vec<Option<super::friction::FrictionPoint>>,
 }
 
-impl ContactState {
+impl<const D: usize> ContactState<D> {
     /// The committed slip and the forces of every frictional point at the end of this state's
     /// step: the history the next load step starts from.
     pub(crate) fn friction_history(
@@ -72,8 +72,8 @@ impl ContactState {
 
 /// The committed slip and the forces of every frictional point of `rows` (`friction` aligned
 /// with them) at the end of a step, by point.
-pub(crate) fn committed_history(
-    rows: &[crate::contact::Constraint],
+pub(crate) fn committed_history<const D: usize>(
+    rows: &[crate::contact::Constraint<D>],
     friction: &[Option<crate::contact::friction::FrictionPoint>],
 ) -> std::collections::HashMap<crate::contact::RowKey, crate::contact::friction::Committed> {
     rows.iter()

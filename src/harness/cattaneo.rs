@@ -220,7 +220,9 @@ pub fn measure(outcome: &Outcome, pair: &str) -> Result<CattaneoLevel> {
             let l = normal[0].hypot(normal[1]);
             ([normal[0] / l, normal[1] / l], None)
         }
-        MasterSide::Rigid(RigidSurface::Circle { .. }) => {
+        MasterSide::Rigid(
+            RigidSurface::Circle { .. } | RigidSurface::Plane { .. } | RigidSurface::Sphere { .. },
+        ) => {
             return Err(refuse(
                 model,
                 format!("pair '{pair}' has a rigid circle master"),

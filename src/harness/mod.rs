@@ -425,7 +425,8 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                     continue;
                 }
             };
-            if let Some(why) = method(e).obstacle(&rows, &model.prescribed) {
+            let sites: Vec<crate::contact::RowSite> = rows.iter().map(|r| r.site()).collect();
+            if let Some(why) = method(e).obstacle(&sites, &model.prescribed) {
                 cell.note = why;
                 cells.push(cell);
                 continue;

@@ -163,6 +163,8 @@ fn json_value<'a>(model: &'a Model, r: &'a PairResults) -> PairFile<'a> {
             MasterSide::Body { body, .. } => model.bodies[*body].name.clone(),
             MasterSide::Rigid(RigidSurface::Line { .. }) => "rigid line".into(),
             MasterSide::Rigid(RigidSurface::Circle { .. }) => "rigid circle".into(),
+            MasterSide::Rigid(RigidSurface::Plane { .. }) => "rigid plane".into(),
+            MasterSide::Rigid(RigidSurface::Sphere { .. }) => "rigid sphere".into(),
         },
         totals: &r.totals,
         points: &r.points,

@@ -305,6 +305,47 @@ pub enum RigidSurface {
     Line { point: [f64; 2], normal: [f64; 2] },
     /// A circle; the slave body lives outside it.
     Circle { centre: [f64; 2], radius: f64 },
+    /// (3D) The plane through `point`; `normal` points to the side where the slave body lives.
+    Plane { point: [f64; 3], normal: [f64; 3] },
+    /// (3D) A sphere; the slave body lives outside it.
+    Sphere { centre: [f64; 3], radius: f64 },
+}
+
+impl RigidSurface {
+    /// The dimension of the space the surface lives in: 2 for a line or circle, 3 for a plane
+    /// or sphere.
+    pub fn dimension(&self) -> usize {
+        match self {
+            RigidSurface::Line { .. } | RigidSurface::Circle { .. } => 2,
+            RigidSurface::Plane { .. } | RigidSurface::Sphere { .. } => 3,
+        }
+    }
+
+    /// Whether the surface is degenerate: a zero normal, a radius that is not positive, or a
+    /// value that is not finite.
+    pub fn is_degenerate(&self) -> bool {
+        fn finite(v: &[f64]) -> bool {
+            v.iter().all(|x| x.is_finite())
+        }
+        fn nonzero(v: &[f64]) -> bool {
+            v.iter().any(|&x| x != 0.0)
+        }
+        let ok = match self {
+            RigidSurface::Line { point, normal } => {
+                finite(point) && finite(normal) && nonzero(normal)
+            }
+            RigidSurface::Plane { point, normal } => {
+                finite(point) && finite(normal) && nonzero(normal)
+            }
+            RigidSurface::Circle { centre, radius } => {
+                finite(centre) && radius.is_finite() && *radius > 0.0
+            }
+            RigidSurface::Sphere { centre, radius } => {
+                finite(centre) && radius.is_finite() && *radius > 0.0
+            }
+        };
+        !ok
+    }
 }
 
 /// The master side of a pair: a facet set of a body, or a rigid surface.

@@ -6,7 +6,7 @@
 //! reference interface must also match node for node (its nodes are then paired by proximity
 //! in the current configuration, `crate::contact::discretization::nodal_normal`).
 
-use crate::contact::discretization::{check_matched_nodes, constraints};
+use crate::contact::discretization::{check_matched_nodes, Discretize};
 use crate::error::{Error, Result};
 use crate::io::scene::{DiscretizationSpec, Kinematics};
 use crate::model::{parse, ContactPair, MasterSide, Model};
@@ -41,7 +41,11 @@ pub fn admit(model: Model) -> Result<Model> {
 }
 
 /// The error of a pair whose discretization does not apply, for `reason`.
-fn not_applicable(model: &Model, pair: &ContactPair, reason: String) -> Error {
+fn not_applicable<const D: usize, K: crate::model::space::SolidCell<D>>(
+    model: &Model<D, K>,
+    pair: &ContactPair,
+    reason: String,
+) -> Error {
     Error::invalid(
         &model.source,
         format!("contact '{}'", pair.name),
@@ -52,14 +56,14 @@ fn not_applicable(model: &Model, pair: &ContactPair, reason: String) -> Error {
 
 /// Every rigid mode of every body must be held by the prescribed dofs and the contact rows
 /// together, every candidate row counted as closed (see `crate::model::rigid`).
-pub fn check_rigid_modes(model: &Model) -> Result<()> {
+pub fn check_rigid_modes<const D: usize, K: Discretize<D>>(model: &Model<D, K>) -> Result<()> {
     let mut rows = Vec::new();
     for pair in &model.contact {
         rows.extend(
-            constraints(model, pair).map_err(|reason| not_applicable(model, pair, reason))?,
+            K::pair_rows(model, pair).map_err(|reason| not_applicable(model, pair, reason))?,
         );
     }
-    let rows: Vec<&crate::contact::Constraint> = rows.iter().collect();
+    let rows: Vec<&crate::contact::Constraint<D>> = rows.iter().collect();
     let Some(free) = crate::model::rigid::free_rigid_mode(model, &rows) else {
         return Ok(());
     };

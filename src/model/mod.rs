@@ -267,6 +267,44 @@ pub fn parse(text: &str, source: &str) -> Result<Case> {
 pub type Model3 = Model<3, SolidKind>;
 
 impl<const D: usize, K: SolidCell<D>> Model<D, K> {
+    /// A model of `bodies` (numbered from dof 0 in order) named `name`, read from `source`:
+    /// nothing prescribed, no loads, no contact, the default physics, solver and limits; the
+    /// caller fills in what its scene has.
+    pub fn with_bodies(name: &str, source: &str, mut bodies: Vec<Body<D, K>>) -> Self {
+        let mut offset = 0;
+        for b in &mut bodies {
+            b.dof_offset = offset;
+            offset += b.dof_count();
+        }
+        let limits = crate::io::scene::Limits::default();
+        Model {
+            name: name.to_string(),
+            description: String::new(),
+            source: source.to_string(),
+            plane: Plane::Strain,
+            thickness: 1.0,
+            bodies,
+            dof_count: offset,
+            prescribed: vec![None; offset],
+            external_force: vec![0.0; offset],
+            load_path: Vec::new(),
+            exact: None,
+            physics: Physics::default(),
+            checks: Vec::new(),
+            support_sets: Vec::new(),
+            contact: Vec::new(),
+            sweep: None,
+            solver: SolverSpec::default(),
+            dynamics: None,
+            warnings: Vec::new(),
+            factor_limit: crate::solver::sparse::WorkLimit {
+                gigabytes: limits.factor_gigabytes,
+                operations: limits.factor_operations,
+            },
+            iteration_dofs: limits.iteration_dofs,
+        }
+    }
+
     /// The largest body's size (a length scale for geometric tolerances).
     pub fn size(&self) -> f64 {
         self.bodies
@@ -369,6 +407,362 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
 
     pub fn body(&self, name: &str) -> Option<&Body<D, K>> {
         self.bodies.iter().find(|b| b.name == name)
+    }
+
+    pub(crate) fn find_body(&self, name: &str, location: &str) -> Result<&Body<D, K>> {
+        self.body(name).ok_or_else(|| {
+            let known: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
+            Error::invalid(
+                &self.source,
+                location,
+                format!("body '{name}' does not exist"),
+                format!("use one of the bodies {known:?}"),
+            )
+        })
+    }
+
+    pub(crate) fn find_node_set<'a>(
+        &self,
+        body: &'a Body<D, K>,
+        set: &str,
+        location: &str,
+    ) -> Result<&'a [usize]> {
+        body.mesh
+            .node_sets
+            .get(set)
+            .map(|v| v.as_slice())
+            .ok_or_else(|| {
+                let known: Vec<&String> = body.mesh.node_sets.keys().collect();
+                Error::invalid(
+                    &self.source,
+                    location,
+                    format!("body '{}' has no node set '{set}'", body.name),
+                    format!("define it under the body's \"node_sets\" or use one of {known:?}"),
+                )
+            })
+    }
+
+    pub(crate) fn find_facet_set<'a>(
+        &self,
+        body: &'a Body<D, K>,
+        set: &str,
+        location: &str,
+    ) -> Result<&'a [Facet]> {
+        body.mesh
+            .facet_sets
+            .get(set)
+            .map(|v| v.as_slice())
+            .ok_or_else(|| {
+                let known: Vec<&String> = body.mesh.facet_sets.keys().collect();
+                Error::invalid(
+                    &self.source,
+                    location,
+                    format!("body '{}' has no facet set '{set}'", body.name),
+                    format!("define it under the body's \"facet_sets\" or use one of {known:?}"),
+                )
+            })
+    }
+
+    fn find_pair(&self, name: &str, location: &str) -> Result<usize> {
+        self.contact
+            .iter()
+            .position(|p| p.name == name)
+            .ok_or_else(|| {
+                let known: Vec<&str> = self.contact.iter().map(|p| p.name.as_str()).collect();
+                Error::invalid(
+                    &self.source,
+                    location,
+                    format!("contact pair '{name}' does not exist"),
+                    format!("use one of {known:?}"),
+                )
+            })
+    }
+
+    pub(crate) fn resolve_contact(&mut self, case: &Case) -> Result<()> {
+        for (k, spec) in case.contact.iter().enumerate() {
+            let at = format!("contact[{k}] '{}'", spec.name);
+            if self.contact.iter().any(|p| p.name == spec.name) {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    "a second contact pair has this name",
+                    "give every pair a unique name",
+                ));
+            }
+            let slave_body = self.find_body(&spec.slave.body, &format!("{at}.slave"))?;
+            let slave_facets = self
+                .find_facet_set(slave_body, &spec.slave.set, &format!("{at}.slave"))?
+                .to_vec();
+            let slave = (
+                self.body_index(&spec.slave.body).expect("found"),
+                slave_facets,
+            );
+            let m = &spec.master;
+            let master = match (&m.body, &m.set, &m.rigid) {
+                (Some(b), Some(set), None) => {
+                    let body = self.find_body(b, &format!("{at}.master"))?;
+                    let facets = self.find_facet_set(body, set, &format!("{at}.master"))?.to_vec();
+                    let body = self.body_index(b).expect("found");
+                    if body == slave.0 {
+                        return Err(Error::invalid(&self.source, format!("{at}.master"), "self-contact (slave and master on one body) is not supported", "use two bodies"));
+                    }
+                    MasterSide::Body { body, facets }
+                }
+                (None, None, Some(rigid)) => {
+                    if rigid.dimension() != D {
+                        let hint = if D == 2 { "a 2D body meets a \"line\" or a \"circle\"" } else { "a 3D body meets a \"plane\" or a \"sphere\"" };
+                        return Err(Error::invalid(&self.source, format!("{at}.master.rigid"), format!("the rigid surface is {}D and the bodies are {D}D", rigid.dimension()), hint));
+                    }
+                    if rigid.is_degenerate() {
+                        return Err(Error::invalid(&self.source, format!("{at}.master.rigid"), "the rigid surface is degenerate (zero normal, non-positive radius or non-finite values)", "give a non-zero normal or a positive radius"));
+                    }
+                    MasterSide::Rigid(rigid.clone())
+                }
+                _ => {
+                    return Err(Error::invalid(
+                        &self.source,
+                        format!("{at}.master"),
+                        "the master needs either \"body\" and \"set\", or \"rigid\"",
+                        "e.g. {\"body\": \"foundation\", \"set\": \"top\"} or {\"rigid\": {\"kind\": \"line\", \"point\": [0, 0], \"normal\": [0, 1]}}",
+                    ))
+                }
+            };
+            if let DiscretizationSpec::NodeToSurface { passes, .. } = spec.discretization {
+                if passes != 1 && passes != 2 {
+                    return Err(Error::invalid(
+                        &self.source,
+                        format!("{at}.discretization.passes"),
+                        format!("passes must be 1 or 2, got {passes}"),
+                        "use 1 (one-pass) or 2 (two-pass)",
+                    ));
+                }
+            }
+            validate_enforcement(
+                &spec.enforcement,
+                &self.source,
+                &format!("{at}.enforcement"),
+            )?;
+            let two_pass = |d: &DiscretizationSpec| {
+                matches!(d, DiscretizationSpec::NodeToSurface { passes: 2, .. })
+            };
+            if !spec.two_pass_penalty.is_full()
+                && !two_pass(&spec.discretization)
+                && !case.sweep.as_ref().is_some_and(|sw| {
+                    sw.discretizations
+                        .iter()
+                        .any(|d| two_pass(&d.discretization))
+                })
+            {
+                return Err(Error::invalid(
+                    &self.source,
+                    format!("{at}.two_pass_penalty"),
+                    "is \"halved\", but neither the pair nor its sweep has a two-pass discretization, so it would change nothing",
+                    "remove it, or use {\"kind\": \"node_to_surface\", \"passes\": 2}",
+                ));
+            }
+            if let Some(d) = spec.search_distance {
+                if !(d.is_finite() && d > 0.0) {
+                    return Err(Error::invalid(
+                        &self.source,
+                        format!("{at}.search_distance"),
+                        format!("the search distance must be positive, got {d}"),
+                        "give a distance larger than the initial gaps",
+                    ));
+                }
+            }
+            let newton = case.solver.scheme == crate::io::scene::Scheme::Newton;
+            if let Interaction::Coulomb { mu, kappa_t } = spec.interaction {
+                validate_coulomb(case, spec, mu, kappa_t, &self.source, &at)?;
+            }
+            let family_of = |e| crate::contact::enforcement::method(e).kernel().family();
+            if newton
+                && !matches!(
+                    family_of(&spec.enforcement),
+                    Family::PenaltyRegularized
+                        | Family::LagrangeMultipliers
+                        | Family::PerturbedTangent
+                        | Family::Elimination
+                )
+            {
+                return Err(Error::invalid(
+                    &self.source,
+                    format!("{at}.enforcement"),
+                    format!(
+                        "the Newton scheme (solver.scheme \"newton\") solves penalty-type methods, the perturbed tangent, Lagrange multipliers and constraint elimination, not {}",
+                        family_of(&spec.enforcement).describe()
+                    ),
+                    "use penalty, the perturbed Lagrangian, the augmented Lagrangian, the perturbed tangent or Lagrange multipliers, or solver.scheme \"active_set\"",
+                ));
+            }
+            if let (true, Some(first)) = (newton, self.contact.first()) {
+                // elimination reduces the whole Newton step: it combines with itself only
+                let eliminates = |e| family_of(e) == Family::Elimination;
+                if eliminates(&first.enforcement) != eliminates(&spec.enforcement) {
+                    return Err(Error::invalid(
+                        &self.source,
+                        format!("{at}.enforcement"),
+                        format!(
+                            "with solver.scheme \"newton\", constraint elimination reduces every Newton step and combines only with itself, and pair '{}' uses {}",
+                            first.name,
+                            family_of(&first.enforcement).describe()
+                        ),
+                        "use constraint elimination for every pair, or another method for this one",
+                    ));
+                }
+            }
+            if newton
+                && family_of(&spec.enforcement) == Family::Elimination
+                && case.physics.contact_geometry == crate::io::scene::ContactGeometry::Current
+            {
+                return Err(Error::invalid(
+                    &self.source,
+                    format!("{at}.enforcement"),
+                    "with solver.scheme \"newton\", constraint elimination is solved in the reference contact geometry only (the rows searched again at every iterate could change the dofs they own)".to_string(),
+                    "set \"physics\": {\"contact_geometry\": \"reference\"}, or solver.scheme \"active_set\"",
+                ));
+            }
+            if newton && newton_mortar_obstacle(&spec.enforcement, &spec.discretization) {
+                return Err(Error::invalid(
+                    &self.source,
+                    format!("{at}.enforcement"),
+                    "the Newton scheme does not yet solve the perturbed Lagrangian's consistent (non-diagonal) coupling of standard mortar multipliers".to_string(),
+                    "use solver.scheme \"active_set\" for this pair, or dual mortar multipliers (where the perturbed Lagrangian is the penalty method)",
+                ));
+            }
+            if let (Some(first), false) = (self.contact.first(), newton) {
+                let (a, b) = (family_of(&first.enforcement), family_of(&spec.enforcement));
+                if a != b {
+                    return Err(Error::invalid(
+                        &self.source,
+                        format!("{at}.enforcement"),
+                        format!(
+                            "the pairs of a case are solved together, and this pair's method cannot be combined with those of pair '{}' ({})",
+                            first.name,
+                            a.describe()
+                        ),
+                        "methods of one family combine, a method per pair: penalty, perturbed Lagrangian and augmented Lagrangian; Lagrange multipliers, the perturbed tangent and constraint elimination each only with themselves (with solver.scheme \"newton\", Lagrange multipliers, the perturbed tangent and penalty-type methods combine too)",
+                    ));
+                }
+            }
+            let same_facets = |a: &[Facet], b: &[Facet]| {
+                let key = |f: &Facet| (f.cell, f.edge);
+                let mut a: Vec<_> = a.iter().map(key).collect();
+                let mut b: Vec<_> = b.iter().map(key).collect();
+                a.sort_unstable();
+                b.sort_unstable();
+                a == b
+            };
+            let repeated = self.contact.iter().find(|p| {
+                let same_slave = p.slave.0 == slave.0 && same_facets(&p.slave.1, &slave.1);
+                match (&p.master, &master) {
+                    (MasterSide::Rigid(a), MasterSide::Rigid(b)) => same_slave && a == b,
+                    (
+                        MasterSide::Body {
+                            body: pb,
+                            facets: pf,
+                        },
+                        MasterSide::Body { body: b, facets: f },
+                    ) => {
+                        (same_slave && pb == b && same_facets(pf, f))
+                            || (p.slave.0 == *b
+                                && same_facets(&p.slave.1, f)
+                                && *pb == slave.0
+                                && same_facets(pf, &slave.1))
+                    }
+                    _ => false,
+                }
+            });
+            if let Some(p) = repeated {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    format!(
+                        "the pair repeats the surfaces of pair '{}'; together they would enforce the same contact twice",
+                        p.name
+                    ),
+                    "remove one of the two pairs (a two-pass pair is \"passes\": 2 on one pair)",
+                ));
+            }
+            self.contact.push(ContactPair {
+                name: spec.name.clone(),
+                slave,
+                master,
+                discretization: spec.discretization.clone(),
+                enforcement: spec.enforcement.clone(),
+                interaction: spec.interaction,
+                search_distance: spec.search_distance,
+                two_pass_penalty: spec.two_pass_penalty,
+            });
+        }
+        if let Some(sweep) = &case.sweep {
+            if self.contact.is_empty() {
+                return Err(Error::invalid(
+                    &self.source,
+                    "sweep",
+                    "a sweep varies the first contact pair, but the case has none",
+                    "add a \"contact\" pair",
+                ));
+            }
+            for (k, e) in sweep.enforcements.iter().enumerate() {
+                validate_enforcement(e, &self.source, &format!("sweep.enforcements[{k}]"))?;
+            }
+            for (k, d) in sweep.discretizations.iter().enumerate() {
+                if let Some(slave) = &d.slave {
+                    let pair = &self.contact[0];
+                    let names: Vec<&str> = std::iter::once(pair.slave.0)
+                        .chain(match &pair.master {
+                            MasterSide::Body { body, .. } => Some(*body),
+                            MasterSide::Rigid(_) => None,
+                        })
+                        .map(|b| self.bodies[b].name.as_str())
+                        .collect();
+                    if !names.contains(&slave.as_str()) {
+                        return Err(Error::invalid(
+                            &self.source,
+                            format!("sweep.discretizations[{k}].slave"),
+                            format!("'{slave}' is not a body of the first contact pair"),
+                            format!("use one of {names:?}"),
+                        ));
+                    }
+                }
+            }
+            if !(sweep.penalty_factor.is_finite()
+                && sweep.penalty_factor > 0.0
+                && sweep.tol.is_finite()
+                && sweep.tol > 0.0
+                && sweep.pressure.is_finite()
+                && sweep.pressure != 0.0)
+            {
+                return Err(Error::invalid(
+                    &self.source,
+                    "sweep",
+                    "penalty_factor and tol must be positive and pressure non-zero",
+                    "e.g. \"penalty_factor\": 1000, \"tol\": 1e-10, \"pressure\": 10",
+                ));
+            }
+            let friction = sweep.catalogue == crate::io::scene::Catalogue::Friction;
+            let coulomb = case
+                .contact
+                .first()
+                .is_some_and(|c| c.interaction.friction().is_some());
+            if friction != (sweep.expect.is_some() && coulomb) {
+                return Err(Error::invalid(
+                    &self.source,
+                    "sweep",
+                    "a friction sweep (\"catalogue\": \"friction\") needs a Coulomb first pair and the status it expects (\"expect\"), and only a friction sweep takes \"expect\"",
+                    "with a Coulomb pair give \"catalogue\": \"friction\" and \"expect\": \"stick\" or \"slip\"; otherwise leave \"expect\" out",
+                ));
+            }
+            if !friction && !sweep.friction_tangents.is_empty() {
+                return Err(Error::invalid(
+                    &self.source,
+                    "sweep.friction_tangents",
+                    "friction tangents vary only in a friction sweep (\"catalogue\": \"friction\")",
+                    "leave \"friction_tangents\" out of this sweep",
+                ));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -709,65 +1103,6 @@ impl Model {
         Ok(())
     }
 
-    fn find_body(&self, name: &str, location: &str) -> Result<&Body> {
-        self.body(name).ok_or_else(|| {
-            let known: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
-            Error::invalid(
-                &self.source,
-                location,
-                format!("body '{name}' does not exist"),
-                format!("use one of the bodies {known:?}"),
-            )
-        })
-    }
-
-    fn find_node_set<'a>(&self, body: &'a Body, set: &str, location: &str) -> Result<&'a [usize]> {
-        body.mesh
-            .node_sets
-            .get(set)
-            .map(|v| v.as_slice())
-            .ok_or_else(|| {
-                let known: Vec<&String> = body.mesh.node_sets.keys().collect();
-                Error::invalid(
-                    &self.source,
-                    location,
-                    format!("body '{}' has no node set '{set}'", body.name),
-                    format!("define it under the body's \"node_sets\" or use one of {known:?}"),
-                )
-            })
-    }
-
-    fn find_facet_set<'a>(&self, body: &'a Body, set: &str, location: &str) -> Result<&'a [Facet]> {
-        body.mesh
-            .facet_sets
-            .get(set)
-            .map(|v| v.as_slice())
-            .ok_or_else(|| {
-                let known: Vec<&String> = body.mesh.facet_sets.keys().collect();
-                Error::invalid(
-                    &self.source,
-                    location,
-                    format!("body '{}' has no facet set '{set}'", body.name),
-                    format!("define it under the body's \"facet_sets\" or use one of {known:?}"),
-                )
-            })
-    }
-
-    fn find_pair(&self, name: &str, location: &str) -> Result<usize> {
-        self.contact
-            .iter()
-            .position(|p| p.name == name)
-            .ok_or_else(|| {
-                let known: Vec<&str> = self.contact.iter().map(|p| p.name.as_str()).collect();
-                Error::invalid(
-                    &self.source,
-                    location,
-                    format!("contact pair '{name}' does not exist"),
-                    format!("use one of {known:?}"),
-                )
-            })
-    }
-
     fn require_exact(&self, location: &str) -> Result<ExactField> {
         self.exact.clone().ok_or_else(|| {
             Error::invalid(
@@ -1024,295 +1359,6 @@ impl Model {
             };
             for f in facets {
                 add_facet_load(body, f, &traction, self.thickness, &mut self.external_force);
-            }
-        }
-        Ok(())
-    }
-
-    fn resolve_contact(&mut self, case: &Case) -> Result<()> {
-        for (k, spec) in case.contact.iter().enumerate() {
-            let at = format!("contact[{k}] '{}'", spec.name);
-            if self.contact.iter().any(|p| p.name == spec.name) {
-                return Err(Error::invalid(
-                    &self.source,
-                    &at,
-                    "a second contact pair has this name",
-                    "give every pair a unique name",
-                ));
-            }
-            let slave_body = self.find_body(&spec.slave.body, &format!("{at}.slave"))?;
-            let slave_facets = self
-                .find_facet_set(slave_body, &spec.slave.set, &format!("{at}.slave"))?
-                .to_vec();
-            let slave = (
-                self.body_index(&spec.slave.body).expect("found"),
-                slave_facets,
-            );
-            let m = &spec.master;
-            let master = match (&m.body, &m.set, &m.rigid) {
-                (Some(b), Some(set), None) => {
-                    let body = self.find_body(b, &format!("{at}.master"))?;
-                    let facets = self.find_facet_set(body, set, &format!("{at}.master"))?.to_vec();
-                    let body = self.body_index(b).expect("found");
-                    if body == slave.0 {
-                        return Err(Error::invalid(&self.source, format!("{at}.master"), "self-contact (slave and master on one body) is not supported", "use two bodies"));
-                    }
-                    MasterSide::Body { body, facets }
-                }
-                (None, None, Some(rigid)) => {
-                    let ok = match *rigid {
-                        RigidSurface::Line { point, normal } => {
-                            point.iter().chain(&normal).all(|v| v.is_finite()) && normal.iter().any(|&v| v != 0.0)
-                        }
-                        RigidSurface::Circle { centre, radius } => centre.iter().all(|v| v.is_finite()) && radius.is_finite() && radius > 0.0,
-                    };
-                    if !ok {
-                        return Err(Error::invalid(&self.source, format!("{at}.master.rigid"), "the rigid surface is degenerate (zero normal, non-positive radius or non-finite values)", "give a non-zero normal or a positive radius"));
-                    }
-                    MasterSide::Rigid(rigid.clone())
-                }
-                _ => {
-                    return Err(Error::invalid(
-                        &self.source,
-                        format!("{at}.master"),
-                        "the master needs either \"body\" and \"set\", or \"rigid\"",
-                        "e.g. {\"body\": \"foundation\", \"set\": \"top\"} or {\"rigid\": {\"kind\": \"line\", \"point\": [0, 0], \"normal\": [0, 1]}}",
-                    ))
-                }
-            };
-            if let DiscretizationSpec::NodeToSurface { passes, .. } = spec.discretization {
-                if passes != 1 && passes != 2 {
-                    return Err(Error::invalid(
-                        &self.source,
-                        format!("{at}.discretization.passes"),
-                        format!("passes must be 1 or 2, got {passes}"),
-                        "use 1 (one-pass) or 2 (two-pass)",
-                    ));
-                }
-            }
-            validate_enforcement(
-                &spec.enforcement,
-                &self.source,
-                &format!("{at}.enforcement"),
-            )?;
-            let two_pass = |d: &DiscretizationSpec| {
-                matches!(d, DiscretizationSpec::NodeToSurface { passes: 2, .. })
-            };
-            if !spec.two_pass_penalty.is_full()
-                && !two_pass(&spec.discretization)
-                && !case.sweep.as_ref().is_some_and(|sw| {
-                    sw.discretizations
-                        .iter()
-                        .any(|d| two_pass(&d.discretization))
-                })
-            {
-                return Err(Error::invalid(
-                    &self.source,
-                    format!("{at}.two_pass_penalty"),
-                    "is \"halved\", but neither the pair nor its sweep has a two-pass discretization, so it would change nothing",
-                    "remove it, or use {\"kind\": \"node_to_surface\", \"passes\": 2}",
-                ));
-            }
-            if let Some(d) = spec.search_distance {
-                if !(d.is_finite() && d > 0.0) {
-                    return Err(Error::invalid(
-                        &self.source,
-                        format!("{at}.search_distance"),
-                        format!("the search distance must be positive, got {d}"),
-                        "give a distance larger than the initial gaps",
-                    ));
-                }
-            }
-            let newton = case.solver.scheme == crate::io::scene::Scheme::Newton;
-            if let Interaction::Coulomb { mu, kappa_t } = spec.interaction {
-                validate_coulomb(case, spec, mu, kappa_t, &self.source, &at)?;
-            }
-            let family_of = |e| crate::contact::enforcement::method(e).kernel().family();
-            if newton
-                && !matches!(
-                    family_of(&spec.enforcement),
-                    Family::PenaltyRegularized
-                        | Family::LagrangeMultipliers
-                        | Family::PerturbedTangent
-                        | Family::Elimination
-                )
-            {
-                return Err(Error::invalid(
-                    &self.source,
-                    format!("{at}.enforcement"),
-                    format!(
-                        "the Newton scheme (solver.scheme \"newton\") solves penalty-type methods, the perturbed tangent, Lagrange multipliers and constraint elimination, not {}",
-                        family_of(&spec.enforcement).describe()
-                    ),
-                    "use penalty, the perturbed Lagrangian, the augmented Lagrangian, the perturbed tangent or Lagrange multipliers, or solver.scheme \"active_set\"",
-                ));
-            }
-            if let (true, Some(first)) = (newton, self.contact.first()) {
-                // elimination reduces the whole Newton step: it combines with itself only
-                let eliminates = |e| family_of(e) == Family::Elimination;
-                if eliminates(&first.enforcement) != eliminates(&spec.enforcement) {
-                    return Err(Error::invalid(
-                        &self.source,
-                        format!("{at}.enforcement"),
-                        format!(
-                            "with solver.scheme \"newton\", constraint elimination reduces every Newton step and combines only with itself, and pair '{}' uses {}",
-                            first.name,
-                            family_of(&first.enforcement).describe()
-                        ),
-                        "use constraint elimination for every pair, or another method for this one",
-                    ));
-                }
-            }
-            if newton
-                && family_of(&spec.enforcement) == Family::Elimination
-                && case.physics.contact_geometry == crate::io::scene::ContactGeometry::Current
-            {
-                return Err(Error::invalid(
-                    &self.source,
-                    format!("{at}.enforcement"),
-                    "with solver.scheme \"newton\", constraint elimination is solved in the reference contact geometry only (the rows searched again at every iterate could change the dofs they own)".to_string(),
-                    "set \"physics\": {\"contact_geometry\": \"reference\"}, or solver.scheme \"active_set\"",
-                ));
-            }
-            if newton && newton_mortar_obstacle(&spec.enforcement, &spec.discretization) {
-                return Err(Error::invalid(
-                    &self.source,
-                    format!("{at}.enforcement"),
-                    "the Newton scheme does not yet solve the perturbed Lagrangian's consistent (non-diagonal) coupling of standard mortar multipliers".to_string(),
-                    "use solver.scheme \"active_set\" for this pair, or dual mortar multipliers (where the perturbed Lagrangian is the penalty method)",
-                ));
-            }
-            if let (Some(first), false) = (self.contact.first(), newton) {
-                let (a, b) = (family_of(&first.enforcement), family_of(&spec.enforcement));
-                if a != b {
-                    return Err(Error::invalid(
-                        &self.source,
-                        format!("{at}.enforcement"),
-                        format!(
-                            "the pairs of a case are solved together, and this pair's method cannot be combined with those of pair '{}' ({})",
-                            first.name,
-                            a.describe()
-                        ),
-                        "methods of one family combine, a method per pair: penalty, perturbed Lagrangian and augmented Lagrangian; Lagrange multipliers, the perturbed tangent and constraint elimination each only with themselves (with solver.scheme \"newton\", Lagrange multipliers, the perturbed tangent and penalty-type methods combine too)",
-                    ));
-                }
-            }
-            let same_facets = |a: &[Facet], b: &[Facet]| {
-                let key = |f: &Facet| (f.cell, f.edge);
-                let mut a: Vec<_> = a.iter().map(key).collect();
-                let mut b: Vec<_> = b.iter().map(key).collect();
-                a.sort_unstable();
-                b.sort_unstable();
-                a == b
-            };
-            let repeated = self.contact.iter().find(|p| {
-                let same_slave = p.slave.0 == slave.0 && same_facets(&p.slave.1, &slave.1);
-                match (&p.master, &master) {
-                    (MasterSide::Rigid(a), MasterSide::Rigid(b)) => same_slave && a == b,
-                    (
-                        MasterSide::Body {
-                            body: pb,
-                            facets: pf,
-                        },
-                        MasterSide::Body { body: b, facets: f },
-                    ) => {
-                        (same_slave && pb == b && same_facets(pf, f))
-                            || (p.slave.0 == *b
-                                && same_facets(&p.slave.1, f)
-                                && *pb == slave.0
-                                && same_facets(pf, &slave.1))
-                    }
-                    _ => false,
-                }
-            });
-            if let Some(p) = repeated {
-                return Err(Error::invalid(
-                    &self.source,
-                    &at,
-                    format!(
-                        "the pair repeats the surfaces of pair '{}'; together they would enforce the same contact twice",
-                        p.name
-                    ),
-                    "remove one of the two pairs (a two-pass pair is \"passes\": 2 on one pair)",
-                ));
-            }
-            self.contact.push(ContactPair {
-                name: spec.name.clone(),
-                slave,
-                master,
-                discretization: spec.discretization.clone(),
-                enforcement: spec.enforcement.clone(),
-                interaction: spec.interaction,
-                search_distance: spec.search_distance,
-                two_pass_penalty: spec.two_pass_penalty,
-            });
-        }
-        if let Some(sweep) = &case.sweep {
-            if self.contact.is_empty() {
-                return Err(Error::invalid(
-                    &self.source,
-                    "sweep",
-                    "a sweep varies the first contact pair, but the case has none",
-                    "add a \"contact\" pair",
-                ));
-            }
-            for (k, e) in sweep.enforcements.iter().enumerate() {
-                validate_enforcement(e, &self.source, &format!("sweep.enforcements[{k}]"))?;
-            }
-            for (k, d) in sweep.discretizations.iter().enumerate() {
-                if let Some(slave) = &d.slave {
-                    let pair = &self.contact[0];
-                    let names: Vec<&str> = std::iter::once(pair.slave.0)
-                        .chain(match &pair.master {
-                            MasterSide::Body { body, .. } => Some(*body),
-                            MasterSide::Rigid(_) => None,
-                        })
-                        .map(|b| self.bodies[b].name.as_str())
-                        .collect();
-                    if !names.contains(&slave.as_str()) {
-                        return Err(Error::invalid(
-                            &self.source,
-                            format!("sweep.discretizations[{k}].slave"),
-                            format!("'{slave}' is not a body of the first contact pair"),
-                            format!("use one of {names:?}"),
-                        ));
-                    }
-                }
-            }
-            if !(sweep.penalty_factor.is_finite()
-                && sweep.penalty_factor > 0.0
-                && sweep.tol.is_finite()
-                && sweep.tol > 0.0
-                && sweep.pressure.is_finite()
-                && sweep.pressure != 0.0)
-            {
-                return Err(Error::invalid(
-                    &self.source,
-                    "sweep",
-                    "penalty_factor and tol must be positive and pressure non-zero",
-                    "e.g. \"penalty_factor\": 1000, \"tol\": 1e-10, \"pressure\": 10",
-                ));
-            }
-            let friction = sweep.catalogue == crate::io::scene::Catalogue::Friction;
-            let coulomb = case
-                .contact
-                .first()
-                .is_some_and(|c| c.interaction.friction().is_some());
-            if friction != (sweep.expect.is_some() && coulomb) {
-                return Err(Error::invalid(
-                    &self.source,
-                    "sweep",
-                    "a friction sweep (\"catalogue\": \"friction\") needs a Coulomb first pair and the status it expects (\"expect\"), and only a friction sweep takes \"expect\"",
-                    "with a Coulomb pair give \"catalogue\": \"friction\" and \"expect\": \"stick\" or \"slip\"; otherwise leave \"expect\" out",
-                ));
-            }
-            if !friction && !sweep.friction_tangents.is_empty() {
-                return Err(Error::invalid(
-                    &self.source,
-                    "sweep.friction_tangents",
-                    "friction tangents vary only in a friction sweep (\"catalogue\": \"friction\")",
-                    "leave \"friction_tangents\" out of this sweep",
-                ));
             }
         }
         Ok(())

@@ -66,7 +66,7 @@
 //! factorizations report pivots that are zero relative to the matrix or needed regularization
 //! ([`crate::solver::sparse`]), and a non-finite iterate is an error naming where it appeared.
 
-use crate::contact::discretization::{constraints, gap_second_derivative};
+use crate::contact::discretization::Discretize;
 use crate::contact::enforcement::{method, method as enforcement_method, Method};
 pub use crate::contact::state::{
     ContactState, Departure, IterationRecord, StepRecord, Termination,
@@ -127,7 +127,10 @@ impl EqRow {
 /// applies the load factor `k / n` and starts from the active set of step `k - 1` (the only
 /// state frictionless contact has to carry). The solve stops at the first step that does not
 /// converge; its termination is the solve's.
-pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+pub fn solve<const D: usize, K: ContactStep<D>>(
+    model: &Model<D, K>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Solution<D>> {
     let n = model.solver.load_steps;
     let mut previous: Option<HashSet<RowKey>> = None;
     let mut records: Vec<StepRecord> = Vec::new();
@@ -147,7 +150,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
             scaled = model.at_step(step, n);
             &scaled
         };
-        let mut solution = solve_step(
+        let mut solution = K::solve_step(
             at,
             previous.take(),
             start.take(),
@@ -186,7 +189,7 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
 }
 
 /// The identities of the active rows of `state`.
-pub(crate) fn active_keys(state: &ContactState) -> HashSet<RowKey> {
+pub(crate) fn active_keys<const D: usize>(state: &ContactState<D>) -> HashSet<RowKey> {
     state
         .rows
         .iter()
@@ -194,6 +197,43 @@ pub(crate) fn active_keys(state: &ContactState) -> HashSet<RowKey> {
         .filter(|(_, &a)| a)
         .map(|(r, _)| row_key(r))
         .collect()
+}
+
+/// One load step of a contact solve in the model's dimension (see [`solve`]): in 2D every
+/// scheme (active set or Newton, reference or current geometry, friction); in 3D the active-set
+/// scheme in the reference configuration, the only one the 3D model admits.
+pub trait ContactStep<const D: usize>: Discretize<D> {
+    fn solve_step(
+        model: &Model<D, Self>,
+        previous: Option<HashSet<RowKey>>,
+        start: Option<Vec<f64>>,
+        friction: HashMap<RowKey, crate::contact::friction::Committed>,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<Solution<D>>;
+}
+
+impl ContactStep<2> for crate::fe::ElementKind {
+    fn solve_step(
+        model: &Model,
+        previous: Option<HashSet<RowKey>>,
+        start: Option<Vec<f64>>,
+        friction: HashMap<RowKey, crate::contact::friction::Committed>,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<Solution> {
+        solve_step(model, previous, start, friction, progress)
+    }
+}
+
+impl ContactStep<3> for crate::fe3d::SolidKind {
+    fn solve_step(
+        model: &crate::model::Model3,
+        previous: Option<HashSet<RowKey>>,
+        _start: Option<Vec<f64>>,
+        _friction: HashMap<RowKey, crate::contact::friction::Committed>,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<Solution<3>> {
+        solve_at(model, None, previous.as_ref(), None, progress)
+    }
 }
 
 /// One load step, starting from the active rows `previous` and (current geometry) the
@@ -305,7 +345,7 @@ pub(crate) use crate::contact::{row_key, RowKey};
 
 /// The rows active in `previous` that have no row in `rows` (their slave nodes left the master
 /// surface), in order.
-fn slid_off(previous: &HashSet<RowKey>, rows: &[Constraint]) -> Vec<RowKey> {
+fn slid_off<const D: usize>(previous: &HashSet<RowKey>, rows: &[Constraint<D>]) -> Vec<RowKey> {
     let now: HashSet<RowKey> = rows.iter().map(row_key).collect();
     let mut lost: Vec<RowKey> = previous
         .iter()
@@ -321,7 +361,9 @@ fn slid_off(previous: &HashSet<RowKey>, rows: &[Constraint]) -> Vec<RowKey> {
 pub(crate) type ReferenceAreas = HashMap<RowKey, f64>;
 
 /// The rows' areas in the reference configuration.
-pub(crate) fn reference_areas(model: &Model) -> Result<ReferenceAreas> {
+pub(crate) fn reference_areas<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
+) -> Result<ReferenceAreas> {
     Ok(rows_at(model, None)?
         .iter()
         .map(|r| (row_key(r), r.area))
@@ -335,10 +377,10 @@ pub(crate) fn reference_areas(model: &Model) -> Result<ReferenceAreas> {
 /// reference area (a nominal pressure), so the penalty force `kappa A_0 g(u)` has the exact
 /// derivative `kappa A_0 dg/du` (the current area would add the variation of the tributary
 /// lengths, which no tangent carries, and Newton would converge only linearly).
-pub(crate) fn rows_at(
-    model: &Model,
+pub(crate) fn rows_at<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
     current: Option<(&[f64], &ReferenceAreas)>,
-) -> Result<Vec<Constraint>> {
+) -> Result<Vec<Constraint<D>>> {
     let u = current.map(|(u, _)| u);
     let moved;
     let geometry = match u {
@@ -348,8 +390,9 @@ pub(crate) fn rows_at(
             for b in &mut m.bodies {
                 let offset = b.dof_offset;
                 for (n, p) in b.mesh.nodes.iter_mut().enumerate() {
-                    p[0] += u[offset + 2 * n];
-                    p[1] += u[offset + 2 * n + 1];
+                    for (i, x) in p.iter_mut().enumerate() {
+                        *x += u[offset + D * n + i];
+                    }
                 }
             }
             moved = m;
@@ -358,7 +401,7 @@ pub(crate) fn rows_at(
     };
     let mut rows = Vec::new();
     for (k, pair) in geometry.contact.iter().enumerate() {
-        let r = constraints(geometry, pair).map_err(|reason| {
+        let r = K::pair_rows(geometry, pair).map_err(|reason| {
             Error::invalid(
                 &model.source,
                 format!("contact '{}'", pair.name),
@@ -396,9 +439,9 @@ pub(crate) fn rows_at(
 /// forces `lambda_k` of the last geometry update reads
 /// `(K - lambda_k H) u = f + B_k^T lambda - lambda_k H u_k`. With it the geometry updates are
 /// Newton iterations (quadratic convergence) instead of a fixed point.
-fn add_geometric_stiffness(
-    model: &Model,
-    rows: &[Constraint],
+fn add_geometric_stiffness<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
+    rows: &[Constraint<D>],
     u: &[f64],
     forces: &HashMap<RowKey, f64>,
     sys: &mut LinearSystem,
@@ -411,20 +454,20 @@ fn add_geometric_stiffness(
             continue;
         }
         let b = &model.bodies[r.slave_body];
-        let dofs = [b.dof(r.slave_node, 0), b.dof(r.slave_node, 1)];
+        let dofs: [usize; D] = std::array::from_fn(|i| b.dof(r.slave_node, i));
         let x = b.mesh.nodes[r.slave_node];
-        let x_s = [x[0] + u[dofs[0]], x[1] + u[dofs[1]]];
-        let Some(h) = gap_second_derivative(model, r, x_s) else {
+        let x_s: [f64; D] = std::array::from_fn(|i| x[i] + u[dofs[i]]);
+        let Some(h) = K::slave_curvature(model, r, x_s) else {
             continue;
         };
-        let eqs = [sys.eq(dofs[0]), sys.eq(dofs[1])];
+        let eqs: [usize; D] = std::array::from_fn(|i| sys.eq(dofs[i]));
         if eqs.contains(&NO_EQUATION) {
             continue;
         }
         let block: Vec<f64> = h.iter().map(|v| -lambda * v).collect();
         sys.pattern.scatter(&eqs, &block, &mut sys.k);
-        for a in 0..2 {
-            sys.rhs[eqs[a]] -= lambda * (h[2 * a] * u[dofs[0]] + h[2 * a + 1] * u[dofs[1]]);
+        for a in 0..D {
+            sys.rhs[eqs[a]] -= lambda * (0..D).map(|c| h[D * a + c] * u[dofs[c]]).sum::<f64>();
         }
     }
 }
@@ -432,13 +475,13 @@ fn add_geometric_stiffness(
 /// One contact solve with the rows of `rows_at(model, current)`; `previous` (the active rows of the
 /// last geometry update) starts the active set together with the rows closed at `u`;
 /// `previous_forces` (of the last geometry update) give Newton's geometric term.
-fn solve_at(
-    model: &Model,
+fn solve_at<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
     current: Option<(&[f64], &ReferenceAreas)>,
     previous: Option<&HashSet<RowKey>>,
     previous_forces: Option<&HashMap<RowKey, f64>>,
     progress: &mut dyn FnMut(&str),
-) -> Result<Solution> {
+) -> Result<Solution<D>> {
     let u = current.map(|(u, _)| u);
     let configuration = u.map(|u| u.to_vec());
     let mut timings = Timings::default();
@@ -638,7 +681,10 @@ fn solve_at(
 /// to the rows of the same pair, pass and direction. `M_ij` is in area units and the rows' forces
 /// are nodal forces `lambda_i = A_i p_i`, so `int Phi_i (g_h + p_h / kappa) = 0` divided by
 /// `A_i` is `g_i + sum_j M_ij lambda_j / (kappa A_i A_j) = 0`.
-fn perturbation(model: &Model, rows: &[Constraint]) -> Vec<Vec<(usize, f64)>> {
+fn perturbation<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
+    rows: &[Constraint<D>],
+) -> Vec<Vec<(usize, f64)>> {
     let index: HashMap<RowKey, usize> = rows
         .iter()
         .enumerate()
@@ -763,18 +809,18 @@ impl Saddle {
     }
 }
 
-struct Kernel<'a> {
+struct Kernel<'a, const D: usize, K: Discretize<D>> {
     /// Whether [`Kernel::factor`] estimates the condition number of what it factors (not for
     /// the penalty predictor, whose systems are never the answer's).
     estimate_condition: bool,
     /// The active set `prepare` last ran for.
     prepared_for: Option<Vec<bool>>,
-    model: &'a Model,
+    model: &'a Model<D, K>,
     sys: &'a LinearSystem,
     rows: &'a [EqRow],
     /// The same rows in global dofs (rigid-mode test, messages).
-    constraints: &'a [Constraint],
-    modes: RigidModes<'a>,
+    constraints: &'a [Constraint<D>],
+    modes: RigidModes<'a, D, K>,
     /// Global dof of each equation.
     eq_dof: Vec<usize>,
     /// The stiffness of the current solve: `K_ff`, plus the stabilizing springs while a rigid
@@ -867,7 +913,7 @@ const PREDICTOR_LEVEL_ITERATIONS: usize = 30;
 const PREDICTOR_STEP: f64 = 100.0;
 const PREDICTOR_SETTLED: usize = 100;
 
-impl Kernel<'_> {
+impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
     /// Gap below which a row counts as closed when the active set starts and when a row is
     /// activated: `1e-14` times the model size.
     fn gap_tol(&self) -> f64 {
@@ -1628,7 +1674,7 @@ impl Kernel<'_> {
             }
             return;
         }
-        let active_rows: Vec<&Constraint> = self
+        let active_rows: Vec<&Constraint<D>> = self
             .constraints
             .iter()
             .zip(active)
@@ -1761,7 +1807,7 @@ impl Kernel<'_> {
     /// at its smallest open gap (within `1e-9` of the model size) are closed too, level by
     /// level: a body held only by contact across a gap is brought into contact at its closest
     /// points, the same ones whatever the numbering of its nodes.
-    fn first_active_set(&self, rows: &[Constraint]) -> Vec<bool> {
+    fn first_active_set(&self, rows: &[Constraint<D>]) -> Vec<bool> {
         let gap_tol = self.gap_tol();
         let mut active: Vec<bool> = rows
             .iter()
@@ -1839,7 +1885,7 @@ impl Kernel<'_> {
     /// least twice), and what to change.
     fn cycling_diagnosis(
         &self,
-        rows: &[Constraint],
+        rows: &[Constraint<D>],
         flipping: &[usize],
         it: usize,
         remedy: CyclingRemedy,
@@ -1881,7 +1927,7 @@ impl Kernel<'_> {
     /// as converged: if the loop settles on it, it ends with [`Termination::Singular`] saying
     /// which body, which mode and why. A non-finite iterate is an error naming where it
     /// appeared.
-    fn active_set_loop(&mut self, method: Method, rows: &[Constraint]) -> Result<LoopResult> {
+    fn active_set_loop(&mut self, method: Method, rows: &[Constraint<D>]) -> Result<LoopResult> {
         let nrows = self.rows.len();
         let gap_tol = self.gap_tol();
         let size = self.model.size();
@@ -2221,7 +2267,7 @@ impl Kernel<'_> {
     fn penalty_predictor(
         &mut self,
         start: Vec<bool>,
-        rows: &[Constraint],
+        rows: &[Constraint<D>],
         after: usize,
         max_iterations: usize,
     ) -> (Vec<bool>, usize) {
@@ -2240,7 +2286,7 @@ impl Kernel<'_> {
     fn predictor_levels(
         &mut self,
         start: Vec<bool>,
-        rows: &[Constraint],
+        rows: &[Constraint<D>],
         after: usize,
         max_iterations: usize,
     ) -> (Vec<bool>, usize) {
@@ -2250,7 +2296,7 @@ impl Kernel<'_> {
             .model
             .bodies
             .iter()
-            .map(|b| b.material.youngs_modulus)
+            .map(|b| K::youngs_modulus(&b.material))
             .fold(0.0f64, f64::max);
         let zero = vec![0.0; nrows];
         let mut active = start;
@@ -2360,7 +2406,7 @@ fn effective_weights(active: &[bool], w: &[f64]) -> Vec<f64> {
 }
 
 /// The largest penetration `-g` over the contact rows (ties excluded) of an iteration.
-fn largest_penetration(rows: &[Constraint], gaps: &[f64]) -> f64 {
+fn largest_penetration<const D: usize>(rows: &[Constraint<D>], gaps: &[f64]) -> f64 {
     rows.iter()
         .zip(gaps)
         .filter(|(r, _)| !r.bilateral)

@@ -1,11 +1,10 @@
-//! The static small-strain solve of one 3D body: `K_ff u_f = f_f - K_fp u_p`.
+//! One 3D body built in code (tests, studies): its supports and loads, the static small-strain
+//! solve `K_ff u_f = f_f - K_fp u_p` and the error norms against a closed form.
 //!
-//! Dofs are numbered `3 node + component` (the 2D numbering `2 node + component` with `D = 3`);
-//! the prescribed dofs are eliminated by the same affine constraints as in 2D
-//! ([`crate::solver::constraints::AffineConstraints::dirichlet`]), the reduced stiffness is
-//! assembled on a [`crate::solver::sparse::SymmetricPattern`] from the element stiffnesses of
-//! [`crate::solid3d`] and factored by the same sparse Cholesky (faer), with two steps of
-//! iterative refinement as in [`crate::solver::linear::solve_elastic`].
+//! The solve is the one every model uses: the body becomes a one-body
+//! [`crate::model::Model3`] (dofs `3 node + component`) and goes through
+//! [`crate::solver::linear::solve_elastic`] (the Dirichlet data as affine constraints, sparse
+//! Cholesky with faer, two steps of iterative refinement).
 //!
 //! Post-processing: element stresses at the quadrature points of the stiffness rule and the
 //! error norms against a closed-form field, `||u - u_h||_L2 = (int |u - u_h|^2 dV)^(1/2)` and
@@ -15,11 +14,9 @@
 use crate::fe::ReferenceCell;
 use crate::fe3d::solid_point_values;
 use crate::mesh::{Facet, Mesh3};
-use crate::solid3d::{
-    body_force_load, element_stiffness3, facet_traction_load, voigt_strain, Elasticity3,
-};
-use crate::solver::constraints::AffineConstraints;
-use crate::solver::sparse::{Cholesky, FactorError, PatternBuilder, WorkLimit};
+use crate::model::{Body3, Model3};
+use crate::solid3d::{body_force_load, facet_traction_load, voigt_strain, Elasticity3};
+use crate::solver::sparse::WorkLimit;
 use nalgebra::{Matrix3, SMatrix};
 
 /// One 3D body with its loads and supports.
@@ -105,45 +102,27 @@ impl Solid3 {
         }
     }
 
+    /// The body as a one-body model named `name`, with the work limit `limit`.
+    pub fn model(&self, name: &str, limit: &WorkLimit) -> Model3 {
+        let body = Body3 {
+            name: name.to_string(),
+            material_name: name.to_string(),
+            material: self.material,
+            hyperelastic: None,
+            mesh: self.mesh.clone(),
+            dof_offset: 0,
+        };
+        let mut model = Model3::with_bodies(name, name, vec![body]);
+        model.prescribed = self.prescribed.clone();
+        model.external_force = self.external_force.clone();
+        model.factor_limit = *limit;
+        model
+    }
+
     /// Solve for the displacement (every dof, prescribed ones included).
-    pub fn solve(&self, limit: &WorkLimit) -> Result<Vec<f64>, FactorError> {
-        let constraints = AffineConstraints::dirichlet(&self.prescribed);
-        let n = constraints.free_count();
-        let mut local = constraints.local();
-        let mut builder = PatternBuilder::new(n);
-        for c in 0..self.mesh.cell_count() {
-            local.add_pattern(&self.cell_dofs(c), &mut builder);
-        }
-        let pattern = builder.build();
-        let mut k = vec![0.0; pattern.nnz()];
-        let mut rhs = constraints.reduce_vector(&self.external_force);
-        let kind = self.mesh.kind;
-        let rule = kind.stiffness_rule();
-        let nd = 3 * kind.node_count();
-        let mut ke = vec![0.0; nd * nd];
-        for c in 0..self.mesh.cell_count() {
-            element_stiffness3(
-                kind,
-                &self.mesh.cell_coords(c),
-                &self.material,
-                &rule,
-                &mut ke,
-            );
-            local.distribute(&self.cell_dofs(c), &ke, &pattern, &mut k, &mut rhs);
-        }
-        let mut x = rhs.clone();
-        if n > 0 {
-            let factor = Cholesky::analyse(&pattern, limit)?.factor(&pattern, &k)?;
-            factor.solve_in_place(&mut x);
-            let mut r = vec![0.0; n];
-            for _ in 0..2 {
-                pattern.mul(&k, &x, &mut r);
-                r.iter_mut().zip(&rhs).for_each(|(a, b)| *a = b - *a);
-                factor.solve_in_place(&mut r);
-                x.iter_mut().zip(&r).for_each(|(a, d)| *a += d);
-            }
-        }
-        Ok(constraints.expand(&x))
+    pub fn solve(&self, limit: &WorkLimit) -> crate::error::Result<Vec<f64>> {
+        let model = self.model("solid", limit);
+        Ok(crate::solver::linear::solve_elastic(&model, &mut |_| {})?.u)
     }
 
     /// The stress of the solution `u` at every quadrature point of the stiffness rule, with

@@ -54,7 +54,7 @@ impl Timings {
 
 /// The displacement solution and what the solve measured.
 #[derive(Clone, Debug)]
-pub struct Solution {
+pub struct Solution<const D: usize = 2> {
     /// Global displacement vector (prescribed values included).
     pub u: Vec<f64>,
     /// `K u - f` at every dof: reactions at prescribed dofs, equilibrium error elsewhere.
@@ -65,7 +65,7 @@ pub struct Solution {
     pub relative_residual: f64,
     pub timings: Timings,
     /// What the contact solve found, when the model has contact pairs.
-    pub contact: Option<crate::contact::state::ContactState>,
+    pub contact: Option<crate::contact::state::ContactState<D>>,
     /// The record of a time integration (`physics.dynamics`); `None` for a static run.
     pub dynamics: Option<Box<crate::solver::history::DynamicHistory>>,
     /// The load stepping of a finite-kinematics solve (every attempt, cuts with their
@@ -311,7 +311,7 @@ pub fn assemble<const D: usize, K: SolidCell<D>>(
 pub fn solve_elastic<const D: usize, K: SolidCell<D>>(
     model: &Model<D, K>,
     progress: &mut dyn FnMut(&str),
-) -> Result<Solution> {
+) -> Result<Solution<D>> {
     let mut timings = Timings::default();
     let t = Instant::now();
     progress("assembling");
@@ -403,7 +403,7 @@ pub fn finish<const D: usize, K: SolidCell<D>>(
     u: Vec<f64>,
     contact_force: &[f64],
     timings: Timings,
-) -> Result<Solution> {
+) -> Result<Solution<D>> {
     if let Some(d) = u.iter().position(|v| !v.is_finite()) {
         return Err(non_finite(
             model,

@@ -39,14 +39,17 @@ pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Sol
 
 /// Refuse rows that a pair's method cannot treat ([`crate::contact::enforcement::Enforcement::obstacle`]): constraint
 /// elimination needs every row to own a free slave dof no other row touches.
-pub(crate) fn refuse_obstacles(
-    model: &crate::model::Model,
-    rows: &[crate::contact::Constraint],
+pub(crate) fn refuse_obstacles<const D: usize, K: crate::model::space::SolidCell<D>>(
+    model: &crate::model::Model<D, K>,
+    rows: &[crate::contact::Constraint<D>],
 ) -> crate::error::Result<()> {
     for (k, pair) in model.contact.iter().enumerate() {
         let enforcement = crate::contact::enforcement::method(&pair.enforcement);
-        let of_pair: Vec<crate::contact::Constraint> =
-            rows.iter().filter(|r| r.pair == k).cloned().collect();
+        let of_pair: Vec<crate::contact::RowSite> = rows
+            .iter()
+            .filter(|r| r.pair == k)
+            .map(|r| r.site())
+            .collect();
         if let Some(why) = enforcement.obstacle(&of_pair, &model.prescribed) {
             return Err(crate::error::Error::invalid(
                 &model.source,

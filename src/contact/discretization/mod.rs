@@ -169,6 +169,53 @@ impl Rows<'_> {
     }
 }
 
+/// The contact rows of a pair in the dimension of the model's cells: the one place where the
+/// discretizations of 2D ([`constraints`]) and 3D meet the dimension-free solver.
+pub trait Discretize<const D: usize>: crate::model::space::SolidCell<D> {
+    /// The rows of `pair` in the reference configuration of `model`, or why the pair's
+    /// discretization does not apply.
+    fn pair_rows(
+        model: &crate::model::Model<D, Self>,
+        pair: &ContactPair,
+    ) -> Result<Vec<Constraint<D>>, String>;
+
+    /// The second derivative `d2 g / dx_s2` (row-major `D x D`) of a row's gap with respect to
+    /// its slave node at the slave position `x_s`, where the discretization has one (Newton's
+    /// geometric term, current geometry); `None` elsewhere.
+    fn slave_curvature(
+        model: &crate::model::Model<D, Self>,
+        row: &Constraint<D>,
+        x_s: [f64; D],
+    ) -> Option<Vec<f64>>;
+}
+
+impl Discretize<2> for crate::fe::ElementKind {
+    fn pair_rows(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>, String> {
+        constraints(model, pair)
+    }
+
+    fn slave_curvature(model: &Model, row: &Constraint, x_s: [f64; 2]) -> Option<Vec<f64>> {
+        gap_second_derivative(model, row, x_s).map(|h| h.to_vec())
+    }
+}
+
+impl Discretize<3> for crate::fe3d::SolidKind {
+    fn pair_rows(
+        _model: &crate::model::Model3,
+        _pair: &ContactPair,
+    ) -> Result<Vec<Constraint<3>>, String> {
+        Err("contact between 3D bodies is not built yet".into())
+    }
+
+    fn slave_curvature(
+        _model: &crate::model::Model3,
+        _row: &Constraint<3>,
+        _x_s: [f64; 3],
+    ) -> Option<Vec<f64>> {
+        None
+    }
+}
+
 /// The constraint rows of `pair`, or the reason the discretization does not apply.
 pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>, String> {
     let slave_body = &model.bodies[pair.slave.0];

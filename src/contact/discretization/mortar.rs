@@ -286,6 +286,10 @@ pub(crate) fn rigid_gap(rigid: &RigidSurface, x: [f64; 2]) -> Result<(f64, [f64;
             }
             Ok((l - radius, [d[0] / l, d[1] / l]))
         }
+        RigidSurface::Plane { .. } | RigidSurface::Sphere { .. } => Err(format!(
+            "the rigid surface is 3D and the slave surface at ({}, {}) 2D",
+            x[0], x[1]
+        )),
     }
 }
 
@@ -303,6 +307,9 @@ pub(crate) fn rigid_mortar_rows(
         RigidSurface::Circle { .. } => RIGID_CIRCLE_GAUSS,
         RigidSurface::Line { .. } if ks == EdgeKind::Line3 => 4,
         RigidSurface::Line { .. } => 3,
+        RigidSurface::Plane { .. } | RigidSurface::Sphere { .. } => {
+            return Err("the rigid surface is 3D and the slave surface 2D".into())
+        }
     });
     // per slave node j: D_jk, int Phi_j g, and int Phi_j N_k n (per k)
     let mut d: BTreeMap<usize, BTreeMap<usize, f64>> = BTreeMap::new();

@@ -364,6 +364,8 @@ pub(crate) fn linearize_rigid_row(
                 let d = [p[0].clone() - centre[0], p[1].clone() - centre[1]];
                 dot2(&d, &d).sqrt() - radius
             }
+            // the model refuses a 3D surface against 2D bodies; no distance is defined
+            RigidSurface::Plane { .. } | RigidSurface::Sphere { .. } => constant(f64::NAN),
         }
     };
     let (mut area, mut weighted) = (constant(0.0), constant(0.0));

@@ -21,7 +21,7 @@
 //! the rows are then not `kappa A_i`), and the two differ wherever the contact pressure is not
 //! uniform (Taylor 2004: "not always same"); see `perturbed_lagrange`.
 
-use super::Constraint;
+use super::{Constraint, RowSite};
 use crate::io::scene::{EnforcementSpec, MultiplierUpdate};
 
 mod augmented_lagrange;
@@ -69,7 +69,7 @@ pub trait Enforcement {
     /// What the solver runs.
     fn kernel(&self) -> Method;
     /// Why the method cannot treat `rows`, if it cannot.
-    fn obstacle(&self, _rows: &[Constraint], _prescribed: &[Option<f64>]) -> Option<String> {
+    fn obstacle(&self, _rows: &[RowSite], _prescribed: &[Option<f64>]) -> Option<String> {
         None
     }
 }
