@@ -35,12 +35,14 @@
 //! Every row carries the slave node's tributary area, so penalty forces (`kappa A g`) do not
 //! depend on the mesh. Geometry is evaluated in the reference configuration (small strain).
 
-pub(crate) mod geometry;
+pub mod facet_projection;
+pub mod geometry;
 pub(crate) mod mortar;
 pub(crate) mod mortar_linearization;
 pub mod nodal_normal;
+pub mod node_based_rows;
 pub mod node_to_segment;
-pub(crate) mod search;
+pub mod search;
 
 use crate::contact::Constraint;
 use crate::io::scene::{
