@@ -110,19 +110,8 @@ pub fn shape_second_derivatives(kind: ElementKind, s: [f64; 2], ddn: &mut [[[f64
             }
         }
         ElementKind::Q9 => {
-            const Q9_NODES: [[f64; 2]; 9] = [
-                [-1.0, -1.0],
-                [1.0, -1.0],
-                [1.0, 1.0],
-                [-1.0, 1.0],
-                [0.0, -1.0],
-                [1.0, 0.0],
-                [0.0, 1.0],
-                [-1.0, 0.0],
-                [0.0, 0.0],
-            ];
             let second = |node: f64| if node.abs() < 0.5 { -2.0 } else { 1.0 };
-            for (a, c) in Q9_NODES.iter().enumerate() {
+            for (a, c) in ElementKind::Q9.node_coordinates().iter().enumerate() {
                 let (ls, dls) = lagrange_1d_quadratic(c[0], s[0]);
                 let (lt, dlt) = lagrange_1d_quadratic(c[1], s[1]);
                 let st = dls * dlt;

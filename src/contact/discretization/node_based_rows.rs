@@ -1,7 +1,7 @@
 //! Node-based contact rows in 3D: node-to-surface one- and two-pass with master normals,
-//! node-to-node, rigid plane and sphere masters, as [`Constraint<3>`] rows (small strain:
-//! geometry taken once in the reference configuration, like the 2D rows of
-//! [`super::constraints`]). Node-to-node and the rigid masters are written once for any
+//! node-to-node, rigid plane and sphere masters, as [`Constraint`] rows with 3 components
+//! (`Constraint<3>`; small strain: geometry taken once in the reference configuration, like the
+//! 2D rows of [`super::constraints`]). Node-to-node and the rigid masters are written once for any
 //! dimension `D` (the same formulas as in 2D, where a rigid plane is a line and a sphere a
 //! circle).
 //!
@@ -112,24 +112,24 @@ pub fn rigid_gap<const D: usize>(
     }
 }
 
-/// The row `g = g0 + nu . (u_s - sum_b w_b u_b)` of slave node `node` of `slave` against master
-/// terms `(node, w_b)` of body `master.0` (`None`: a rigid master), pass `pass` (module notes).
-#[allow(clippy::too_many_arguments)]
-pub fn node_row<const D: usize, K>(
-    settings: &RowSettings,
-    slave: &Surface<D, K>,
-    node: usize,
+/// The gradient of `g = nu . (sum_k a_k u_k - sum_l b_l u_l)` over slave terms `(node, a_k)`
+/// (global dof `slave_dof(node, component)`) and master terms `(node, b_l)` of body `master.0`
+/// (`master_dof(body, node, component)`): the dofs in that order, each once, with their
+/// coefficients. Coefficients below `1e-12` of the row's largest weight times its largest
+/// `|nu_i|` are round-off of exact zeros (mortar integrals of disjoint supports, shape functions
+/// at a node) and are dropped; kept, they could pin a dof on their own. Shared by the 2D rows
+/// ([`super::weighted_row`]) and these.
+pub(crate) fn gradient_coefficients<const D: usize>(
     nu: [f64; D],
-    g0: f64,
-    master: Option<(usize, &[(usize, f64)])>,
-    pass: u8,
-) -> Constraint<D> {
-    let dofs_of = settings.dofs;
-    let largest = master
-        .map(|m| m.1)
-        .unwrap_or(&[])
+    slave_terms: &[(usize, f64)],
+    slave_dof: impl Fn(usize, usize) -> usize,
+    master: (usize, &[(usize, f64)]),
+    master_dof: impl Fn(usize, usize, usize) -> usize,
+) -> (Vec<usize>, Vec<f64>) {
+    let largest = slave_terms
         .iter()
-        .fold(1.0f64, |a, t| a.max(t.1.abs()))
+        .chain(master.1)
+        .fold(0.0f64, |a, t| a.max(t.1.abs()))
         * nu.iter().fold(0.0f64, |a, c| a.max(c.abs()));
     let mut dofs = Vec::new();
     let mut coeffs = Vec::new();
@@ -144,22 +144,52 @@ pub fn node_row<const D: usize, K>(
             }
         }
     };
-    for (i, &c) in nu.iter().enumerate() {
-        push(dofs_of.dof(slave.body, node, i), c);
-    }
-    if let Some((body, terms)) = master {
-        for &(m, w) in terms {
-            for (i, &c) in nu.iter().enumerate() {
-                push(dofs_of.dof(body, m, i), -w * c);
-            }
+    for &(n, a) in slave_terms {
+        for (i, &c) in nu.iter().enumerate() {
+            push(slave_dof(n, i), a * c);
         }
     }
+    for &(n, b) in master.1 {
+        for (i, &c) in nu.iter().enumerate() {
+            push(master_dof(master.0, n, i), -b * c);
+        }
+    }
+    (dofs, coeffs)
+}
+
+/// The component of `nu` with the largest magnitude (the later one on a tie): the slave dof a
+/// row owns.
+pub(crate) fn dominant_component<const D: usize>(nu: [f64; D]) -> usize {
     let mut component = 0;
     for i in 1..D {
         if nu[i].abs() >= nu[component].abs() {
             component = i;
         }
     }
+    component
+}
+
+/// The row `g = g0 + nu . (u_s - sum_b w_b u_b)` of slave node `node` of `slave` against master
+/// terms `(node, w_b)` of body `master.0` (`None`: a rigid master), pass `pass` (module notes).
+#[allow(clippy::too_many_arguments)]
+pub fn node_row<const D: usize, K>(
+    settings: &RowSettings,
+    slave: &Surface<D, K>,
+    node: usize,
+    nu: [f64; D],
+    g0: f64,
+    master: Option<(usize, &[(usize, f64)])>,
+    pass: u8,
+) -> Constraint<D> {
+    let dofs_of = settings.dofs;
+    let (dofs, coeffs) = gradient_coefficients(
+        nu,
+        &[(node, 1.0)],
+        |n, i| dofs_of.dof(slave.body, n, i),
+        master.map_or((0, &[][..]), |m| m),
+        |b, n, i| dofs_of.dof(b, n, i),
+    );
+    let component = dominant_component(nu);
     let data = slave.nodes[&node];
     Constraint {
         dofs,
