@@ -35,12 +35,14 @@
 //! Every row carries the slave node's tributary area, so penalty forces (`kappa A g`) do not
 //! depend on the mesh. Geometry is evaluated in the reference configuration (small strain).
 
-pub(crate) mod geometry;
+pub mod facet_projection;
+pub mod geometry;
 pub(crate) mod mortar;
 pub(crate) mod mortar_linearization;
 pub mod nodal_normal;
+pub mod node_based_rows;
 pub mod node_to_segment;
-pub(crate) mod search;
+pub mod search;
 
 use crate::contact::Constraint;
 use crate::io::scene::{
@@ -309,40 +311,14 @@ pub(crate) fn weighted_row(
     bilateral: bool,
 ) -> Constraint {
     let sb = &model.bodies[slave.body];
-    let mut dofs = Vec::new();
-    let mut coeffs = Vec::new();
-    // coefficients below 1e-12 of the row's largest weight are round-off of exact zeros (mortar
-    // integrals of disjoint supports); kept, they could pin a dof on their own
-    let largest = slave_terms
-        .iter()
-        .chain(master.map(|m| m.1).unwrap_or(&[]))
-        .fold(0.0f64, |a, t| a.max(t.1.abs()))
-        * nu[0].abs().max(nu[1].abs());
-    let mut push = |dof: usize, c: f64| {
-        if c.abs() > 1e-12 * largest {
-            match dofs.iter().position(|&d| d == dof) {
-                Some(k) => coeffs[k] += c,
-                None => {
-                    dofs.push(dof);
-                    coeffs.push(c);
-                }
-            }
-        }
-    };
-    for &(n, a) in slave_terms {
-        for i in 0..2 {
-            push(sb.dof(n, i), a * nu[i]);
-        }
-    }
-    if let Some((mb, terms)) = master {
-        let mb = &model.bodies[mb];
-        for &(n, b) in terms {
-            for i in 0..2 {
-                push(mb.dof(n, i), -b * nu[i]);
-            }
-        }
-    }
-    let comp = if nu[0].abs() > nu[1].abs() { 0 } else { 1 };
+    let (dofs, coeffs) = node_based_rows::gradient_coefficients(
+        nu,
+        slave_terms,
+        |n, i| sb.dof(n, i),
+        master.unwrap_or((0, &[])),
+        |b, n, i| model.bodies[b].dof(n, i),
+    );
+    let comp = node_based_rows::dominant_component(nu);
     let owner = sb.dof(node, comp);
     let data = slave.nodes[&node];
     Constraint {

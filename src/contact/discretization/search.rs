@@ -1,38 +1,70 @@
-//! Candidate search: a uniform bucket grid over the bounding boxes of master facets.
+//! Candidate search: a uniform bucket grid over the bounding boxes of items (master facets or
+//! nodes) in `D` dimensions (2 or 3; one code path).
 //!
-//! Building the grid is O(n) in the number of facets, a query is O(1) on average for
+//! Building the grid is O(n) in the number of items, a query is O(1) on average for
 //! quasi-uniform surfaces, so the search over all slave nodes is O(n) (better than the
 //! n log n the harness asks for). The cell size is the largest item's extent (at least the
-//! mean spacing of the items), so a facet overlaps at most a 2 x 2 block of cells.
+//! mean spacing of the items), so an item overlaps at most a 2 x 2 (x 2) block of cells.
 
 use std::collections::HashMap;
 
 #[derive(Debug)]
-pub struct BucketGrid {
+pub struct BucketGrid<const D: usize = 2> {
     cell: f64,
-    buckets: HashMap<(i64, i64), Vec<usize>>,
-    boxes: Vec<[[f64; 2]; 2]>,
+    buckets: HashMap<[i64; D], Vec<usize>>,
+    boxes: Vec<[[f64; D]; 2]>,
     /// The smallest and largest bucket keys in use: a query never looks outside them.
-    key_range: [(i64, i64); 2],
+    key_range: [[i64; D]; 2],
 }
 
-impl BucketGrid {
+/// Calls `visit` with every key of the box `lo..=hi` (inclusive in every component; none
+/// when some `lo[i] > hi[i]`).
+fn for_each_key<const D: usize>(lo: [i64; D], hi: [i64; D], mut visit: impl FnMut([i64; D])) {
+    if (0..D).any(|i| lo[i] > hi[i]) {
+        return;
+    }
+    let mut key = lo;
+    loop {
+        visit(key);
+        // odometer: advance the first component that has room, reset those before it
+        let mut i = 0;
+        loop {
+            if i == D {
+                return;
+            }
+            if key[i] < hi[i] {
+                key[i] += 1;
+                break;
+            }
+            key[i] = lo[i];
+            i += 1;
+        }
+    }
+}
+
+impl<const D: usize> BucketGrid<D> {
     /// `boxes[i] = [min, max]` of item `i`.
-    pub fn new(boxes: Vec<[[f64; 2]; 2]>) -> Self {
+    pub fn new(boxes: Vec<[[f64; D]; 2]>) -> Self {
         // cell size: the largest item, but no smaller than the mean spacing of the items over
         // their bounding box (points have no extent), so the grid follows the data's units
         let extent = boxes
             .iter()
-            .map(|b| (b[1][0] - b[0][0]).max(b[1][1] - b[0][1]))
+            .map(|b| {
+                (0..D)
+                    .map(|i| b[1][i] - b[0][i])
+                    .fold(f64::NEG_INFINITY, f64::max)
+            })
             .fold(0.0f64, f64::max);
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        let (mut lo, mut hi) = ([f64::INFINITY; D], [f64::NEG_INFINITY; D]);
         for b in &boxes {
-            for i in 0..2 {
+            for i in 0..D {
                 lo[i] = lo[i].min(b[0][i]);
                 hi[i] = hi[i].max(b[1][i]);
             }
         }
-        let span = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+        let span = (0..D)
+            .map(|i| hi[i] - lo[i])
+            .fold(f64::NEG_INFINITY, f64::max);
         let spacing = if boxes.is_empty() || !span.is_finite() {
             0.0
         } else {
@@ -44,28 +76,24 @@ impl BucketGrid {
             cell,
             buckets: HashMap::new(),
             boxes,
-            key_range: [(i64::MAX, i64::MAX), (i64::MIN, i64::MIN)],
+            key_range: [[i64::MAX; D], [i64::MIN; D]],
         };
         for i in 0..grid.boxes.len() {
             let [lo, hi] = grid.boxes[i];
             let (a, b) = (grid.key(lo), grid.key(hi));
-            for x in a.0..=b.0 {
-                for y in a.1..=b.1 {
-                    grid.buckets.entry((x, y)).or_default().push(i);
-                }
-            }
+            let buckets = &mut grid.buckets;
+            for_each_key(a, b, |k| buckets.entry(k).or_default().push(i));
             let [kl, kh] = &mut grid.key_range;
-            *kl = (kl.0.min(a.0), kl.1.min(a.1));
-            *kh = (kh.0.max(b.0), kh.1.max(b.1));
+            for d in 0..D {
+                kl[d] = kl[d].min(a[d]);
+                kh[d] = kh[d].max(b[d]);
+            }
         }
         grid
     }
 
-    fn key(&self, p: [f64; 2]) -> (i64, i64) {
-        (
-            (p[0] / self.cell).floor() as i64,
-            (p[1] / self.cell).floor() as i64,
-        )
+    fn key(&self, p: [f64; D]) -> [i64; D] {
+        p.map(|x| (x / self.cell).floor() as i64)
     }
 
     /// Items whose box, grown by `radius`, contains `p` (sorted, without repeats).
@@ -73,47 +101,43 @@ impl BucketGrid {
     /// The cost is bounded by the number of buckets in use, whatever `radius` is: the query's
     /// key range is clipped to the keys in use, and when it still spans more keys than there are
     /// buckets, the buckets are visited instead of the keys.
-    pub fn query(&self, p: [f64; 2], radius: f64) -> Vec<usize> {
+    pub fn query(&self, p: [f64; D], radius: f64) -> Vec<usize> {
         let (a, b) = (
-            self.key([p[0] - radius, p[1] - radius]),
-            self.key([p[0] + radius, p[1] + radius]),
+            self.key(p.map(|x| x - radius)),
+            self.key(p.map(|x| x + radius)),
         );
         let [kl, kh] = self.key_range;
-        let (a, b) = (
-            (a.0.max(kl.0), a.1.max(kl.1)),
-            (b.0.min(kh.0), b.1.min(kh.1)),
-        );
+        let mut a = a;
+        let mut b = b;
+        for d in 0..D {
+            a[d] = a[d].max(kl[d]);
+            b[d] = b[d].min(kh[d]);
+        }
         let mut out = Vec::new();
         let mut visit = |items: &Vec<usize>| {
             for &i in items {
                 let [lo, hi] = self.boxes[i];
-                if p[0] >= lo[0] - radius
-                    && p[0] <= hi[0] + radius
-                    && p[1] >= lo[1] - radius
-                    && p[1] <= hi[1] + radius
-                {
+                if (0..D).all(|d| p[d] >= lo[d] - radius && p[d] <= hi[d] + radius) {
                     out.push(i);
                 }
             }
         };
-        if a.0 > b.0 || a.1 > b.1 {
+        if (0..D).any(|d| a[d] > b[d]) {
             return out;
         }
-        let keys = (b.0 as i128 - a.0 as i128 + 1) * (b.1 as i128 - a.1 as i128 + 1);
+        let keys: i128 = (0..D).map(|d| b[d] as i128 - a[d] as i128 + 1).product();
         if keys > self.buckets.len() as i128 {
             for (k, items) in &self.buckets {
-                if (a.0..=b.0).contains(&k.0) && (a.1..=b.1).contains(&k.1) {
+                if (0..D).all(|d| (a[d]..=b[d]).contains(&k[d])) {
                     visit(items);
                 }
             }
         } else {
-            for x in a.0..=b.0 {
-                for y in a.1..=b.1 {
-                    if let Some(items) = self.buckets.get(&(x, y)) {
-                        visit(items);
-                    }
+            for_each_key(a, b, |k| {
+                if let Some(items) = self.buckets.get(&k) {
+                    visit(items);
                 }
-            }
+            });
         }
         out.sort_unstable();
         out.dedup();
@@ -146,6 +170,52 @@ mod tests {
                 .collect();
             assert_eq!(grid.query(p, r), brute);
         }
+    }
+
+    /// A deterministic pseudo-random sequence in [0, 1) (a linear congruential generator).
+    fn uniform(state: &mut u64) -> f64 {
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Random boxes (some of them points) and queries in `D` dimensions against the brute
+    /// force over all boxes.
+    fn random_boxes_match_brute_force<const D: usize>(seed: u64) {
+        let mut state = seed;
+        let boxes: Vec<[[f64; D]; 2]> = (0..400)
+            .map(|k| {
+                let lo: [f64; D] = std::array::from_fn(|_| 20.0 * uniform(&mut state) - 10.0);
+                let size: [f64; D] = std::array::from_fn(|_| {
+                    if k % 5 == 0 {
+                        0.0
+                    } else {
+                        1.5 * uniform(&mut state)
+                    }
+                });
+                [lo, std::array::from_fn(|i| lo[i] + size[i])]
+            })
+            .collect();
+        let grid = BucketGrid::new(boxes.clone());
+        for _ in 0..300 {
+            let p: [f64; D] = std::array::from_fn(|_| 24.0 * uniform(&mut state) - 12.0);
+            let r = 2.0 * uniform(&mut state);
+            let brute: Vec<usize> = (0..boxes.len())
+                .filter(|&i| {
+                    let [lo, hi] = boxes[i];
+                    (0..D).all(|d| p[d] >= lo[d] - r && p[d] <= hi[d] + r)
+                })
+                .collect();
+            assert_eq!(grid.query(p, r), brute, "query at {p:?}, radius {r}");
+        }
+    }
+
+    #[test]
+    fn random_boxes_in_2d_and_3d_match_brute_force() {
+        random_boxes_match_brute_force::<2>(7);
+        random_boxes_match_brute_force::<3>(11);
+        random_boxes_match_brute_force::<3>(12345);
     }
 
     #[test]
