@@ -37,6 +37,7 @@
 
 pub(crate) mod geometry;
 pub(crate) mod mortar;
+pub mod mortar3;
 pub(crate) mod mortar_linearization;
 pub mod nodal_normal;
 pub mod node_to_segment;
