@@ -958,3 +958,140 @@ fn bad_input_is_refused_with_a_reason() {
         mortar_integrals3(&slave, &master, MultiplierSpace::Dual, Some(f64::NAN)).unwrap_err();
     assert!(err.contains("search distance"), "{err}");
 }
+
+#[test]
+fn block_meshes_stacked_with_non_matching_faces() {
+    use contact_patch::fe3d::SolidKind;
+    use contact_patch::mesh::block3;
+    // a foundation [0, 1]^2 x [-0.5, 0] (master: its top) under a punch
+    // [0.1, 0.9]^2 x [d, 0.5 + d] (slave: its bottom) on other breaks, vertices moved in plane
+    let d = 0.004;
+    for (punch_kind, foundation_kind) in [
+        (SolidKind::Hex8, SolidKind::Hex8),
+        (SolidKind::Tet4, SolidKind::Hex8),
+        (SolidKind::Hex8, SolidKind::Tet4),
+        (SolidKind::Tet4, SolidKind::Tet4),
+    ] {
+        let foundation = block3(
+            foundation_kind,
+            &[0.0, 0.3, 0.55, 1.0],
+            &[0.0, 0.25, 0.6, 0.8, 1.0],
+            &[-0.5, -0.2, 0.0],
+            &[([0.3, 0.25, 0.0], [0.36, 0.2, 0.0])],
+        )
+        .expect("foundation");
+        let punch = block3(
+            punch_kind,
+            &[0.1, 0.4, 0.9],
+            &[0.1, 0.35, 0.65, 0.9],
+            &[d, 0.5 + d],
+            &[([0.4, 0.35, d], [0.45, 0.31, d])],
+        )
+        .expect("punch");
+        let slave = FacetSet3::from_mesh(&punch, &punch.facet_sets["bottom"]).expect("slave");
+        let master =
+            FacetSet3::from_mesh(&foundation, &foundation.facet_sets["top"]).expect("master");
+        let normals = nodal_normals(&slave);
+        assert!(normals.values().all(|n| (n[2] + 1.0).abs() < 1e-15));
+        let punch_nodes = punch.nodes.len();
+        let numbering = RowNumbering {
+            slave_body: 1,
+            pair: 0,
+            pass: 1,
+            slave_dof: &|n, i| 3 * n + i,
+            master_dof: &|n, i| 3 * (punch_nodes + n) + i,
+            tied: false,
+        };
+        for space in SPACES {
+            let (rows, integrals) =
+                mortar_rows3(&slave, &master, space, &normals, &numbering, None).expect("rows");
+            let covered: f64 = integrals.cells.iter().map(|c| c.area).sum();
+            assert!(
+                (covered - 0.64).abs() <= 1e-14,
+                "{punch_kind:?}: overlap {covered}"
+            );
+            let (linear, _) = momentum_defects(&integrals, &slave, &master);
+            assert!(linear <= 1e-13, "{linear:e}");
+            assert_eq!(rows.len(), slave.positions().len());
+            for row in &rows {
+                assert!(
+                    (row.g0 - d).abs() <= 1e-14,
+                    "{punch_kind:?} {space:?}: {}",
+                    row.g0
+                );
+                let e_z = [0.0, 0.0, 1.0];
+                assert!((0..3).all(|c| (row.normal[c] - e_z[c]).abs() <= 1e-15));
+            }
+            // angular momentum at the gap: sum D x - sum M x = d e_z A_j
+            let (xs, xm) = (slave.positions(), master.positions());
+            for (j, dj) in &integrals.d {
+                let area: f64 = dj.values().sum();
+                for c in 0..3 {
+                    let ds: f64 = dj.iter().map(|(k, w)| w * xs[k][c]).sum();
+                    let ms: f64 = integrals.m[j].iter().map(|(l, w)| w * xm[l][c]).sum();
+                    let exact = if c == 2 { d * area } else { 0.0 };
+                    assert!((ds - ms - exact).abs() <= 1e-14 * area.max(1.0));
+                }
+            }
+        }
+    }
+    let hex27 = block3(SolidKind::Hex27, &[0.0, 1.0], &[0.0, 1.0], &[0.0, 1.0], &[]).expect("mesh");
+    let err = FacetSet3::from_mesh(&hex27, &hex27.facet_sets["top"]).unwrap_err();
+    assert!(err.contains("Quad9"), "{err}");
+}
+
+#[test]
+fn matching_curved_surfaces_have_zero_weighted_gap_and_m_equal_to_d() {
+    // both sides the same doubly curved (warped Quad4, curved Tri3) cap z = 0.3 (x^2 - 0.5 y^2):
+    // every Gauss point of a slave facet maps to the same point of its twin master facet
+    for kind in [ElementKind::Q4, ElementKind::T3] {
+        let map = |p: [f64; 2]| p;
+        let lift = |s: &FacetSet3, offset: usize| {
+            let coords = s
+                .coords
+                .iter()
+                .map(|xs| {
+                    xs.iter()
+                        .map(|x| [x[0], x[1], 0.3 * (x[0] * x[0] - 0.5 * x[1] * x[1])])
+                        .collect()
+                })
+                .collect();
+            let facets = s
+                .facets
+                .iter()
+                .map(|f| f.iter().map(|n| n + offset).collect())
+                .collect();
+            FacetSet3::new(kind, facets, coords).expect("curved facets")
+        };
+        let flat_slave = surface(kind, 4, 3, &map, 0.0, false, 0, &IDENTITY);
+        let flat_master = surface(kind, 4, 3, &map, 0.0, true, 0, &IDENTITY);
+        let slave = lift(&flat_slave, 0);
+        let master = lift(&flat_master, MASTER_IDS);
+        let normals = nodal_normals(&slave);
+        for space in SPACES {
+            let (rows, integrals) =
+                mortar_rows3(&slave, &master, space, &normals, &numbering(false), None)
+                    .expect("rows");
+            for row in &rows {
+                assert!(row.g0.abs() <= 1e-14, "{kind:?} {space:?}: gap {}", row.g0);
+            }
+            for (j, dj) in &integrals.d {
+                for (k, v) in dj {
+                    let mv = integrals.m[j]
+                        .get(&(k + MASTER_IDS))
+                        .copied()
+                        .unwrap_or(0.0);
+                    assert!(
+                        (v - mv).abs() <= 1e-14,
+                        "{kind:?} {space:?}: D[{j}][{k}] {v} vs M {mv}"
+                    );
+                }
+                assert_eq!(
+                    dj.len(),
+                    integrals.m[j].len(),
+                    "{kind:?}: M touches other nodes"
+                );
+            }
+        }
+    }
+}

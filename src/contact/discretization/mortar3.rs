@@ -80,6 +80,7 @@
 use crate::contact::Constraint;
 use crate::fe::{gauss_square, triangle_rule, ElementKind, QuadPoint};
 use crate::io::scene::MultiplierSpace;
+use crate::mesh::{Facet, Mesh3};
 use nalgebra::DMatrix;
 use std::collections::{BTreeMap, HashMap};
 
@@ -163,6 +164,17 @@ impl FacetSet3 {
             facets,
             coords,
         })
+    }
+
+    /// The facet set of `facets` of a 3D mesh (node ids are the mesh's), or why not (see
+    /// [`FacetSet3::new`]; Hex27 and Tet10 bodies have Quad9 and Tri6 facets, refused).
+    pub fn from_mesh(mesh: &Mesh3, facets: &[Facet]) -> Result<Self, String> {
+        let ids: Vec<Vec<usize>> = facets.iter().map(|&f| mesh.facet_nodes(f)).collect();
+        let coords = ids
+            .iter()
+            .map(|f| f.iter().map(|&n| mesh.nodes[n]).collect())
+            .collect();
+        FacetSet3::new(mesh.kind.facet_kind(), ids, coords)
     }
 
     /// Axis-aligned bounding boxes of the facets, `[lo, hi]`.
