@@ -9,8 +9,8 @@
 //! clipping edge cases, and the refusals.
 
 use contact_patch::contact::discretization::mortar3::{
-    clip_convex_polygons, dual_coefficients, mortar_integrals3, mortar_rows3, weighted_gap,
-    FacetSet3, MortarIntegrals3, RowNumbering,
+    clip_convex_polygons, collapsed_triangle_rule, dual_coefficients, mortar_integrals3,
+    mortar_rows3, weighted_gap, FacetSet3, MortarIntegrals3, RowNumbering,
 };
 use contact_patch::contact::Constraint;
 use contact_patch::fe::{gauss_square, triangle_rule, ElementKind};
@@ -18,11 +18,14 @@ use contact_patch::io::scene::MultiplierSpace;
 use std::collections::BTreeMap;
 
 const SPACES: [MultiplierSpace; 2] = [MultiplierSpace::Standard, MultiplierSpace::Dual];
-const KINDS: [(ElementKind, ElementKind); 4] = [
+const KINDS: [(ElementKind, ElementKind); 7] = [
     (ElementKind::Q4, ElementKind::Q4),
     (ElementKind::T3, ElementKind::T3),
     (ElementKind::Q4, ElementKind::T3),
     (ElementKind::T3, ElementKind::Q4),
+    (ElementKind::Q9, ElementKind::Q9),
+    (ElementKind::Q9, ElementKind::Q4),
+    (ElementKind::T3, ElementKind::Q9),
 ];
 /// Master node ids start here (slave ids from 0).
 const MASTER_IDS: usize = 10_000;
@@ -31,7 +34,8 @@ type Map = Box<dyn Fn([f64; 2]) -> [f64; 2]>;
 
 /// A surface over the parameter square `[0, 1]^2` cut into `nx x ny` cells, mapped into the
 /// plane `z = z` by `map` then rotated by `rotation`; facets ordered for an outward normal
-/// along `+z` (`up`) or `-z` before the rotation; each quad split in two triangles for Tri3.
+/// along `+z` (`up`) or `-z` before the rotation; each quad split in two triangles for Tri3;
+/// Quad9 nodes on the grid of half cells (mid-edge and centre nodes mapped too).
 #[allow(clippy::too_many_arguments)]
 fn surface(
     kind: ElementKind,
@@ -43,25 +47,47 @@ fn surface(
     first_id: usize,
     rotation: &[[f64; 3]; 3],
 ) -> FacetSet3 {
-    let id = |i: usize, j: usize| first_id + j * (nx + 1) + i;
+    // grid points per cell side: 1, or 2 for Quad9
+    let r = if kind == ElementKind::Q9 { 2 } else { 1 };
+    let id = |i: usize, j: usize| first_id + j * (r * nx + 1) + i;
     let position = |i: usize, j: usize| {
-        let [x, y] = map([i as f64 / nx as f64, j as f64 / ny as f64]);
+        let [x, y] = map([i as f64 / (r * nx) as f64, j as f64 / (r * ny) as f64]);
         rotate(rotation, [x, y, z])
     };
     let mut facets = Vec::new();
     let mut coords = Vec::new();
-    let mut push = |mut corners: Vec<(usize, usize)>| {
+    let mut push = |mut nodes: Vec<(usize, usize)>| {
         if !up {
-            corners.reverse();
+            // the same facet seen from the other side: corners 0 3 2 1, mid-edges 7 6 5 4
+            let order: &[usize] = match nodes.len() {
+                9 => &[0, 3, 2, 1, 7, 6, 5, 4, 8],
+                4 => &[0, 3, 2, 1],
+                _ => &[0, 2, 1],
+            };
+            nodes = order.iter().map(|&k| nodes[k]).collect();
         }
-        facets.push(corners.iter().map(|&(i, j)| id(i, j)).collect());
-        coords.push(corners.iter().map(|&(i, j)| position(i, j)).collect());
+        facets.push(nodes.iter().map(|&(i, j)| id(i, j)).collect());
+        coords.push(nodes.iter().map(|&(i, j)| position(i, j)).collect());
     };
     for j in 0..ny {
         for i in 0..nx {
             let (a, b, c, d) = ((i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1));
             match kind {
                 ElementKind::Q4 => push(vec![a, b, c, d]),
+                ElementKind::Q9 => {
+                    let (i, j) = (2 * i, 2 * j);
+                    push(vec![
+                        (i, j),
+                        (i + 2, j),
+                        (i + 2, j + 2),
+                        (i, j + 2),
+                        (i + 1, j),
+                        (i + 2, j + 1),
+                        (i + 1, j + 2),
+                        (i, j + 1),
+                        (i + 1, j + 1),
+                    ])
+                }
                 _ => {
                     push(vec![a, b, c]);
                     push(vec![a, c, d]);
@@ -204,8 +230,19 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// Vector area of a facet's corner polygon (its area times its outward normal).
+/// Vector area of a facet's corner polygon (its area times its outward normal); of a Quad9,
+/// the sum of its four sub-quadrilaterals'.
 fn vector_area(xs: &[[f64; 3]]) -> [f64; 3] {
+    if xs.len() == 9 {
+        let mut v = [0.0; 3];
+        for piece in [[0, 4, 8, 7], [4, 1, 5, 8], [8, 5, 2, 6], [7, 8, 6, 3]] {
+            let a = vector_area(&piece.map(|k| xs[k]));
+            for d in 0..3 {
+                v[d] += a[d];
+            }
+        }
+        return v;
+    }
     let k = if xs.len() == 4 { 4 } else { 3 };
     let mut v = [0.0; 3];
     for i in 0..k {
@@ -397,11 +434,30 @@ fn weighted_gap_of_a_uniform_separation_is_the_separation_times_the_row_area() {
 }
 
 /// The consistent mass matrix of a flat parallelogram Quad4 or a flat Tri3 facet (closed
-/// form): `A/36 [4 on the node, 2 along an edge, 1 across]`, `A/12 (1 + delta)`.
+/// form): `A/36 [4 on the node, 2 along an edge, 1 across]`, `A/12 (1 + delta)`; of a flat
+/// straight-edged parallelogram Quad9, `A/4 m(xi_a, xi_b) m(eta_a, eta_b)` with the Line3
+/// mass `m` on nodes -1, 0, 1: `[[4, 2, -1], [2, 16, 2], [-1, 2, 4]] / 15`.
 fn closed_form_mass(xs: &[[f64; 3]]) -> Vec<Vec<f64>> {
     let a = vector_area(xs);
     let area = dot(a, a).sqrt();
     let n = xs.len();
+    if n == 9 {
+        let line3 = |s: f64, t: f64| {
+            let (i, j) = ((s + 1.0) as usize, (t + 1.0) as usize);
+            [[4.0, 2.0, -1.0], [2.0, 16.0, 2.0], [-1.0, 2.0, 4.0]][i][j] / 15.0
+        };
+        let natural = ElementKind::Q9.node_coordinates();
+        return (0..9)
+            .map(|j| {
+                (0..9)
+                    .map(|k| {
+                        let (a, b) = (natural[j], natural[k]);
+                        0.25 * area * line3(a[0], b[0]) * line3(a[1], b[1])
+                    })
+                    .collect()
+            })
+            .collect();
+    }
     (0..n)
         .map(|j| {
             (0..n)
@@ -889,8 +945,6 @@ fn partially_covered_slave_facets_integrate_only_the_covered_part() {
 
 #[test]
 fn bad_input_is_refused_with_a_reason() {
-    let quad9 = FacetSet3::new(ElementKind::Q9, vec![vec![0; 9]], vec![vec![[0.0; 3]; 9]]);
-    assert!(quad9.unwrap_err().contains("Quad9"));
     let tri6 = FacetSet3::new(ElementKind::T6, vec![vec![0; 6]], vec![vec![[0.0; 3]; 6]]);
     assert!(tri6.unwrap_err().contains("modified basis"));
     let short = FacetSet3::new(ElementKind::T3, vec![vec![0, 1, 2]], vec![]);
@@ -971,6 +1025,9 @@ fn block_meshes_stacked_with_non_matching_faces() {
         (SolidKind::Tet4, SolidKind::Hex8),
         (SolidKind::Hex8, SolidKind::Tet4),
         (SolidKind::Tet4, SolidKind::Tet4),
+        (SolidKind::Hex27, SolidKind::Hex8),
+        (SolidKind::Hex27, SolidKind::Hex27),
+        (SolidKind::Tet4, SolidKind::Hex27),
     ] {
         let foundation = block3(
             foundation_kind,
@@ -1035,16 +1092,16 @@ fn block_meshes_stacked_with_non_matching_faces() {
             }
         }
     }
-    let hex27 = block3(SolidKind::Hex27, &[0.0, 1.0], &[0.0, 1.0], &[0.0, 1.0], &[]).expect("mesh");
-    let err = FacetSet3::from_mesh(&hex27, &hex27.facet_sets["top"]).unwrap_err();
-    assert!(err.contains("Quad9"), "{err}");
+    let tet10 = block3(SolidKind::Tet10, &[0.0, 1.0], &[0.0, 1.0], &[0.0, 1.0], &[]).expect("mesh");
+    let err = FacetSet3::from_mesh(&tet10, &tet10.facet_sets["top"]).unwrap_err();
+    assert!(err.contains("modified basis"), "{err}");
 }
 
 #[test]
 fn matching_curved_surfaces_have_zero_weighted_gap_and_m_equal_to_d() {
     // both sides the same doubly curved (warped Quad4, curved Tri3) cap z = 0.3 (x^2 - 0.5 y^2):
     // every Gauss point of a slave facet maps to the same point of its twin master facet
-    for kind in [ElementKind::Q4, ElementKind::T3] {
+    for kind in [ElementKind::Q4, ElementKind::T3, ElementKind::Q9] {
         let map = |p: [f64; 2]| p;
         let lift = |s: &FacetSet3, offset: usize| {
             let coords = s
@@ -1092,6 +1149,26 @@ fn matching_curved_surfaces_have_zero_weighted_gap_and_m_equal_to_d() {
                     "{kind:?}: M touches other nodes"
                 );
             }
+        }
+    }
+}
+
+#[test]
+fn collapsed_triangle_rule_integrates_degree_eight_exactly() {
+    // int_T x^i y^j = i! j! / (i + j + 2)! on the reference triangle
+    let factorial = |n: usize| (1..=n).map(|k| k as f64).product::<f64>();
+    let rule = collapsed_triangle_rule(5);
+    for i in 0..=8 {
+        for j in 0..=8 - i {
+            let got: f64 = rule
+                .iter()
+                .map(|q| q.weight * q.xi[0].powi(i as i32) * q.xi[1].powi(j as i32))
+                .sum();
+            let exact = factorial(i) * factorial(j) / factorial(i + j + 2);
+            assert!(
+                (got - exact).abs() <= 1e-14 * exact,
+                "x^{i} y^{j}: {got} vs {exact}"
+            );
         }
     }
 }

@@ -1,4 +1,4 @@
-//! Segment-based mortar integration in 3D (Quad4 and Tri3 facets), standard and dual
+//! Segment-based mortar integration in 3D (Quad4, Tri3 and Quad9 facets), standard and dual
 //! multipliers: the mortar matrices `D`, `M` and the weighted-gap rows
 //! [`crate::contact::Constraint<3>`].
 //!
@@ -39,18 +39,29 @@
 //!    convex polygon). On each triangle a symmetric rule on the reference triangle: degree 2
 //!    (3 points) between Tri3 facets (the integrands `Phi_j N_k` are products of two linear
 //!    functions), degree 5 (Radon's 7 points) where a Quad4 takes part (products of two
-//!    bilinear functions, total degree 4 when the facet map is affine). The weight is the
+//!    bilinear functions, total degree 4 when the facet map is affine), degree 8 (the
+//!    collapsed 5 x 5 Gauss product, [`collapsed_triangle_rule`]) where a Quad9 takes part
+//!    (two biquadratic functions, total degree 8). The weight is the
 //!    rule's weight times twice the triangle's area: the integrals are taken over the
 //!    auxiliary plane (exact for flat slave facets, Puso and Laursen's approximation
 //!    otherwise).
 //! 5. **Back to the facets.** Each Gauss point `p` of the plane maps to the slave and master
 //!    natural coordinates by inverting the projected facet map `xi -> P(x(xi))`: in closed form
-//!    for Tri3 (affine), by Newton from the centre for Quad4 (bilinear; converged to `1e-13`
-//!    in `xi`, at most 50 steps, a failure is an error naming the facets).
+//!    for Tri3 (affine), by Newton for Quad4 and Quad9 from the centre of the piece the point
+//!    lies in (converged to `1e-13` in `xi`, at most 50 steps, a failure is an error naming
+//!    the facets).
+//!
+//! **Quad9 facets** (Hex27) are segmented by their four sub-quadrilaterals through the mid-edge
+//! and centre nodes (Puso, Laursen and Solberg, "A segment-to-segment mortar contact method
+//! for quadratic elements and large deformations", CMAME 197 (2008)): each slave piece clips
+//! each master piece, and the cells are integrated with the full biquadratic shape functions.
+//! Exact for straight-edged facets (every facet of `mesh::block3`); on curved facets the
+//! pieces' chords stand for the curved edges.
 //!
 //! **Multipliers.** Standard: `Phi_j = N_j`. Dual: `Phi_j = sum_k a_jk N_k` per slave facet,
 //! `A_e = D_e M_e^-1` with `D_e = diag(int_e N_k dA)` and `M_e = [int_e N_j N_k dA]` over the
-//! whole facet in the same (auxiliary-plane) measure (Gauss 3x3 for Quad4, degree 2 for Tri3),
+//! whole facet in the same (auxiliary-plane) measure (Gauss 3x3 for Quad4, 4x4 for Quad9,
+//! degree 2 for Tri3),
 //! so `int_e Psi_j N_k dA = delta_jk int_e N_k dA` and `D` is diagonal where the slave facet is
 //! covered. On affine facets this is `Psi_j = 4 N_j - 1` (Tri3) and
 //! `a = [[4, -2, 1, -2], ...]` (Quad4, the nodal pattern of `4 N_j - 2 N_{j+1} + N_{j+2} -
@@ -74,11 +85,12 @@
 //! `sum_k D_jk x_k = sum_l M_jl x_l` on flat coplanar interfaces (both facets reproduce the
 //! plane point at every Gauss point).
 //!
-//! Quad9 and Tri6 facets are refused with a reason (Tri6 needs the modified basis before a dual
-//! basis exists; neither is built here).
+//! Tri6 facets (Tet10) are refused with a reason: their dual basis needs the modified basis
+//! (vertex functions plus 1/5 of the adjacent edge functions) first, which is not built here.
+//! Quad9 needs none (its corner integrals `int N_k` are positive).
 
 use crate::contact::Constraint;
-use crate::fe::{gauss_square, triangle_rule, ElementKind, QuadPoint};
+use crate::fe::{gauss_legendre, gauss_square, triangle_rule, ElementKind, QuadPoint, MAX_NODES};
 use crate::io::scene::MultiplierSpace;
 use crate::mesh::{Facet, Mesh3};
 use nalgebra::DMatrix;
@@ -167,7 +179,7 @@ impl FacetSet3 {
     }
 
     /// The facet set of `facets` of a 3D mesh (node ids are the mesh's), or why not (see
-    /// [`FacetSet3::new`]; Hex27 and Tet10 bodies have Quad9 and Tri6 facets, refused).
+    /// [`FacetSet3::new`]; Tet10 bodies have Tri6 facets, refused).
     pub fn from_mesh(mesh: &Mesh3, facets: &[Facet]) -> Result<Self, String> {
         let ids: Vec<Vec<usize>> = facets.iter().map(|&f| mesh.facet_nodes(f)).collect();
         let coords = ids
@@ -202,12 +214,9 @@ impl FacetSet3 {
 /// Whether the 3D mortar is built for facets of `kind`, the reason where not.
 pub fn supported(kind: ElementKind) -> Result<(), String> {
     match kind {
-        ElementKind::Q4 | ElementKind::T3 => Ok(()),
-        ElementKind::Q9 => Err(
-            "segment-based 3D mortar is built for Quad4 and Tri3 facets; Quad9 facets (Hex27) are not built yet: use Hex8 or Tet4 bodies on the interface, or node-to-surface".into(),
-        ),
+        ElementKind::Q4 | ElementKind::T3 | ElementKind::Q9 => Ok(()),
         ElementKind::T6 => Err(
-            "segment-based 3D mortar is built for Quad4 and Tri3 facets; Tri6 facets (Tet10) are not built: their dual basis needs the modified basis (vertex + 1/5 of the adjacent edge functions) first; use Tet4 or Hex8 bodies on the interface, or node-to-surface".into(),
+            "segment-based 3D mortar is built for Quad4, Tri3 and Quad9 facets; Tri6 facets (Tet10) are not built: their dual basis needs the modified basis (vertex + 1/5 of the adjacent edge functions) first; use Tet4, Hex8 or Hex27 bodies on the interface, or node-to-surface".into(),
         ),
     }
 }
@@ -274,10 +283,10 @@ impl AuxiliaryPlane {
     }
 }
 
-/// Shape functions (at most 4) of a linear facet at `xi`, and their natural derivatives.
-fn shape(kind: ElementKind, xi: [f64; 2]) -> ([f64; 4], [[f64; 2]; 4]) {
-    let mut n = [0.0; 4];
-    let mut dn = [[0.0; 2]; 4];
+/// Shape functions (at most 9) of a facet at `xi`, and their natural derivatives.
+fn shape(kind: ElementKind, xi: [f64; 2]) -> ([f64; MAX_NODES], [[f64; 2]; MAX_NODES]) {
+    let mut n = [0.0; MAX_NODES];
+    let mut dn = [[0.0; 2]; MAX_NODES];
     kind.shape(xi, &mut n, &mut dn);
     (n, dn)
 }
@@ -321,10 +330,15 @@ fn planar_map(kind: ElementKind, q: &[[f64; 2]], xi: [f64; 2]) -> ([f64; 2], [[f
     (p, j)
 }
 
-/// The natural coordinates of in-plane point `p` on the projected facet with corners `q`:
-/// closed form for Tri3, Newton from the centre for Quad4. `None` if the map is singular or
-/// Newton does not converge.
-fn inverse_map(kind: ElementKind, q: &[[f64; 2]], p: [f64; 2]) -> Option<[f64; 2]> {
+/// The natural coordinates of in-plane point `p` on the projected facet with nodes `q`:
+/// closed form for Tri3, Newton from `start` for Quad4 and Quad9. `None` if the map is
+/// singular or Newton does not converge.
+fn inverse_map(
+    kind: ElementKind,
+    q: &[[f64; 2]],
+    p: [f64; 2],
+    start: [f64; 2],
+) -> Option<[f64; 2]> {
     let solve = |j: [[f64; 2]; 2], r: [f64; 2]| {
         let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
         let scale = (j[0][0].abs() + j[0][1].abs()) * (j[1][0].abs() + j[1][1].abs());
@@ -344,7 +358,7 @@ fn inverse_map(kind: ElementKind, q: &[[f64; 2]], p: [f64; 2]) -> Option<[f64; 2
             solve(j, [p[0] - q[0][0], p[1] - q[0][1]])
         }
         _ => {
-            let mut xi = kind.centre();
+            let mut xi = start;
             for _ in 0..NEWTON_STEPS {
                 let (x, j) = planar_map(kind, q, xi);
                 let step = solve(j, [p[0] - x[0], p[1] - x[1]])?;
@@ -508,10 +522,17 @@ impl BoxGrid {
 
 /// The dual coefficients `a_jk` of a slave facet whose projected corners are `q` (see the
 /// module notes): `A_e = D_e M_e^-1` over the facet in the auxiliary-plane measure.
-pub fn dual_coefficients(kind: ElementKind, q: &[[f64; 2]]) -> Result<[[f64; 4]; 4], String> {
+pub fn dual_coefficients(
+    kind: ElementKind,
+    q: &[[f64; 2]],
+) -> Result<[[f64; MAX_NODES]; MAX_NODES], String> {
+    supported(kind)?;
     let n = kind.node_count();
+    // exact for N_j N_k |J| on straight-sided facets: degree 2 (Tri3), (3, 3) (Quad4),
+    // (7, 7) (Quad9)
     let rule: Vec<QuadPoint> = match kind {
         ElementKind::T3 => triangle_rule(2),
+        ElementKind::Q9 => gauss_square(4),
         _ => gauss_square(3),
     };
     let mut mass = DMatrix::<f64>::zeros(n, n);
@@ -530,13 +551,109 @@ pub fn dual_coefficients(kind: ElementKind, q: &[[f64; 2]]) -> Result<[[f64; 4];
     let inverse = mass
         .try_inverse()
         .ok_or("the slave facet's mass matrix is singular (a degenerate facet); fix the mesh")?;
-    let mut a = [[0.0; 4]; 4];
+    let mut a = [[0.0; MAX_NODES]; MAX_NODES];
     for j in 0..n {
         for k in 0..n {
             a[j][k] = lumped[j] * inverse[(j, k)];
         }
     }
     Ok(a)
+}
+
+/// The pieces a facet is segmented by, each with its local nodes (counter-clockwise) and the
+/// natural point the inverse map starts from: the facet itself (Quad4, Tri3), or the four
+/// sub-quadrilaterals of a Quad9 through its mid-edge and centre nodes (Puso, Laursen and
+/// Solberg's segmentation of quadratic facets; exact for straight-edged facets, chords of
+/// curved ones).
+fn pieces(kind: ElementKind) -> &'static [(&'static [usize], [f64; 2])] {
+    const QUAD4: [(&[usize], [f64; 2]); 1] = [(&[0, 1, 2, 3], [0.0, 0.0])];
+    const TRI3: [(&[usize], [f64; 2]); 1] = [(&[0, 1, 2], [1.0 / 3.0, 1.0 / 3.0])];
+    const QUAD9: [(&[usize], [f64; 2]); 4] = [
+        (&[0, 4, 8, 7], [-0.5, -0.5]),
+        (&[4, 1, 5, 8], [0.5, -0.5]),
+        (&[8, 5, 2, 6], [0.5, 0.5]),
+        (&[7, 8, 6, 3], [-0.5, 0.5]),
+    ];
+    match kind {
+        ElementKind::Q9 => &QUAD9,
+        ElementKind::T3 | ElementKind::T6 => &TRI3,
+        ElementKind::Q4 => &QUAD4,
+    }
+}
+
+/// A triangle of a cell: its first corner, its two edge vectors from there, its area.
+struct CellTriangle {
+    corner: [f64; 2],
+    edges: [[f64; 2]; 2],
+    area: f64,
+}
+
+impl CellTriangle {
+    /// The in-plane point of natural coordinates `[r, t]` on the reference triangle.
+    fn point(&self, [r, t]: [f64; 2]) -> [f64; 2] {
+        let [e1, e2] = self.edges;
+        [
+            self.corner[0] + r * e1[0] + t * e2[0],
+            self.corner[1] + r * e1[1] + t * e2[1],
+        ]
+    }
+}
+
+/// The triangles of a convex counter-clockwise polygon about its vertex average (degenerate
+/// ones left out).
+fn fan(polygon: &[[f64; 2]]) -> Vec<CellTriangle> {
+    let k = polygon.len();
+    let centroid = polygon
+        .iter()
+        .fold([0.0; 2], |s, p| [s[0] + p[0], s[1] + p[1]])
+        .map(|v| v / k as f64);
+    (0..k)
+        .filter_map(|i| {
+            let (a, b) = (polygon[i], polygon[(i + 1) % k]);
+            let e1 = [a[0] - centroid[0], a[1] - centroid[1]];
+            let e2 = [b[0] - centroid[0], b[1] - centroid[1]];
+            let area = 0.5 * (e1[0] * e2[1] - e1[1] * e2[0]);
+            (area > 0.0).then_some(CellTriangle {
+                corner: centroid,
+                edges: [e1, e2],
+                area,
+            })
+        })
+        .collect()
+}
+
+/// The rule on each cell triangle (weights summing to 1/2): degree 2 between Tri3 facets,
+/// degree 5 (Radon's 7 points) where a Quad4 takes part, degree 8 where a Quad9 does
+/// (biquadratic times biquadratic: the collapsed 5 x 5 Gauss product, see
+/// [`collapsed_triangle_rule`]).
+fn cell_rule(slave: ElementKind, master: ElementKind) -> Vec<QuadPoint> {
+    if slave == ElementKind::Q9 || master == ElementKind::Q9 {
+        collapsed_triangle_rule(5)
+    } else if slave == ElementKind::T3 && master == ElementKind::T3 {
+        triangle_rule(2)
+    } else {
+        triangle_rule(5)
+    }
+}
+
+/// The `n x n` Gauss-Legendre product on the square mapped onto the reference triangle by
+/// `(a, b) -> (a (1 - b), b)` (Duffy), weights times the map's Jacobian `1 - b`: a monomial of
+/// total degree `d` becomes degree `d` in `a` and `d + 1` in `b`, so the rule is exact for
+/// total degree `2 n - 2`.
+pub fn collapsed_triangle_rule(n: usize) -> Vec<QuadPoint> {
+    let g = gauss_legendre(n);
+    let mut out = Vec::with_capacity(n * n);
+    for &(t, wt) in &g {
+        let b = 0.5 * (t + 1.0);
+        for &(s, ws) in &g {
+            let a = 0.5 * (s + 1.0);
+            out.push(QuadPoint {
+                xi: [a * (1.0 - b), b],
+                weight: 0.25 * ws * wt * (1.0 - b),
+            });
+        }
+    }
+    out
 }
 
 /// The projected corners of facet `xs` on `plane`.
@@ -566,11 +683,7 @@ pub fn mortar_integrals3(
     };
     let (ks, km) = (slave.kind, master.kind);
     let (ns, nm) = (ks.node_count(), km.node_count());
-    let rule = triangle_rule(if ks == ElementKind::T3 && km == ElementKind::T3 {
-        2
-    } else {
-        5
-    });
+    let rule = cell_rule(ks, km);
     let grid = BoxGrid::new(
         master
             .boxes()
@@ -588,13 +701,17 @@ pub fn mortar_integrals3(
         let q_slave = projected(&plane, xs);
         let size = diameter(xs);
         let tol = CLIP_TOLERANCE * size;
-        if !is_convex(&q_slave, 1e-10) {
+        let windows: Vec<(Vec<[f64; 2]>, [f64; 2])> = pieces(ks)
+            .iter()
+            .map(|(local, start)| (local.iter().map(|&a| q_slave[a]).collect(), *start))
+            .collect();
+        if windows.iter().any(|(w, _)| !is_convex(w, 1e-10)) {
             return Err(format!(
                 "slave facet {f} (nodes {:?}) is not convex in its own plane (warped or folded); fix the mesh",
                 slave.facets[f]
             ));
         }
-        let slave_area = 0.5 * twice_signed_area(&q_slave);
+        let slave_area = 0.5 * twice_signed_area(&q_slave[..ks.corner_count()]);
         let phi_of = match space {
             MultiplierSpace::Standard => None,
             MultiplierSpace::Dual => Some(
@@ -602,74 +719,68 @@ pub fn mortar_integrals3(
             ),
         };
         let [lo, hi] = bounding_box(xs);
-        let mut d_local = [[0.0; 4]; 4];
-        let mut m_local: Vec<(usize, [[f64; 4]; 4])> = Vec::new();
+        let mut d_local = [[0.0; MAX_NODES]; MAX_NODES];
+        let mut m_local: Vec<(usize, [[f64; MAX_NODES]; MAX_NODES])> = Vec::new();
         for c in grid.query(lo, hi) {
             let q_master = projected(&plane, &master.coords[c]);
             // a master facet facing the slave one projects clockwise; edge-on or back: skipped
-            let master_area = 0.5 * twice_signed_area(&q_master);
+            let master_area = 0.5 * twice_signed_area(&q_master[..km.corner_count()]);
             if -master_area <= 0.5e-9 * twice_area_3d(km, &master.coords[c]) {
                 continue;
             }
-            let q_counter_clockwise: Vec<[f64; 2]> = q_master.iter().rev().copied().collect();
-            let clipped = clip_convex_polygons(&q_counter_clockwise, &q_slave, tol);
-            if clipped.len() < 3 || 0.5 * twice_signed_area(&clipped) <= 1e-12 * slave_area {
-                continue;
-            }
-            if km == ElementKind::Q4 && !is_convex(&q_counter_clockwise, 1e-10) {
-                return Err(format!(
-                    "master facet {c} (nodes {:?}) projects onto the plane of slave facet {f} as a non-convex quadrilateral (warped, or nearly edge-on); refine the mesh",
-                    master.facets[c]
-                ));
-            }
-            let mut m_facet = [[0.0; 4]; 4];
-            let centroid = clipped
-                .iter()
-                .fold([0.0; 2], |s, p| [s[0] + p[0], s[1] + p[1]])
-                .map(|v| v / clipped.len() as f64);
-            let mut area = 0.0;
-            for i in 0..clipped.len() {
-                let (a, b) = (clipped[i], clipped[(i + 1) % clipped.len()]);
-                let e1 = [a[0] - centroid[0], a[1] - centroid[1]];
-                let e2 = [b[0] - centroid[0], b[1] - centroid[1]];
-                let triangle_area = 0.5 * (e1[0] * e2[1] - e1[1] * e2[0]);
-                if triangle_area <= 0.0 {
-                    continue;
-                }
-                area += triangle_area;
-                for qp in &rule {
-                    let [r, s] = qp.xi;
-                    let p = [
-                        centroid[0] + r * e1[0] + s * e2[0],
-                        centroid[1] + r * e1[1] + s * e2[1],
-                    ];
-                    let w = qp.weight * 2.0 * triangle_area;
-                    let xi_s = inverse_map(ks, &q_slave, p).ok_or_else(|| {
-                        format!("the point {:?} of slave facet {f} has no natural coordinates on it (the inverse map did not converge); fix the mesh", plane.lift(p))
-                    })?;
-                    let xi_m = inverse_map(km, &q_master, p).ok_or_else(|| {
-                        format!("the point {:?} of slave facet {f} has no natural coordinates on master facet {c} (the inverse map did not converge); fix the mesh", plane.lift(p))
-                    })?;
-                    let (n_s, _) = shape(ks, xi_s);
-                    let (n_m, _) = shape(km, xi_m);
-                    let phi = multiplier_values(ns, &n_s, phi_of.as_ref());
-                    for j in 0..ns {
-                        for k in 0..ns {
-                            d_local[j][k] += w * phi[j] * n_s[k];
-                        }
-                        for l in 0..nm {
-                            m_facet[j][l] += w * phi[j] * n_m[l];
+            let mut m_facet = [[0.0; MAX_NODES]; MAX_NODES];
+            let mut overlaps = false;
+            for (local, start_m) in pieces(km) {
+                let subject: Vec<[f64; 2]> = local.iter().rev().map(|&a| q_master[a]).collect();
+                for (window, start_s) in &windows {
+                    let clipped = clip_convex_polygons(&subject, window, tol);
+                    if clipped.len() < 3 || 0.5 * twice_signed_area(&clipped) <= 1e-12 * slave_area
+                    {
+                        continue;
+                    }
+                    if subject.len() == 4 && !is_convex(&subject, 1e-10) {
+                        return Err(format!(
+                            "master facet {c} (nodes {:?}) projects onto the plane of slave facet {f} as a non-convex quadrilateral (warped, or nearly edge-on); refine the mesh",
+                            master.facets[c]
+                        ));
+                    }
+                    overlaps = true;
+                    let mut area = 0.0;
+                    for triangle in fan(&clipped) {
+                        area += triangle.area;
+                        for qp in &rule {
+                            let p = triangle.point(qp.xi);
+                            let w = qp.weight * 2.0 * triangle.area;
+                            let xi_s = inverse_map(ks, &q_slave, p, *start_s).ok_or_else(|| {
+                                format!("the point {:?} of slave facet {f} has no natural coordinates on it (the inverse map did not converge); fix the mesh", plane.lift(p))
+                            })?;
+                            let xi_m = inverse_map(km, &q_master, p, *start_m).ok_or_else(|| {
+                                format!("the point {:?} of slave facet {f} has no natural coordinates on master facet {c} (the inverse map did not converge); fix the mesh", plane.lift(p))
+                            })?;
+                            let (n_s, _) = shape(ks, xi_s);
+                            let (n_m, _) = shape(km, xi_m);
+                            let phi = multiplier_values(ns, &n_s, phi_of.as_ref());
+                            for j in 0..ns {
+                                for k in 0..ns {
+                                    d_local[j][k] += w * phi[j] * n_s[k];
+                                }
+                                for l in 0..nm {
+                                    m_facet[j][l] += w * phi[j] * n_m[l];
+                                }
+                            }
                         }
                     }
+                    cells.push(IntegrationCell {
+                        slave_facet: f,
+                        master_facet: c,
+                        polygon: clipped.iter().map(|&p| plane.lift(p)).collect(),
+                        area,
+                    });
                 }
             }
-            cells.push(IntegrationCell {
-                slave_facet: f,
-                master_facet: c,
-                polygon: clipped.iter().map(|&p| plane.lift(p)).collect(),
-                area,
-            });
-            m_local.push((c, m_facet));
+            if overlaps {
+                m_local.push((c, m_facet));
+            }
         }
         if m_local.is_empty() {
             continue;
@@ -693,11 +804,15 @@ pub fn mortar_integrals3(
 
 /// The multiplier functions at a point with slave shape values `n`: `N` itself (standard) or
 /// `sum_k a_jk N_k` (dual).
-fn multiplier_values(ns: usize, n: &[f64; 4], dual: Option<&[[f64; 4]; 4]>) -> [f64; 4] {
+fn multiplier_values(
+    ns: usize,
+    n: &[f64; MAX_NODES],
+    dual: Option<&[[f64; MAX_NODES]; MAX_NODES]>,
+) -> [f64; MAX_NODES] {
     match dual {
         None => *n,
         Some(a) => {
-            let mut phi = [0.0; 4];
+            let mut phi = [0.0; MAX_NODES];
             for j in 0..ns {
                 phi[j] = (0..ns).map(|k| a[j][k] * n[k]).sum();
             }
