@@ -38,6 +38,7 @@
 pub mod facet_projection;
 pub mod geometry;
 pub(crate) mod mortar;
+pub mod mortar3;
 pub(crate) mod mortar_linearization;
 pub mod nodal_normal;
 pub mod node_based_rows;

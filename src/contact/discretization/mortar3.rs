@@ -1,0 +1,1072 @@
+//! Segment-based mortar integration in 3D (Quad4, Tri3 and Quad9 facets), standard and dual
+//! multipliers: the mortar matrices `D`, `M` and the weighted-gap rows
+//! [`crate::contact::Constraint<3>`].
+//!
+//! References: M. A. Puso and T. A. Laursen, "A mortar segment-to-segment contact method for
+//! large deformation solid mechanics", CMAME 193 (2004) (the auxiliary plane, projection and
+//! clipping); A. Popp, M. W. Gee and W. A. Wall, "A finite deformation mortar contact
+//! formulation using a primal-dual active set strategy" (2009) and A. Popp et al., "Finite
+//! deformation frictional mortar contact using a semi-smooth Newton method with consistent
+//! linearization" (2010) (the element-wise dual basis in 3D); Taylor 2004, "2002-2004: Mortar
+//! Methods for Contact & Ties" (the interface term `int lambda . (x_m - x_s) dGamma`).
+//!
+//! With multiplier functions `Phi_j` on the slave surface,
+//!
+//! ```text
+//! D_jk = int Phi_j N_k dA          (slave node j, slave node k)
+//! M_jl = int Phi_j N^m_l dA        (slave node j, master node l)
+//! g~_j = nu_j . (sum_k D_jk x_k - sum_l M_jl x_l),   A_j = sum_k D_jk
+//! ```
+//!
+//! The integrals are taken segment by segment:
+//!
+//! 1. **Auxiliary plane.** For each slave facet: the plane through the facet's centre
+//!    `x_0 = x(xi_c)` with normal `n_0 = x_xi x x_eta / |x_xi x x_eta|` there (outward); an
+//!    orthonormal frame `t_1, t_2, n_0`; points are projected onto it along `n_0`.
+//! 2. **Candidates.** Master facets whose bounding boxes, grown by the search distance, meet
+//!    the slave facet's box (a local uniform grid of boxes, [`BoxGrid`]). A master facet takes
+//!    part only if it faces the slave facet: its projection has the opposite orientation
+//!    (negative signed area in the slave's counter-clockwise frame, beyond `1e-9` of its own
+//!    area); a facet seen edge-on or from its back does not.
+//! 3. **Clipping.** The projected slave polygon (convex, counter-clockwise) clips the projected
+//!    master polygon (reversed to counter-clockwise) by Sutherland-Hodgman
+//!    ([`clip_convex_polygons`]): a point is inside an edge when its signed distance is at least
+//!    `-tol` (`tol = 1e-12` of the slave facet's diameter), an intersection parameter is clamped
+//!    to `[0, 1]` (nearly parallel edges), consecutive vertices closer than `tol` merge, and a
+//!    polygon with fewer than 3 vertices or an area below `1e-12` of the slave facet's is no
+//!    overlap (disjoint facets and facets touching along an edge or a corner).
+//! 4. **Cells.** The clip polygon is split into triangles about its vertex average (inside a
+//!    convex polygon). On each triangle a symmetric rule on the reference triangle: degree 2
+//!    (3 points) between Tri3 facets (the integrands `Phi_j N_k` are products of two linear
+//!    functions), degree 5 (Radon's 7 points) where a Quad4 takes part (products of two
+//!    bilinear functions, total degree 4 when the facet map is affine), degree 8 (the
+//!    collapsed 5 x 5 Gauss product, [`collapsed_triangle_rule`]) where a Quad9 takes part
+//!    (two biquadratic functions, total degree 8). The weight is the
+//!    rule's weight times twice the triangle's area: the integrals are taken over the
+//!    auxiliary plane (exact for flat slave facets, Puso and Laursen's approximation
+//!    otherwise).
+//! 5. **Back to the facets.** Each Gauss point `p` of the plane maps to the slave and master
+//!    natural coordinates by inverting the projected facet map `xi -> P(x(xi))`: in closed form
+//!    for Tri3 (affine), by Newton for Quad4 and Quad9 from the centre of the piece the point
+//!    lies in (converged to `1e-13` in `xi`, at most 50 steps, a failure is an error naming
+//!    the facets).
+//!
+//! **Quad9 facets** (Hex27) are segmented by their four sub-quadrilaterals through the mid-edge
+//! and centre nodes (Puso, Laursen and Solberg, "A segment-to-segment mortar contact method
+//! for quadratic elements and large deformations", CMAME 197 (2008)): each slave piece clips
+//! each master piece, and the cells are integrated with the full biquadratic shape functions.
+//! Exact for straight-edged facets (every facet of `mesh::block3`); on curved facets the
+//! pieces' chords stand for the curved edges.
+//!
+//! **Multipliers.** Standard: `Phi_j = N_j`. Dual: `Phi_j = sum_k a_jk N_k` per slave facet,
+//! `A_e = D_e M_e^-1` with `D_e = diag(int_e N_k dA)` and `M_e = [int_e N_j N_k dA]` over the
+//! whole facet in the same (auxiliary-plane) measure (Gauss 3x3 for Quad4, 4x4 for Quad9,
+//! degree 2 for Tri3),
+//! so `int_e Psi_j N_k dA = delta_jk int_e N_k dA` and `D` is diagonal where the slave facet is
+//! covered. On affine facets this is `Psi_j = 4 N_j - 1` (Tri3) and
+//! `a = [[4, -2, 1, -2], ...]` (Quad4, the nodal pattern of `4 N_j - 2 N_{j+1} + N_{j+2} -
+//! 2 N_{j+3}`). On facets whose map is not affine the cell quadrature of `D` is not exact, so
+//! biorthogonality then holds to the quadrature error only.
+//!
+//! **Rows.** For slave node `j` with the slave surface's outward unit nodal normal `n_j` (an
+//! input: the caller owns nodal normals), the gap direction is `nu_j = -n_j` (from master to
+//! slave, as the 2D mortar's); the row, normalized by `A_j` as in 2D so that penalty forces
+//! `kappa A g` keep their meaning, is
+//!
+//! ```text
+//! g_j(u) = g~_j / A_j + sum_k (D_jk / A_j) nu_j . u_k - sum_l (M_jl / A_j) nu_j . u_l
+//! ```
+//!
+//! with `area = A_j` and, for standard multipliers, the multiplier mass line
+//! `mass = [(k, D_jk)]` (the row's own node first); dual rows carry none (lumped). The
+//! coefficients are the small-strain linearization: `D`, `M` and `nu` frozen at the reference
+//! configuration. Linear momentum: `sum_k D_jk = sum_l M_jl` where the slave facets are
+//! covered (the shape functions sum to one at every Gauss point); angular momentum:
+//! `sum_k D_jk x_k = sum_l M_jl x_l` on flat coplanar interfaces (both facets reproduce the
+//! plane point at every Gauss point).
+//!
+//! Tri6 facets (Tet10) are refused with a reason: their dual basis needs the modified basis
+//! (vertex functions plus 1/5 of the adjacent edge functions) first, which is not built here.
+//! Quad9 needs none (its corner integrals `int N_k` are positive).
+
+use crate::contact::Constraint;
+use crate::fe::{gauss_legendre, gauss_square, triangle_rule, ElementKind, QuadPoint, MAX_NODES};
+use crate::io::scene::MultiplierSpace;
+use crate::mesh::{Facet, Mesh3};
+use nalgebra::DMatrix;
+use std::collections::{BTreeMap, HashMap};
+
+/// `D_jk` or `M_jl` by slave node `j` (over slave nodes `k` or master nodes `l`).
+pub type MortarMatrix3 = BTreeMap<usize, BTreeMap<usize, f64>>;
+
+/// Tolerance on the natural-coordinate step of the inverse Quad4 map.
+const NEWTON_TOLERANCE: f64 = 1e-13;
+/// Largest number of Newton steps of the inverse Quad4 map.
+const NEWTON_STEPS: usize = 50;
+/// Relative size (of the slave facet's diameter) below which polygon vertices coincide.
+const CLIP_TOLERANCE: f64 = 1e-12;
+
+/// One side of a 3D interface: facets of one kind, their node ids and coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FacetSet3 {
+    /// The facets' 2D reference element (`Q4` = Quad4, `T3` = Tri3).
+    pub kind: ElementKind,
+    /// Node ids of each facet, in the reference element's order (counter-clockwise seen from
+    /// outside the body, so `x_xi x x_eta` is the outward normal).
+    pub facets: Vec<Vec<usize>>,
+    /// Reference coordinates of each facet's nodes (the same order).
+    pub coords: Vec<Vec<[f64; 3]>>,
+}
+
+impl FacetSet3 {
+    /// The facet set, or the reason it cannot take part in the 3D mortar: an unsupported
+    /// facet kind, facets and coordinates of different lengths, non-finite coordinates, a
+    /// node given two positions, or a degenerate facet.
+    pub fn new(
+        kind: ElementKind,
+        facets: Vec<Vec<usize>>,
+        coords: Vec<Vec<[f64; 3]>>,
+    ) -> Result<Self, String> {
+        supported(kind)?;
+        if facets.len() != coords.len() {
+            return Err(format!(
+                "{} facets but {} coordinate lists: give one list of node coordinates per facet",
+                facets.len(),
+                coords.len()
+            ));
+        }
+        if facets.is_empty() {
+            return Err("the facet set is empty: name a surface with at least one facet".into());
+        }
+        let n = kind.node_count();
+        let mut seen: HashMap<usize, [f64; 3]> = HashMap::new();
+        let size = coords
+            .iter()
+            .flatten()
+            .flat_map(|p| p.iter())
+            .fold(0.0f64, |a, v| a.max(v.abs()));
+        for (f, (ids, xs)) in facets.iter().zip(&coords).enumerate() {
+            if ids.len() != n || xs.len() != n {
+                return Err(format!(
+                    "facet {f} has {} node ids and {} coordinates; a {kind:?} facet has {n}",
+                    ids.len(),
+                    xs.len()
+                ));
+            }
+            for (&id, x) in ids.iter().zip(xs) {
+                if x.iter().any(|v| !v.is_finite()) {
+                    return Err(format!(
+                        "facet {f}: node {id} has a non-finite coordinate {x:?}"
+                    ));
+                }
+                if let Some(y) = seen.insert(id, *x) {
+                    if distance(*x, y) > 1e-12 * size.max(1e-300) {
+                        return Err(format!(
+                            "node {id} has two positions, {y:?} and {x:?} (facet {f}): one node id, one position"
+                        ));
+                    }
+                }
+            }
+            let (_, normal) = centre_and_normal(kind, xs)
+                .map_err(|why| format!("facet {f} (nodes {ids:?}): {why}"))?;
+            debug_assert!(normal.iter().all(|v| v.is_finite()));
+        }
+        Ok(FacetSet3 {
+            kind,
+            facets,
+            coords,
+        })
+    }
+
+    /// The facet set of `facets` of a 3D mesh (node ids are the mesh's), or why not (see
+    /// [`FacetSet3::new`]; Tet10 bodies have Tri6 facets, refused).
+    pub fn from_mesh(mesh: &Mesh3, facets: &[Facet]) -> Result<Self, String> {
+        let ids: Vec<Vec<usize>> = facets.iter().map(|&f| mesh.facet_nodes(f)).collect();
+        let coords = ids
+            .iter()
+            .map(|f| f.iter().map(|&n| mesh.nodes[n]).collect())
+            .collect();
+        FacetSet3::new(mesh.kind.facet_kind(), ids, coords)
+    }
+
+    /// Axis-aligned bounding boxes of the facets, `[lo, hi]`.
+    pub fn boxes(&self) -> Vec<[[f64; 3]; 2]> {
+        self.coords.iter().map(|c| bounding_box(c)).collect()
+    }
+
+    /// The largest facet diameter (the largest distance between two of a facet's nodes).
+    pub fn facet_size(&self) -> f64 {
+        self.coords.iter().map(|c| diameter(c)).fold(0.0, f64::max)
+    }
+
+    /// Each node's position (from the first facet that names it).
+    pub fn positions(&self) -> BTreeMap<usize, [f64; 3]> {
+        let mut out = BTreeMap::new();
+        for (ids, xs) in self.facets.iter().zip(&self.coords) {
+            for (&id, &x) in ids.iter().zip(xs) {
+                out.entry(id).or_insert(x);
+            }
+        }
+        out
+    }
+}
+
+/// Whether the 3D mortar is built for facets of `kind`, the reason where not.
+pub fn supported(kind: ElementKind) -> Result<(), String> {
+    match kind {
+        ElementKind::Q4 | ElementKind::T3 | ElementKind::Q9 => Ok(()),
+        ElementKind::T6 => Err(
+            "segment-based 3D mortar is built for Quad4, Tri3 and Quad9 facets; Tri6 facets (Tet10) are not built: their dual basis needs the modified basis (vertex + 1/5 of the adjacent edge functions) first; use Tet4, Hex8 or Hex27 bodies on the interface, or node-to-surface".into(),
+        ),
+    }
+}
+
+/// One integration cell: a clip polygon of a slave facet against one master facet, in 3D on
+/// the slave facet's auxiliary plane.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IntegrationCell {
+    pub slave_facet: usize,
+    pub master_facet: usize,
+    /// The clip polygon's vertices (counter-clockwise seen along the slave's outward normal).
+    pub polygon: Vec<[f64; 3]>,
+    /// Its area.
+    pub area: f64,
+}
+
+/// The mortar matrices of an interface and the cells they were integrated on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MortarIntegrals3 {
+    /// `D_jk` (slave-slave), by slave node `j`.
+    pub d: MortarMatrix3,
+    /// `M_jl` (slave-master), by slave node `j`.
+    pub m: MortarMatrix3,
+    /// Every non-empty clip polygon.
+    pub cells: Vec<IntegrationCell>,
+}
+
+/// The auxiliary plane of a slave facet: origin and orthonormal in-plane axes (`t_1 x t_2`
+/// is the facet's unit normal at its centre).
+#[derive(Copy, Clone, Debug)]
+struct AuxiliaryPlane {
+    origin: [f64; 3],
+    axes: [[f64; 3]; 2],
+}
+
+impl AuxiliaryPlane {
+    fn new(origin: [f64; 3], normal: [f64; 3]) -> Self {
+        // the in-plane axis: the coordinate axis least aligned with the normal, made orthogonal
+        let k = (0..3)
+            .min_by(|&a, &b| normal[a].abs().total_cmp(&normal[b].abs()))
+            .unwrap_or(0);
+        let mut e = [0.0; 3];
+        e[k] = 1.0;
+        let t1 = unit(sub(e, scale(normal, dot(e, normal))));
+        let t2 = cross(normal, t1);
+        AuxiliaryPlane {
+            origin,
+            axes: [t1, t2],
+        }
+    }
+
+    /// In-plane coordinates of `x` projected along the normal.
+    fn project(&self, x: [f64; 3]) -> [f64; 2] {
+        let d = sub(x, self.origin);
+        [dot(d, self.axes[0]), dot(d, self.axes[1])]
+    }
+
+    /// The 3D point of in-plane coordinates `p`.
+    fn lift(&self, p: [f64; 2]) -> [f64; 3] {
+        add(
+            self.origin,
+            add(scale(self.axes[0], p[0]), scale(self.axes[1], p[1])),
+        )
+    }
+}
+
+/// Shape functions (at most 9) of a facet at `xi`, and their natural derivatives.
+fn shape(kind: ElementKind, xi: [f64; 2]) -> ([f64; MAX_NODES], [[f64; 2]; MAX_NODES]) {
+    let mut n = [0.0; MAX_NODES];
+    let mut dn = [[0.0; 2]; MAX_NODES];
+    kind.shape(xi, &mut n, &mut dn);
+    (n, dn)
+}
+
+/// The centre `x(xi_c)` of a facet and its outward unit normal there, or why it has none.
+fn centre_and_normal(kind: ElementKind, xs: &[[f64; 3]]) -> Result<([f64; 3], [f64; 3]), String> {
+    let (n, dn) = shape(kind, kind.centre());
+    let mut x = [0.0; 3];
+    let mut tangents = [[0.0; 3]; 2];
+    for (a, p) in xs.iter().enumerate() {
+        x = add(x, scale(*p, n[a]));
+        for (t, d) in tangents.iter_mut().zip(dn[a]) {
+            *t = add(*t, scale(*p, d));
+        }
+    }
+    let normal = cross(tangents[0], tangents[1]);
+    let length = norm(normal);
+    let size = diameter(xs);
+    if length.is_nan() || length <= 1e-12 * size * size {
+        return Err(format!(
+            "the facet is degenerate (its tangents at the centre are parallel, |x_xi x x_eta| = {length:e}); fix the mesh"
+        ));
+    }
+    Ok((x, scale(normal, 1.0 / length)))
+}
+
+/// The projected facet map `xi -> sum_a N_a(xi) q_a` on in-plane corners `q`: its value and
+/// Jacobian `[[dp0/dxi, dp0/deta], [dp1/dxi, dp1/deta]]`.
+fn planar_map(kind: ElementKind, q: &[[f64; 2]], xi: [f64; 2]) -> ([f64; 2], [[f64; 2]; 2]) {
+    let (n, dn) = shape(kind, xi);
+    let mut p = [0.0; 2];
+    let mut j = [[0.0; 2]; 2];
+    for (a, qa) in q.iter().enumerate() {
+        for r in 0..2 {
+            p[r] += n[a] * qa[r];
+            for c in 0..2 {
+                j[r][c] += dn[a][c] * qa[r];
+            }
+        }
+    }
+    (p, j)
+}
+
+/// The natural coordinates of in-plane point `p` on the projected facet with nodes `q`:
+/// closed form for Tri3, Newton from `start` for Quad4 and Quad9. `None` if the map is
+/// singular or Newton does not converge.
+fn inverse_map(
+    kind: ElementKind,
+    q: &[[f64; 2]],
+    p: [f64; 2],
+    start: [f64; 2],
+) -> Option<[f64; 2]> {
+    let solve = |j: [[f64; 2]; 2], r: [f64; 2]| {
+        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+        let scale = (j[0][0].abs() + j[0][1].abs()) * (j[1][0].abs() + j[1][1].abs());
+        (det.abs() > 1e-14 * scale).then(|| {
+            [
+                (j[1][1] * r[0] - j[0][1] * r[1]) / det,
+                (-j[1][0] * r[0] + j[0][0] * r[1]) / det,
+            ]
+        })
+    };
+    match kind {
+        ElementKind::T3 => {
+            let j = [
+                [q[1][0] - q[0][0], q[2][0] - q[0][0]],
+                [q[1][1] - q[0][1], q[2][1] - q[0][1]],
+            ];
+            solve(j, [p[0] - q[0][0], p[1] - q[0][1]])
+        }
+        _ => {
+            let mut xi = start;
+            for _ in 0..NEWTON_STEPS {
+                let (x, j) = planar_map(kind, q, xi);
+                let step = solve(j, [p[0] - x[0], p[1] - x[1]])?;
+                xi = [xi[0] + step[0], xi[1] + step[1]];
+                if !(xi[0].is_finite() && xi[1].is_finite()) {
+                    return None;
+                }
+                if step[0].abs().max(step[1].abs()) < NEWTON_TOLERANCE {
+                    return Some(xi);
+                }
+            }
+            None
+        }
+    }
+}
+
+/// Twice the signed area of a planar polygon (positive counter-clockwise).
+fn twice_signed_area(polygon: &[[f64; 2]]) -> f64 {
+    let k = polygon.len();
+    (0..k)
+        .map(|i| {
+            let (a, b) = (polygon[i], polygon[(i + 1) % k]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum()
+}
+
+/// Whether a counter-clockwise polygon is strictly convex (every turn to the left, beyond
+/// `tol` times the edge lengths' product).
+fn is_convex(polygon: &[[f64; 2]], tol: f64) -> bool {
+    let k = polygon.len();
+    (0..k).all(|i| {
+        let (a, b, c) = (polygon[i], polygon[(i + 1) % k], polygon[(i + 2) % k]);
+        let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
+        u[0] * v[1] - u[1] * v[0] > tol * u[0].hypot(u[1]) * v[0].hypot(v[1])
+    })
+}
+
+/// The intersection of the polygon `subject` with the convex counter-clockwise polygon
+/// `window` (Sutherland-Hodgman), both in the plane: counter-clockwise if `subject` is, with
+/// vertices closer than `tol` merged; empty when the overlap has fewer than 3 vertices or no
+/// area above `tol` squared (disjoint polygons, or touching along an edge or at a corner). A
+/// point is inside a window edge when its signed distance from it is at least `-tol`;
+/// intersection parameters are clamped to `[0, 1]`, so nearly parallel edges give no point
+/// outside the segment.
+pub fn clip_convex_polygons(subject: &[[f64; 2]], window: &[[f64; 2]], tol: f64) -> Vec<[f64; 2]> {
+    let mut out: Vec<[f64; 2]> = subject.to_vec();
+    let k = window.len();
+    for i in 0..k {
+        if out.is_empty() {
+            break;
+        }
+        let (a, b) = (window[i], window[(i + 1) % k]);
+        let e = [b[0] - a[0], b[1] - a[1]];
+        let length = e[0].hypot(e[1]);
+        if length <= tol {
+            continue;
+        }
+        let distance = |p: [f64; 2]| (e[0] * (p[1] - a[1]) - e[1] * (p[0] - a[0])) / length;
+        let input = std::mem::take(&mut out);
+        let m = input.len();
+        for s in 0..m {
+            let (p, q) = (input[s], input[(s + 1) % m]);
+            let (dp, dq) = (distance(p), distance(q));
+            let (p_in, q_in) = (dp >= -tol, dq >= -tol);
+            if p_in {
+                out.push(p);
+            }
+            if p_in != q_in {
+                let t = (dp / (dp - dq)).clamp(0.0, 1.0);
+                out.push([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]);
+            }
+        }
+    }
+    // merge coincident neighbours (also the last with the first)
+    let mut merged: Vec<[f64; 2]> = Vec::with_capacity(out.len());
+    for p in out {
+        if merged
+            .last()
+            .is_none_or(|l| (l[0] - p[0]).hypot(l[1] - p[1]) > tol)
+        {
+            merged.push(p);
+        }
+    }
+    while merged.len() > 1 {
+        let (f, l) = (merged[0], merged[merged.len() - 1]);
+        if (f[0] - l[0]).hypot(f[1] - l[1]) > tol {
+            break;
+        }
+        merged.pop();
+    }
+    if merged.len() < 3 || twice_signed_area(&merged).abs() <= 2.0 * tol * tol {
+        return Vec::new();
+    }
+    merged
+}
+
+/// A uniform grid of boxes (cells the size of the largest box) for the candidate search.
+pub struct BoxGrid {
+    boxes: Vec<[[f64; 3]; 2]>,
+    cell: f64,
+    buckets: HashMap<[i64; 3], Vec<usize>>,
+}
+
+impl BoxGrid {
+    /// The grid of `boxes` (`[lo, hi]` each).
+    pub fn new(boxes: Vec<[[f64; 3]; 2]>) -> Self {
+        let cell = boxes
+            .iter()
+            .flat_map(|[lo, hi]| (0..3).map(move |i| hi[i] - lo[i]))
+            .fold(0.0f64, f64::max)
+            .max(f64::MIN_POSITIVE);
+        let mut grid = BoxGrid {
+            boxes,
+            cell,
+            buckets: HashMap::new(),
+        };
+        for (b, [lo, hi]) in grid.boxes.iter().enumerate() {
+            let (a, z) = (grid.key(*lo), grid.key(*hi));
+            for i in a[0]..=z[0] {
+                for j in a[1]..=z[1] {
+                    for k in a[2]..=z[2] {
+                        grid.buckets.entry([i, j, k]).or_default().push(b);
+                    }
+                }
+            }
+        }
+        grid
+    }
+
+    fn key(&self, x: [f64; 3]) -> [i64; 3] {
+        x.map(|v| (v / self.cell).floor() as i64)
+    }
+
+    /// The boxes that meet `[lo, hi]`, in increasing order.
+    pub fn query(&self, lo: [f64; 3], hi: [f64; 3]) -> Vec<usize> {
+        let meets = |b: &[[f64; 3]; 2]| (0..3).all(|i| b[0][i] <= hi[i] && lo[i] <= b[1][i]);
+        let (a, z) = (self.key(lo), self.key(hi));
+        let cells: i64 = (0..3).map(|i| z[i] - a[i] + 1).product();
+        let mut found: Vec<usize> = if cells as usize > self.boxes.len() {
+            (0..self.boxes.len()).collect()
+        } else {
+            let mut v = Vec::new();
+            for i in a[0]..=z[0] {
+                for j in a[1]..=z[1] {
+                    for k in a[2]..=z[2] {
+                        if let Some(bucket) = self.buckets.get(&[i, j, k]) {
+                            v.extend_from_slice(bucket);
+                        }
+                    }
+                }
+            }
+            v
+        };
+        found.sort_unstable();
+        found.dedup();
+        found.retain(|&b| meets(&self.boxes[b]));
+        found
+    }
+}
+
+/// The dual coefficients `a_jk` of a slave facet whose projected corners are `q` (see the
+/// module notes): `A_e = D_e M_e^-1` over the facet in the auxiliary-plane measure.
+pub fn dual_coefficients(
+    kind: ElementKind,
+    q: &[[f64; 2]],
+) -> Result<[[f64; MAX_NODES]; MAX_NODES], String> {
+    supported(kind)?;
+    let n = kind.node_count();
+    // exact for N_j N_k |J| on straight-sided facets: degree 2 (Tri3), (3, 3) (Quad4),
+    // (7, 7) (Quad9)
+    let rule: Vec<QuadPoint> = match kind {
+        ElementKind::T3 => triangle_rule(2),
+        ElementKind::Q9 => gauss_square(4),
+        _ => gauss_square(3),
+    };
+    let mut mass = DMatrix::<f64>::zeros(n, n);
+    let mut lumped = vec![0.0; n];
+    for qp in &rule {
+        let (values, _) = shape(kind, qp.xi);
+        let (_, j) = planar_map(kind, q, qp.xi);
+        let w = qp.weight * (j[0][0] * j[1][1] - j[0][1] * j[1][0]).abs();
+        for a in 0..n {
+            lumped[a] += w * values[a];
+            for b in 0..n {
+                mass[(a, b)] += w * values[a] * values[b];
+            }
+        }
+    }
+    let inverse = mass
+        .try_inverse()
+        .ok_or("the slave facet's mass matrix is singular (a degenerate facet); fix the mesh")?;
+    let mut a = [[0.0; MAX_NODES]; MAX_NODES];
+    for j in 0..n {
+        for k in 0..n {
+            a[j][k] = lumped[j] * inverse[(j, k)];
+        }
+    }
+    Ok(a)
+}
+
+/// The pieces a facet is segmented by, each with its local nodes (counter-clockwise) and the
+/// natural point the inverse map starts from: the facet itself (Quad4, Tri3), or the four
+/// sub-quadrilaterals of a Quad9 through its mid-edge and centre nodes (Puso, Laursen and
+/// Solberg's segmentation of quadratic facets; exact for straight-edged facets, chords of
+/// curved ones).
+fn pieces(kind: ElementKind) -> &'static [(&'static [usize], [f64; 2])] {
+    const QUAD4: [(&[usize], [f64; 2]); 1] = [(&[0, 1, 2, 3], [0.0, 0.0])];
+    const TRI3: [(&[usize], [f64; 2]); 1] = [(&[0, 1, 2], [1.0 / 3.0, 1.0 / 3.0])];
+    const QUAD9: [(&[usize], [f64; 2]); 4] = [
+        (&[0, 4, 8, 7], [-0.5, -0.5]),
+        (&[4, 1, 5, 8], [0.5, -0.5]),
+        (&[8, 5, 2, 6], [0.5, 0.5]),
+        (&[7, 8, 6, 3], [-0.5, 0.5]),
+    ];
+    match kind {
+        ElementKind::Q9 => &QUAD9,
+        ElementKind::T3 | ElementKind::T6 => &TRI3,
+        ElementKind::Q4 => &QUAD4,
+    }
+}
+
+/// A triangle of a cell: its first corner, its two edge vectors from there, its area.
+struct CellTriangle {
+    corner: [f64; 2],
+    edges: [[f64; 2]; 2],
+    area: f64,
+}
+
+impl CellTriangle {
+    /// The in-plane point of natural coordinates `[r, t]` on the reference triangle.
+    fn point(&self, [r, t]: [f64; 2]) -> [f64; 2] {
+        let [e1, e2] = self.edges;
+        [
+            self.corner[0] + r * e1[0] + t * e2[0],
+            self.corner[1] + r * e1[1] + t * e2[1],
+        ]
+    }
+}
+
+/// The triangles of a convex counter-clockwise polygon about its vertex average (degenerate
+/// ones left out).
+fn fan(polygon: &[[f64; 2]]) -> Vec<CellTriangle> {
+    let k = polygon.len();
+    let centroid = polygon
+        .iter()
+        .fold([0.0; 2], |s, p| [s[0] + p[0], s[1] + p[1]])
+        .map(|v| v / k as f64);
+    (0..k)
+        .filter_map(|i| {
+            let (a, b) = (polygon[i], polygon[(i + 1) % k]);
+            let e1 = [a[0] - centroid[0], a[1] - centroid[1]];
+            let e2 = [b[0] - centroid[0], b[1] - centroid[1]];
+            let area = 0.5 * (e1[0] * e2[1] - e1[1] * e2[0]);
+            (area > 0.0).then_some(CellTriangle {
+                corner: centroid,
+                edges: [e1, e2],
+                area,
+            })
+        })
+        .collect()
+}
+
+/// The rule on each cell triangle (weights summing to 1/2): degree 2 between Tri3 facets,
+/// degree 5 (Radon's 7 points) where a Quad4 takes part, degree 8 where a Quad9 does
+/// (biquadratic times biquadratic: the collapsed 5 x 5 Gauss product, see
+/// [`collapsed_triangle_rule`]).
+fn cell_rule(slave: ElementKind, master: ElementKind) -> Vec<QuadPoint> {
+    if slave == ElementKind::Q9 || master == ElementKind::Q9 {
+        collapsed_triangle_rule(5)
+    } else if slave == ElementKind::T3 && master == ElementKind::T3 {
+        triangle_rule(2)
+    } else {
+        triangle_rule(5)
+    }
+}
+
+/// The `n x n` Gauss-Legendre product on the square mapped onto the reference triangle by
+/// `(a, b) -> (a (1 - b), b)` (Duffy), weights times the map's Jacobian `1 - b`: a monomial of
+/// total degree `d` becomes degree `d` in `a` and `d + 1` in `b`, so the rule is exact for
+/// total degree `2 n - 2`.
+pub fn collapsed_triangle_rule(n: usize) -> Vec<QuadPoint> {
+    let g = gauss_legendre(n);
+    let mut out = Vec::with_capacity(n * n);
+    for &(t, wt) in &g {
+        let b = 0.5 * (t + 1.0);
+        for &(s, ws) in &g {
+            let a = 0.5 * (s + 1.0);
+            out.push(QuadPoint {
+                xi: [a * (1.0 - b), b],
+                weight: 0.25 * ws * wt * (1.0 - b),
+            });
+        }
+    }
+    out
+}
+
+/// The projected corners of facet `xs` on `plane`.
+fn projected(plane: &AuxiliaryPlane, xs: &[[f64; 3]]) -> Vec<[f64; 2]> {
+    xs.iter().map(|&x| plane.project(x)).collect()
+}
+
+/// The segment-based mortar integrals of `slave` against `master` (see the module notes).
+/// `search_distance`: how far apart (in the bounding boxes) a master facet may still be a
+/// candidate; `None` for the largest master facet's diameter.
+pub fn mortar_integrals3(
+    slave: &FacetSet3,
+    master: &FacetSet3,
+    space: MultiplierSpace,
+    search_distance: Option<f64>,
+) -> Result<MortarIntegrals3, String> {
+    supported(slave.kind)?;
+    supported(master.kind)?;
+    let reach = match search_distance {
+        Some(r) if r.is_finite() && r >= 0.0 => r,
+        Some(r) => {
+            return Err(format!(
+                "the search distance {r} is not a finite non-negative length"
+            ))
+        }
+        None => master.facet_size(),
+    };
+    let (ks, km) = (slave.kind, master.kind);
+    let (ns, nm) = (ks.node_count(), km.node_count());
+    let rule = cell_rule(ks, km);
+    let grid = BoxGrid::new(
+        master
+            .boxes()
+            .into_iter()
+            .map(|[lo, hi]| [lo.map(|v| v - reach), hi.map(|v| v + reach)])
+            .collect(),
+    );
+    let mut d: MortarMatrix3 = BTreeMap::new();
+    let mut m: MortarMatrix3 = BTreeMap::new();
+    let mut cells = Vec::new();
+    for (f, xs) in slave.coords.iter().enumerate() {
+        let (origin, normal) = centre_and_normal(ks, xs)
+            .map_err(|why| format!("slave facet {f} (nodes {:?}): {why}", slave.facets[f]))?;
+        let plane = AuxiliaryPlane::new(origin, normal);
+        let q_slave = projected(&plane, xs);
+        let size = diameter(xs);
+        let tol = CLIP_TOLERANCE * size;
+        let windows: Vec<(Vec<[f64; 2]>, [f64; 2])> = pieces(ks)
+            .iter()
+            .map(|(local, start)| (local.iter().map(|&a| q_slave[a]).collect(), *start))
+            .collect();
+        if windows.iter().any(|(w, _)| !is_convex(w, 1e-10)) {
+            return Err(format!(
+                "slave facet {f} (nodes {:?}) is not convex in its own plane (warped or folded); fix the mesh",
+                slave.facets[f]
+            ));
+        }
+        let slave_area = 0.5 * twice_signed_area(&q_slave[..ks.corner_count()]);
+        let phi_of = match space {
+            MultiplierSpace::Standard => None,
+            MultiplierSpace::Dual => Some(
+                dual_coefficients(ks, &q_slave).map_err(|why| format!("slave facet {f}: {why}"))?,
+            ),
+        };
+        let [lo, hi] = bounding_box(xs);
+        let mut d_local = [[0.0; MAX_NODES]; MAX_NODES];
+        let mut m_local: Vec<(usize, [[f64; MAX_NODES]; MAX_NODES])> = Vec::new();
+        for c in grid.query(lo, hi) {
+            let q_master = projected(&plane, &master.coords[c]);
+            // a master facet facing the slave one projects clockwise; edge-on or back: skipped
+            let master_area = 0.5 * twice_signed_area(&q_master[..km.corner_count()]);
+            if -master_area <= 0.5e-9 * twice_area_3d(km, &master.coords[c]) {
+                continue;
+            }
+            let mut m_facet = [[0.0; MAX_NODES]; MAX_NODES];
+            let mut overlaps = false;
+            for (local, start_m) in pieces(km) {
+                let subject: Vec<[f64; 2]> = local.iter().rev().map(|&a| q_master[a]).collect();
+                for (window, start_s) in &windows {
+                    let clipped = clip_convex_polygons(&subject, window, tol);
+                    if clipped.len() < 3 || 0.5 * twice_signed_area(&clipped) <= 1e-12 * slave_area
+                    {
+                        continue;
+                    }
+                    if subject.len() == 4 && !is_convex(&subject, 1e-10) {
+                        return Err(format!(
+                            "master facet {c} (nodes {:?}) projects onto the plane of slave facet {f} as a non-convex quadrilateral (warped, or nearly edge-on); refine the mesh",
+                            master.facets[c]
+                        ));
+                    }
+                    overlaps = true;
+                    let mut area = 0.0;
+                    for triangle in fan(&clipped) {
+                        area += triangle.area;
+                        for qp in &rule {
+                            let p = triangle.point(qp.xi);
+                            let w = qp.weight * 2.0 * triangle.area;
+                            let xi_s = inverse_map(ks, &q_slave, p, *start_s).ok_or_else(|| {
+                                format!("the point {:?} of slave facet {f} has no natural coordinates on it (the inverse map did not converge); fix the mesh", plane.lift(p))
+                            })?;
+                            let xi_m = inverse_map(km, &q_master, p, *start_m).ok_or_else(|| {
+                                format!("the point {:?} of slave facet {f} has no natural coordinates on master facet {c} (the inverse map did not converge); fix the mesh", plane.lift(p))
+                            })?;
+                            let (n_s, _) = shape(ks, xi_s);
+                            let (n_m, _) = shape(km, xi_m);
+                            let phi = multiplier_values(ns, &n_s, phi_of.as_ref());
+                            for j in 0..ns {
+                                for k in 0..ns {
+                                    d_local[j][k] += w * phi[j] * n_s[k];
+                                }
+                                for l in 0..nm {
+                                    m_facet[j][l] += w * phi[j] * n_m[l];
+                                }
+                            }
+                        }
+                    }
+                    cells.push(IntegrationCell {
+                        slave_facet: f,
+                        master_facet: c,
+                        polygon: clipped.iter().map(|&p| plane.lift(p)).collect(),
+                        area,
+                    });
+                }
+            }
+            if overlaps {
+                m_local.push((c, m_facet));
+            }
+        }
+        if m_local.is_empty() {
+            continue;
+        }
+        let ids = &slave.facets[f];
+        for j in 0..ns {
+            let dj = d.entry(ids[j]).or_default();
+            for k in 0..ns {
+                *dj.entry(ids[k]).or_default() += d_local[j][k];
+            }
+            let mj = m.entry(ids[j]).or_default();
+            for (c, m_facet) in &m_local {
+                for l in 0..nm {
+                    *mj.entry(master.facets[*c][l]).or_default() += m_facet[j][l];
+                }
+            }
+        }
+    }
+    Ok(MortarIntegrals3 { d, m, cells })
+}
+
+/// The multiplier functions at a point with slave shape values `n`: `N` itself (standard) or
+/// `sum_k a_jk N_k` (dual).
+fn multiplier_values(
+    ns: usize,
+    n: &[f64; MAX_NODES],
+    dual: Option<&[[f64; MAX_NODES]; MAX_NODES]>,
+) -> [f64; MAX_NODES] {
+    match dual {
+        None => *n,
+        Some(a) => {
+            let mut phi = [0.0; MAX_NODES];
+            for j in 0..ns {
+                phi[j] = (0..ns).map(|k| a[j][k] * n[k]).sum();
+            }
+            phi
+        }
+    }
+}
+
+/// The weighted gap of slave node `j`: `g~_j = nu . (sum_k D_jk x_k - sum_l M_jl x_l)` for
+/// positions `slave_x`, `master_x` (by node id), or `None` where `j` has no `D` line.
+pub fn weighted_gap(
+    integrals: &MortarIntegrals3,
+    j: usize,
+    nu: [f64; 3],
+    slave_x: &BTreeMap<usize, [f64; 3]>,
+    master_x: &BTreeMap<usize, [f64; 3]>,
+) -> Option<f64> {
+    let dj = integrals.d.get(&j)?;
+    let mut g = 0.0;
+    for (k, w) in dj {
+        g += w * dot(nu, slave_x[k]);
+    }
+    for (l, w) in integrals.m.get(&j).into_iter().flatten() {
+        g -= w * dot(nu, master_x[l]);
+    }
+    Some(g)
+}
+
+/// Who the rows belong to and how their dofs are numbered (the caller's numbering).
+pub struct RowNumbering<'a> {
+    /// The slave body's index (for [`Constraint::slave_body`]).
+    pub slave_body: usize,
+    /// The contact pair's index (for [`Constraint::pair`]).
+    pub pair: usize,
+    /// 1 or 2 (two-pass: the roles swapped).
+    pub pass: u8,
+    /// The global dof of component `i` of slave node `n`: `slave_dof(n, i)`.
+    pub slave_dof: &'a dyn Fn(usize, usize) -> usize,
+    /// The global dof of component `i` of master node `n`.
+    pub master_dof: &'a dyn Fn(usize, usize) -> usize,
+    /// Tied rows: three bilateral rows per slave node (along `e_x`, `e_y`, `e_z`, zero initial
+    /// gap) with the same weights, in place of the one frictionless row along `nu_j`.
+    pub tied: bool,
+}
+
+/// The mortar rows of `slave` against `master` (see the module notes): one row per slave node
+/// whose multiplier sees the master surface, in increasing node id. `normals` gives each slave
+/// node's outward unit normal (the caller's nodal normals; any non-zero length is normalized).
+/// Errors: unsupported facets, a missing or degenerate normal, no overlap at all.
+pub fn mortar_rows3(
+    slave: &FacetSet3,
+    master: &FacetSet3,
+    space: MultiplierSpace,
+    normals: &BTreeMap<usize, [f64; 3]>,
+    numbering: &RowNumbering,
+    search_distance: Option<f64>,
+) -> Result<(Vec<Constraint<3>>, MortarIntegrals3), String> {
+    let integrals = mortar_integrals3(slave, master, space, search_distance)?;
+    let slave_x = slave.positions();
+    let master_x = master.positions();
+    let smallest_area = 1e-12 * slave.facet_size().powi(2);
+    let mut rows = Vec::new();
+    for (&j, dj) in &integrals.d {
+        let area: f64 = dj.values().sum();
+        if area <= smallest_area {
+            continue; // the node's multiplier sees no master surface
+        }
+        let n = *normals.get(&j).ok_or_else(|| {
+            format!(
+                "slave node {j} at {:?} has no nodal normal: give one for every node of the slave surface",
+                slave_x[&j]
+            )
+        })?;
+        let length = norm(n);
+        if !(length.is_finite() && length > 0.0) {
+            return Err(format!(
+                "the nodal normal {n:?} of slave node {j} at {:?} is zero or not finite",
+                slave_x[&j]
+            ));
+        }
+        let n = scale(n, 1.0 / length);
+        let nu = scale(n, -1.0);
+        let slave_terms: Vec<(usize, f64)> = std::iter::once(j)
+            .chain(dj.keys().copied().filter(|&k| k != j))
+            .map(|k| (k, dj.get(&k).copied().unwrap_or(0.0) / area))
+            .collect();
+        let master_terms: Vec<(usize, f64)> = integrals
+            .m
+            .get(&j)
+            .map(|mj| mj.iter().map(|(&l, &v)| (l, v / area)).collect())
+            .unwrap_or_default();
+        let mass: Vec<(usize, f64)> = match space {
+            MultiplierSpace::Standard => slave_terms.iter().map(|&(k, w)| (k, w * area)).collect(),
+            MultiplierSpace::Dual => Vec::new(),
+        };
+        let directions: Vec<([f64; 3], f64)> = if numbering.tied {
+            (0..3)
+                .map(|i| {
+                    let mut e = [0.0; 3];
+                    e[i] = 1.0;
+                    (e, 0.0)
+                })
+                .collect()
+        } else {
+            let g = weighted_gap(&integrals, j, nu, &slave_x, &master_x).unwrap_or(0.0);
+            vec![(nu, g / area)]
+        };
+        for (direction, g0) in directions {
+            let mut row = weighted_row(numbering, j, direction, &slave_terms, &master_terms);
+            row.g0 = g0;
+            row.area = area;
+            row.slave_normal = n;
+            row.point = slave_x[&j];
+            row.bilateral = numbering.tied;
+            row.mass = mass.clone();
+            rows.push(row);
+        }
+    }
+    if rows.is_empty() {
+        return Err(
+            "no slave facet overlaps a master facet facing it: check that the two surfaces face each other (outward normals opposed) and lie within the search distance".into(),
+        );
+    }
+    Ok((rows, integrals))
+}
+
+/// A row `nu . (sum_k a_k u_k - sum_l b_l u_l)` (zero gap, unit area; the caller fills in the
+/// rest); coefficients below `1e-12` of the largest are round-off of exact zeros and dropped.
+/// The owner is the row's own node's dof with the largest `|nu_i|`.
+fn weighted_row(
+    numbering: &RowNumbering,
+    node: usize,
+    nu: [f64; 3],
+    slave_terms: &[(usize, f64)],
+    master_terms: &[(usize, f64)],
+) -> Constraint<3> {
+    let largest = slave_terms
+        .iter()
+        .chain(master_terms)
+        .fold(0.0f64, |a, t| a.max(t.1.abs()))
+        * nu.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let mut dofs = Vec::new();
+    let mut coeffs = Vec::new();
+    let mut push = |dof: usize, c: f64| {
+        if c.abs() > 1e-12 * largest {
+            match dofs.iter().position(|&d| d == dof) {
+                Some(k) => coeffs[k] += c,
+                None => {
+                    dofs.push(dof);
+                    coeffs.push(c);
+                }
+            }
+        }
+    };
+    for &(k, a) in slave_terms {
+        for (i, v) in nu.iter().enumerate() {
+            push((numbering.slave_dof)(k, i), a * v);
+        }
+    }
+    for &(l, b) in master_terms {
+        for (i, v) in nu.iter().enumerate() {
+            push((numbering.master_dof)(l, i), -b * v);
+        }
+    }
+    let component = (0..3)
+        .max_by(|&a, &b| nu[a].abs().total_cmp(&nu[b].abs()))
+        .unwrap_or(0);
+    Constraint {
+        dofs,
+        coeffs,
+        g0: 0.0,
+        area: 1.0,
+        normal: nu,
+        slave_normal: [0.0; 3],
+        slave_body: numbering.slave_body,
+        slave_node: node,
+        point: [0.0; 3],
+        pass: numbering.pass,
+        owner: (numbering.slave_dof)(node, component),
+        pair: numbering.pair,
+        bilateral: false,
+        mass: Vec::new(),
+        tangent: None,
+        segment: None,
+        nodal_normal: None,
+        hessian: None,
+    }
+}
+
+fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    scale(a, 1.0 / norm(a))
+}
+
+fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    norm(sub(a, b))
+}
+
+/// The largest distance between two of `xs`.
+fn diameter(xs: &[[f64; 3]]) -> f64 {
+    let mut d = 0.0f64;
+    for (i, &a) in xs.iter().enumerate() {
+        for &b in &xs[i + 1..] {
+            d = d.max(distance(a, b));
+        }
+    }
+    d
+}
+
+fn bounding_box(xs: &[[f64; 3]]) -> [[f64; 3]; 2] {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in xs {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    [lo, hi]
+}
+
+/// Twice the area of a facet's corner polygon in 3D (the norm of its vector area).
+fn twice_area_3d(kind: ElementKind, xs: &[[f64; 3]]) -> f64 {
+    let k = kind.corner_count();
+    let mut v = [0.0; 3];
+    for i in 0..k {
+        v = add(v, cross(xs[i], xs[(i + 1) % k]));
+    }
+    norm(v)
+}
