@@ -43,6 +43,7 @@ pub(crate) mod mortar_linearization;
 pub mod nodal_normal;
 pub mod node_based_rows;
 pub mod node_to_segment;
+pub mod pair3;
 pub mod search;
 
 use crate::contact::Constraint;
@@ -204,10 +205,10 @@ impl Discretize<2> for crate::fe::ElementKind {
 
 impl Discretize<3> for crate::fe3d::SolidKind {
     fn pair_rows(
-        _model: &crate::model::Model3,
-        _pair: &ContactPair,
+        model: &crate::model::Model3,
+        pair: &ContactPair,
     ) -> Result<Vec<Constraint<3>>, String> {
-        Err("contact between 3D bodies is not built yet".into())
+        pair3::pair_rows(model, pair)
     }
 
     fn slave_curvature(

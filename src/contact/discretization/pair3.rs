@@ -1,0 +1,174 @@
+//! The rows of a contact pair between 3D bodies: the discretization axis in 3D, meeting the
+//! dimension-free enforcement through [`Constraint<3>`] rows (see [`super::Discretize`]).
+//!
+//! * Node-to-surface, one and two passes, master normals
+//!   ([`super::node_based_rows::node_to_surface_rows`]: closest point on Quad4, Quad9, Tri3 and
+//!   Tri6 facets with edges and corners);
+//! * node-to-node on matching interfaces ([`super::node_based_rows::node_to_node_rows`]);
+//! * rigid plane and sphere masters ([`super::node_based_rows::rigid_rows`]), one pass;
+//! * segment-based mortar, standard and dual multipliers
+//!   ([`super::mortar3::mortar_rows3`]: auxiliary plane, polygon clipping), with the slave
+//!   surface's nodal normals (normalized `int N_a n dA`, [`super::geometry::Surface`]).
+//!
+//! **Tied pairs** keep the interface's initial geometry: every node-based row
+//! `g = nu . (u_s - sum_b w_b u_b)` gives three bilateral rows `e_i . (u_s - sum_b w_b u_b)`
+//! with zero gap, one per axis (Taylor 2004, "Tied Interfaces"); mortar builds its tied rows
+//! with the same `D` and `M` weights. The weights `w_b` of a node-based row are recovered
+//! from its coefficients on the component where `|nu_i|` is largest (at least `1/sqrt 3`), so
+//! they are exact.
+//!
+//! Small strain: the geometry is taken once in the reference configuration. Slave normals,
+//! Coulomb friction and mortar against rigid surfaces are not built in 3D and are refused with
+//! the reason.
+
+use super::geometry::Surface3;
+use super::mortar3::{mortar_rows3, FacetSet3, RowNumbering};
+use super::node_based_rows::{
+    dominant_component, gradient_coefficients, node_to_node_rows, node_to_surface_rows, rigid_rows,
+    RigidMaster, RowSettings,
+};
+use crate::contact::Constraint;
+use crate::io::scene::{DiscretizationSpec, Interaction, NormalChoice, RigidSurface};
+use crate::model::{ContactPair, MasterSide, Model3};
+use std::collections::BTreeMap;
+
+/// The rows of `pair` of the 3D model `model`, or why its discretization does not apply.
+pub fn pair_rows(model: &Model3, pair: &ContactPair) -> Result<Vec<Constraint<3>>, String> {
+    if pair.interaction.friction().is_some() {
+        return Err("Coulomb friction in 3D is not built yet".into());
+    }
+    let tied = pair.interaction == Interaction::Tied;
+    let (slave_body, slave_facets) = &pair.slave;
+    let slave =
+        Surface3::from_solid_mesh(*slave_body, &model.bodies[*slave_body].mesh, slave_facets);
+    let numbering = |b: usize, n: usize, c: usize| model.bodies[b].dof(n, c);
+    let settings = RowSettings {
+        dofs: &numbering,
+        pair: 0,
+        search_distance: pair.search_distance,
+    };
+    let rows = match (&pair.master, &pair.discretization) {
+        (MasterSide::Rigid(rigid), DiscretizationSpec::NodeToSurface { passes, .. }) => {
+            if *passes != 1 {
+                return Err("a rigid master has no nodes to be slaves of a second pass: use \"passes\": 1".into());
+            }
+            rigid_rows(&slave, &rigid_master(rigid)?, &settings)?
+        }
+        (MasterSide::Rigid(_), _) => {
+            return Err(
+                "against a rigid surface in 3D only node-to-surface is built: use {\"kind\": \"node_to_surface\", \"passes\": 1}".into(),
+            )
+        }
+        (MasterSide::Body { body, facets }, discretization) => {
+            let master = Surface3::from_solid_mesh(*body, &model.bodies[*body].mesh, facets);
+            match discretization {
+                DiscretizationSpec::NodeToSurface { normal, passes, .. } => {
+                    if *normal != NormalChoice::Master {
+                        return Err("slave normals in 3D are not built yet: use \"normal\": \"master\"".into());
+                    }
+                    node_to_surface_rows(&slave, &master, *passes, &settings)?
+                }
+                DiscretizationSpec::NodeToNode => node_to_node_rows(&slave, &master, &settings)?,
+                DiscretizationSpec::Mortar { multiplier } => {
+                    return mortar(model, pair, &slave, *body, facets, *multiplier, tied)
+                }
+            }
+        }
+    };
+    Ok(if tied { tie(model, rows) } else { rows })
+}
+
+/// The rigid master of a 3D pair.
+fn rigid_master(rigid: &RigidSurface) -> Result<RigidMaster<3>, String> {
+    match *rigid {
+        RigidSurface::Plane { point, normal } => Ok(RigidMaster::Plane { point, normal }),
+        RigidSurface::Sphere { centre, radius } => Ok(RigidMaster::Sphere { centre, radius }),
+        RigidSurface::Line { .. } | RigidSurface::Circle { .. } => {
+            Err("a rigid line or circle is 2D: a 3D body meets a \"plane\" or a \"sphere\"".into())
+        }
+    }
+}
+
+/// The mortar rows of the pair (frictionless or tied).
+fn mortar(
+    model: &Model3,
+    pair: &ContactPair,
+    slave: &Surface3,
+    master_body: usize,
+    master_facets: &[crate::mesh::Facet],
+    multiplier: crate::io::scene::MultiplierSpace,
+    tied: bool,
+) -> Result<Vec<Constraint<3>>, String> {
+    let (slave_body, slave_facets) = &pair.slave;
+    let slave_set = FacetSet3::from_mesh(&model.bodies[*slave_body].mesh, slave_facets)?;
+    let master_set = FacetSet3::from_mesh(&model.bodies[master_body].mesh, master_facets)?;
+    let normals: BTreeMap<usize, [f64; 3]> =
+        slave.nodes.iter().map(|(&n, d)| (n, d.normal)).collect();
+    let slave_dof = |n: usize, i: usize| model.bodies[*slave_body].dof(n, i);
+    let master_dof = |n: usize, i: usize| model.bodies[master_body].dof(n, i);
+    let numbering = RowNumbering {
+        slave_body: *slave_body,
+        pair: 0,
+        pass: 1,
+        slave_dof: &slave_dof,
+        master_dof: &master_dof,
+        tied,
+    };
+    let (rows, _) = mortar_rows3(
+        &slave_set,
+        &master_set,
+        multiplier,
+        &normals,
+        &numbering,
+        pair.search_distance,
+    )?;
+    Ok(rows)
+}
+
+/// Three bilateral rows (x, y, z) with zero gap for every node-based row, with its weights.
+fn tie(model: &Model3, rows: Vec<Constraint<3>>) -> Vec<Constraint<3>> {
+    let mut out = Vec::with_capacity(3 * rows.len());
+    for r in rows {
+        let i = dominant_component(r.normal);
+        // the weights of the row's nodes: coefficient on component i over nu_i
+        let mut slave_terms: Vec<(usize, f64)> = Vec::new();
+        let mut master_terms: Vec<(usize, usize, f64)> = Vec::new();
+        for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
+            let Some(owner) = model.dof_owner(d) else {
+                continue;
+            };
+            if owner.component != i {
+                continue;
+            }
+            let w = c / r.normal[i];
+            if owner.body == r.slave_body {
+                slave_terms.push((owner.node, w));
+            } else {
+                master_terms.push((owner.body, owner.node, -w));
+            }
+        }
+        let master_body = master_terms.first().map_or(r.slave_body, |t| t.0);
+        let master: Vec<(usize, f64)> = master_terms.iter().map(|t| (t.1, t.2)).collect();
+        for axis in 0..3 {
+            let mut e = [0.0; 3];
+            e[axis] = 1.0;
+            let (dofs, coeffs) = gradient_coefficients(
+                e,
+                &slave_terms,
+                |n, c| model.bodies[r.slave_body].dof(n, c),
+                (master_body, &master),
+                |b, n, c| model.bodies[b].dof(n, c),
+            );
+            out.push(Constraint {
+                dofs,
+                coeffs,
+                g0: 0.0,
+                normal: e,
+                owner: model.bodies[r.slave_body].dof(r.slave_node, axis),
+                bilateral: true,
+                ..r.clone()
+            });
+        }
+    }
+    out
+}
