@@ -28,8 +28,9 @@
 //!    part only if it faces the slave facet: its projection has the opposite orientation
 //!    (negative signed area in the slave's counter-clockwise frame, beyond `1e-9` of its own
 //!    area); a facet seen edge-on or from its back does not.
-//! 3. **Clipping.** The projected slave polygon (convex, counter-clockwise) clips the projected
-//!    master polygon (reversed to counter-clockwise) by Sutherland-Hodgman
+//! 3. **Clipping.** The projected slave polygon (convex, counter-clockwise; each of its pieces
+//!    for Quad9, see below) clips the projected master polygon (reversed to counter-clockwise)
+//!    by Sutherland-Hodgman
 //!    ([`clip_convex_polygons`]): a point is inside an edge when its signed distance is at least
 //!    `-tol` (`tol = 1e-12` of the slave facet's diameter), an intersection parameter is clamped
 //!    to `[0, 1]` (nearly parallel edges), consecutive vertices closer than `tol` merge, and a
@@ -41,10 +42,9 @@
 //!    functions), degree 5 (Radon's 7 points) where a Quad4 takes part (products of two
 //!    bilinear functions, total degree 4 when the facet map is affine), degree 8 (the
 //!    collapsed 5 x 5 Gauss product, [`collapsed_triangle_rule`]) where a Quad9 takes part
-//!    (two biquadratic functions, total degree 8). The weight is the
-//!    rule's weight times twice the triangle's area: the integrals are taken over the
-//!    auxiliary plane (exact for flat slave facets, Puso and Laursen's approximation
-//!    otherwise).
+//!    (two biquadratic functions, total degree 8). The weight is the rule's weight times twice
+//!    the triangle's area: the integrals are taken over the auxiliary plane (exact for flat
+//!    slave facets, Puso and Laursen's approximation otherwise).
 //! 5. **Back to the facets.** Each Gauss point `p` of the plane maps to the slave and master
 //!    natural coordinates by inverting the projected facet map `xi -> P(x(xi))`: in closed form
 //!    for Tri3 (affine), by Newton for Quad4 and Quad9 from the centre of the piece the point
@@ -80,8 +80,8 @@
 //! with `area = A_j` and, for standard multipliers, the multiplier mass line
 //! `mass = [(k, D_jk)]` (the row's own node first); dual rows carry none (lumped). The
 //! coefficients are the small-strain linearization: `D`, `M` and `nu` frozen at the reference
-//! configuration. Linear momentum: `sum_k D_jk = sum_l M_jl` where the slave facets are
-//! covered (the shape functions sum to one at every Gauss point); angular momentum:
+//! configuration. Linear momentum: `sum_k D_jk = sum_l M_jl` at every slave node (both sides'
+//! shape functions sum to one at every Gauss point of every cell); angular momentum:
 //! `sum_k D_jk x_k = sum_l M_jl x_l` on flat coplanar interfaces (both facets reproduce the
 //! plane point at every Gauss point).
 //!
@@ -99,9 +99,9 @@ use std::collections::{BTreeMap, HashMap};
 /// `D_jk` or `M_jl` by slave node `j` (over slave nodes `k` or master nodes `l`).
 pub type MortarMatrix3 = BTreeMap<usize, BTreeMap<usize, f64>>;
 
-/// Tolerance on the natural-coordinate step of the inverse Quad4 map.
+/// Tolerance on the natural-coordinate step of the inverse Quad4 and Quad9 maps.
 const NEWTON_TOLERANCE: f64 = 1e-13;
-/// Largest number of Newton steps of the inverse Quad4 map.
+/// Largest number of Newton steps of the inverse Quad4 and Quad9 maps.
 const NEWTON_STEPS: usize = 50;
 /// Relative size (of the slave facet's diameter) below which polygon vertices coincide.
 const CLIP_TOLERANCE: f64 = 1e-12;
@@ -109,7 +109,7 @@ const CLIP_TOLERANCE: f64 = 1e-12;
 /// One side of a 3D interface: facets of one kind, their node ids and coordinates.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FacetSet3 {
-    /// The facets' 2D reference element (`Q4` = Quad4, `T3` = Tri3).
+    /// The facets' 2D reference element (`Q4` = Quad4, `T3` = Tri3, `Q9` = Quad9).
     pub kind: ElementKind,
     /// Node ids of each facet, in the reference element's order (counter-clockwise seen from
     /// outside the body, so `x_xi x x_eta` is the outward normal).
