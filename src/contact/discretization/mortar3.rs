@@ -89,6 +89,7 @@
 //! (vertex functions plus 1/5 of the adjacent edge functions) first, which is not built here.
 //! Quad9 needs none (its corner integrals `int N_k` are positive).
 
+use super::node_based_rows::{dominant_component, gradient_coefficients};
 use crate::contact::Constraint;
 use crate::fe::{gauss_legendre, gauss_square, triangle_rule, ElementKind, QuadPoint, MAX_NODES};
 use crate::io::scene::MultiplierSpace;
@@ -949,37 +950,14 @@ fn weighted_row(
     slave_terms: &[(usize, f64)],
     master_terms: &[(usize, f64)],
 ) -> Constraint<3> {
-    let largest = slave_terms
-        .iter()
-        .chain(master_terms)
-        .fold(0.0f64, |a, t| a.max(t.1.abs()))
-        * nu.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    let mut dofs = Vec::new();
-    let mut coeffs = Vec::new();
-    let mut push = |dof: usize, c: f64| {
-        if c.abs() > 1e-12 * largest {
-            match dofs.iter().position(|&d| d == dof) {
-                Some(k) => coeffs[k] += c,
-                None => {
-                    dofs.push(dof);
-                    coeffs.push(c);
-                }
-            }
-        }
-    };
-    for &(k, a) in slave_terms {
-        for (i, v) in nu.iter().enumerate() {
-            push((numbering.slave_dof)(k, i), a * v);
-        }
-    }
-    for &(l, b) in master_terms {
-        for (i, v) in nu.iter().enumerate() {
-            push((numbering.master_dof)(l, i), -b * v);
-        }
-    }
-    let component = (0..3)
-        .max_by(|&a, &b| nu[a].abs().total_cmp(&nu[b].abs()))
-        .unwrap_or(0);
+    let (dofs, coeffs) = gradient_coefficients(
+        nu,
+        slave_terms,
+        |k, i| (numbering.slave_dof)(k, i),
+        (0, master_terms),
+        |_, l, i| (numbering.master_dof)(l, i),
+    );
+    let component = dominant_component(nu);
     Constraint {
         dofs,
         coeffs,
