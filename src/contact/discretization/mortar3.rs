@@ -24,7 +24,7 @@
 //!    `x_0 = x(xi_c)` with normal `n_0 = x_xi x x_eta / |x_xi x x_eta|` there (outward); an
 //!    orthonormal frame `t_1, t_2, n_0`; points are projected onto it along `n_0`.
 //! 2. **Candidates.** Master facets whose bounding boxes, grown by the search distance, meet
-//!    the slave facet's box (a local uniform grid of boxes, [`BoxGrid`]). A master facet takes
+//!    the slave facet's box (the bucket grid of the contact search, [`BucketGrid`]). A master facet takes
 //!    part only if it faces the slave facet: its projection has the opposite orientation
 //!    (negative signed area in the slave's counter-clockwise frame, beyond `1e-9` of its own
 //!    area); a facet seen edge-on or from its back does not.
@@ -90,6 +90,7 @@
 //! Quad9 needs none (its corner integrals `int N_k` are positive).
 
 use super::node_based_rows::{dominant_component, gradient_coefficients};
+use super::search::BucketGrid;
 use crate::contact::Constraint;
 use crate::fe::{gauss_legendre, gauss_square, triangle_rule, ElementKind, QuadPoint, MAX_NODES};
 use crate::io::scene::MultiplierSpace;
@@ -457,70 +458,6 @@ pub fn clip_convex_polygons(subject: &[[f64; 2]], window: &[[f64; 2]], tol: f64)
     merged
 }
 
-/// A uniform grid of boxes (cells the size of the largest box) for the candidate search.
-pub struct BoxGrid {
-    boxes: Vec<[[f64; 3]; 2]>,
-    cell: f64,
-    buckets: HashMap<[i64; 3], Vec<usize>>,
-}
-
-impl BoxGrid {
-    /// The grid of `boxes` (`[lo, hi]` each).
-    pub fn new(boxes: Vec<[[f64; 3]; 2]>) -> Self {
-        let cell = boxes
-            .iter()
-            .flat_map(|[lo, hi]| (0..3).map(move |i| hi[i] - lo[i]))
-            .fold(0.0f64, f64::max)
-            .max(f64::MIN_POSITIVE);
-        let mut grid = BoxGrid {
-            boxes,
-            cell,
-            buckets: HashMap::new(),
-        };
-        for (b, [lo, hi]) in grid.boxes.iter().enumerate() {
-            let (a, z) = (grid.key(*lo), grid.key(*hi));
-            for i in a[0]..=z[0] {
-                for j in a[1]..=z[1] {
-                    for k in a[2]..=z[2] {
-                        grid.buckets.entry([i, j, k]).or_default().push(b);
-                    }
-                }
-            }
-        }
-        grid
-    }
-
-    fn key(&self, x: [f64; 3]) -> [i64; 3] {
-        x.map(|v| (v / self.cell).floor() as i64)
-    }
-
-    /// The boxes that meet `[lo, hi]`, in increasing order.
-    pub fn query(&self, lo: [f64; 3], hi: [f64; 3]) -> Vec<usize> {
-        let meets = |b: &[[f64; 3]; 2]| (0..3).all(|i| b[0][i] <= hi[i] && lo[i] <= b[1][i]);
-        let (a, z) = (self.key(lo), self.key(hi));
-        let cells: i64 = (0..3).map(|i| z[i] - a[i] + 1).product();
-        let mut found: Vec<usize> = if cells as usize > self.boxes.len() {
-            (0..self.boxes.len()).collect()
-        } else {
-            let mut v = Vec::new();
-            for i in a[0]..=z[0] {
-                for j in a[1]..=z[1] {
-                    for k in a[2]..=z[2] {
-                        if let Some(bucket) = self.buckets.get(&[i, j, k]) {
-                            v.extend_from_slice(bucket);
-                        }
-                    }
-                }
-            }
-            v
-        };
-        found.sort_unstable();
-        found.dedup();
-        found.retain(|&b| meets(&self.boxes[b]));
-        found
-    }
-}
-
 /// The dual coefficients `a_jk` of a slave facet whose projected corners are `q` (see the
 /// module notes): `A_e = D_e M_e^-1` over the facet in the auxiliary-plane measure.
 pub fn dual_coefficients(
@@ -685,7 +622,7 @@ pub fn mortar_integrals3(
     let (ks, km) = (slave.kind, master.kind);
     let (ns, nm) = (ks.node_count(), km.node_count());
     let rule = cell_rule(ks, km);
-    let grid = BoxGrid::new(
+    let grid = BucketGrid::new(
         master
             .boxes()
             .into_iter()
@@ -722,7 +659,14 @@ pub fn mortar_integrals3(
         let [lo, hi] = bounding_box(xs);
         let mut d_local = [[0.0; MAX_NODES]; MAX_NODES];
         let mut m_local: Vec<(usize, [[f64; MAX_NODES]; MAX_NODES])> = Vec::new();
-        for c in grid.query(lo, hi) {
+        // the cube about the slave box's centre holds the box; keep the boxes that meet it
+        let centre: [f64; 3] = std::array::from_fn(|i| 0.5 * (lo[i] + hi[i]));
+        let half = (0..3).map(|i| 0.5 * (hi[i] - lo[i])).fold(0.0, f64::max);
+        let candidates = grid.query(centre, half).into_iter().filter(|&c| {
+            let [blo, bhi] = grid.item_box(c);
+            (0..3).all(|i| blo[i] <= hi[i] && lo[i] <= bhi[i])
+        });
+        for c in candidates {
             let q_master = projected(&plane, &master.coords[c]);
             // a master facet facing the slave one projects clockwise; edge-on or back: skipped
             let master_area = 0.5 * twice_signed_area(&q_master[..km.corner_count()]);

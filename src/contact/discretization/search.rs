@@ -96,6 +96,11 @@ impl<const D: usize> BucketGrid<D> {
         p.map(|x| (x / self.cell).floor() as i64)
     }
 
+    /// The box `[lo, hi]` of item `i`.
+    pub fn item_box(&self, i: usize) -> [[f64; D]; 2] {
+        self.boxes[i]
+    }
+
     /// Items whose box, grown by `radius`, contains `p` (sorted, without repeats).
     ///
     /// The cost is bounded by the number of buckets in use, whatever `radius` is: the query's
