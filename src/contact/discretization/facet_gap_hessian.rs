@@ -202,14 +202,7 @@ mod tests {
         for (k, z) in [(4, 0.15), (5, -0.1), (6, 0.2), (7, 0.05), (8, 0.25)] {
             quad9[k][2] = z;
         }
-        let tri6 = vec![
-            [0.0, 0.0, 0.0],
-            [1.5, 0.1, 0.0],
-            [0.2, 1.3, 0.1],
-            [0.75, 0.0, -0.15],
-            [0.9, 0.7, 0.2],
-            [0.1, 0.65, -0.1],
-        ];
+        let tri6 = super::super::facet_projection::tests::curved_tri6();
         let warped_quad4 = vec![
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.2],
@@ -233,7 +226,10 @@ mod tests {
             }
             let len = 3 * (coords.len() + 1);
             let largest = hessian.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            assert!(largest > 0.1, "{kind:?} at {x_s:?}: a Hessian of size {largest}");
+            assert!(
+                largest > 0.1,
+                "{kind:?} at {x_s:?}: a Hessian of size {largest}"
+            );
             for j in 0..len {
                 let moved = |d: f64| {
                     let (mut c, mut s) = (coords.clone(), x_s);
