@@ -328,9 +328,21 @@ pub fn project_onto_facet(kind: ElementKind, coords: &[[f64; 3]], p: [f64; 3]) -
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::contact::discretization::geometry::FacetShape;
+
+    /// A Tri6 facet with straight-line corners and mid-edge nodes moved off them (curved).
+    pub(crate) fn curved_tri6() -> Vec<[f64; 3]> {
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.5, 0.1, 0.0],
+            [0.2, 1.3, 0.1],
+            [0.75, 0.0, -0.15],
+            [0.9, 0.7, 0.2],
+            [0.1, 0.65, -0.1],
+        ]
+    }
 
     /// A flat, a bilinear-warped and two curved facets of every kind.
     fn facets() -> Vec<(ElementKind, Vec<[f64; 3]>, &'static str)> {
@@ -351,14 +363,7 @@ mod tests {
             quad9_curved[k][2] = lift;
         }
         quad9_curved[8][0] += 0.1;
-        let tri6_curved = vec![
-            [0.0, 0.0, 0.0],
-            [1.5, 0.1, 0.0],
-            [0.2, 1.3, 0.1],
-            [0.75, 0.0, -0.15],
-            [0.9, 0.7, 0.2],
-            [0.1, 0.65, -0.1],
-        ];
+        let tri6_curved = curved_tri6();
         vec![
             (
                 ElementKind::Q4,

@@ -35,6 +35,7 @@
 //! Every row carries the slave node's tributary area, so penalty forces (`kappa A g`) do not
 //! depend on the mesh. Geometry is evaluated in the reference configuration (small strain).
 
+pub mod facet_gap_hessian;
 pub mod facet_projection;
 pub mod geometry;
 pub(crate) mod mortar;

@@ -1,0 +1,267 @@
+//! The second derivative of the 3D node-to-surface gap with respect to the nodal positions, for
+//! finite kinematics. **Not wired**: no solver consumes it yet (the small-strain rows of
+//! [`super::node_based_rows`] do not need it); it is here, checked against finite differences
+//! of the gap's gradient, for the 3D counterpart of [`super::node_to_segment`].
+//!
+//! The gap of slave node `x_s` against the closest point `x(xi)` inside a master facet
+//! `x(xi) = sum_a N_a(xi) x_a` is `g = n . (x_s - x(xi))`, `n` the facet's unit normal at `xi`,
+//! and its gradient is `dg = n . dr~`, `dr~ = dx_s - sum_a N_a dx_a` (see
+//! [`super::node_based_rows`]). With the tangents `t_a = dx/dxi_a`, the metric
+//! `m_ab = t_a . t_b` (inverse `m^ab`), the curvature `h_ab = n . x_,ab` and
+//! `T_a dq = sum_b N_b,a dx_b` (Wriggers, Computational Contact Mechanics, 2nd ed. 2006,
+//! section 4.3; Laursen 2002, section 5.3):
+//!
+//! * the closest point moves by `(m_ab - g h_ab) Dxi_b = t_a . Dr~ + g n . T_a Dq` (the variation
+//!   of `(x_s - x(xi)) . t_a = 0`),
+//! * the normal turns by `Dn = -m^ab (n . Dt_a) t_b`, `Dt_a = T_a Dq + x_,ab Dxi_b`,
+//! * so `D(dg) = Dn . dr~ - (n . T_a dq) Dxi_a`
+//!   `= -m^ab (n . T_a Dq + h_ac Dxi_c)(t_b . dr~) - (n . T_a dq) Dxi_a`.
+//!
+//! At a corner held by the corner condition, `g = |x_s - x_v|` and the second derivative is
+//! `(I - nu nu^T) / g` on `x_s` and `-` that between `x_s` and `x_v`. Edge points are not
+//! provided (`None`).
+
+use super::facet_projection::{project_onto_facet, shape_second_derivatives, FacetFeature};
+use super::geometry::{dot, facet_frame, FacetShape, MAX_FACET_NODES};
+use crate::fe::ElementKind;
+
+/// The second derivative of the gap of slave position `x_s` against the facet `coords` of kind
+/// `kind`, over the positions `q = [x_s, x_1, .., x_n]` (3 components each): `values[i * len +
+/// j] = d2 g / dq_i dq_j`, `len = 3 (n + 1)`, symmetric; `None` where the closest point is on an
+/// edge, or the slave node sits on a corner.
+pub fn node_to_facet_gap_hessian(
+    kind: ElementKind,
+    coords: &[[f64; 3]],
+    x_s: [f64; 3],
+) -> Option<Vec<f64>> {
+    let n_nodes = coords.len();
+    let len = 3 * (n_nodes + 1);
+    let q = project_onto_facet(kind, coords, x_s);
+    let mut h = vec![0.0; len * len];
+    match q.feature {
+        FacetFeature::Interior => {}
+        FacetFeature::Edge(_) => return None,
+        FacetFeature::Corner(k) => {
+            if q.distance == 0.0 {
+                return None;
+            }
+            let nu = std::array::from_fn::<f64, 3, _>(|i| (x_s[i] - q.point[i]) / q.distance);
+            for i in 0..3 {
+                for j in 0..3 {
+                    let v = (f64::from(u8::from(i == j)) - nu[i] * nu[j]) / q.distance;
+                    for (a, b, sign) in [(0, 0, 1.0), (0, k + 1, -1.0), (k + 1, 0, -1.0)] {
+                        h[(3 * a + i) * len + 3 * b + j] += sign * v;
+                    }
+                    h[(3 * (k + 1) + i) * len + 3 * (k + 1) + j] += v;
+                }
+            }
+            return Some(h);
+        }
+    }
+    let xi = q.natural;
+    let n = q.normal;
+    let g = dot(n, std::array::from_fn(|i| x_s[i] - q.point[i]));
+    let mut shape = [0.0; MAX_FACET_NODES];
+    let mut dshape = [[0.0; 2]; MAX_FACET_NODES];
+    FacetShape::<3>::shape(kind, xi, &mut shape[..n_nodes], &mut dshape[..n_nodes]);
+    let mut ddshape = [[[0.0; 2]; 2]; MAX_FACET_NODES];
+    shape_second_derivatives(kind, xi, &mut ddshape);
+    let (_, t) = facet_frame(kind, coords, xi);
+    let mut xab = [[[0.0; 3]; 2]; 2];
+    for (a, p) in coords.iter().enumerate() {
+        for (al, row) in xab.iter_mut().enumerate() {
+            for (be, v) in row.iter_mut().enumerate() {
+                for i in 0..3 {
+                    v[i] += ddshape[a][al][be] * p[i];
+                }
+            }
+        }
+    }
+    let m = [
+        [dot(t[0], t[0]), dot(t[0], t[1])],
+        [dot(t[1], t[0]), dot(t[1], t[1])],
+    ];
+    let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    let m_inv = [
+        [m[1][1] / det, -m[0][1] / det],
+        [-m[1][0] / det, m[0][0] / det],
+    ];
+    let curvature = [
+        [dot(n, xab[0][0]), dot(n, xab[0][1])],
+        [dot(n, xab[1][0]), dot(n, xab[1][1])],
+    ];
+    // rows over q: R^T t_b (t_b . dr~), T_a^T n (n . T_a dq)
+    let r_t = |b: usize| -> Vec<f64> {
+        let mut v = vec![0.0; len];
+        for i in 0..3 {
+            v[i] = t[b][i];
+            for a in 0..n_nodes {
+                v[3 * (a + 1) + i] = -shape[a] * t[b][i];
+            }
+        }
+        v
+    };
+    let t_n = |al: usize| -> Vec<f64> {
+        let mut v = vec![0.0; len];
+        for a in 0..n_nodes {
+            for i in 0..3 {
+                v[3 * (a + 1) + i] = dshape[a][al] * n[i];
+            }
+        }
+        v
+    };
+    let rt = [r_t(0), r_t(1)];
+    let tn = [t_n(0), t_n(1)];
+    // Dxi = A^-1 (t_a . Dr~ + g n . T_a Dq), A = m - g h
+    let a = [
+        [m[0][0] - g * curvature[0][0], m[0][1] - g * curvature[0][1]],
+        [m[1][0] - g * curvature[1][0], m[1][1] - g * curvature[1][1]],
+    ];
+    let det_a = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+    let a_inv = [
+        [a[1][1] / det_a, -a[0][1] / det_a],
+        [-a[1][0] / det_a, a[0][0] / det_a],
+    ];
+    let rhs: [Vec<f64>; 2] =
+        std::array::from_fn(|al| (0..len).map(|j| rt[al][j] + g * tn[al][j]).collect());
+    let dxi: [Vec<f64>; 2] = std::array::from_fn(|al| {
+        (0..len)
+            .map(|j| a_inv[al][0] * rhs[0][j] + a_inv[al][1] * rhs[1][j])
+            .collect()
+    });
+    // n . Dt_a = n . T_a Dq + h_ac Dxi_c
+    let n_dt: [Vec<f64>; 2] = std::array::from_fn(|al| {
+        (0..len)
+            .map(|j| tn[al][j] + curvature[al][0] * dxi[0][j] + curvature[al][1] * dxi[1][j])
+            .collect()
+    });
+    for i in 0..len {
+        for j in 0..len {
+            let mut v = 0.0;
+            for al in 0..2 {
+                for be in 0..2 {
+                    v -= m_inv[al][be] * rt[be][i] * n_dt[al][j];
+                }
+                v -= tn[al][i] * dxi[al][j];
+            }
+            h[i * len + j] = v;
+        }
+    }
+    // the exact form is symmetric; average away the round-off
+    for i in 0..len {
+        for j in 0..i {
+            let s = 0.5 * (h[i * len + j] + h[j * len + i]);
+            h[i * len + j] = s;
+            h[j * len + i] = s;
+        }
+    }
+    Some(h)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The gap's gradient over `q = [x_s, x_1, .., x_n]` at these positions (re-projected):
+    /// `n` on the slave, `-N_a n` on node `a` inside; `nu`, `-nu` at a corner.
+    fn gradient(kind: ElementKind, coords: &[[f64; 3]], x_s: [f64; 3]) -> Vec<f64> {
+        let q = project_onto_facet(kind, coords, x_s);
+        let mut out = vec![0.0; 3 * (coords.len() + 1)];
+        let (nu, weights): ([f64; 3], Vec<f64>) = match q.feature {
+            FacetFeature::Interior => {
+                let mut shape = [0.0; MAX_FACET_NODES];
+                let mut dshape = [[0.0; 2]; MAX_FACET_NODES];
+                let k = coords.len();
+                FacetShape::<3>::shape(kind, q.natural, &mut shape[..k], &mut dshape[..k]);
+                (q.normal, shape[..k].to_vec())
+            }
+            FacetFeature::Corner(c) => (
+                std::array::from_fn(|i| (x_s[i] - q.point[i]) / q.distance),
+                (0..coords.len())
+                    .map(|a| f64::from(u8::from(a == c)))
+                    .collect(),
+            ),
+            FacetFeature::Edge(_) => unreachable!("the test points avoid edges"),
+        };
+        for i in 0..3 {
+            out[i] = nu[i];
+            for (a, w) in weights.iter().enumerate() {
+                out[3 * (a + 1) + i] = -w * nu[i];
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn the_hessian_is_the_difference_of_the_gradient_on_curved_facets() {
+        let mut quad9: Vec<[f64; 3]> = ElementKind::Q9
+            .node_coordinates()
+            .iter()
+            .map(|c| [c[0] + 0.05 * c[1], 0.8 * c[1], 0.0])
+            .collect();
+        for (k, z) in [(4, 0.15), (5, -0.1), (6, 0.2), (7, 0.05), (8, 0.25)] {
+            quad9[k][2] = z;
+        }
+        let tri6 = super::super::facet_projection::tests::curved_tri6();
+        let warped_quad4 = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.2],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.2],
+        ];
+        let cases = [
+            (ElementKind::Q9, quad9, [0.2, 0.1, 0.4]),
+            (ElementKind::Q9, quad9_below(), [-0.3, 0.2, -0.2]),
+            (ElementKind::T6, tri6.clone(), [0.5, 0.4, 0.35]),
+            (ElementKind::T6, tri6, [0.4, 0.3, -0.1]),
+            (ElementKind::Q4, warped_quad4.clone(), [0.6, 0.3, 0.5]),
+            (ElementKind::Q4, warped_quad4, [1.3, 1.2, 0.3]),
+        ];
+        let h = 1e-6;
+        let mut corners = 0;
+        for (kind, coords, x_s) in cases {
+            let hessian = node_to_facet_gap_hessian(kind, &coords, x_s).expect("not on an edge");
+            if project_onto_facet(kind, &coords, x_s).feature != FacetFeature::Interior {
+                corners += 1;
+            }
+            let len = 3 * (coords.len() + 1);
+            let largest = hessian.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            assert!(
+                largest > 0.1,
+                "{kind:?} at {x_s:?}: a Hessian of size {largest}"
+            );
+            for j in 0..len {
+                let moved = |d: f64| {
+                    let (mut c, mut s) = (coords.clone(), x_s);
+                    if j < 3 {
+                        s[j] += d;
+                    } else {
+                        c[j / 3 - 1][j % 3] += d;
+                    }
+                    gradient(kind, &c, s)
+                };
+                let (plus, minus) = (moved(h), moved(-h));
+                for i in 0..len {
+                    let fd = (plus[i] - minus[i]) / (2.0 * h);
+                    assert!(
+                        (fd - hessian[i * len + j]).abs() < 1e-6,
+                        "{kind:?} at {x_s:?}: d2g/dq{i}dq{j} = {} vs finite difference {fd}",
+                        hessian[i * len + j]
+                    );
+                }
+            }
+        }
+        assert_eq!(corners, 1, "one corner case");
+    }
+
+    /// A curved Quad9 below its slave point (the gap is negative: penetration).
+    fn quad9_below() -> Vec<[f64; 3]> {
+        let mut c: Vec<[f64; 3]> = ElementKind::Q9
+            .node_coordinates()
+            .iter()
+            .map(|c| [c[0], c[1], 0.1 * c[0] * c[1]])
+            .collect();
+        c[8][2] = 0.2;
+        c
+    }
+}
