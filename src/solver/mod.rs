@@ -18,6 +18,7 @@ pub mod history;
 pub mod linear;
 pub mod low_rank;
 pub mod newton;
+pub mod ordering;
 pub mod sparse;
 
 use crate::error::Result;

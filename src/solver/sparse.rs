@@ -392,13 +392,7 @@ impl Cholesky {
     /// Analyse the pattern (ordering, elimination tree, supernodes); a factor whose work
     /// exceeds `limit` is [`FactorError::TooLarge`].
     pub fn analyse(pattern: &SymmetricPattern, limit: &WorkLimit) -> Result<Self, FactorError> {
-        let symbolic = factorize_symbolic_cholesky(
-            pattern.symbolic(),
-            Side::Upper,
-            SymmetricOrdering::Amd,
-            Default::default(),
-        )
-        .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+        let symbolic = cheaper_order(pattern)?;
         FactorWork::of(&symbolic).check(limit)?;
         Ok(Cholesky {
             symbolic: Arc::new(symbolic),
@@ -611,6 +605,50 @@ fn multipliers_after_their_displacements(
         inv[e] = k;
     }
     Ok((fwd, inv))
+}
+
+/// Above this many multiply-adds of the AMD factor, the nested-dissection order
+/// ([`crate::solver::ordering`]) is analysed too and the cheaper of the two kept: on large 3D
+/// meshes it takes a fraction of AMD's operations; below it the second analysis would cost
+/// more than it could save.
+pub const NESTED_DISSECTION_ABOVE: f64 = 1e10;
+
+/// The symbolic factor of `pattern` for AMD or, on large factors, for nested dissection when
+/// that takes fewer operations.
+fn cheaper_order(pattern: &SymmetricPattern) -> Result<SymbolicCholesky<usize>, FactorError> {
+    fn other(e: impl std::fmt::Debug) -> FactorError {
+        FactorError::Other(format!("{e:?}"))
+    }
+    let amd = factorize_symbolic_cholesky(
+        pattern.symbolic(),
+        Side::Upper,
+        SymmetricOrdering::Amd,
+        Default::default(),
+    )
+    .map_err(other)?;
+    if FactorWork::of(&amd).operations <= NESTED_DISSECTION_ABOVE {
+        return Ok(amd);
+    }
+    let fwd = crate::solver::ordering::nested_dissection(pattern);
+    let mut inv = vec![0usize; fwd.len()];
+    for (k, &e) in fwd.iter().enumerate() {
+        inv[e] = k;
+    }
+    let perm = faer::perm::PermRef::new_checked(&fwd, &inv, pattern.n);
+    let nd = factorize_symbolic_cholesky(
+        pattern.symbolic(),
+        Side::Upper,
+        SymmetricOrdering::Custom(perm),
+        Default::default(),
+    )
+    .map_err(other)?;
+    Ok(
+        if FactorWork::of(&nd).operations < FactorWork::of(&amd).operations {
+            nd
+        } else {
+            amd
+        },
+    )
 }
 
 /// The symbolic factor for the order "AMD of the leading `leading x leading` block, then the
