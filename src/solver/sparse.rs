@@ -666,7 +666,8 @@ impl Factor {
         let n = b.len();
         let c = self.trailing.as_ref().map_or(0, |t| t.len());
         let par = faer::get_global_parallelism();
-        let step_of = |k: usize| original(&self.symbolic, k);
+        let fwd = self.symbolic.perm().map(|p| p.arrays().0);
+        let step_of = |k: usize| fwd.map_or(k, |f| f[k]);
         let mut y = Mat::<f64>::from_fn(n, 1, |k, _| b[step_of(k)]);
         let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, par));
         let stack = MemStack::new(&mut mem);
