@@ -168,5 +168,31 @@ fn assembly(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, kernels, assembly);
+/// The 2D block mesher and the boundary facets of its mesh (every facet set and contact surface
+/// of a case selects from them), 500 x 500 Q4.
+fn mesh(c: &mut Criterion) {
+    let breaks: Vec<f64> = (0..=500).map(|i| i as f64 / 500.0).collect();
+    let mut group = c.benchmark_group("q4_block_500x500");
+    group.sample_size(10);
+    group.bench_function("block_mesher", |b| {
+        b.iter(|| {
+            contact_patch::mesh::block(
+                contact_patch::fe::ElementKind::Q4,
+                black_box(&breaks),
+                &breaks,
+                &[],
+            )
+            .unwrap()
+        })
+    });
+    let mesh =
+        contact_patch::mesh::block(contact_patch::fe::ElementKind::Q4, &breaks, &breaks, &[])
+            .unwrap();
+    group.bench_function("boundary_facets", |b| {
+        b.iter(|| black_box(&mesh).boundary_facets())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, kernels, assembly, mesh);
 criterion_main!(benches);

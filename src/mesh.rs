@@ -15,7 +15,7 @@
 
 use crate::fe::{ElementKind, ReferenceCell};
 use crate::fe3d::SolidKind;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
 /// A facet: a cell and one of its local facets (an edge in 2D, a face in 3D; the field keeps
 /// the 2D name `edge`), numbered as in [`ReferenceCell::facets`].
@@ -127,24 +127,47 @@ impl<const D: usize, K: ReferenceCell<D>> Mesh<D, K> {
         key
     }
 
-    /// Facets that belong to exactly one cell, in cell order.
+    /// Facets that belong to exactly one cell, in cell order. The facets are bucketed by their
+    /// smallest node (a counting sort, linear in the facets), and a facet is on the boundary
+    /// when no other facet of its bucket has the same corner nodes.
     pub fn boundary_facets(&self) -> Vec<Facet> {
-        let mut count: HashMap<[usize; 4], usize> = HashMap::new();
         let facet_count = self.kind.facets().len();
-        for c in 0..self.cell_count() {
-            for k in 0..facet_count {
-                *count.entry(self.facet_key(c, k)).or_default() += 1;
-            }
+        let total = self.cell_count() * facet_count;
+        let keys: Vec<[usize; 4]> = (0..total)
+            .map(|f| self.facet_key(f / facet_count, f % facet_count))
+            .collect();
+        let mut start = vec![0usize; self.nodes.len() + 1];
+        for key in &keys {
+            start[key[0] + 1] += 1;
         }
-        let mut out = Vec::new();
-        for c in 0..self.cell_count() {
-            for k in 0..facet_count {
-                if count[&self.facet_key(c, k)] == 1 {
-                    out.push(Facet { cell: c, edge: k });
+        for v in 0..self.nodes.len() {
+            start[v + 1] += start[v];
+        }
+        let mut next = start.clone();
+        let mut bucketed = vec![0usize; total];
+        for (f, key) in keys.iter().enumerate() {
+            bucketed[next[key[0]]] = f;
+            next[key[0]] += 1;
+        }
+        let mut shared = vec![false; total];
+        for v in 0..self.nodes.len() {
+            let bucket = &bucketed[start[v]..start[v + 1]];
+            for (a, &f) in bucket.iter().enumerate() {
+                for &g in &bucket[a + 1..] {
+                    if keys[f] == keys[g] {
+                        shared[f] = true;
+                        shared[g] = true;
+                    }
                 }
             }
         }
-        out
+        (0..total)
+            .filter(|&f| !shared[f])
+            .map(|f| Facet {
+                cell: f / facet_count,
+                edge: f % facet_count,
+            })
+            .collect()
     }
 
     /// Nodes inside the closed box `[lo, hi]` (with tolerance `tol`).

@@ -457,6 +457,43 @@ pub fn write_vtu(path: &Path, body: &Body, u: &[f64], nodal_stress: &[[f64; 3]])
     write_vtu_with(path, body, u, nodal_stress, &[])
 }
 
+/// The text `line(0, ..) + line(1, ..) + .. + line(count - 1, ..)`, formatted in as many
+/// consecutive chunks as the machine has threads, each on its own thread (formatting numbers
+/// is most of the cost of writing a large mesh's `.vtu`); the text is the same whatever the
+/// number of threads.
+fn lines_in_parallel(count: usize, line: impl Fn(usize, &mut String) + Sync) -> String {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .min(count / PARALLEL_LINES_MIN + 1);
+    let chunk = count.div_ceil(threads.max(1)).max(1);
+    let format = |range: std::ops::Range<usize>| {
+        let mut t = String::new();
+        for k in range {
+            line(k, &mut t);
+        }
+        t
+    };
+    if threads <= 1 {
+        return format(0..count);
+    }
+    std::thread::scope(|scope| {
+        let parts: Vec<_> = (0..count)
+            .step_by(chunk)
+            .map(|start| {
+                let format = &format;
+                scope.spawn(move || format(start..(start + chunk).min(count)))
+            })
+            .collect();
+        parts
+            .into_iter()
+            .map(|p| p.join().expect("formatting thread"))
+            .collect()
+    })
+}
+
+/// Below this many lines per thread, [`lines_in_parallel`] formats on one thread.
+const PARALLEL_LINES_MIN: usize = 20_000;
+
 /// [`write_vtu`] with more point data (`extra`, e.g. the contact fields).
 pub fn write_vtu_with(
     path: &Path,
@@ -489,18 +526,19 @@ pub fn write_vtu_with(
         text,
         "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
     );
-    for p in &mesh.nodes {
-        let _ = writeln!(text, "{} {} 0", p[0], p[1]);
-    }
+    text += &lines_in_parallel(mesh.nodes.len(), |n, t| {
+        let p = mesh.nodes[n];
+        let _ = writeln!(t, "{} {} 0", p[0], p[1]);
+    });
     let _ = writeln!(text, "</DataArray></Points>");
     let _ = writeln!(
         text,
         "<Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
     );
-    for c in 0..mesh.cell_count() {
+    text += &lines_in_parallel(mesh.cell_count(), |c, t| {
         let ids: Vec<String> = mesh.cell(c).iter().map(|n| n.to_string()).collect();
-        let _ = writeln!(text, "{}", ids.join(" "));
-    }
+        let _ = writeln!(t, "{}", ids.join(" "));
+    });
     let _ = writeln!(
         text,
         "</DataArray><DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
@@ -518,22 +556,23 @@ pub fn write_vtu_with(
     let _ = writeln!(text, "</DataArray></Cells>");
     let _ = writeln!(text, "<PointData Vectors=\"displacement\">");
     let _ = writeln!(text, "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">");
-    for n in 0..mesh.nodes.len() {
-        let _ = writeln!(text, "{} {} 0", u[body.dof(n, 0)], u[body.dof(n, 1)]);
-    }
+    text += &lines_in_parallel(mesh.nodes.len(), |n, t| {
+        let _ = writeln!(t, "{} {} 0", u[body.dof(n, 0)], u[body.dof(n, 1)]);
+    });
     let _ = writeln!(text, "</DataArray>");
     let _ = writeln!(text, "<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"3\" ComponentName0=\"xx\" ComponentName1=\"yy\" ComponentName2=\"xy\" format=\"ascii\">");
-    for s in nodal_stress {
-        let _ = writeln!(text, "{} {} {}", s[0], s[1], s[2]);
-    }
+    text += &lines_in_parallel(nodal_stress.len(), |n, t| {
+        let s = nodal_stress[n];
+        let _ = writeln!(t, "{} {} {}", s[0], s[1], s[2]);
+    });
     let _ = writeln!(text, "</DataArray>");
     let _ = writeln!(
         text,
         "<DataArray type=\"Float64\" Name=\"stress_zz\" format=\"ascii\">"
     );
-    for s in nodal_stress {
-        let _ = writeln!(text, "{}", body.material.sigma_zz(*s));
-    }
+    text += &lines_in_parallel(nodal_stress.len(), |n, t| {
+        let _ = writeln!(t, "{}", body.material.sigma_zz(nodal_stress[n]));
+    });
     if extra.is_empty() {
         let _ = writeln!(text, "</DataArray></PointData>");
     } else {
@@ -545,9 +584,10 @@ pub fn write_vtu_with(
     }
     let _ = writeln!(text, "<CellData Tensors=\"\">");
     let _ = writeln!(text, "<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"3\" ComponentName0=\"xx\" ComponentName1=\"yy\" ComponentName2=\"xy\" format=\"ascii\">");
-    for s in &cells {
-        let _ = writeln!(text, "{} {} {}", s[0], s[1], s[2]);
-    }
+    text += &lines_in_parallel(cells.len(), |c, t| {
+        let s = cells[c];
+        let _ = writeln!(t, "{} {} {}", s[0], s[1], s[2]);
+    });
     let _ = writeln!(text, "</DataArray></CellData>");
     let _ = writeln!(text, "</Piece></UnstructuredGrid></VTKFile>");
     w.write_all(text.as_bytes()).map_err(io)?;

@@ -572,7 +572,8 @@ fn solve_at<const D: usize, K: Discretize<D>>(
 
     let t = Instant::now();
     progress("contact iterations");
-    let chol = Cholesky::analyse(&sys.pattern, &model.factor_limit)
+    let trailing = trailing_equations(&eq_rows, model.solver.factor_update, sys.n);
+    let chol = Cholesky::analyse_with_trailing(&sys.pattern, &trailing, &model.factor_limit)
         .map_err(|e| sys.factor_error(model, e))?;
     let chol_work = chol.work();
     let initial_active = previous.map(|previous| {
@@ -993,21 +994,24 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
         let t = Instant::now();
         let rows = self.rows;
         let n = self.sys.n;
+        let row = |i: usize| (&rows[i].eqs[..], &rows[i].coeffs[..]);
         let update = match self.low_rank.as_mut() {
-            Some(base) if self.update_rank > 0 => base.update(
-                &effective_weights(active, w),
-                |i| (&rows[i].eqs[..], &rows[i].coeffs[..]),
-                n,
-                self.update_rank,
-                self.update_columns,
-            ),
+            Some(base) if self.update_rank > 0 => {
+                let weights = effective_weights(active, w);
+                match base.trailing_update(&weights, row, n) {
+                    Some(update) => Some(Operator::Trailing(update)),
+                    None => base
+                        .update(&weights, row, n, self.update_rank, self.update_columns)
+                        .map(Operator::Updated),
+                }
+            }
             _ => None,
         };
         let Some(update) = update else {
             return self.factor(active, w);
         };
         let values = self.augmented(active, w);
-        let f = Rc::new(Operator::Updated(update));
+        let f = Rc::new(update);
         self.finish_operator(active, w, &values, &f, t);
         Ok(f)
     }
@@ -1318,11 +1322,7 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
         let f = self.factor_or_update(active, w)?;
         let (x, best) = self.regularized_with(&f, active, w, lambda_k);
         if f.rank() == 0 || best <= EQUILIBRIUM_ROUND_OFF {
-            self.linear_solver = if f.rank() == 0 {
-                "cholesky"
-            } else {
-                "cholesky-low-rank-update"
-            };
+            self.linear_solver = f.solver_name();
             return Ok(x);
         }
         // the update's answer did not reach round-off: factor this matrix and solve again
@@ -2394,6 +2394,32 @@ fn update_rank(mode: FactorUpdate, n: usize) -> usize {
 /// about one factorization; an update may take half that, leaving time for its other solves.
 fn new_columns_bound(work: &crate::solver::sparse::FactorWork) -> usize {
     (work.operations / (8.0 * work.entries.max(1) as f64)) as usize
+}
+
+/// The equations the factorization eliminates last so that an active-set change is a change of
+/// its trailing block alone ([`crate::solver::low_rank::TrailingUpdate`]): every equation a row
+/// has a nonzero coefficient on, in the `auto` mode from [`LOW_RANK_MIN_EQUATIONS`] on and up to
+/// [`crate::solver::low_rank::MAX_TRAILING_EQUATIONS`] of them; else none (the AMD order).
+fn trailing_equations(rows: &[EqRow], mode: FactorUpdate, n: usize) -> Vec<usize> {
+    if mode != FactorUpdate::Auto || n < LOW_RANK_MIN_EQUATIONS {
+        return Vec::new();
+    }
+    let mut eqs: Vec<usize> = rows
+        .iter()
+        .flat_map(|r| {
+            r.eqs
+                .iter()
+                .zip(&r.coeffs)
+                .filter(|(_, &c)| c != 0.0)
+                .map(|(&e, _)| e)
+        })
+        .collect();
+    eqs.sort_unstable();
+    eqs.dedup();
+    if eqs.len() > crate::solver::low_rank::MAX_TRAILING_EQUATIONS {
+        return Vec::new();
+    }
+    eqs
 }
 
 /// The weight each row adds to the matrix: `w_i` when active, else 0.

@@ -28,20 +28,27 @@
 //! refactor `M` when the update's answer does not reach round-off (the fallback), when `C` is
 //! singular to working precision, or when more rows changed than the update allows.
 
-use crate::solver::sparse::Factor;
-use faer::linalg::solvers::{PartialPivLu, Solve};
-use faer::Mat;
+use crate::solver::sparse::{Factor, TINY_PIVOT};
+use faer::linalg::matmul::triangular::{matmul, BlockStructure};
+use faer::linalg::solvers::{Llt, PartialPivLu, Solve};
+use faer::{Accum, Mat, MatRef, Side};
 use std::collections::HashMap;
 use std::rc::Rc;
+
+/// The most trailing equations a trailing-block update factors densely (`8 c^2` bytes for the
+/// Schur complement and as much for its factor: 128 MB each at this bound).
+pub const MAX_TRAILING_EQUATIONS: usize = 4000;
 
 /// A pivot of the capacitance `C` below this share of its largest entry counts as zero: the
 /// update is refused and the caller refactors.
 pub const CAPACITANCE_TINY_PIVOT: f64 = 1e-13;
 
-/// Either a factorization of `M` itself or the base factorization with a Woodbury update.
+/// Either a factorization of `M` itself or the base factorization with a Woodbury update or
+/// a trailing-block update.
 pub enum Operator {
     Factored(Rc<Factor>),
     Updated(LowRankUpdate),
+    Trailing(TrailingUpdate),
 }
 
 impl Operator {
@@ -50,14 +57,26 @@ impl Operator {
         match self {
             Operator::Factored(f) => f.solve_in_place(b),
             Operator::Updated(u) => u.solve_in_place(b),
+            Operator::Trailing(u) => u.solve_in_place(b),
         }
     }
 
-    /// The rank of the update (0 for a factorization of `M` itself).
+    /// The rank of the update (0 for a factorization of `M` itself): the rows whose weight
+    /// changed.
     pub fn rank(&self) -> usize {
         match self {
             Operator::Factored(_) => 0,
             Operator::Updated(u) => u.columns.len(),
+            Operator::Trailing(u) => u.changes.len(),
+        }
+    }
+
+    /// The name of the linear solver in the iteration history.
+    pub fn solver_name(&self) -> &'static str {
+        match self {
+            Operator::Factored(_) => "cholesky",
+            Operator::Updated(_) => "cholesky-low-rank-update",
+            Operator::Trailing(_) => "cholesky-trailing-update",
         }
     }
 }
@@ -95,12 +114,94 @@ impl LowRankUpdate {
     }
 }
 
+/// The base factor's trailing block `L_CC` and the Schur complement on the trailing equations
+/// `C` it gives, dense: `A_C = L_CC L_CC^T = A_CC - A_CL A_LL^-1 A_LC`
+/// ([`Factor::trailing_block`]).
+pub struct TrailingBase {
+    /// Each equation's position in the block (`usize::MAX` for a leading equation).
+    position: Vec<usize>,
+    /// `L_CC`, lower triangular.
+    factor: Mat<f64>,
+    /// `A_C` (both triangles).
+    schur: Mat<f64>,
+}
+
+impl TrailingBase {
+    fn new(factor: &Factor, n: usize) -> Option<TrailingBase> {
+        let equations = factor.trailing_equations()?.clone();
+        let l = factor.trailing_block()?;
+        let c = equations.len();
+        let mut schur = Mat::<f64>::zeros(c, c);
+        matmul(
+            schur.as_mut(),
+            BlockStructure::TriangularLower,
+            Accum::Replace,
+            l.as_ref(),
+            BlockStructure::TriangularLower,
+            l.transpose(),
+            BlockStructure::TriangularUpper,
+            1.0,
+            faer::get_global_parallelism(),
+        );
+        for j in 0..c {
+            for i in 0..j {
+                schur[(i, j)] = schur[(j, i)];
+            }
+        }
+        let mut position = vec![usize::MAX; n];
+        for (k, &e) in equations.iter().enumerate() {
+            position[e] = k;
+        }
+        Some(TrailingBase {
+            position,
+            factor: l,
+            schur,
+        })
+    }
+}
+
+/// `M^-1` for `M = A + E dP E^T` whose change `dP = sum_i dw_i b_i b_i^T` from the factored
+/// base `A = P^T L L^T P` lies in the block of the trailing equations `C` (`E` selects them,
+/// eliminated last): `L^-1 E = [0; L_CC^-1]`, so
+///
+/// ```text
+/// M = P^T L diag(I, L_CC^-1 (A_C + dP) L_CC^-T) L^T P,   A_C = L_CC L_CC^T,
+/// M^-1 b = P^T L^-T diag(I, L_CC^T (A_C + dP)^-1 L_CC) L^-1 P b,
+/// ```
+///
+/// where `A_C + dP` is the Schur complement of the new matrix on `C`, factored densely
+/// (`c^3 / 3` multiply-adds) and positive definite exactly when `M` is. A solve costs one solve
+/// with the base factor and `3 c^2` multiply-adds; any number of rows may change.
+pub struct TrailingUpdate {
+    base: Rc<Factor>,
+    block: Rc<TrailingBase>,
+    /// The changed rows: positions in the block, coefficients and the change of weight.
+    changes: Vec<(Vec<usize>, Vec<f64>, f64)>,
+    llt: Llt<f64>,
+}
+
+impl TrailingUpdate {
+    /// `b <- M^-1 b`.
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        let l = &self.block.factor;
+        self.base.solve_in_place_with_trailing(b, |y| {
+            let c = y.len();
+            let y_c = MatRef::from_column_major_slice(y, c, 1);
+            let z = self.llt.solve(l.as_ref() * y_c);
+            let x_c = l.transpose() * z;
+            y.iter_mut().enumerate().for_each(|(k, v)| *v = x_c[(k, 0)]);
+        });
+    }
+}
+
 /// The factored base matrix `A = K + sum_i w_i b_i b_i^T` (the weights `w_i`, zero for an
 /// inactive row, of the set it was factored for) and the columns `A^-1 b_i` computed so far.
 pub struct LowRankBase {
     factor: Rc<Factor>,
     weights: Vec<f64>,
     known: HashMap<usize, Rc<Vec<f64>>>,
+    /// The Schur complement on the trailing equations, once an update asked for it.
+    trailing: Option<Rc<TrailingBase>>,
 }
 
 impl LowRankBase {
@@ -109,7 +210,69 @@ impl LowRankBase {
             factor,
             weights,
             known: HashMap::new(),
+            trailing: None,
         }
+    }
+
+    /// The update to `M = A + sum_i (weights_i - base_i) b_i b_i^T` through the base's trailing
+    /// block ([`TrailingUpdate`]), whatever the number of changed rows; `None` when the base
+    /// has no trailing equations, no row changed, a changed row has a nonzero coefficient on a
+    /// leading equation, or the new Schur complement is not positive definite to working
+    /// precision (the caller then updates by low rank or refactors).
+    pub fn trailing_update<'a>(
+        &mut self,
+        weights: &[f64],
+        row: impl Fn(usize) -> (&'a [usize], &'a [f64]),
+        n: usize,
+    ) -> Option<TrailingUpdate> {
+        let changed = self.changed(weights);
+        if changed.is_empty() || self.factor.trailing_equations().is_none() {
+            return None;
+        }
+        if self.trailing.is_none() {
+            self.trailing = Some(Rc::new(TrailingBase::new(&self.factor, n)?));
+        }
+        let block = self.trailing.clone()?;
+        let mut changes = Vec::with_capacity(changed.len());
+        for &i in &changed {
+            let (eqs, coeffs) = row(i);
+            let mut positions = Vec::with_capacity(eqs.len());
+            let mut kept = Vec::with_capacity(eqs.len());
+            for (&e, &a) in eqs.iter().zip(coeffs) {
+                if a == 0.0 {
+                    continue;
+                }
+                let p = block.position[e];
+                if p == usize::MAX {
+                    return None;
+                }
+                positions.push(p);
+                kept.push(a);
+            }
+            changes.push((positions, kept, weights[i] - self.weights[i]));
+        }
+        let mut m = block.schur.clone();
+        for (positions, coeffs, dw) in &changes {
+            for (&p, &a) in positions.iter().zip(coeffs) {
+                for (&q, &b) in positions.iter().zip(coeffs) {
+                    m[(p, q)] += dw * a * b;
+                }
+            }
+        }
+        let llt = m.llt(Side::Lower).ok()?;
+        let l = llt.L();
+        if (0..m.nrows()).any(|k| {
+            let d = l[(k, k)] * l[(k, k)];
+            !d.is_finite() || d <= TINY_PIVOT * m[(k, k)].abs()
+        }) {
+            return None;
+        }
+        Some(TrailingUpdate {
+            base: self.factor.clone(),
+            block,
+            changes,
+            llt,
+        })
     }
 
     /// The rows whose weight differs from the base's.
@@ -303,6 +466,102 @@ mod tests {
                 / scale;
             assert!(err < 1e-12, "({lo}, {hi}): relative difference {err:.2e}");
         }
+    }
+
+    /// Rows on the second half of a chain, whose equations the factor eliminates last: 90
+    /// rows that close and open at once (beyond any Woodbury rank bound), and then a second set
+    /// over the same base, are solved through the trailing block like a new factorization; a
+    /// base without trailing equations, or a row reaching a leading equation, gives none.
+    #[test]
+    fn a_trailing_update_solves_like_a_new_factorization() {
+        let n = 200;
+        let (pattern, k) = laplacian(n);
+        let all = rows(n);
+        // rows on equations 200.. only (the others carry no row: weight 0 throughout)
+        let rows: Vec<SparseColumn> = all
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                if i >= 100 {
+                    r.clone()
+                } else {
+                    (vec![], vec![])
+                }
+            })
+            .collect();
+        let mut trailing: Vec<usize> = rows.iter().flat_map(|r| r.0.clone()).collect();
+        trailing.sort_unstable();
+        trailing.dedup();
+        let chol = Cholesky::analyse_with_trailing(&pattern, &trailing, &UNLIMITED).unwrap();
+        let base_w: Vec<f64> = (0..n)
+            .map(|i| if (100..150).contains(&i) { 1e3 } else { 0.0 })
+            .collect();
+        let factor_of = |w: &[f64]| {
+            let mut values = k.clone();
+            for ((eqs, c), &wi) in rows.iter().zip(w) {
+                let m = eqs.len();
+                let block: Vec<f64> = (0..m * m).map(|q| wi * c[q / m] * c[q % m]).collect();
+                pattern.scatter(eqs, &block, &mut values);
+            }
+            values
+        };
+        let base_factor = chol.factor(&pattern, &factor_of(&base_w)).unwrap();
+        let mut base = LowRankBase::new(Rc::new(base_factor), base_w.clone());
+        let row = |i: usize| (&rows[i].0[..], &rows[i].1[..]);
+        let b: Vec<f64> = (0..n).map(|i| ((i * 7) % 11) as f64 - 5.0).collect();
+        for (lo, hi) in [(105, 195), (110, 140)] {
+            let w: Vec<f64> = (0..n)
+                .map(|i| {
+                    if i >= 100 && ((i < 150) != (lo <= i && i < hi)) {
+                        1e3
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            let update = base.trailing_update(&w, row, n).expect("a trailing update");
+            let operator = Operator::Trailing(update);
+            assert_eq!(operator.rank(), hi - lo);
+            assert_eq!(operator.solver_name(), "cholesky-trailing-update");
+            let mut x = b.clone();
+            operator.solve_in_place(&mut x);
+            let mut exact = b.clone();
+            factored(&pattern, &k, &rows, &w).solve_in_place(&mut exact);
+            let scale = exact.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let err = x
+                .iter()
+                .zip(&exact)
+                .fold(0.0f64, |m, (a, e)| m.max((a - e).abs()))
+                / scale;
+            assert!(err < 1e-12, "({lo}, {hi}): relative difference {err:.2e}");
+        }
+        assert!(base.trailing_update(&base_w, row, n).is_none(), "no change");
+        // a row that reaches equation 0, which the factor eliminates first
+        let reaching: Vec<SparseColumn> = rows
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                if i == 120 {
+                    (vec![0, 120], vec![1.0, 1.0])
+                } else {
+                    r.clone()
+                }
+            })
+            .collect();
+        let mut w = base_w.clone();
+        w[120] = 0.0;
+        let reach = |i: usize| (&reaching[i].0[..], &reaching[i].1[..]);
+        assert!(
+            base.trailing_update(&w, reach, n).is_none(),
+            "leading equation"
+        );
+        let amd = Cholesky::analyse(&pattern, &UNLIMITED).unwrap();
+        let plain = amd.factor(&pattern, &factor_of(&base_w)).unwrap();
+        let mut plain = LowRankBase::new(Rc::new(plain), base_w.clone());
+        assert!(
+            plain.trailing_update(&w, row, n).is_none(),
+            "no trailing block"
+        );
     }
 
     /// More changed rows than allowed, no change, or an update that makes `M` singular: no

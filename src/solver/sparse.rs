@@ -42,10 +42,12 @@
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError;
 use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
     SymmetricOrdering,
 };
+use faer::sparse::linalg::triangular_solve;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, Par, Side};
 use std::sync::Arc;
@@ -386,6 +388,9 @@ fn original(symbolic: &SymbolicCholesky<usize>, k: usize) -> usize {
 /// supernodes) done once per pattern and shared by every numeric factorization.
 pub struct Cholesky {
     symbolic: Arc<SymbolicCholesky<usize>>,
+    /// With [`Cholesky::analyse_with_trailing`], the original equations of the last steps of
+    /// the elimination, in step order.
+    trailing: Option<Arc<[usize]>>,
 }
 
 impl Cholesky {
@@ -396,6 +401,100 @@ impl Cholesky {
         FactorWork::of(&symbolic).check(limit)?;
         Ok(Cholesky {
             symbolic: Arc::new(symbolic),
+            trailing: None,
+        })
+    }
+
+    /// Analyse the pattern with the equations `trailing` eliminated last (in the given order)
+    /// and the others in the AMD order of their own block, so that the factor's trailing block
+    /// `L_CC` gives the Schur complement `S + P_C = L_CC L_CC^T` of the leading equations
+    /// ([`Factor::trailing_block`]): a later matrix that differs from this one in the
+    /// `trailing x trailing` block alone is then solved with this factor and a dense
+    /// factorization of that block ([`crate::solver::low_rank::TrailingUpdate`]). An empty
+    /// `trailing`, or one that is not a set of distinct equations of the pattern, is the AMD
+    /// analysis of [`Cholesky::analyse`].
+    pub fn analyse_with_trailing(
+        pattern: &SymmetricPattern,
+        trailing: &[usize],
+        limit: &WorkLimit,
+    ) -> Result<Self, FactorError> {
+        let n = pattern.n;
+        let mut is_trailing = vec![false; n];
+        for &e in trailing {
+            if e >= n || is_trailing[e] {
+                return Self::analyse(pattern, limit);
+            }
+            is_trailing[e] = true;
+        }
+        if trailing.is_empty() || trailing.len() == n {
+            return Self::analyse(pattern, limit);
+        }
+        fn other(e: impl std::fmt::Debug) -> FactorError {
+            FactorError::Other(format!("{e:?}"))
+        }
+        // the leading equations, renumbered 0..m, and the upper pattern of their block
+        let leading: Vec<usize> = (0..n).filter(|&e| !is_trailing[e]).collect();
+        let mut local = vec![usize::MAX; n];
+        for (k, &e) in leading.iter().enumerate() {
+            local[e] = k;
+        }
+        let m = leading.len();
+        let mut col_ptr = Vec::with_capacity(m + 1);
+        let mut row_idx = Vec::with_capacity(pattern.nnz());
+        col_ptr.push(0);
+        for &j in &leading {
+            // rows of column j below it in the original numbering keep their order: the
+            // renumbering is increasing
+            row_idx.extend(
+                pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]]
+                    .iter()
+                    .filter(|&&i| !is_trailing[i])
+                    .map(|&i| local[i]),
+            );
+            col_ptr.push(row_idx.len());
+        }
+        let block = SymbolicSparseColMatRef::new_checked(m, m, &col_ptr, None, &row_idx);
+        let mut order = vec![0usize; m];
+        let mut order_inv = vec![0usize; m];
+        let mut mem = MemBuffer::try_new(faer::sparse::linalg::amd::order_scratch::<usize>(
+            m,
+            row_idx.len(),
+        ))
+        .map_err(other)?;
+        faer::sparse::linalg::amd::order(
+            &mut order,
+            &mut order_inv,
+            block,
+            Default::default(),
+            MemStack::new(&mut mem),
+        )
+        .map_err(other)?;
+        let fwd: Vec<usize> = order
+            .iter()
+            .map(|&k| leading[k])
+            .chain(trailing.iter().copied())
+            .collect();
+        let mut inv = vec![0usize; n];
+        for (k, &e) in fwd.iter().enumerate() {
+            inv[e] = k;
+        }
+        let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.symbolic(),
+            Side::Upper,
+            SymmetricOrdering::Custom(perm),
+            Default::default(),
+        )
+        .map_err(other)?;
+        FactorWork::of(&symbolic).check(limit)?;
+        // the symbolic analysis may reorder (postorder) the elimination tree: the trailing
+        // block is the one it ends with, which must still be the trailing equations
+        let c = trailing.len();
+        let last: Vec<usize> = (n - c..n).map(|k| original(&symbolic, k)).collect();
+        let kept = last.iter().all(|&e| is_trailing[e]);
+        Ok(Cholesky {
+            symbolic: Arc::new(symbolic),
+            trailing: kept.then(|| last.into()),
         })
     }
 
@@ -468,6 +567,7 @@ impl Cholesky {
         Ok(Factor {
             symbolic: self.symbolic.clone(),
             values: l,
+            trailing: self.trailing.clone(),
         })
     }
 }
@@ -476,9 +576,64 @@ impl Cholesky {
 pub struct Factor {
     symbolic: Arc<SymbolicCholesky<usize>>,
     values: Vec<f64>,
+    trailing: Option<Arc<[usize]>>,
 }
 
 impl Factor {
+    /// The equations eliminated last ([`Cholesky::analyse_with_trailing`]), in step order.
+    pub fn trailing_equations(&self) -> Option<&Arc<[usize]>> {
+        self.trailing.as_ref()
+    }
+
+    /// The trailing block `L_CC` of the factor (dense, lower triangular, rows and columns in
+    /// the order of [`Factor::trailing_equations`]): with `A = [[A_LL, A_LC], [A_CL, A_CC]]`
+    /// and `C` eliminated last, `L_CC L_CC^T = A_CC - A_CL A_LL^-1 A_LC`, the Schur complement
+    /// of the leading block. `None` without trailing equations.
+    pub fn trailing_block(&self) -> Option<Mat<f64>> {
+        let c = self.trailing.as_ref()?.len();
+        let n = self.symbolic.nrows();
+        let first = n - c;
+        let mut block = Mat::<f64>::zeros(c, c);
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let (col_ptr, row_idx) = (s.col_ptr(), s.row_idx());
+                for j in first..n {
+                    for k in col_ptr[j]..col_ptr[j + 1] {
+                        let i = row_idx[k];
+                        if i >= first {
+                            block[(i - first, j - first)] = self.values[k];
+                        }
+                    }
+                }
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                for sn in 0..s.n_supernodes() {
+                    let (begin, end) = (s.supernode_begin()[sn], s.supernode_end()[sn]);
+                    if end <= first {
+                        continue;
+                    }
+                    // a column-major block: the supernode's own rows, then its pattern
+                    let width = end - begin;
+                    let pattern = s.supernode(sn).pattern();
+                    let rows = width + pattern.len();
+                    let base = s.col_ptr_for_val()[sn];
+                    for j in begin.max(first)..end {
+                        let col = base + (j - begin) * rows;
+                        for i in j..end {
+                            block[(i - first, j - first)] = self.values[col + i - begin];
+                        }
+                        for (q, &i) in pattern.iter().enumerate() {
+                            if i >= first {
+                                block[(i - first, j - first)] = self.values[col + width + q];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Some(block)
+    }
+
     /// Solve `A x = b` in place.
     pub fn solve_in_place(&self, b: &mut [f64]) {
         let par = faer::get_global_parallelism();
@@ -492,6 +647,45 @@ impl Factor {
         );
         for (i, v) in b.iter_mut().enumerate() {
             *v = rhs[(i, 0)];
+        }
+    }
+
+    /// Solve `A x = b` in place as `P^T L^-T T L^-1 P b`, where `T` is `middle` applied to the
+    /// trailing `c` entries of `L^-1 P b` (steps `n - c ..`, in the order of
+    /// [`Factor::trailing_equations`]) and the identity on the others: with `middle` the
+    /// identity this is [`Factor::solve_in_place`]; a trailing-block update puts its dense
+    /// correction there ([`crate::solver::low_rank::TrailingUpdate`]). `c` is 0 without
+    /// trailing equations.
+    pub fn solve_in_place_with_trailing(&self, b: &mut [f64], middle: impl FnOnce(&mut [f64])) {
+        let n = b.len();
+        let c = self.trailing.as_ref().map_or(0, |t| t.len());
+        let par = faer::get_global_parallelism();
+        let fwd = self.symbolic.perm().map(|p| p.arrays().0);
+        let step_of = |k: usize| fwd.map_or(k, |f| f[k]);
+        let mut y = Mat::<f64>::from_fn(n, 1, |k, _| b[step_of(k)]);
+        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, par));
+        let stack = MemStack::new(&mut mem);
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let l = SparseColMatRef::new(s.factor(), &self.values);
+                triangular_solve::solve_lower_triangular_in_place(l, Conj::No, y.as_mut(), par);
+                middle(&mut y.col_as_slice_mut(0)[n - c..]);
+                triangular_solve::solve_lower_triangular_transpose_in_place(
+                    l,
+                    Conj::No,
+                    y.as_mut(),
+                    par,
+                );
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                let l = SupernodalLltRef::new(s, &self.values);
+                l.l_solve_with_conj(Conj::No, y.as_mut(), par, stack);
+                middle(&mut y.col_as_slice_mut(0)[n - c..]);
+                l.l_transpose_solve_with_conj(Conj::No, y.as_mut(), par, stack);
+            }
+        }
+        for k in 0..n {
+            b[step_of(k)] = y[(k, 0)];
         }
     }
 
@@ -1097,6 +1291,109 @@ impl LuFactor {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The 5-point Laplacian of an `m x m` grid plus a unit mass (positive definite): its
+    /// pattern and values, equation `i + m j` at node `(i, j)`.
+    fn grid_laplacian(m: usize) -> (SymmetricPattern, Vec<f64>) {
+        let mut b = PatternBuilder::new(m * m);
+        for j in 0..m {
+            for i in 0..m {
+                if i + 1 < m {
+                    b.add_block(&[i + m * j, i + 1 + m * j]);
+                }
+                if j + 1 < m {
+                    b.add_block(&[i + m * j, i + m * (j + 1)]);
+                }
+            }
+        }
+        let p = b.build();
+        let mut v = vec![0.0; p.nnz()];
+        for j in 0..p.n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                v[k] = if p.row_idx[k] == j { 5.0 } else { -1.0 };
+            }
+        }
+        (p, v)
+    }
+
+    /// With the bottom and left edges of a grid eliminated last, the factor's trailing block
+    /// gives the Schur complement `S = A_CC - A_CL A_LL^-1 A_LC`, checked against `(A^-1)_CC =
+    /// S^-1` from an independent factorization (AMD order); on a small grid (faer's simplicial
+    /// factor) and a larger one (supernodal).
+    #[test]
+    fn the_trailing_block_gives_the_schur_complement() {
+        for m in [6usize, 100] {
+            let (p, v) = grid_laplacian(m);
+            let mut trailing: Vec<usize> = (0..m).collect();
+            trailing.extend((1..m).map(|j| m * j));
+            let chol = Cholesky::analyse_with_trailing(&p, &trailing, &UNLIMITED).unwrap();
+            let factor = chol.factor(&p, &v).unwrap();
+            let order = factor
+                .trailing_equations()
+                .expect("trailing equations kept")
+                .clone();
+            let mut sorted = order.to_vec();
+            sorted.sort_unstable();
+            assert_eq!(sorted, {
+                let mut t = trailing.clone();
+                t.sort_unstable();
+                t
+            });
+            let l = factor.trailing_block().unwrap();
+            let c = order.len();
+            // (A^-1)_CC = S^-1: the trailing columns of A^-1 from the AMD factorization
+            let amd = Cholesky::analyse(&p, &UNLIMITED).unwrap();
+            let mut e = Mat::<f64>::zeros(p.n, c);
+            for (k, &i) in order.iter().enumerate() {
+                e[(i, k)] = 1.0;
+            }
+            amd.factor(&p, &v).unwrap().solve_columns_in_place(&mut e);
+            let inverse = Mat::<f64>::from_fn(c, c, |i, j| e[(order[i], j)]);
+            let product = &l * (l.transpose() * &inverse);
+            let err = (0..c)
+                .flat_map(|i| (0..c).map(move |j| (i, j)))
+                .fold(0.0f64, |m, (i, j)| {
+                    let identity = if i == j { 1.0 } else { 0.0 };
+                    m.max((product[(i, j)] - identity).abs())
+                });
+            assert!(
+                err < 1e-12,
+                "m = {m}: |L_CC L_CC^T (A^-1)_CC - I| = {err:.2e}"
+            );
+            assert_eq!(chol.is_supernodal(), m == 100, "m = {m}: the path tested");
+            // the split solve with the identity in the middle is the solve
+            let b: Vec<f64> = (0..p.n).map(|i| ((i * 13) % 7) as f64 - 3.0).collect();
+            let (mut x1, mut x2) = (b.clone(), b.clone());
+            factor.solve_in_place(&mut x1);
+            factor.solve_in_place_with_trailing(&mut x2, |y| assert_eq!(y.len(), c));
+            let d = x1
+                .iter()
+                .zip(&x2)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(d < 1e-14, "m = {m}: split solve differs by {d:.2e}");
+            let mut r = vec![0.0; p.n];
+            p.mul(&v, &x2, &mut r);
+            let res = r
+                .iter()
+                .zip(&b)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(res < 1e-12, "m = {m}: residual {res:.2e}");
+        }
+    }
+
+    /// Repeated or out-of-range trailing equations fall back to the AMD analysis.
+    #[test]
+    fn an_invalid_trailing_set_is_the_amd_analysis() {
+        let (p, _) = grid_laplacian(5);
+        for bad in [vec![0, 0], vec![3, 25], vec![]] {
+            let chol = Cholesky::analyse_with_trailing(&p, &bad, &UNLIMITED).unwrap();
+            assert!(chol.trailing.is_none(), "{bad:?}");
+            assert_eq!(
+                chol.work(),
+                Cholesky::analyse(&p, &UNLIMITED).unwrap().work()
+            );
+        }
+    }
 
     /// Upper pattern of a dense `n x n` matrix.
     fn dense_pattern(n: usize) -> SymmetricPattern {
