@@ -74,13 +74,17 @@ impl Outcome3 {
 
 /// Run the 3D case `case` read from `source`.
 pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
+    let start = std::time::Instant::now();
     let model = build3(case, source)?;
+    let meshed = start.elapsed().as_secs_f64();
     crate::model::admit::check_rigid_modes(&model)?;
-    let solution = if model.contact.is_empty() {
+    let mut solution = if model.contact.is_empty() {
         crate::solver::linear::solve_elastic(&model, &mut |_| {})?
     } else {
         crate::solver::active_set::solve(&model, &mut |_| {})?
     };
+    solution.timings.mesh = meshed;
+    solution.timings.total = start.elapsed().as_secs_f64();
     let checks = case
         .checks
         .iter()
@@ -566,6 +570,7 @@ pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
         "bodies": bodies,
         "dofs": model.dof_count,
         "relative_residual": outcome.solution.relative_residual,
+        "timings": outcome.solution.timings,
         "contact": contact_summary(outcome),
         "passed": outcome.passed(),
         "checks": outcome.checks.iter().map(|c| serde_json::json!({
