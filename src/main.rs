@@ -206,6 +206,18 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// Hertz in 3D: a rigid sphere pressed into an elastic quarter block on four graded
+    /// Hex8 meshes, the contact radius and peak pressure against the closed form; writes
+    /// reports/hertz-3d.md, .json and an SVG of the pressure profile.
+    #[command(
+        name = "hertz-3d",
+        after_help = "Example:\n  contact-patch hertz-3d\n  contact-patch hertz-3d --out /tmp/reports\n\nThe problem and the measures: src/harness/hertz3d.rs."
+    )]
+    Hertz3d {
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
     /// Large sliding at finite strain: a neo-Hookean block pressed and slid by six facet
     /// lengths over a non-matching neo-Hookean foundation, per contact discretization (those
     /// finite strain refuses are listed with the reason); the oscillation of the contact forces
@@ -386,6 +398,7 @@ fn main() -> ExitCode {
         Command::FrictionConvergence { out } => friction_convergence(&out),
         Command::FinitePatch { out } => finite_patch(&out),
         Command::HertzFinite { out } => hertz_finite(&out),
+        Command::Hertz3d { out } => hertz_3d(&out),
         Command::FiniteSliding { out } => finite_sliding(&out),
         Command::Ironing { out } => ironing(&out),
         Command::Profile { case, pair, out } => profile(&case, &pair, &out),
@@ -1449,6 +1462,22 @@ fn hertz_finite(out: &Path) -> ExitCode {
             ),
         ];
         files.extend(hertz_finite::plots(&study));
+        Ok(files)
+    })
+}
+
+fn hertz_3d(out: &Path) -> ExitCode {
+    use contact_patch::harness::hertz3d;
+    write_study(out, || {
+        let study = hertz3d::study(&hertz3d::REPORT_SIZES)?;
+        let mut files = vec![
+            ("hertz-3d.md".to_string(), hertz3d::report(&study)),
+            (
+                "hertz-3d.json".to_string(),
+                serde_json::to_string_pretty(&study).expect("the study serializes") + "\n",
+            ),
+        ];
+        files.extend(hertz3d::plots(&study));
         Ok(files)
     })
 }

@@ -83,6 +83,11 @@ pub const KNOWN_REPORTS: &[KnownReport] = &[
         command: "contact-patch hertz-finite",
     },
     KnownReport {
+        stem: "hertz-3d",
+        title: "Hertz in 3D: a rigid sphere on an elastic block",
+        command: "contact-patch hertz-3d",
+    },
+    KnownReport {
         stem: "finite-sliding",
         title: "Large sliding at finite strain",
         command: "contact-patch finite-sliding",

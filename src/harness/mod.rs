@@ -39,6 +39,7 @@ pub mod finite_sliding;
 pub mod friction;
 pub mod friction_convergence;
 pub mod hard;
+pub mod hertz3d;
 pub mod hertz_finite;
 pub mod impact;
 pub mod impact_cost;
