@@ -193,6 +193,19 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// The 3D contact patch test (a punch on a foundation of the same footprint; matching,
+    /// nested, non-matching and skewed interfaces; Hex8, Tet4, Hex27, Tet10; every 3D
+    /// discretization and enforcement) and the 3D tied patch tests (normal, parallel, shear);
+    /// writes reports/patch-table-3d.md and .json.
+    #[command(
+        name = "patch-3d",
+        after_help = "Example:\n  contact-patch patch-3d\n  contact-patch patch-3d --out /tmp/reports"
+    )]
+    Patch3d {
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
     /// Hertz at loads where geometric nonlinearity matters: a block pressed onto a rigid
     /// cylinder with small-strain and finite-strain (neo-Hookean) kinematics over approaches
     /// 0.005 to 0.32 of its top, and the finite-strain result at the largest on four meshes;
@@ -397,6 +410,7 @@ fn main() -> ExitCode {
         Command::ImpactReport { paths, out, study } => impact_report(&paths, &out, study),
         Command::FrictionConvergence { out } => friction_convergence(&out),
         Command::FinitePatch { out } => finite_patch(&out),
+        Command::Patch3d { out } => patch_3d(&out),
         Command::HertzFinite { out } => hertz_finite(&out),
         Command::Hertz3d { out } => hertz_3d(&out),
         Command::FiniteSliding { out } => finite_sliding(&out),
@@ -1374,6 +1388,47 @@ fn finite_patch(out: &Path) -> ExitCode {
                 "wrote {} and {}",
                 folder.shown("finite-patch-table.md").display(),
                 folder.shown("finite-patch-table.json").display()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// `contact-patch patch-3d`: the 3D contact and tied patch tables.
+fn patch_3d(out: &Path) -> ExitCode {
+    use contact_patch::harness::patch3d;
+    let folder = match ReportFolder::new(out) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let bar = progress_bar(patch3d::cell_count());
+    let result = patch3d::run(&mut |name| {
+        if let Some(b) = &bar {
+            b.set_message(name.to_string());
+            b.inc(1);
+        }
+    })
+    .and_then(|cells| {
+        folder.write_file("patch-table-3d.md", &patch3d::report(&cells))?;
+        let json = serde_json::to_string_pretty(&cells).expect("cells serialize") + "\n";
+        folder.write_file("patch-table-3d.json", &json)
+    });
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    match result {
+        Ok(()) => {
+            println!(
+                "wrote {} and {}",
+                folder.shown("patch-table-3d.md").display(),
+                folder.shown("patch-table-3d.json").display()
             );
             ExitCode::SUCCESS
         }

@@ -58,6 +58,11 @@ pub const KNOWN_REPORTS: &[KnownReport] = &[
         command: "contact-patch finite-patch",
     },
     KnownReport {
+        stem: "patch-table-3d",
+        title: "Contact and tied patch tests in 3D",
+        command: "contact-patch patch-3d",
+    },
+    KnownReport {
         stem: "hard-cases",
         title: "Stability suite (hard cases)",
         command: "contact-patch hard",

@@ -51,6 +51,7 @@ pub mod layer;
 pub mod load_path;
 pub mod outside_contact;
 pub mod outside_results;
+pub mod patch3d;
 pub mod profile;
 pub mod report;
 pub mod shard;
