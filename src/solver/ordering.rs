@@ -18,9 +18,15 @@
 //! separator: on a 3D grid of `n` vertices the factor holds `O(n^(4/3))` entries and takes
 //! `O(n^2)` operations, against far more for minimum degree on the same grids (which orders
 //! the interior of large slabs poorly). The caller compares the factor's work with that of
-//! AMD and keeps the cheaper ([`crate::solver::sparse::Cholesky::analyse`]).
+//! AMD and keeps the cheaper (`Cholesky::analyse` in `crate::solver::sparse`).
 
-use crate::solver::sparse::SymmetricPattern;
+/// The upper-triangular CSC pattern of a symmetric `n x n` matrix, as the ordering reads it.
+#[derive(Clone, Copy, Debug)]
+pub struct Pattern<'a> {
+    pub n: usize,
+    pub col_ptr: &'a [usize],
+    pub row_idx: &'a [usize],
+}
 
 /// Sets of at most this many vertices are not dissected further.
 pub const LEAF: usize = 64;
@@ -34,7 +40,7 @@ struct Quotient {
 }
 
 /// Full (both triangles) adjacency of the pattern, without the diagonal, as CSR.
-fn full_adjacency(pattern: &SymmetricPattern) -> (Vec<usize>, Vec<usize>) {
+fn full_adjacency(pattern: &Pattern) -> (Vec<usize>, Vec<usize>) {
     let n = pattern.n;
     let mut degree = vec![0usize; n];
     for j in 0..n {
@@ -69,7 +75,7 @@ fn full_adjacency(pattern: &SymmetricPattern) -> (Vec<usize>, Vec<usize>) {
 
 /// Group consecutive equations whose closed neighbourhoods (neighbours and the equation
 /// itself) are equal.
-fn quotient(pattern: &SymmetricPattern) -> Quotient {
+fn quotient(pattern: &Pattern) -> Quotient {
     let n = pattern.n;
     let (start, adjacency) = full_adjacency(pattern);
     let closed = |i: usize| -> Vec<usize> {
@@ -238,7 +244,7 @@ fn dissect(q: &Quotient, marks: &mut Marks, set: Vec<usize>, order: &mut Vec<usi
 
 /// The nested-dissection order of the equations of `pattern`: `order[k]` is the equation
 /// eliminated `k`-th.
-pub fn nested_dissection(pattern: &SymmetricPattern) -> Vec<usize> {
+pub fn nested_dissection(pattern: &Pattern) -> Vec<usize> {
     let q = quotient(pattern);
     let nv = q.groups.len();
     let mut marks = Marks {
@@ -258,12 +264,62 @@ pub fn nested_dissection(pattern: &SymmetricPattern) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solver::sparse::PatternBuilder;
+
+    /// An upper-triangular CSC pattern built from dense blocks.
+    struct Owned {
+        n: usize,
+        col_ptr: Vec<usize>,
+        row_idx: Vec<usize>,
+    }
+
+    impl Owned {
+        fn view(&self) -> Pattern<'_> {
+            Pattern {
+                n: self.n,
+                col_ptr: &self.col_ptr,
+                row_idx: &self.row_idx,
+            }
+        }
+    }
+
+    struct Builder {
+        columns: Vec<std::collections::BTreeSet<usize>>,
+    }
+
+    impl Builder {
+        fn new(n: usize) -> Self {
+            Builder {
+                columns: vec![Default::default(); n],
+            }
+        }
+        fn add_block(&mut self, eqs: &[usize]) {
+            for &i in eqs {
+                for &j in eqs {
+                    if i <= j {
+                        self.columns[j].insert(i);
+                    }
+                }
+            }
+        }
+        fn build(self) -> Owned {
+            let mut col_ptr = vec![0];
+            let mut row_idx = Vec::new();
+            for c in &self.columns {
+                row_idx.extend(c.iter().copied());
+                col_ptr.push(row_idx.len());
+            }
+            Owned {
+                n: self.columns.len(),
+                col_ptr,
+                row_idx,
+            }
+        }
+    }
 
     /// The pattern of the 5-point Laplacian on an `n x n` grid with `dofs` unknowns per node.
-    fn grid(n: usize, dofs: usize) -> SymmetricPattern {
+    fn grid(n: usize, dofs: usize) -> Owned {
         let node = |i: usize, j: usize| i * n + j;
-        let mut b = PatternBuilder::new(n * n * dofs);
+        let mut b = Builder::new(n * n * dofs);
         for i in 0..n {
             for j in 0..n {
                 let mut block = vec![node(i, j)];
@@ -291,7 +347,7 @@ mod tests {
     fn the_order_is_a_permutation_keeping_each_node_s_dofs_together() {
         for (n, dofs) in [(1, 1), (7, 1), (20, 2), (33, 3)] {
             let p = grid(n, dofs);
-            let order = nested_dissection(&p);
+            let order = nested_dissection(&p.view());
             let mut sorted = order.clone();
             sorted.sort_unstable();
             assert_eq!(sorted, (0..p.n).collect::<Vec<_>>(), "n {n}");
@@ -308,8 +364,8 @@ mod tests {
         // leaves two parts with no edge between them
         let n = 41;
         let p = grid(n, 1);
-        let order = nested_dissection(&p);
-        let (start, adjacency) = full_adjacency(&p);
+        let order = nested_dissection(&p.view());
+        let (start, adjacency) = full_adjacency(&p.view());
         // the last eliminated set: the vertices after the position where the last leaf ends
         let top: std::collections::HashSet<usize> =
             order[order.len() - n..].iter().copied().collect();

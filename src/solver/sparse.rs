@@ -823,7 +823,11 @@ fn cheaper_order(pattern: &SymmetricPattern) -> Result<SymbolicCholesky<usize>, 
     if FactorWork::of(&amd).operations <= NESTED_DISSECTION_ABOVE {
         return Ok(amd);
     }
-    let fwd = crate::solver::ordering::nested_dissection(pattern);
+    let fwd = crate::solver::ordering::nested_dissection(&crate::solver::ordering::Pattern {
+        n: pattern.n,
+        col_ptr: &pattern.col_ptr,
+        row_idx: &pattern.row_idx,
+    });
     let mut inv = vec![0usize; fwd.len()];
     for (k, &e) in fwd.iter().enumerate() {
         inv[e] = k;
