@@ -378,6 +378,15 @@ mod tests {
     use super::*;
     use crate::solver::sparse::{Cholesky, PatternBuilder, SymmetricPattern, UNLIMITED};
 
+    /// `max |x - exact| / max |exact|`.
+    fn relative_difference(x: &[f64], exact: &[f64]) -> f64 {
+        let scale = exact.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        x.iter()
+            .zip(exact)
+            .fold(0.0f64, |m, (a, e)| m.max((a - e).abs()))
+            / scale
+    }
+
     /// The 1D Laplacian with a spring at the left end, `n` equations, plus the pattern.
     fn laplacian(n: usize) -> (SymmetricPattern, Vec<f64>) {
         let mut builder = PatternBuilder::new(n);
@@ -458,12 +467,7 @@ mod tests {
             update.solve_in_place(&mut x);
             let mut exact = b.clone();
             factored(&pattern, &k, &rows, &w).solve_in_place(&mut exact);
-            let scale = exact.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let err = x
-                .iter()
-                .zip(&exact)
-                .fold(0.0f64, |m, (a, e)| m.max((a - e).abs()))
-                / scale;
+            let err = relative_difference(&x, &exact);
             assert!(err < 1e-12, "({lo}, {hi}): relative difference {err:.2e}");
         }
     }
@@ -527,12 +531,7 @@ mod tests {
             operator.solve_in_place(&mut x);
             let mut exact = b.clone();
             factored(&pattern, &k, &rows, &w).solve_in_place(&mut exact);
-            let scale = exact.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let err = x
-                .iter()
-                .zip(&exact)
-                .fold(0.0f64, |m, (a, e)| m.max((a - e).abs()))
-                / scale;
+            let err = relative_difference(&x, &exact);
             assert!(err < 1e-12, "({lo}, {hi}): relative difference {err:.2e}");
         }
         assert!(base.trailing_update(&base_w, row, n).is_none(), "no change");
