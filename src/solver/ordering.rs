@@ -173,8 +173,7 @@ fn dissect(q: &Quotient, marks: &mut Marks, set: Vec<usize>, order: &mut Vec<usi
             marks.set[v] = stamp;
         }
         // the component of the first vertex, its pseudo-peripheral vertex and levels
-        let mut root = set[0];
-        let mut structure = levels(q, marks, root, set.len());
+        let mut structure = levels(q, marks, set[0], set.len());
         let reached: usize = structure.iter().map(Vec::len).sum();
         if reached < set.len() {
             // several components: dissect each on its own
@@ -202,13 +201,11 @@ fn dissect(q: &Quotient, marks: &mut Marks, set: Vec<usize>, order: &mut Vec<usi
             }
             let candidate = levels(q, marks, far, set.len());
             if candidate.len() > structure.len() {
-                root = far;
                 structure = candidate;
             } else {
                 break;
             }
         }
-        let _ = root;
         if structure.len() < 3 {
             order.extend_from_slice(&set);
             continue;
@@ -225,14 +222,12 @@ fn dissect(q: &Quotient, marks: &mut Marks, set: Vec<usize>, order: &mut Vec<usi
             }
         }
         // thin the separator: the vertices of the middle level that touch the next one
-        let stamp = marks.stamp;
         let next_level: std::collections::HashSet<usize> =
             structure[middle + 1].iter().copied().collect();
         let (separator, moved): (Vec<usize>, Vec<usize>) = structure[middle]
             .iter()
             .copied()
             .partition(|&v| q.neighbours(v).iter().any(|w| next_level.contains(w)));
-        let _ = stamp;
         let mut before: Vec<usize> = structure[..middle].concat();
         before.extend(moved);
         let after: Vec<usize> = structure[middle + 1..].concat();
