@@ -1357,8 +1357,14 @@ fn cattaneo(paths: &[PathBuf], pair: &str, out: &Path) -> ExitCode {
     }
 }
 
-/// `contact-patch friction-convergence`: the residual histories of the friction tangents.
-fn finite_patch(out: &Path) -> ExitCode {
+/// A report command whose `count` cells run under a progress bar: `run` (told each cell's name)
+/// gives the report's Markdown and JSON, written as `<stem>.md` and `<stem>.json` into `out`.
+fn cell_report(
+    out: &Path,
+    count: usize,
+    stem: &str,
+    run: impl FnOnce(&mut dyn FnMut(&str)) -> contact_patch::Result<(String, String)>,
+) -> ExitCode {
     let folder = match ReportFolder::new(out) {
         Ok(f) => f,
         Err(e) => {
@@ -1366,59 +1372,17 @@ fn finite_patch(out: &Path) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let bar = progress_bar(contact_patch::harness::finite_patch::cell_count());
-    let result = (|| -> contact_patch::Result<()> {
-        use contact_patch::harness::finite_patch;
-        let cells = finite_patch::run(Path::new("."), &mut |name| {
-            if let Some(b) = &bar {
-                b.set_message(name.to_string());
-                b.inc(1);
-            }
-        })?;
-        folder.write_file("finite-patch-table.md", &finite_patch::report(&cells))?;
-        let json = serde_json::to_string_pretty(&cells).expect("cells serialize") + "\n";
-        folder.write_file("finite-patch-table.json", &json)
-    })();
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
-    match result {
-        Ok(()) => {
-            println!(
-                "wrote {} and {}",
-                folder.shown("finite-patch-table.md").display(),
-                folder.shown("finite-patch-table.json").display()
-            );
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(2)
-        }
-    }
-}
-
-/// `contact-patch patch-3d`: the 3D contact and tied patch tables.
-fn patch_3d(out: &Path) -> ExitCode {
-    use contact_patch::harness::patch3d;
-    let folder = match ReportFolder::new(out) {
-        Ok(f) => f,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let bar = progress_bar(patch3d::cell_count());
-    let result = patch3d::run(&mut |name| {
+    let (md, json) = (format!("{stem}.md"), format!("{stem}.json"));
+    let bar = progress_bar(count);
+    let result = run(&mut |name| {
         if let Some(b) = &bar {
             b.set_message(name.to_string());
             b.inc(1);
         }
     })
-    .and_then(|cells| {
-        folder.write_file("patch-table-3d.md", &patch3d::report(&cells))?;
-        let json = serde_json::to_string_pretty(&cells).expect("cells serialize") + "\n";
-        folder.write_file("patch-table-3d.json", &json)
+    .and_then(|(report, data)| {
+        folder.write_file(&md, &report)?;
+        folder.write_file(&json, &data)
     });
     if let Some(b) = bar {
         b.finish_and_clear();
@@ -1427,8 +1391,8 @@ fn patch_3d(out: &Path) -> ExitCode {
         Ok(()) => {
             println!(
                 "wrote {} and {}",
-                folder.shown("patch-table-3d.md").display(),
-                folder.shown("patch-table-3d.json").display()
+                folder.shown(&md).display(),
+                folder.shown(&json).display()
             );
             ExitCode::SUCCESS
         }
@@ -1439,6 +1403,32 @@ fn patch_3d(out: &Path) -> ExitCode {
     }
 }
 
+/// `contact-patch finite-patch`: the contact patch test at finite strain.
+fn finite_patch(out: &Path) -> ExitCode {
+    use contact_patch::harness::finite_patch;
+    cell_report(
+        out,
+        finite_patch::cell_count(),
+        "finite-patch-table",
+        |progress| {
+            let cells = finite_patch::run(Path::new("."), progress)?;
+            let json = serde_json::to_string_pretty(&cells).expect("cells serialize") + "\n";
+            Ok((finite_patch::report(&cells), json))
+        },
+    )
+}
+
+/// `contact-patch patch-3d`: the 3D contact and tied patch tables.
+fn patch_3d(out: &Path) -> ExitCode {
+    use contact_patch::harness::patch3d;
+    cell_report(out, patch3d::cell_count(), "patch-table-3d", |progress| {
+        let cells = patch3d::run(progress)?;
+        let json = serde_json::to_string_pretty(&cells).expect("cells serialize") + "\n";
+        Ok((patch3d::report(&cells), json))
+    })
+}
+
+/// `contact-patch friction-convergence`: the residual histories of the friction tangents.
 fn friction_convergence(out: &Path) -> ExitCode {
     let folder = match ReportFolder::new(out) {
         Ok(f) => f,
