@@ -10,7 +10,8 @@
 
 use contact_patch::contact::discretization::mortar3::{
     clip_convex_polygons, collapsed_triangle_rule, dual_coefficients, mortar_integrals3,
-    mortar_rows3, weighted_gap, FacetSet3, MortarIntegrals3, RowNumbering,
+    mortar_integrals3_with_points, mortar_rows3, weighted_gap, FacetSet3, MortarIntegrals3,
+    RowNumbering, NON_AFFINE_POINTS,
 };
 use contact_patch::contact::Constraint;
 use contact_patch::fe::{gauss_square, triangle_rule, ElementKind};
@@ -1169,6 +1170,57 @@ fn collapsed_triangle_rule_integrates_degree_eight_exactly() {
                 (got - exact).abs() <= 1e-14 * exact,
                 "x^{i} y^{j}: {got} vs {exact}"
             );
+        }
+    }
+}
+
+/// The largest difference between two sets of integrals (`D` and `M`, entry by entry, an entry
+/// missing from one side counting as zero), relative to the largest entry.
+fn integrals_difference(a: &MortarIntegrals3, b: &MortarIntegrals3) -> f64 {
+    let mut largest = 0.0f64;
+    let mut difference = 0.0f64;
+    for (x, y) in [(&a.d, &b.d), (&a.m, &b.m)] {
+        for (j, row) in x.iter().chain(y.iter()) {
+            for (k, _) in row.iter() {
+                let get = |m: &BTreeMap<usize, BTreeMap<usize, f64>>| {
+                    m.get(j).and_then(|r| r.get(k)).copied().unwrap_or(0.0)
+                };
+                let (p, q) = (get(x), get(y));
+                largest = largest.max(p.abs()).max(q.abs());
+                difference = difference.max((p - q).abs());
+            }
+        }
+    }
+    difference / largest
+}
+
+#[test]
+fn non_affine_quad4_cells_are_integrated_to_round_off() {
+    // Quad4 facets that are not parallelograms have maps that are not affine: the integrands
+    // are not polynomials on the clip cells. The rule they take (NON_AFFINE_POINTS per
+    // direction) agrees with a 20 x 20 product to round-off, where a degree-4 rule (3 x 3,
+    // about the accuracy of the affine cells' Radon rule) does not.
+    let layout = layouts()
+        .into_iter()
+        .find(|l| !l.affine)
+        .expect("a distorted layout");
+    for kinds in [
+        (ElementKind::Q4, ElementKind::Q4),
+        (ElementKind::Q4, ElementKind::T3),
+    ] {
+        let (slave, master) = interface(&layout, kinds, 0.0, &tilt());
+        for space in SPACES {
+            let at = |n| mortar_integrals3_with_points(&slave, &master, space, None, n).unwrap();
+            let reference = at(20);
+            let used = integrals_difference(&at(NON_AFFINE_POINTS), &reference);
+            let coarse = integrals_difference(&at(3), &reference);
+            assert!(used < 1e-13, "{kinds:?} {space:?}: {used:e}");
+            assert!(
+                coarse > 1e-9,
+                "{kinds:?} {space:?}: the coarse rule is already exact ({coarse:e})"
+            );
+            let default = mortar_integrals3(&slave, &master, space, None).unwrap();
+            assert_eq!(integrals_difference(&default, &at(NON_AFFINE_POINTS)), 0.0);
         }
     }
 }

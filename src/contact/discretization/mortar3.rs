@@ -42,7 +42,13 @@
 //!    functions), degree 5 (Radon's 7 points) where a Quad4 takes part (products of two
 //!    bilinear functions, total degree 4 when the facet map is affine), degree 8 (the
 //!    collapsed 5 x 5 Gauss product, [`collapsed_triangle_rule`]) where a Quad9 takes part
-//!    (two biquadratic functions, total degree 8). The weight is the rule's weight times twice
+//!    (two biquadratic functions, total degree 8). A Quad4 facet that is not a parallelogram
+//!    (its projection onto the auxiliary plane) has a bilinear map that is not affine; the
+//!    natural coordinates of a plane point are then not polynomials in it, no triangle rule is
+//!    exact, and the pair is integrated with the collapsed 8 x 8 product (degree 14,
+//!    [`NON_AFFINE_POINTS`]): its integrals agree with a 20 x 20 product to round-off on
+//!    distorted facets (`tests/mortar3.rs`), and the skewed Hex8 punch of the 3D patch table
+//!    passes (Radon's degree-5 rule left a stress error of 3.7e-8 there). The weight is the rule's weight times twice
 //!    the triangle's area: the integrals are taken over the auxiliary plane (exact for flat
 //!    slave facets, Puso and Laursen's approximation otherwise).
 //! 5. **Back to the facets.** Each Gauss point `p` of the plane maps to the slave and master
@@ -574,6 +580,27 @@ fn cell_rule(slave: ElementKind, master: ElementKind) -> Vec<QuadPoint> {
     }
 }
 
+/// Points per direction of the collapsed Gauss product for cells where a Quad4 facet that is
+/// not a parallelogram takes part (module notes, step 4).
+pub const NON_AFFINE_POINTS: usize = 8;
+
+/// Whether a facet's projected map (corner positions `q` on the auxiliary plane) is affine: a
+/// Tri3 always, a Quad4 when it is a parallelogram (`q0 - q1 + q2 - q3 = 0` to `1e-12` of its
+/// diameter). Quad9 facets keep their degree-8 rule on sub-quadrilaterals either way.
+fn affine_in_plane(kind: ElementKind, q: &[[f64; 2]]) -> bool {
+    if kind != ElementKind::Q4 {
+        return true;
+    }
+    let size = (0..4)
+        .flat_map(|a| (0..4).map(move |b| (a, b)))
+        .map(|(a, b)| (q[a][0] - q[b][0]).hypot(q[a][1] - q[b][1]))
+        .fold(0.0, f64::max);
+    let skew = (0..2)
+        .map(|i| (q[0][i] - q[1][i] + q[2][i] - q[3][i]).abs())
+        .fold(0.0, f64::max);
+    skew <= 1e-12 * size
+}
+
 /// The `n x n` Gauss-Legendre product on the square mapped onto the reference triangle by
 /// `(a, b) -> (a (1 - b), b)` (Duffy), weights times the map's Jacobian `1 - b`: a monomial of
 /// total degree `d` becomes degree `d` in `a` and `d + 1` in `b`, so the rule is exact for
@@ -608,6 +635,18 @@ pub fn mortar_integrals3(
     space: MultiplierSpace,
     search_distance: Option<f64>,
 ) -> Result<MortarIntegrals3, String> {
+    mortar_integrals3_with_points(slave, master, space, search_distance, NON_AFFINE_POINTS)
+}
+
+/// [`mortar_integrals3`] with `non_affine_points` points per direction of the collapsed Gauss
+/// product on the cells of non-affine Quad4 pairs (module notes, step 4), to study that rule.
+pub fn mortar_integrals3_with_points(
+    slave: &FacetSet3,
+    master: &FacetSet3,
+    space: MultiplierSpace,
+    search_distance: Option<f64>,
+    non_affine_points: usize,
+) -> Result<MortarIntegrals3, String> {
     supported(slave.kind)?;
     supported(master.kind)?;
     let reach = match search_distance {
@@ -621,7 +660,8 @@ pub fn mortar_integrals3(
     };
     let (ks, km) = (slave.kind, master.kind);
     let (ns, nm) = (ks.node_count(), km.node_count());
-    let rule = cell_rule(ks, km);
+    let affine_rule = cell_rule(ks, km);
+    let non_affine_rule = collapsed_triangle_rule(non_affine_points.max(1));
     let grid = BucketGrid::new(
         master
             .boxes()
@@ -650,6 +690,7 @@ pub fn mortar_integrals3(
             ));
         }
         let slave_area = 0.5 * twice_signed_area(&q_slave[..ks.corner_count()]);
+        let slave_affine = affine_in_plane(ks, &q_slave);
         let phi_of = match space {
             MultiplierSpace::Standard => None,
             MultiplierSpace::Dual => Some(
@@ -673,6 +714,11 @@ pub fn mortar_integrals3(
             if -master_area <= 0.5e-9 * twice_area_3d(km, &master.coords[c]) {
                 continue;
             }
+            let rule = if slave_affine && affine_in_plane(km, &q_master) {
+                &affine_rule
+            } else {
+                &non_affine_rule
+            };
             let mut m_facet = [[0.0; MAX_NODES]; MAX_NODES];
             let mut overlaps = false;
             for (local, start_m) in pieces(km) {
@@ -693,7 +739,7 @@ pub fn mortar_integrals3(
                     let mut area = 0.0;
                     for triangle in fan(&clipped) {
                         area += triangle.area;
-                        for qp in &rule {
+                        for qp in rule {
                             let p = triangle.point(qp.xi);
                             let w = qp.weight * 2.0 * triangle.area;
                             let xi_s = inverse_map(ks, &q_slave, p, *start_s).ok_or_else(|| {
