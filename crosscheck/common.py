@@ -18,6 +18,13 @@ The definitions mirror the Rust sources:
 Each solver receives supports as (node coordinates, component, values) and loads as
 (facet box, traction function), and finds its own dofs and facets geometrically.
 
+3D cases (src/run3d.rs: one body with a `block3d` mesh of Hex8, Hex27, Tet4 or Tet10): `Problem3`
+reads the .vtu (VTK node order, src/fe3d.rs), resolves supports with numbers on the automatic
+sets (sides left/right, front/back, bottom/top; corners `bottom_front_left` ...; `all`) and
+pressures on the side facet sets, and frictionless penalty pairs against a rigid plane or
+sphere (`RigidContact3`) whose penalty term is integrated with the nodal rule of our weights
+(`nodal_rule_3d`).
+
 Contact (src/contact/): a single-body case may declare frictionless pairs of the body against a
 rigid line or circle with node-to-surface rows and a penalty (`RigidContact`), or Coulomb pairs
 against a rigid line (penalty return map of src/contact/friction.rs, load-stepped along the

@@ -53,6 +53,19 @@ derives the tangent; Newton's method in numpy/scipy per load step (the case's fa
 the last step's state, to a relative residual of 1e-14 or its round-off floor (at most 1e-12).
 No .vtu is written for these cases.
 
+3D cases (bodies with a `block3d` mesh, src/run3d.rs; `solve3`, `common.Problem3`): the .vtu
+cells (hexahedron, hexahedron27, tetra, tetra10) permuted by `cell_perm_vtk`, with a Lagrange
+coordinate element of the cell's degree; the map is checked first (`check_geometry_3d`: cell
+volumes against our corners in VTK order, and the degree-2 geometry nodes at basix's reference
+nodes under each cell's vertex map). Vector Lagrange of the same degree, the stiffness
+quadrature of src/fe3d.rs (common.STIFFNESS_DEGREE_3D), supports on the automatic sets,
+pressures -p n at degree 8, MUMPS. Penalty contact against a rigid plane or sphere
+(`newton_penalty3`): the 2D method above, the penalty term integrated with a custom rule whose
+points are the slave facet's nodes and whose weights are our nodal weights
+(`common.nodal_rule_3d`, checked against int N_a dA before use). DOLFINx's own .vtu holds
+`displacement` and `stress` (xx, yy, zz, yz, xz, xy), which `contact-patch judge` reads for 3D
+cases (`write_vtu3`).
+
 The solution is also written by DOLFINx itself (`dolfinx.io.VTKFile`, ASCII) as
 OUT_ROOT/<case>/dolfinx.pvd + dolfinx_p0_000000.vtu, with the point fields `displacement` and
 `stress` (xx, yy, xy of sigma(u_h) interpolated at the nodes of a Lagrange space of the same
@@ -897,10 +910,11 @@ def check_geometry_3d(msh, pb, degree):
     return {"cell_volume_difference": dvol, "node_place_difference": dnode}
 
 
-def solve3(pb):
+def solve3(pb, vtu_path=None):
     """Linear elasticity in 3D on our .vtu mesh (see the module text), with frictionless
     penalty contact against a rigid plane or sphere when the case has pairs (`newton_penalty3`).
-    Returns the displacement in .vtu order and the reference's extra data."""
+    Returns the displacement in .vtu order and the reference's extra data; writes DOLFINx's own
+    .vtu (`write_vtu3`) when `vtu_path` is given."""
     cellname, degree = CELL_3D[pb.element]
     nn = pb.cells.shape[1]
     perm = cell_perm_vtk(DCELL_3D[cellname], nn)
@@ -1004,9 +1018,26 @@ def solve3(pb):
         reason = problem.solver.getConvergedReason()
         if reason <= 0:
             raise RuntimeError(f"{pb.name}: PETSc solve did not converge (reason {reason})")
+    if vtu_path is not None:
+        write_vtu3(vtu_path, msh, degree, uh, sigma)
     out = np.empty_like(pb.u_ours)
     out[ids] = uh.x.array.reshape(-1, 3)
     return out, extra
+
+
+def write_vtu3(path, msh, degree, uh, sigma):
+    """DOLFINx's own VTK output of a 3D solution: `displacement` (3 components) and `stress`,
+    sigma(u_h) interpolated at the nodes of a Lagrange space of the same degree as the six
+    components xx, yy, zz, yz, xz, xy (the order of our .vtu and of `contact-patch judge`)."""
+    uh.name = "displacement"
+    W = fem.functionspace(msh, ("Lagrange", degree, (6,)))
+    s = fem.Function(W)
+    s.name = "stress"
+    S = sigma(uh)
+    s.interpolate(fem.Expression(ufl.as_vector([S[0, 0], S[1, 1], S[2, 2], S[1, 2], S[0, 2],
+                                                S[0, 1]]), W.element.interpolation_points))
+    with dolfinx.io.VTKFile(MPI.COMM_SELF, str(path), "w") as f:
+        f.write_function([uh, s])
 
 
 def newton_penalty3(pb, msh, V, a, L, bcs_values, bcs0, mt, contact_tags, ids):
@@ -1158,7 +1189,7 @@ def main(argv):
                 continue
             if is_3d_case(json.loads(Path(case).read_text())):
                 pb = Problem3(case, root / name)
-                u, extra = solve3(pb)
+                u, extra = solve3(pb, root / name / "dolfinx.pvd")
             elif (json.loads(Path(case).read_text()).get("physics") or {}).get("dynamics"):
                 pb = Problem(case, root / name, dynamic=True)
                 u, extra = solve_wave(pb)

@@ -20,6 +20,15 @@ weights 1/2, 1/2 for Q4; end, mid, end with 1/6, 2/3, 1/6 for Q9); the tangent a
 t kappa (n . du)(n . v) where g <= 0. The iteration stops when the active set repeats (the
 problem is piecewise linear, so the last step is then exact up to round-off).
 
+3D cases (src/run3d.rs; `solve3`, `Body3`, `common.Problem3`): `from_meshio` of the .vtu
+(hexahedron -> MeshHex1, hexahedron27 -> MeshHex2 through scikit-fem's own VTK permutation,
+tetra -> MeshTet1, tetra10 -> MeshTet2), ElementVector of ElementHex1 / ElementHex2 /
+ElementTetP1 / ElementTetP2 with the stiffness quadrature of src/fe3d.rs, pressures on a
+FacetBasis (order 8), supports on the automatic sets by coordinates, SuperLU with the condition
+estimate; penalty contact against a rigid plane or sphere by Newton's method as above, the
+FacetBasis quadrature being the nodal rule of our weights (`common.nodal_rule_3d`: the facet's
+nodes, checked against int N_a dA before use).
+
 Two bodies tied by a mortar pair (`common.TiedCase`), in the spirit of scikit-fem's mortar
 example (docs/examples/ex04.py: trace meshes of the interface, a 1D supermesh, FacetBasis
 objects whose quadrature is built element by element on the supermesh with

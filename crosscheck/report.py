@@ -29,6 +29,11 @@ contact results or the tie solutions; see ref_dolfinx.py and ref_skfem.py). Quan
   the same load steps): the field, and with contact the total contact force (x, y), the nodal
   contact force at every slave node (ours: `<pair>.contact.csv`) and the number of closed
   nodes (equal); TOL_FINITE = 1e-10 (both Newton solves end below 1e-12). scikit-fem: n/a.
+* 3D (bodies with a `block3d` mesh, src/run3d.rs; common.Problem3): the field (3
+  components) and the corner `top_back_right`; elasticity at TOL (or kappa_1 eps), penalty
+  contact against a rigid plane or sphere at TOL_CONTACT with also the total contact force
+  (ours: summary.json `contact.force_on_slaves`) and the number of active rows (equal). Both
+  references solve every 3D case.
 * two bodies tied by a mortar pair: scikit-fem's mortar tie with the same multipliers; the
   field over both bodies (and per body), tolerance 1e-10. DOLFINx: not applicable (n/a).
 * elastic waves (physics.dynamics, no contact): DOLFINx only (ref_dolfinx.solve_wave, the
@@ -962,7 +967,12 @@ def write_md(path, report):
         "contact, the same penalty rows (the current gap at the slave nodes, our nodal "
         "weights); the field, the total and nodal contact forces and the closed nodes (equal) "
         "are compared, tolerance 1e-10 (both Newton solves end below a relative residual of "
-        "1e-12); scikit-fem: n/a.",
+        "1e-12); scikit-fem: n/a. 3D cases (`patch-*` of cases/3d, `*-3d-*`; plane column "
+        "*3D*): both references solve them on our Hex8, Hex27, Tet4 and Tet10 meshes with the "
+        "stiffness quadrature of src/fe3d.rs; the field (3 components), the corner "
+        "`top_back_right` and, for the rigid sphere with penalty rows, the total contact force "
+        "and the number of active rows are compared, at the 2D tolerances (1e-10 or k1 eps; "
+        "1e-8 with contact).",
         "",
         "| case | element | plane | nodes | quantity | ours | DOLFINx | scikit-fem "
         "| rel. diff DOLFINx | rel. diff scikit-fem | tol | verdict |",
@@ -1157,6 +1167,13 @@ def write_md(path, report):
         "active set is a genuine unknown) and a rigid cylinder (Hertz), Q4 and Q9; the "
         "references solve the same penalty problem by Newton's method with the nodal "
         "quadrature of our rows.",
+        "- `cases/3d/patch-*`: the 3D uniform-stress patch tests (pressure on a distorted "
+        "block, Hex8, Hex27, Tet4, Tet10).",
+        "- `crosscheck/cases/3d/*`: `clamped-pressure-3d-*`, a block clamped on one side under "
+        "pressures on its top and back (bending and twisting) on meshes with eight vertex "
+        "moves; `sphere-block-penalty-3d-*`, a rigid sphere pressed into a block by its "
+        "lifted bottom, node-to-surface penalty rows (kappa = 1e5), an off-centre contact patch "
+        "of 12 to 16 of the 121 top nodes; all four elements.",
         "- `one-body-layer-*-x*`, `tied-layer-*-x*` (generated from `cases/tied-layer/`): the "
         "tied layer's one-body meshes (elasticity rows) and dual mortar ties (tie rows) at "
         "levels 1, 2, 4, 8.",
