@@ -18,6 +18,13 @@ The definitions mirror the Rust sources:
 Each solver receives supports as (node coordinates, component, values) and loads as
 (facet box, traction function), and finds its own dofs and facets geometrically.
 
+3D cases (src/run3d.rs: one body with a `block3d` mesh of Hex8, Hex27, Tet4 or Tet10): `Problem3`
+reads the .vtu (VTK node order, src/fe3d.rs), resolves supports with numbers on the automatic
+sets (sides left/right, front/back, bottom/top; corners `bottom_front_left` ...; `all`) and
+pressures on the side facet sets, and frictionless penalty pairs against a rigid plane or
+sphere (`RigidContact3`) whose penalty term is integrated with the nodal rule of our weights
+(`nodal_rule_3d`).
+
 Contact (src/contact/): a single-body case may declare frictionless pairs of the body against a
 rigid line or circle with node-to-surface rows and a penalty (`RigidContact`), or Coulomb pairs
 against a rigid line (penalty return map of src/contact/friction.rs, load-stepped along the
@@ -603,3 +610,270 @@ def write_reference(path, problem, solver, u_on_vtu, extra):
     }
     data.update(extra)
     Path(path).write_text(json.dumps(data))
+
+
+# --- 3D cases (bodies with a `block3d` mesh; src/run3d.rs) -----------------------------------
+# VTK cell types our tool writes in 3D (src/fe3d.rs, VTK node order) -> (element, meshio name)
+MESHIO_CELL_3D = {"Hex8": "hexahedron", "Hex27": "hexahedron27", "Tet4": "tetra",
+                  "Tet10": "tetra10"}
+ELEMENT_OF_MESHIO_3D = {v: k for k, v in MESHIO_CELL_3D.items()}
+# The stiffness quadrature of src/fe3d.rs (`SolidKind::stiffness_rule`): Gauss 2x2x2 (Hex8),
+# 3x3x3 (Hex27); the centroid (Tet4) and Keast's 4-point degree-2 rule (Tet10). basix and
+# scikit-fem use tensor Gauss(-Jacobi) rules of ceil((q+1)/2) points per direction on
+# hexahedra, so degrees 3 and 5 are our rules; the tetrahedra are affine (straight edges, the
+# Tet10 mid-edge nodes at the edge midpoints), where any rule of at least the integrand's
+# degree (0 and 2) gives the same matrix.
+STIFFNESS_DEGREE_3D = {"Hex8": 3, "Hex27": 5, "Tet4": 1, "Tet10": 2}
+# The automatic sets of a 3D block (src/mesh.rs `add_automatic_sets`): x left/right, y
+# front/back, z bottom/top; corners named from z to x (`bottom_front_left`).
+SIDES_3D = (("left", "right"), ("front", "back"), ("bottom", "top"))
+# Facets of each cell in our (VTK) node order, corners counter-clockwise seen from outside, then
+# the mid-edge nodes and the centre (src/fe3d.rs HEX8_FACETS ... TET10_FACETS).
+FACETS_3D = {
+    "Hex8": [(0, 4, 7, 3), (1, 2, 6, 5), (0, 1, 5, 4), (3, 7, 6, 2), (0, 3, 2, 1), (4, 5, 6, 7)],
+    "Hex27": [(0, 4, 7, 3, 16, 15, 19, 11, 20), (1, 2, 6, 5, 9, 18, 13, 17, 21),
+              (0, 1, 5, 4, 8, 17, 12, 16, 22), (3, 7, 6, 2, 19, 14, 18, 10, 23),
+              (0, 3, 2, 1, 11, 10, 9, 8, 24), (4, 5, 6, 7, 12, 13, 14, 15, 25)],
+    "Tet4": [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)],
+    "Tet10": [(0, 2, 1, 6, 5, 4), (0, 1, 3, 4, 8, 7), (0, 3, 2, 7, 9, 6), (1, 2, 3, 5, 9, 8)],
+}
+# The nodal weights of our 3D contact rows (src/contact/discretization/geometry.rs
+# `weight_basis`): A_a = int M_a dA with M_a the facet's shape functions, except on Tri6
+# facets (Tet10), whose corner functions integrate to zero on a flat triangle: there the
+# modified basis M_corner = N_corner + alpha (N_m + N_m'), M_mid = (1 - 2 alpha) N_mid,
+# alpha = TRI6_MODIFIED_ALPHA = 0.2, which gives 2/15 of the area at each corner and 1/5 at
+# each mid-edge node. On a flat facet of constant Jacobian (a parallelogram; every triangle
+# here) these are quadrature rules with the facet's nodes as points: A_a = w_a |facet|.
+# Points on basix's reference facets ([0, 1]^2, the triangle (0,0), (1,0), (0,1)) and
+# weights summing to the reference area; the rules are symmetric under the facet's symmetries,
+# so the facet's orientation in a cell does not matter. Q4: the vertices, 1/4 each; Q9: the
+# tensor Simpson rule (1/6, 2/3, 1/6 per direction); T3: the vertices, 1/6 each (1/3 of the
+# area 1/2); T6: corners 2/15 and mid-edges 1/5 of the area 1/2.
+TRI6_MODIFIED_ALPHA = 0.2
+
+
+def nodal_rule_3d(element):
+    """(points (m, 2), weights (m,)) of the nodal rule of our contact weights on the facets of
+    `element` (see above)."""
+    if element in ("Hex8", "Hex27"):
+        s, w = (([0.0, 1.0], [0.5, 0.5]) if element == "Hex8"
+                else ([0.0, 0.5, 1.0], [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0]))
+        pts = np.array([[a, b] for a in s for b in s])
+        wts = np.array([wa * wb for wa in w for wb in w])
+        return pts, wts
+    if element == "Tet4":
+        return np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), np.full(3, 1.0 / 6.0)
+    a = TRI6_MODIFIED_ALPHA
+    corner, mid = 2.0 * a / 3.0, (1.0 - 2.0 * a) / 3.0     # 2/15, 1/5 of the area
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5]])
+    return pts, 0.5 * np.array([corner] * 3 + [mid] * 3)
+
+
+def is_3d_case(case):
+    """Whether a case (parsed JSON) has a 3D body (src/run3d.rs `is_3d`)."""
+    return any("block3d" in (b.get("mesh") or {}) for b in case.get("bodies", []))
+
+
+class RigidContact3:
+    """A frictionless pair of the body's facet set against a rigid plane or sphere with
+    node-to-surface rows and a penalty (src/contact/discretization/node_based_rows.rs
+    `rigid_rows`, `rigid_gap`). Small strain: at a slave point X the gap is linearized at the
+    reference configuration, g(u) = g0(X) + n(X) . u; plane through p with unit normal n:
+    g0 = n . (X - p); sphere (c, R): n = (X - c)/|X - c|, g0 = |X - c| - R. `gap(X, U, sqrt)`
+    takes lists of the three coordinates and components (numpy arrays or UFL expressions)."""
+
+    def __init__(self, spec, pb):
+        self.name = spec["name"]
+        sl = spec["slave"]
+        if sl["body"] != pb.body:
+            raise Unsupported(f"contact '{self.name}': slave body {sl['body']!r}")
+        self.set = sl["set"]
+        self.box = pb.facet_box(sl["set"])
+        rigid = (spec.get("master") or {}).get("rigid")
+        if rigid is None:
+            raise Unsupported(f"contact '{self.name}' between bodies (the 3D cross-check "
+                              "models rigid masters only)")
+        self.kind = rigid["kind"]
+        if self.kind == "plane":
+            n = np.asarray(rigid["normal"], dtype=float)
+            self.normal = n / np.linalg.norm(n)
+            self.point = np.asarray(rigid["point"], dtype=float)
+        elif self.kind == "sphere":
+            self.centre = np.asarray(rigid["centre"], dtype=float)
+            self.radius = float(rigid["radius"])
+        else:
+            raise Unsupported(f"rigid surface kind {self.kind!r} in 3D")
+        if spec.get("interaction", "frictionless") != "frictionless":
+            raise Unsupported(f"contact '{self.name}': interaction {spec.get('interaction')!r}")
+        disc = spec["discretization"]
+        if disc.get("kind") != "node_to_surface" or int(disc.get("passes", 1)) != 1:
+            raise Unsupported(f"contact '{self.name}': discretization {disc}")
+        enf = spec["enforcement"]
+        if enf.get("kind") not in ("penalty", "perturbed_lagrange"):
+            raise Unsupported(f"contact '{self.name}': enforcement {enf.get('kind')!r} "
+                              "(the cross-check solves penalty problems)")
+        self.kappa = float(enf["kappa"])
+        for key in spec:
+            if key not in {"name", "slave", "master", "interaction", "discretization",
+                           "enforcement"}:
+                raise Unsupported(f"contact '{self.name}': {key!r}")
+        self.rule = nodal_rule_3d(pb.element)
+
+    def gap(self, X, U, sqrt):
+        """(g, n) at reference point X for displacement U (lists of 3)."""
+        if self.kind == "plane":
+            n = [float(c) for c in self.normal]
+            g0 = sum(n[i] * (X[i] - float(self.point[i])) for i in range(3))
+        else:
+            d = [X[i] - float(self.centre[i]) for i in range(3)]
+            length = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+            n = [d[i] / length for i in range(3)]
+            g0 = length - self.radius
+        return g0 + n[0] * U[0] + n[1] * U[1] + n[2] * U[2], n
+
+
+class Problem3:
+    """One 3D body (a `block3d` mesh) resolved on its .vtu, as src/run3d.rs builds it: linear
+    elasticity (E, nu), supports with numbers on the automatic node sets, pressures on the
+    automatic facet sets, and frictionless penalty contact against a rigid plane or sphere.
+    Everything else is refused (as run3d refuses it, or as the cross-check does not model it)."""
+
+    def __init__(self, case_path, out_dir):
+        self.case_path = Path(case_path)
+        self.case = json.loads(self.case_path.read_text())
+        c = self.case
+        self.name = c["name"]
+        bodies = c.get("bodies", [])
+        if len(bodies) != 1:
+            raise Unsupported(f"{len(bodies)} bodies (the 3D cross-check has one-body cases)")
+        for key in c:
+            if key not in {"name", "description", "materials", "bodies", "supports", "loads",
+                           "checks", "contact", "analysis"}:
+                raise Unsupported(f"case section {key!r} in 3D")
+        body = bodies[0]
+        self.body = body["name"]
+        if body.get("node_sets") or body.get("facet_sets"):
+            raise Unsupported("user-defined sets in 3D (src/run3d.rs refuses them)")
+        m = c["materials"][body["material"]]
+        if m.get("model", "linear_elastic") != "linear_elastic":
+            raise Unsupported(f"material model {m.get('model')!r} in 3D")
+        self.E, self.nu = float(m["E"]), float(m["nu"])
+        self.mu = self.E / (2.0 * (1.0 + self.nu))
+        self.lam = self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+
+        self.vtu = Path(out_dir) / f"{self.body}.vtu"
+        mesh = meshio.read(self.vtu)
+        if len(mesh.cells) != 1 or mesh.cells[0].type not in ELEMENT_OF_MESHIO_3D:
+            raise Unsupported(f"cells {[b.type for b in mesh.cells]} in {self.vtu}")
+        self.meshio = mesh
+        self.element = ELEMENT_OF_MESHIO_3D[mesh.cells[0].type]
+        self.points = np.ascontiguousarray(mesh.points[:, :3], dtype=np.float64)
+        self.cells = np.asarray(mesh.cells[0].data, dtype=np.int64)
+        self.u_ours = np.asarray(mesh.point_data["displacement"][:, :3], dtype=np.float64)
+        self.lo, self.hi = self.points.min(axis=0), self.points.max(axis=0)
+        self.size = float(np.linalg.norm(self.hi - self.lo))
+        self.tol = 1e-9 * self.size
+        self.supports = self._supports()
+        self.loads = self._loads()
+        self.contact = [RigidContact3(p, self) for p in c.get("contact", []) or []]
+
+    # --- sets -----------------------------------------------------------------------------
+    def _side_box(self, name):
+        inf = math.inf
+        for axis, pair in enumerate(SIDES_3D):
+            for side, side_name in enumerate(pair):
+                if name == side_name:
+                    lo, hi = [-inf] * 3, [inf] * 3
+                    lo[axis] = hi[axis] = (self.lo if side == 0 else self.hi)[axis]
+                    return lo, hi
+        if name == "all":
+            return [-inf] * 3, [inf] * 3
+        parts = name.split("_")
+        if len(parts) == 3:   # a corner: z side, y side, x side
+            p = []
+            for axis, part in zip((2, 1, 0), parts):
+                if part not in SIDES_3D[axis]:
+                    return None
+                p.append((axis, (self.lo if SIDES_3D[axis].index(part) == 0 else self.hi)[axis]))
+            pt = [0.0] * 3
+            for axis, v in p:
+                pt[axis] = v
+            return pt, pt
+        return None
+
+    def node_set(self, name):
+        b = self._side_box(name)
+        if b is None:
+            raise Unsupported(f"node set {name!r} (3D has the automatic sets only)")
+        return np.flatnonzero(in_box(self.points, (b[0], b[1], self.tol)))
+
+    def facet_box(self, name):
+        if name not in [s for pair in SIDES_3D for s in pair]:
+            raise Unsupported(f"facet set {name!r} (3D has the six sides only)")
+        b = self._side_box(name)
+        return (b[0], b[1], self.tol)
+
+    def boundary_facets(self):
+        """Boundary facets (node tuples in FACETS_3D order), each a cell face no other cell
+        has."""
+        count, first = {}, {}
+        ncorner = 4 if self.element.startswith("Hex") else 3
+        for cell in self.cells:
+            for f in FACETS_3D[self.element]:
+                nodes = tuple(int(cell[i]) for i in f)
+                key = tuple(sorted(nodes[:ncorner]))
+                count[key] = count.get(key, 0) + 1
+                first.setdefault(key, nodes)
+        return [first[k] for k, c in count.items() if c == 1]
+
+    def facets_in_box(self, box):
+        return [f for f in self.boundary_facets() if in_box(self.points[list(f)], box).all()]
+
+    # --- supports and loads ------------------------------------------------------------------
+    def _supports(self):
+        """[(coords (k, 3), component, values (k,))] in case order."""
+        out = []
+        for s in self.case.get("supports", []):
+            if s["body"] != self.body:
+                raise Unsupported(f"support on body {s['body']!r}")
+            if s.get("path") is not None:
+                raise Unsupported("a load path in 3D")
+            nodes = self.node_set(s["set"])
+            if len(nodes) == 0:
+                raise Unsupported(f"support set {s['set']!r} is empty")
+            for comp, key in ((0, "x"), (1, "y"), (2, "z")):
+                v = s.get(key)
+                if v is None:
+                    continue
+                if not isinstance(v, (int, float)):
+                    raise Unsupported(f"support value {v!r} in 3D (numbers only)")
+                out.append((self.points[nodes], comp, np.full(len(nodes), float(v))))
+        return out
+
+    def _loads(self):
+        """[(facet box, pressure)]: t = -p n on the facets of the set."""
+        out = []
+        for ld in self.case.get("loads", []):
+            if ld["body"] != self.body:
+                raise Unsupported(f"load on body {ld['body']!r}")
+            if set(ld) - {"body", "set", "pressure"} or "pressure" not in ld:
+                raise Unsupported(f"load {ld} in 3D (pressures on facet sets only)")
+            out.append((self.facet_box(ld["set"]), float(ld["pressure"])))
+        return out
+
+    def match(self, coords):
+        """Map solver node coordinates (M, 3) onto .vtu point ids; (ids, max distance)."""
+        from scipy.spatial import cKDTree
+
+        d, ids = cKDTree(self.points).query(np.asarray(coords)[:, :3])
+        if len(np.unique(ids)) != len(ids) or len(ids) != len(self.points):
+            raise RuntimeError(
+                f"{self.name}: solver nodes do not map one-to-one onto the .vtu points "
+                f"({len(ids)} nodes, {len(np.unique(ids))} distinct, {len(self.points)} points)")
+        if d.max() > self.tol:
+            raise RuntimeError(f"{self.name}: node match distance {d.max():.3e} > {self.tol:.3e}")
+        return ids, float(d.max())
+
+    def slave_nodes(self, pair):
+        """The .vtu ids of the slave nodes of `pair` (every node of its facets)."""
+        return np.array(sorted({n for f in self.facets_in_box(pair.box) for n in f}))

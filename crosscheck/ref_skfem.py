@@ -20,6 +20,15 @@ weights 1/2, 1/2 for Q4; end, mid, end with 1/6, 2/3, 1/6 for Q9); the tangent a
 t kappa (n . du)(n . v) where g <= 0. The iteration stops when the active set repeats (the
 problem is piecewise linear, so the last step is then exact up to round-off).
 
+3D cases (src/run3d.rs; `solve3`, `Body3`, `common.Problem3`): `from_meshio` of the .vtu
+(hexahedron -> MeshHex1, hexahedron27 -> MeshHex2 through scikit-fem's own VTK permutation,
+tetra -> MeshTet1, tetra10 -> MeshTet2), ElementVector of ElementHex1 / ElementHex2 /
+ElementTetP1 / ElementTetP2 with the stiffness quadrature of src/fe3d.rs, pressures on a
+FacetBasis (order 8), supports on the automatic sets by coordinates, SuperLU with the condition
+estimate; penalty contact against a rigid plane or sphere by Newton's method as above, the
+FacetBasis quadrature being the nodal rule of our weights (`common.nodal_rule_3d`: the facet's
+nodes, checked against int N_a dA before use).
+
 Two bodies tied by a mortar pair (`common.TiedCase`), in the spirit of scikit-fem's mortar
 example (docs/examples/ex04.py: trace meshes of the interface, a 1D supermesh, FacetBasis
 objects whose quadrature is built element by element on the supermesh with
@@ -50,8 +59,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 import skfem
 from scipy.spatial import cKDTree
-from skfem import (Basis, BilinearForm, ElementQuad1, ElementQuad2, ElementTriP1, ElementTriP2,
-                   ElementVector, FacetBasis, LinearForm, MeshLine, asm, condense, solve)
+from skfem import (Basis, BilinearForm, ElementHex1, ElementHex2, ElementQuad1, ElementQuad2,
+                   ElementTetP1, ElementTetP2, ElementTriP1, ElementTriP2, ElementVector,
+                   FacetBasis, LinearForm, MeshLine, asm, condense, solve)
 from skfem.element import ElementDG
 from skfem.helpers import dot, mul, sym_grad
 from skfem.io.meshio import from_meshio
@@ -60,8 +70,8 @@ from skfem.supermeshing import elementwise_quadrature
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import (BODY_FORCE_DEGREE, LOAD_DEGREE, NODAL_RULE, STIFFNESS_DEGREE,  # noqa: E402
-                    Problem, TiedCase, Unsupported, facets_in_box, in_box,
-                    write_reference)
+                    STIFFNESS_DEGREE_3D, Problem, Problem3, TiedCase, Unsupported,
+                    facets_in_box, in_box, is_3d_case, write_reference)
 
 ELEMENT = {"Q4": ElementQuad1, "Q9": ElementQuad2, "T3": ElementTriP1, "T6": ElementTriP2}
 DEGREE = {"Q4": 1, "Q9": 2, "T3": 1, "T6": 2}
@@ -494,6 +504,193 @@ def solve_tie(tc):
     return out, nit, info
 
 
+# --- 3D (src/run3d.rs) -------------------------------------------------------------------------
+ELEMENT_3D = {"Hex8": ElementHex1, "Hex27": ElementHex2, "Tet4": ElementTetP1,
+              "Tet10": ElementTetP2}
+
+
+class Body3:
+    """One 3D body assembled on our .vtu (`common.Problem3`): `from_meshio` (hexahedron ->
+    MeshHex1, hexahedron27 -> MeshHex2 with scikit-fem's own VTK permutation, tetra ->
+    MeshTet1, tetra10 -> MeshTet2), ElementVector of ElementHex1 / ElementHex2 (27-node Q2) /
+    ElementTetP1 / ElementTetP2 with the stiffness quadrature of src/fe3d.rs
+    (common.STIFFNESS_DEGREE_3D), pressures on a FacetBasis of quadrature order 8, supports and
+    the map to the .vtu points by coordinates."""
+
+    def __init__(self, pb):
+        self.pb = pb
+        self.mesh = from_meshio(pb.meshio)
+        self.e = ElementVector(ELEMENT_3D[pb.element]())
+        self.basis = Basis(self.mesh, self.e, intorder=STIFFNESS_DEGREE_3D[pb.element])
+        self.K = asm(linear_elasticity(pb.lam, pb.mu), self.basis)
+        self.N = self.basis.N
+        self.f = np.zeros(self.N)
+        mesh = self.mesh
+        # boundary facets and their vertices (vertex dofs come first in doflocs)
+        self.bfacets = mesh.boundary_facets()
+        self.corners = [mesh.doflocs[:, mesh.facets[i, self.bfacets]].T
+                        for i in range(mesh.facets.shape[0])]
+        for k, (box, p) in enumerate(pb.loads):
+            sel = self.facets(box)
+            if len(sel) == 0:
+                raise RuntimeError(f"{pb.name}: load {k} selects no boundary facet")
+            fb = FacetBasis(mesh, self.e, facets=sel, intorder=LOAD_DEGREE)
+
+            @LinearForm
+            def pressure(v, w, p=p):
+                return -p * dot(w.n, v)
+
+            self.f += asm(pressure, fb)
+        self.comp_dofs = self.basis.split_indices()
+        self.fixed = {}
+        for coords, c, values in pb.supports:
+            I = self.comp_dofs[c]
+            d, idx = cKDTree(self.basis.doflocs[:, I].T).query(coords)
+            if d.max() > pb.tol:
+                raise RuntimeError(f"{pb.name}: support node not found (distance {d.max():.3e})")
+            for dof, val in zip(I[idx], values):
+                self.fixed[int(dof)] = float(val)
+        self.point_of = np.empty(self.N, dtype=np.int64)
+        self.match_distance = 0.0
+        for c in range(3):
+            I = self.comp_dofs[c]
+            ids, dc = pb.match(self.basis.doflocs[:, I].T)
+            self.point_of[I] = ids
+            self.match_distance = max(self.match_distance, dc)
+
+    def facets(self, box):
+        """Boundary facets with every vertex in the box."""
+        inside = np.ones(len(self.bfacets), dtype=bool)
+        for c in self.corners:
+            inside &= in_box(c, box)
+        return self.bfacets[inside]
+
+    def on_vtu(self, u):
+        out = np.empty_like(self.pb.u_ours)
+        for c in range(3):
+            I = self.comp_dofs[c]
+            out[self.point_of[I], c] = u[I]
+        return out
+
+    def dof_of(self, point_ids, comp):
+        I = self.comp_dofs[comp]
+        inv = {int(p): int(d) for p, d in zip(self.point_of[I], I)}
+        return np.array([inv[int(p)] for p in point_ids], dtype=np.int64)
+
+
+def solve3(pb):
+    """3D linear elasticity (SuperLU, with the condition estimate), or with rigid contact
+    pairs Newton's method on the penalty problem: the term int kappa (g)_- (n . v) dA on a
+    FacetBasis of the slave facets whose quadrature is the nodal rule of our weights
+    (common.nodal_rule_3d; checked against int N_a dA on Lagrange facets), the tangent
+    kappa (n . du)(n . v) where g <= 0, until the active set repeats."""
+    body = Body3(pb)
+    D, u = prescribed(body)
+    extra = {"dimension": 3, "match_distance": body.match_distance, "dofs": int(body.N),
+             "stiffness_quadrature_order": STIFFNESS_DEGREE_3D[pb.element],
+             "load_quadrature_order": LOAD_DEGREE}
+    if not pb.contact:
+        A, b, _, I = condense(body.K, body.f, x=u, D=D)
+        lu = spla.splu(A.tocsc())
+        u[I] = lu.solve(b)
+        extra["cond1_estimate"] = cond1(lu, A)
+        return body.on_vtu(u), extra
+
+    compiled = []
+    for pair in pb.contact:
+        sel = body.facets(pair.box)
+        if len(sel) == 0:
+            raise RuntimeError(f"{pb.name}: contact '{pair.name}' selects no boundary facet")
+        pts, wts = pair.rule
+        fb = FacetBasis(body.mesh, body.e, facets=sel, quadrature=(pts.T.copy(), wts))
+        fbe = FacetBasis(body.mesh, body.e, facets=sel, intorder=LOAD_DEGREE)
+        nodes = pb.slave_nodes(pair)
+        dofs = [body.dof_of(nodes, c) for c in range(3)]
+
+        @BilinearForm
+        def tangent(du, v, w, pair=pair):
+            g, n = pair.gap(w.x, w.prev, np.sqrt)
+            act = (g <= 0.0).astype(float)
+            return pair.kappa * act * (n[0] * du[0] + n[1] * du[1] + n[2] * du[2]) \
+                * (n[0] * v[0] + n[1] * v[1] + n[2] * v[2])
+
+        @LinearForm
+        def force(v, w, pair=pair):
+            g, n = pair.gap(w.x, w.prev, np.sqrt)
+            return pair.kappa * np.maximum(-g, 0.0) * (n[0] * v[0] + n[1] * v[1] + n[2] * v[2])
+
+        @LinearForm
+        def area(v, w):
+            return v[0]
+
+        A_rule = area.assemble(fb)[dofs[0]]
+        A_exact = area.assemble(fbe)[dofs[0]]
+        dev = (abs(A_rule.sum() - A_exact.sum()) / A_exact.sum() if pb.element == "Tet10"
+               else float(np.abs(A_rule - A_exact).max() / np.abs(A_exact).max()))
+        if dev > 1e-12:
+            raise Unsupported(f"{pb.name}: contact '{pair.name}': the nodal rule misses our "
+                              f"weights by {dev:.1e} (slave facets that are not flat "
+                              "parallelograms)")
+        compiled.append((pair, fb, nodes, dofs, tangent, force, A_rule, dev))
+
+    def gaps(u):
+        out = []
+        for pair, fb, nodes, dofs, *_ in compiled:
+            X = pb.points[nodes]
+            g, _ = pair.gap([X[:, 0], X[:, 1], X[:, 2]], [u[d] for d in dofs], np.sqrt)
+            out.append(np.broadcast_to(g, nodes.shape))
+        return out
+
+    def active_sets(u):
+        return tuple(tuple(bool(t) for t in g <= 0.0) for g in gaps(u))
+
+    def residual(u):
+        r = body.K @ u - body.f
+        for pair, fb, nodes, dofs, tangent, force, *_ in compiled:
+            r -= force.assemble(fb, prev=fb.interpolate(u))
+        return r
+
+    history, seen = [], set()
+    current = active_sets(u)
+    for it in range(1, 101):
+        Kt = body.K.copy()
+        for pair, fb, nodes, dofs, tangent, *_ in compiled:
+            Kt = Kt + tangent.assemble(fb, prev=fb.interpolate(u))
+        du = solve(*condense(Kt, -residual(u), D=D))
+        u = u + du
+        new = active_sets(u)
+        history.append({"iteration": it, "active": [sum(s) for s in current],
+                        "relative_step": float(np.abs(du).max() / np.abs(u).max())})
+        if new == current:
+            break
+        if new in seen:
+            raise RuntimeError(f"{pb.name}: the Newton active sets cycle")
+        seen.add(current)
+        current = new
+    else:
+        raise RuntimeError(f"{pb.name}: Newton did not settle in 100 iterations")
+    r = residual(u)
+    r[D] = 0.0
+    scale = max(float(np.abs(body.f).max()), float(np.abs(body.K @ u).max()))
+    res = float(np.abs(r).max() / scale)
+    if not res <= 1e-9:
+        raise RuntimeError(f"{pb.name}: Newton settled with relative residual {res:.2e}")
+    out_pairs = []
+    for (pair, fb, nodes, dofs, tangent, force, A_rule, dev), g in zip(compiled, gaps(u)):
+        fvec = force.assemble(fb, prev=fb.interpolate(u))
+        out_pairs.append({"name": pair.name,
+                          "total_force": [float(fvec[body.comp_dofs[c]].sum()) for c in range(3)],
+                          "nodes": nodes.tolist(), "area": A_rule.tolist(),
+                          "pressure": (pair.kappa * np.maximum(-g, 0.0)).tolist(),
+                          "gap": g.tolist(), "active": [bool(t) for t in g <= 0.0],
+                          "slave_force": np.stack([fvec[d] for d in dofs], axis=1).tolist(),
+                          "weight_check": dev})
+    extra["contact"] = {"pairs": out_pairs, "newton": history, "iterations": len(history),
+                        "relative_residual": res,
+                        "contact_quadrature": "the facet's nodes with our nodal weights"}
+    return body.on_vtu(u), extra
+
+
 def main(argv):
     root = Path(argv[1])
     failed = 0
@@ -509,7 +706,13 @@ def main(argv):
                     "time histories (physics.dynamics) are cross-checked with DOLFINx only")}))
                 print(f"skfem {name}: not applicable (dynamics)", flush=True)
                 continue
-            if len(spec.get("bodies", [])) > 1:
+            if is_3d_case(spec):
+                pb = Problem3(case, root / name)
+                u, extra = solve3(pb)
+                extra.update({"seconds": time.perf_counter() - t0,
+                              "versions": {"scikit-fem": skfem.__version__}})
+                write_reference(target, pb, "skfem", u, extra)
+            elif len(spec.get("bodies", [])) > 1:
                 tc = TiedCase(case, root / name)
                 u, nit, extra = solve_tie(tc)
                 extra.update({"seconds": time.perf_counter() - t0,

@@ -29,6 +29,11 @@ contact results or the tie solutions; see ref_dolfinx.py and ref_skfem.py). Quan
   the same load steps): the field, and with contact the total contact force (x, y), the nodal
   contact force at every slave node (ours: `<pair>.contact.csv`) and the number of closed
   nodes (equal); TOL_FINITE = 1e-10 (both Newton solves end below 1e-12). scikit-fem: n/a.
+* 3D (bodies with a `block3d` mesh, src/run3d.rs; common.Problem3): the field (3
+  components) and the corner `top_back_right`; elasticity at TOL (or kappa_1 eps), penalty
+  contact against a rigid plane or sphere at TOL_CONTACT with also the total contact force
+  (ours: summary.json `contact.force_on_slaves`) and the number of active rows (equal). Both
+  references solve every 3D case.
 * two bodies tied by a mortar pair: scikit-fem's mortar tie with the same multipliers; the
   field over both bodies (and per body), tolerance 1e-10. DOLFINx: not applicable (n/a).
 * elastic waves (physics.dynamics, no contact): DOLFINx only (ref_dolfinx.solve_wave, the
@@ -63,8 +68,8 @@ import meshio
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import (ELEMENT_OF_MESHIO, Exact, Material, Problem, Sampler,  # noqa: E402
-                    TiedCase, facets_in_box)
+from common import (ELEMENT_OF_MESHIO, Exact, Material, Problem, Problem3,  # noqa: E402
+                    Sampler, TiedCase, facets_in_box, is_3d_case)
 
 TOL = 1e-10            # same discrete linear problem: round-off
 TOL_CONTACT = 1e-8     # penalty contact: the references' Newton residuals are <= 1e-9
@@ -192,18 +197,21 @@ class Rows:
         self.rows.append(q)
 
 
-def field_rows(rows, u, refs, tol, tol_txt, corner=None, label="u, all nodes (max abs)"):
+def field_rows(rows, u, refs, tol, tol_txt, corner=None, label="u, all nodes (max abs)",
+               corner_name="top_right"):
+    """The field row and, given the corner node, one row per component there (2 in 2D, 3 in
+    3D, whose corner is `top_back_right`)."""
     scale = float(np.abs(u).max()) or 1.0
     vals = {s: float(np.abs(r).max()) for s, r in refs.items()}
     diffs = {s: float(np.abs(r - u).max() / scale) for s, r in refs.items()}
     rows.add(label, float(np.abs(u).max()), vals, diffs, tol, tol_txt)
     if corner is not None:
-        for comp, name in ((0, "u_x"), (1, "u_y")):
+        for comp, name in list(enumerate(("u_x", "u_y", "u_z")))[:u.shape[1]]:
             vals = {s: float(r[corner, comp]) for s, r in refs.items()}
             diffs = {s: float(abs(r[corner, comp] - u[corner, comp]) / scale)
                      for s, r in refs.items()}
-            rows.add(f"{name} at top_right", float(u[corner, comp]), vals, diffs, tol, tol_txt,
-                     fmt="signed")
+            rows.add(f"{name} at {corner_name}", float(u[corner, comp]), vals, diffs, tol,
+                     tol_txt, fmt="signed")
 
 
 def load_resultant(pb):
@@ -257,7 +265,10 @@ def case_entry(case_path, root, repo):
     try:
         case = json.loads(Path(case_path).read_text())
         summary = json.loads((out / "summary.json").read_text())
-        if len(case.get("bodies", [])) > 1:
+        if is_3d_case(case):
+            pb = Problem3(case_path, out)
+            kind = "contact-3d" if pb.contact else "elasticity-3d"
+        elif len(case.get("bodies", [])) > 1:
             tc = TiedCase(case_path, out)
             kind = "tie"
         elif (case.get("physics") or {}).get("dynamics") is not None:
@@ -306,7 +317,10 @@ def case_entry(case_path, root, repo):
                     errors[s] = f"not applicable to a one-body case: {why}"
                 entry["errors"] = errors
                 na = {}
-            rows, hertz = body_rows(entry, pb, summary, kind, datas, errors)
+            if kind.endswith("-3d"):
+                rows = body_rows3(entry, pb, summary, kind, datas, errors)
+            else:
+                rows, hertz = body_rows(entry, pb, summary, kind, datas, errors)
     except Exception as e:  # noqa: BLE001
         entry.update({"error": f"comparison failed: {type(e).__name__}: {e}",
                       "verdict": "fail", "quantities": []})
@@ -402,6 +416,50 @@ def body_rows(entry, pb, summary, kind, datas, errors):
                       "bound_text": f"node spacing {spacing:.3g}",
                       "verdict": verdict(herr, spacing)}]}
     return rows, hertz
+
+
+def body_rows3(entry, pb, summary, kind, datas, errors):
+    """A 3D case (src/run3d.rs; common.Problem3): the displacement field (3 components) and the
+    node at the corner `top_back_right`, with the elasticity tolerance (round-off, or kappa_1
+    eps from scikit-fem's estimate); with penalty contact against a rigid plane or sphere
+    (TOL_CONTACT) also the total contact force on the body (ours: summary.json
+    `contact.force_on_slaves`, the rows' forces along their normals) and the number of active
+    rows (equal). Both references must solve the case."""
+    refs = {s: np.asarray(d["u"], dtype=float) for s, d in datas.items()}
+    entry.update({"element": pb.element, "plane": "3D", "nodes": len(pb.points),
+                  "cells": len(pb.cells)})
+    rows = Rows(refs, errors, {})
+    corner = pb.node_set("top_back_right")
+    corner = int(corner[0]) if len(corner) == 1 else None
+    if kind == "elasticity-3d":
+        k1 = (datas.get("skfem") or {}).get("cond1_estimate")
+        if k1 is not None and k1 * EPS > TOL:
+            tol, txt = k1 * EPS, f"{sci(k1 * EPS)} (k1 eps, k1 = {sci(k1)})"
+        else:
+            tol, txt = TOL, tol_text(TOL)
+        entry["tolerance_rule"] = ("kappa_1 eps (scikit-fem's cond1_estimate)" if tol > TOL
+                                   else "round-off, 1e-10")
+        field_rows(rows, pb.u_ours, refs, tol, txt, corner, corner_name="top_back_right")
+        return rows
+    tol, txt = TOL_CONTACT, tol_text(TOL_CONTACT)
+    field_rows(rows, pb.u_ours, refs, tol, txt, corner, corner_name="top_back_right")
+    c = summary.get("contact")
+    if c is None:
+        raise RuntimeError("our summary.json has no contact section")
+    if c.get("termination") != "Converged":
+        raise RuntimeError(f"our contact solve ended with {c.get('termination')}")
+    F = np.asarray(c["force_on_slaves"], dtype=float)
+    fn = float(np.linalg.norm(F)) or 1.0
+    totals = {s: np.sum([p["total_force"] for p in d["contact"]["pairs"]], axis=0)
+              for s, d in datas.items()}
+    rows.add("total contact force (norm)", float(np.linalg.norm(F)),
+             {s: float(np.linalg.norm(t)) for s, t in totals.items()},
+             {s: float(np.linalg.norm(t - F) / fn) for s, t in totals.items()}, tol, txt)
+    active = {s: sum(sum(p["active"]) for p in d["contact"]["pairs"]) for s, d in datas.items()}
+    rows.add(f"active nodes (of {c['rows']} rows)", int(c["active"]), active,
+             {s: float(abs(a - int(c["active"]))) for s, a in active.items()},
+             0.0, "equal", kind="equal", fmt="int")
+    return rows
 
 
 def friction_rows(entry, pb, out, summary, datas, errors, na):
@@ -909,7 +967,12 @@ def write_md(path, report):
         "contact, the same penalty rows (the current gap at the slave nodes, our nodal "
         "weights); the field, the total and nodal contact forces and the closed nodes (equal) "
         "are compared, tolerance 1e-10 (both Newton solves end below a relative residual of "
-        "1e-12); scikit-fem: n/a.",
+        "1e-12); scikit-fem: n/a. 3D cases (`patch-*` of cases/3d, `*-3d-*`; plane column "
+        "*3D*): both references solve them on our Hex8, Hex27, Tet4 and Tet10 meshes with the "
+        "stiffness quadrature of src/fe3d.rs; the field (3 components), the corner "
+        "`top_back_right` and, for the rigid sphere with penalty rows, the total contact force "
+        "and the number of active rows are compared, at the 2D tolerances (1e-10 or k1 eps; "
+        "1e-8 with contact).",
         "",
         "| case | element | plane | nodes | quantity | ours | DOLFINx | scikit-fem "
         "| rel. diff DOLFINx | rel. diff scikit-fem | tol | verdict |",
@@ -1104,6 +1167,13 @@ def write_md(path, report):
         "active set is a genuine unknown) and a rigid cylinder (Hertz), Q4 and Q9; the "
         "references solve the same penalty problem by Newton's method with the nodal "
         "quadrature of our rows.",
+        "- `cases/3d/patch-*`: the 3D uniform-stress patch tests (pressure on a distorted "
+        "block, Hex8, Hex27, Tet4, Tet10).",
+        "- `crosscheck/cases/3d/*`: `clamped-pressure-3d-*`, a block clamped on one side under "
+        "pressures on its top and back (bending and twisting) on meshes with eight vertex "
+        "moves; `sphere-block-penalty-3d-*`, a rigid sphere pressed into a block by its "
+        "lifted bottom, node-to-surface penalty rows (kappa = 1e5), an off-centre contact patch "
+        "of 12 to 16 of the 121 top nodes; all four elements.",
         "- `one-body-layer-*-x*`, `tied-layer-*-x*` (generated from `cases/tied-layer/`): the "
         "tied layer's one-body meshes (elasticity rows) and dual mortar ties (tie rows) at "
         "levels 1, 2, 4, 8.",

@@ -20,7 +20,10 @@
 # line in two load steps, DOLFINx only), crosscheck/cases/dynamics (elastic waves in a bar, stepped by
 # DOLFINx with the same mesh, mass and Newmark parameters), crosscheck/cases/finite (finite
 # kinematics: hyperelastic cantilevers and a neo-Hookean block pressed onto a rigid line with a
-# penalty, DOLFINx only, the same load steps), and the studies that crosscheck/studies.py generates into the
+# penalty, DOLFINx only, the same load steps), in 3D cases/3d (uniform-stress patch tests on
+# Hex8, Hex27, Tet4, Tet10) and crosscheck/cases/3d (a clamped block under two pressures on
+# distorted meshes, and a rigid sphere pressed into a block with penalty rows, all four
+# elements), and the studies that crosscheck/studies.py generates into the
 # run folder: the tied layer (cases/tied-layer at levels 1, 2, 4, 8) and the two blocks
 # (crosscheck/cases/two-block at levels 1, 2, 4, and its fine one-body reference). With CASE
 # arguments only those cases run (no studies).
@@ -89,7 +92,8 @@ if [ "$#" -gt 0 ]; then
 else
     CASES=(cases/patch-single/*.json cases/convergence/*.json crosscheck/cases/*.json
            crosscheck/cases/contact/*.json crosscheck/cases/friction/*.json
-           crosscheck/cases/dynamics/*.json crosscheck/cases/finite/*.json)
+           crosscheck/cases/dynamics/*.json crosscheck/cases/finite/*.json
+           cases/3d/*.json crosscheck/cases/3d/*.json)
     "$PY" crosscheck/studies.py "$OUT" > "$OUT/study-cases.txt"
     mapfile -t STUDY_CASES < "$OUT/study-cases.txt"
     CASES+=("${STUDY_CASES[@]}")

@@ -793,6 +793,9 @@ fn judge(case: &Path, results: &Path, match_tol: f64, junit_path: Option<&Path>)
         Ok(f) => f,
         Err(code) => return code,
     };
+    if let Some(case3) = contact_patch::run3d::read_3d_case(case) {
+        return judge3(case, &case3, results, match_tol, junit_out);
+    }
     let judged = contact_patch::model::admit::load(case).and_then(|model| {
         let found = judge::load_results(&model, results)?;
         let j = judge::judge(&model, &found, match_tol)?;
@@ -821,7 +824,74 @@ fn judge(case: &Path, results: &Path, match_tol: f64, junit_path: Option<&Path>)
             f.use_
         );
     }
-    for c in &j.checks {
+    judge_verdicts(
+        case,
+        results,
+        &model.name,
+        &j.checks,
+        &j.not_judged,
+        junit_out,
+    )
+}
+
+/// `judge` for a 3D case (`contact_patch::harness::judge3`).
+fn judge3(
+    path: &Path,
+    case: &contact_patch::io::scene::Case,
+    results: &Path,
+    match_tol: f64,
+    junit_out: Option<NamedFile>,
+) -> ExitCode {
+    use contact_patch::harness::judge3;
+    let source = path.display().to_string();
+    let judged = contact_patch::run3d::build3(case, &source).and_then(|model| {
+        let found = judge3::load_results3(&model, results)?;
+        let j = judge3::judge3(&model, &found, match_tol)?;
+        Ok((model, j))
+    });
+    let (model, j) = match judged {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    println!(
+        "{}: {} nodes matched to {} (largest distance {:.3e}, allowed {:.3e}; 3D)",
+        model.name,
+        j.nodes,
+        results.display(),
+        j.largest_distance,
+        j.match_distance
+    );
+    println!(
+        "  field 'stress': {}",
+        if j.stress_field {
+            "found (a uniform-stress check of the results' own nodal stress)"
+        } else {
+            "missing (stresses are judged from the displacement only)"
+        }
+    );
+    judge_verdicts(
+        path,
+        results,
+        &model.name,
+        &j.checks,
+        &j.not_judged,
+        junit_out,
+    )
+}
+
+/// The judged checks and the ones not judged, printed and written as JUnit; the exit code.
+fn judge_verdicts(
+    case: &Path,
+    results: &Path,
+    name: &str,
+    checks: &[contact_patch::harness::checks::CheckResult],
+    not_judged: &[contact_patch::harness::judge::NotJudged],
+    junit_out: Option<NamedFile>,
+) -> ExitCode {
+    for c in checks {
         println!(
             "  {} {} (error {:.3e}, tol {:.1e})",
             if c.passed { "pass" } else { "FAIL" },
@@ -830,12 +900,12 @@ fn judge(case: &Path, results: &Path, match_tol: f64, junit_path: Option<&Path>)
             c.tol
         );
     }
-    for n in &j.not_judged {
+    for n in not_judged {
         println!("  not judged {}: {}", n.check, n.why);
     }
-    let mut cases = junit::check_cases(&model.name, &j.checks);
-    cases.extend(j.not_judged.iter().map(|n| junit::TestCase {
-        classname: model.name.clone(),
+    let mut cases = junit::check_cases(name, checks);
+    cases.extend(not_judged.iter().map(|n| junit::TestCase {
+        classname: name.to_string(),
         name: n.check.clone(),
         seconds: 0.0,
         verdict: junit::Verdict::Skipped {
@@ -850,12 +920,12 @@ fn judge(case: &Path, results: &Path, match_tol: f64, junit_path: Option<&Path>)
     if !write_junit(junit_out.as_ref(), "contact-patch judge", &[suite]) {
         return ExitCode::from(2);
     }
-    let failed = j.checks.iter().filter(|c| !c.passed).count();
+    let failed = checks.iter().filter(|c| !c.passed).count();
     println!(
         "{} judged checks: {} pass, {failed} fail; {} not judged",
-        j.checks.len(),
-        j.checks.len() - failed,
-        j.not_judged.len()
+        checks.len(),
+        checks.len() - failed,
+        not_judged.len()
     );
     if failed == 0 {
         ExitCode::SUCCESS

@@ -46,6 +46,7 @@ pub mod impact_cost;
 pub mod index_page;
 pub mod ironing;
 pub mod judge;
+pub mod judge3;
 pub mod junit;
 pub mod layer;
 pub mod load_path;

@@ -52,14 +52,19 @@ impl Results {
 /// Read the results at `path`: a `.vtu` file (for every body), or a folder with `<body>.vtu`
 /// for each body of `model` (the layout `contact-patch run` writes).
 pub fn load_results(model: &Model, path: &Path) -> Result<Results> {
+    load_results_of(model.bodies.iter().map(|b| b.name.as_str()), path)
+}
+
+/// [`load_results`] for the bodies named `bodies` (in order; a 2D or a 3D model's).
+pub fn load_results_of<'a>(bodies: impl Iterator<Item = &'a str>, path: &Path) -> Result<Results> {
     if path.is_dir() {
         let mut files = Vec::new();
-        for body in &model.bodies {
-            let file = path.join(file_name("body name", &body.name, ".vtu")?);
+        for body in bodies {
+            let file = path.join(file_name("body name", body, ".vtu")?);
             if !file.is_file() {
                 return Err(Error::invalid(
                     path.display(),
-                    format!("body '{}'", body.name),
+                    format!("body '{body}'"),
                     format!("the folder holds no {}", file.display()),
                     "a results folder holds one <body name>.vtu per body of the case; or give \
                      one .vtu file that holds every body",
