@@ -57,17 +57,23 @@ FULL_BLOCK = (1734, 288)
 def sizes(dofs):
     """Divisions of the square and the block for about `dofs` unknowns each."""
     d = max(2, round(math.sqrt(dofs / 2.0)) - 1)
-    # the block keeps the 6:1 cell counts of 1734 x 288, NX even (a node at x = 0)
+    # the block keeps the 6:1 cell counts of 1734 x 288, NX a multiple of 6 (nodes at x = -2
+    # and x = 0, the ends of the loaded zone, so that the load is 2 at every size)
     ny = max(2, round(math.sqrt(dofs / 2.0 / (FULL_BLOCK[0] / FULL_BLOCK[1]))))
-    nx = 2 * max(1, round(ny * FULL_BLOCK[0] / FULL_BLOCK[1] / 2.0))
+    nx = 6 * max(1, round(ny * FULL_BLOCK[0] / FULL_BLOCK[1] / 6.0))
     return d, (nx, ny)
 
 
 def with_cg(case):
-    """The case solved by CG + AMG at GAMG's relative tolerance (1e-10)."""
+    """The case solved by CG + AMG at GAMG's relative tolerance (1e-10). The force-balance
+    check (tolerance 1e-10 of the load, a round-off check of the direct solver) is left out:
+    a relative residual of 1e-10 leaves an out-of-balance force of a few 1e-10 of the load;
+    the answers are compared as the direct runs' are (exact field, contact force, active
+    nodes, penetration)."""
     case = json.loads(json.dumps(case))
     case["name"] += "-cg-amg"
     case.setdefault("solver", {}).update({"linear_solver": "cg_amg", "linear_tolerance": 1e-10})
+    case["checks"] = [c for c in case.get("checks", []) if c["check"] != "force_balance"]
     return case
 
 
