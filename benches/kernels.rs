@@ -3,7 +3,8 @@
 //! Representative configurations, not sweeps: one stiffness per element kind on a distorted
 //! cell (beside `<kind>_reference`, the array-loop kernel that preceded the nalgebra one), and full assembly (pattern + values), kernels + scatter, and factorization of a 50 x 50
 //! Q4 plane-strain block (5,202 dofs), by `sparse::Cholesky` and by faer's high-level `Llt`
-//! side by side. Compare the figures as ratios within one run (e.g. Q9 vs Q4 kernel,
+//! side by side, and the multigrid solver's matrix-vector product, V-cycle and setup (a CG
+//! solve, really: setup and iterations) on a 200 x 200 block. Compare the figures as ratios within one run (e.g. Q9 vs Q4 kernel,
 //! factorization vs assembly, `numeric_cholesky` vs `numeric_cholesky_faer_llt`), never as
 //! absolute times across machines.
 
@@ -194,5 +195,42 @@ fn mesh(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, kernels, assembly, mesh);
+/// The multigrid solver's hot paths on a 200 x 200 Q4 plane-strain block (80,798 equations):
+/// one product `y = K x` of the full CSR matrix (rayon row blocks), one V-cycle of the
+/// smoothed-aggregation hierarchy (src/solver/amg.rs), and the hierarchy's setup. Compare the
+/// V-cycle with the product (a V-cycle is worth a handful of products) in one run.
+fn multigrid(c: &mut Criterion) {
+    let mut model = block_model(200);
+    model.solver.linear_solver = contact_patch::io::scene::LinearSolver::CgAmg;
+    let sys = assemble(&model, &[]);
+    let a = contact_patch::solver::amg::CsrMatrix::from_symmetric_upper(&sys.pattern, &sys.k);
+    let mut group = c.benchmark_group("q4_block_200x200");
+    group.sample_size(20);
+    let x: Vec<f64> = (0..sys.n).map(|i| (i as f64 * 0.618).fract()).collect();
+    let mut y = vec![0.0; sys.n];
+    group.bench_function("spmv", |b| b.iter(|| a.mul(black_box(&x), &mut y)));
+    let mut amg =
+        contact_patch::solver::iterative::AmgSolver::new(&model, sys.constraints.free_dofs());
+    let mut u = vec![0.0; sys.n];
+    amg.solve(&sys.pattern, &sys.k, &sys.rhs, &mut u).unwrap();
+    let hierarchy = amg.hierarchy().unwrap();
+    println!("multigrid levels: {:?}", hierarchy.level_sizes());
+    group.bench_function("v_cycle", |b| {
+        b.iter(|| hierarchy.apply(black_box(&x), &mut y))
+    });
+    group.sample_size(10);
+    group.bench_function("amg_setup_and_cg_solve", |b| {
+        b.iter(|| {
+            let mut fresh = contact_patch::solver::iterative::AmgSolver::new(
+                &model,
+                sys.constraints.free_dofs(),
+            );
+            let mut u = vec![0.0; sys.n];
+            fresh.solve(&sys.pattern, &sys.k, &sys.rhs, &mut u).unwrap();
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, kernels, assembly, mesh, multigrid);
 criterion_main!(benches);

@@ -541,6 +541,9 @@ fn run3(
                 o.model.dof_count,
                 cells.join(", ")
             );
+            if let Some(r) = &o.solution.iterative {
+                println!("  linear solver: {}", r.describe());
+            }
             if let Some(c) = &o.solution.contact {
                 let active = c.active.iter().filter(|&&a| a).count();
                 println!(
@@ -578,6 +581,9 @@ fn print_outcome(o: &Outcome) {
         "{}: {} dofs, {} equations; mesh {:.3}s, assembly {:.3}s, factorization {:.3}s, solve {:.3}s, total {:.3}s",
         o.model.name, o.model.dof_count, o.solution.equations, t.mesh, t.assembly, t.factorization, t.solve, t.total
     );
+    if let Some(r) = &o.solution.iterative {
+        println!("  linear solver: {}", r.describe());
+    }
     for c in &o.checks {
         println!(
             "  {} {} (error {:.3e}, tol {:.1e})",

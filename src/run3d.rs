@@ -582,7 +582,7 @@ pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
             })
         })
         .collect();
-    let summary = serde_json::json!({
+    let mut summary = serde_json::json!({
         "case": outcome.name,
         "dimension": 3,
         "bodies": bodies,
@@ -595,6 +595,11 @@ pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
             "check": c.check, "error": c.error, "tol": c.tol, "passed": c.passed,
         })).collect::<Vec<_>>(),
     });
+    // the iterative solves, only when the case asked for them (a direct run writes what it
+    // wrote before)
+    if let Some(record) = &outcome.solution.iterative {
+        summary["linear_solver"] = serde_json::to_value(record).expect("the record serializes");
+    }
     folder.write(|tmp| {
         let text = serde_json::to_string_pretty(&summary).expect("the summary serializes");
         crate::io::paths::write_new_file(&tmp.join("summary.json"), &(text + "\n"))?;

@@ -491,6 +491,7 @@ fn solution_of(model: &Model, u: Vec<f64>, contact_force: Option<&[f64]>) -> Sol
         contact: None,
         dynamics: None,
         finite: None,
+        iterative: None,
     }
 }
 

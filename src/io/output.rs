@@ -54,6 +54,10 @@ pub struct Summary {
     /// reasons, and the Newton residuals); absent with small strain.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub finite: Option<crate::solver::history::FiniteHistory>,
+    /// What the iterative linear solves did (`solver.linear_solver: "cg_amg"`: iterations,
+    /// final relative residual, hierarchy); absent with the direct solver.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub linear_solver: Option<crate::solver::iterative::IterativeRecord>,
     pub timings: Timings,
     /// The effects the scene asked for and simulated, with the time each took.
     pub effects: Vec<EffectSummary>,
@@ -419,6 +423,7 @@ fn summary_with(outcome: &Outcome, nodal: &[Vec<[f64; 3]>], results: &[PairResul
             .as_ref()
             .map(|_| crate::harness::stability::conditioning(model, solution)),
         timings: solution.timings.clone(),
+        linear_solver: solution.iterative.clone(),
         effects: effects(outcome),
     }
 }

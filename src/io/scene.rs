@@ -99,6 +99,38 @@ pub struct SolverSpec {
     /// see `src/solver/low_rank.rs`.
     #[serde(default)]
     pub factor_update: FactorUpdate,
+    /// The solver of the linear systems: `"direct"` (default: sparse Cholesky) or `"cg_amg"`
+    /// (conjugate gradients preconditioned by smoothed-aggregation algebraic multigrid,
+    /// `src/solver/amg.rs`), for symmetric positive definite systems only: elasticity and the
+    /// penalty and augmented Lagrangian contact rows of the active-set scheme. Every other
+    /// system is refused with the reason.
+    #[serde(default)]
+    pub linear_solver: LinearSolver,
+    /// `"cg_amg"`: the relative residual `||b - A x|| / ||b||` at which CG stops; default
+    /// 1e-10. A solve that does not reach it within `linear_max_iterations` is an error.
+    #[serde(default = "linear_tolerance")]
+    pub linear_tolerance: f64,
+    /// `"cg_amg"`: the most CG iterations of one linear solve; default 500.
+    #[serde(default = "five_hundred")]
+    pub linear_max_iterations: usize,
+}
+
+/// The solver of the linear systems of a static small-strain solve.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum LinearSolver {
+    /// Sparse Cholesky (faer), exact to round-off.
+    #[default]
+    Direct,
+    /// Conjugate gradients with a smoothed-aggregation AMG V-cycle, to a relative residual.
+    CgAmg,
+}
+
+fn linear_tolerance() -> f64 {
+    1e-10
+}
+fn five_hundred() -> usize {
+    500
 }
 
 /// Whether the active-set iterations reuse the last factorization with a low-rank
@@ -173,6 +205,9 @@ impl Default for SolverSpec {
             friction_tangent: FrictionTangent::Consistent,
             cycling_remedy: CyclingRemedy::Hold,
             factor_update: FactorUpdate::Auto,
+            linear_solver: LinearSolver::Direct,
+            linear_tolerance: linear_tolerance(),
+            linear_max_iterations: five_hundred(),
         }
     }
 }

@@ -837,6 +837,22 @@ impl Model {
                 ));
             }
         }
+        let tol = case.solver.linear_tolerance;
+        if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
+            return Err(invalid(
+                "solver.linear_tolerance".into(),
+                format!("must lie in (0, 1), got {tol}"),
+                "the default is 1e-10 (the relative residual of the CG solve)",
+            ));
+        }
+        let n = case.solver.linear_max_iterations;
+        if !(1..=MAX_SOLVER_COUNT).contains(&n) {
+            return Err(invalid(
+                "solver.linear_max_iterations".into(),
+                format!("must be from 1 to {MAX_SOLVER_COUNT}, got {n}"),
+                "the default is 500",
+            ));
+        }
         let tol = case.solver.geometry_tolerance;
         if !(tol.is_finite() && tol > 0.0) {
             return Err(invalid(

@@ -131,7 +131,9 @@ pub fn solve<const D: usize, K: ContactStep<D>>(
     model: &Model<D, K>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Solution<D>> {
+    crate::solver::iterative::refuse_unless_admitted(model)?;
     let n = model.solver.load_steps;
+    let mut iterative: Option<crate::solver::iterative::IterativeRecord> = None;
     let mut previous: Option<HashSet<RowKey>> = None;
     let mut records: Vec<StepRecord> = Vec::new();
     let mut start: Option<Vec<f64>> = None;
@@ -159,6 +161,8 @@ pub fn solve<const D: usize, K: ContactStep<D>>(
         )?;
         timings.accumulate(&solution.timings);
         solution.timings = timings.clone();
+        crate::solver::iterative::IterativeRecord::merge(&mut iterative, &solution.iterative);
+        solution.iterative = iterative.clone();
         let state = solution.contact.as_mut().expect("a contact solve");
         records.push(StepRecord {
             step,
@@ -261,6 +265,7 @@ fn solve_step(
             let mut history: Vec<IterationRecord> = Vec::new();
             let mut forces: Option<HashMap<RowKey, f64>> = None;
             let mut timings = crate::solver::linear::Timings::default();
+            let mut iterative: Option<crate::solver::iterative::IterativeRecord> = None;
             let mut changes: Vec<f64> = Vec::new();
             let max_updates = model.solver.max_geometry_updates;
             let areas = reference_areas(model)?;
@@ -295,6 +300,11 @@ fn solve_step(
                 state.departures = departures.clone();
                 timings.accumulate(&solution.timings);
                 solution.timings = timings.clone();
+                crate::solver::iterative::IterativeRecord::merge(
+                    &mut iterative,
+                    &solution.iterative,
+                );
+                solution.iterative = iterative.clone();
                 let state = solution.contact.as_mut().expect("a contact solve");
                 for r in &mut state.history {
                     r.geometry_update = update;
@@ -572,10 +582,31 @@ fn solve_at<const D: usize, K: Discretize<D>>(
 
     let t = Instant::now();
     progress("contact iterations");
-    let trailing = trailing_equations(&eq_rows, model.solver.factor_update, sys.n);
-    let chol = Cholesky::analyse_with_trailing(&sys.pattern, &trailing, &model.factor_limit)
-        .map_err(|e| sys.factor_error(model, e))?;
-    let chol_work = chol.work();
+    // with CG + AMG nothing is factored: no symbolic analysis, no updates of a factor
+    let amg = (model.solver.linear_solver == crate::io::scene::LinearSolver::CgAmg)
+        .then(|| crate::solver::iterative::AmgSolver::new(model, sys.constraints.free_dofs()));
+    if amg.is_some() && coupled {
+        return Err(crate::solver::iterative::refuse_saddle_point(model));
+    }
+    let chol = match amg {
+        Some(_) => None,
+        None => {
+            let trailing = trailing_equations(&eq_rows, model.solver.factor_update, sys.n);
+            Some(
+                Cholesky::analyse_with_trailing(&sys.pattern, &trailing, &model.factor_limit)
+                    .map_err(|e| sys.factor_error(model, e))?,
+            )
+        }
+    };
+    let update_rank = match amg {
+        Some(_) => 0,
+        None => update_rank(model.solver.factor_update, sys.n),
+    };
+    let update_columns = match (model.solver.factor_update, &chol) {
+        (FactorUpdate::LowRank, _) => MAX_UPDATE_RANK,
+        (_, Some(chol)) => new_columns_bound(&chol.work()),
+        (_, None) => 0,
+    };
     let initial_active = previous.map(|previous| {
         rows.iter()
             .map(|r| {
@@ -612,12 +643,11 @@ fn solve_at<const D: usize, K: Discretize<D>>(
         extra_solves: 0,
         cache: None,
         low_rank: None,
-        update_rank: update_rank(model.solver.factor_update, sys.n),
-        update_columns: match model.solver.factor_update {
-            FactorUpdate::LowRank => MAX_UPDATE_RANK,
-            _ => new_columns_bound(&chol_work),
-        },
-        deferred_condition: update_rank(model.solver.factor_update, sys.n) > 0,
+        update_columns,
+        update_rank,
+        deferred_condition: update_rank > 0,
+        amg,
+        last_iterate: None,
         factorizations: 0.0,
         estimate_condition: true,
     };
@@ -625,6 +655,7 @@ fn solve_at<const D: usize, K: Discretize<D>>(
     kernel.estimate_last_condition();
     let (x, forces, active, termination, iterations) = state;
     let linear_solver = kernel.linear_solver;
+    let iterative = kernel.amg.take().map(|amg| amg.record);
     let history = std::mem::take(&mut kernel.history);
     let factor_time = kernel.factorizations;
     timings.factorization = factor_time;
@@ -653,6 +684,7 @@ fn solve_at<const D: usize, K: Discretize<D>>(
     let rank_deficiency =
         (active_rows.len() <= rank_limit).then(|| rank_deficiency(&active_rows, sys.n));
     let mut solution = finish(model, &sys, u, &contact_force, timings)?;
+    solution.iterative = iterative;
     let n_rows = rows.len();
     solution.contact = Some(ContactState {
         rows,
@@ -834,7 +866,13 @@ struct Kernel<'a, const D: usize, K: Discretize<D>> {
     free: Option<Free>,
     /// The iteration of the active-set loop (for messages).
     iteration: usize,
-    chol: Cholesky,
+    /// The symbolic analysis of `M` (`None` with CG + AMG, which factors nothing).
+    chol: Option<Cholesky>,
+    /// CG + AMG (`solver.linear_solver: "cg_amg"`), with its hierarchy kept between
+    /// iterations ([`crate::solver::iterative`]).
+    amg: Option<crate::solver::iterative::AmgSolver>,
+    /// The last iterate of the CG path, the start of the next solve.
+    last_iterate: Option<Vec<f64>>,
     /// Built only for Lagrange multipliers and for perturbed Lagrangian rows with a consistent
     /// multiplier mass.
     saddle: Option<Saddle>,
@@ -965,9 +1003,11 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
         }
         let t = Instant::now();
         let values = self.augmented(active, w);
+        let Some(chol) = self.chol.as_ref() else {
+            return Err("no factorization with CG + AMG (solver.linear_solver)".into());
+        };
         let f = Rc::new(
-            self.chol
-                .factor(&self.sys.pattern, &values)
+            chol.factor(&self.sys.pattern, &values)
                 .map_err(|e| self.sys.factor_error(self.model, e).to_string())?,
         );
         if self.update_rank > 0 {
@@ -1319,6 +1359,9 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
     /// against the unpenalized equilibrium residual when that is not at round-off (see
     /// [`Kernel::penalty_equilibrium`]).
     fn regularized(&mut self, active: &[bool], w: &[f64], lambda_k: &[f64]) -> Step<Vec<f64>> {
+        if self.amg.is_some() {
+            return self.regularized_iterative(active, w, lambda_k);
+        }
         let f = self.factor_or_update(active, w)?;
         let (x, best) = self.regularized_with(&f, active, w, lambda_k);
         if f.rank() == 0 || best <= EQUILIBRIUM_ROUND_OFF {
@@ -1330,6 +1373,46 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
         let f = self.factor(active, w)?;
         self.linear_solver = "cholesky";
         Ok(self.regularized_with(&f, active, w, lambda_k).0)
+    }
+
+    /// The solve of [`Kernel::regularized`] by CG + AMG from the last iterate, to the case's
+    /// relative residual: `M x = f_f - K_fp u_p + sum_active b_i (lambda_k,i - w_i g0_i)`.
+    /// A solve that does not converge ends the run (never a silent answer).
+    fn regularized_iterative(
+        &mut self,
+        active: &[bool],
+        w: &[f64],
+        lambda_k: &[f64],
+    ) -> Step<Vec<f64>> {
+        let values = self.augmented(active, w);
+        let mut b = self.rhs.clone();
+        for (i, row) in self.rows.iter().enumerate() {
+            if active[i] {
+                row.add_to(lambda_k[i] - w[i] * row.g0, &mut b);
+            }
+        }
+        let mut x = self
+            .last_iterate
+            .take()
+            .unwrap_or_else(|| vec![0.0; self.sys.n]);
+        let amg = self.amg.as_mut().expect("the CG path has its solver");
+        let setup = amg.record.setup_seconds;
+        let outcome = amg.solve(&self.sys.pattern, &values, &b, &mut x);
+        self.factorizations += amg.record.setup_seconds - setup;
+        if let Err(why) = outcome {
+            return Err(StepError::Fatal(Error::Solver {
+                path: self.model.source.clone(),
+                problem: format!(
+                    "the linear solve of active-set iteration {} is {why}",
+                    self.iteration
+                ),
+                hint: "a body held only by contact that lost it is a mechanism, which also stops CG; check the supports".into(),
+            }));
+        }
+        self.linear_solver = "cg-amg";
+        self.condition = None;
+        self.last_iterate = Some(x.clone());
+        Ok(x)
     }
 
     /// The solve of [`Kernel::regularized`] with the operator `f`, refined; returns the iterate

@@ -1478,6 +1478,7 @@ pub(crate) fn solve_step(
             contact: None,
             dynamics: None,
             finite: None,
+            iterative: None,
         }
     } else {
         finish(model, &system.sys, u.clone(), &contact_force, timings)?

@@ -32,9 +32,10 @@ pub struct Timings {
     pub mesh: f64,
     /// Sparsity pattern, element kernels and scatter.
     pub assembly: f64,
-    /// Symbolic analysis and numeric Cholesky factorization.
+    /// Symbolic analysis and numeric Cholesky factorization (with `"cg_amg"`: the multigrid
+    /// setups).
     pub factorization: f64,
-    /// Triangular solves and reactions.
+    /// Triangular solves and reactions (with `"cg_amg"`: the CG iterations).
     pub solve: f64,
     /// Contact search and row evaluation (every geometry update and load step); 0 without
     /// contact.
@@ -71,6 +72,9 @@ pub struct Solution<const D: usize = 2> {
     /// The load stepping of a finite-kinematics solve (every attempt, cuts with their
     /// reasons); `None` with small strain.
     pub finite: Option<Box<crate::solver::history::FiniteHistory>>,
+    /// What the iterative linear solves did (`solver.linear_solver: "cg_amg"`); `None` with
+    /// the direct solver.
+    pub iterative: Option<crate::solver::iterative::IterativeRecord>,
 }
 
 /// Calls `visit(dofs, ke)` for every cell of every body.
@@ -319,6 +323,29 @@ pub fn solve_elastic<const D: usize, K: SolidCell<D>>(
     sys.check_assembled(model)?;
     timings.assembly = t.elapsed().as_secs_f64();
 
+    if model.solver.linear_solver == crate::io::scene::LinearSolver::CgAmg {
+        crate::solver::iterative::refuse_unless_admitted(model)?;
+        progress("multigrid setup and CG");
+        let mut amg = crate::solver::iterative::AmgSolver::new(model, sys.constraints.free_dofs());
+        let mut x = vec![0.0; sys.n];
+        if sys.n > 0 {
+            amg.solve(&sys.pattern, &sys.k, &sys.rhs, &mut x)
+                .map_err(|why| Error::Solver {
+                    path: model.source.clone(),
+                    problem: format!("the elastic solve is {why}"),
+                    hint: "a mechanism (a part not held by the supports) also stops CG; check the supports".into(),
+                })?;
+            sys.check_finite(model, &x, "the displacement", "in the CG solve of K u = f")?;
+        }
+        timings.factorization = amg.record.setup_seconds;
+        timings.solve = amg.record.cg_seconds;
+        let u = sys.expand(&x);
+        let t = Instant::now();
+        let mut solution = finish(model, &sys, u, &[], timings)?;
+        solution.timings.solve += t.elapsed().as_secs_f64();
+        solution.iterative = Some(amg.record);
+        return Ok(solution);
+    }
     let t = Instant::now();
     progress("factorizing");
     let mut x = sys.rhs.clone();
@@ -455,6 +482,7 @@ pub fn finish<const D: usize, K: SolidCell<D>>(
         contact: None,
         dynamics: None,
         finite: None,
+        iterative: None,
     })
 }
 

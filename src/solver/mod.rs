@@ -6,6 +6,7 @@
 //! [`crate::solver::finite`] (Newton in load steps with cuts), with or without contact.
 
 pub mod active_set;
+pub mod amg;
 pub mod conditioning;
 pub mod constraints;
 pub mod contact_newton;
@@ -15,6 +16,7 @@ pub mod elastic3d;
 pub mod finite;
 pub mod finite_assembly;
 pub mod history;
+pub mod iterative;
 pub mod linear;
 pub mod low_rank;
 pub mod newton;
@@ -27,6 +29,7 @@ use crate::solver::linear::Solution;
 
 /// Solve `model`; `progress` is told the name of each stage as it starts.
 pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+    crate::solver::iterative::refuse_unless_admitted(model)?;
     if model.physics.kinematics == crate::io::scene::Kinematics::Finite {
         crate::solver::finite::solve(model, progress)
     } else if model.dynamics.is_some() {
