@@ -525,3 +525,39 @@ fn the_augmented_lagrangian_and_the_perturbed_tangent_drag_the_block_on_the_disc
         }
     }
 }
+
+#[test]
+fn the_newton_scheme_in_3d_gives_the_active_set_answer_without_friction() {
+    // the Newton scheme, now generic over the dimension, solves frictionless 3D pairs too:
+    // the punch pressed on its foundation (no drag) by both schemes, penalty and Lagrange rows
+    for enforcement in [
+        json!({"kind": "penalty", "kappa": 1e4}),
+        json!({"kind": "lagrange"}),
+    ] {
+        let mut newton =
+            dragged_punch(json!({"kind": "node_to_surface", "passes": 1}), 3, 0.0, 0.0);
+        newton["contact"][0]["enforcement"] = enforcement.clone();
+        newton["contact"][0]
+            .as_object_mut()
+            .unwrap()
+            .remove("interaction");
+        let mut active_set = newton.clone();
+        active_set["solver"] = json!({"scheme": "active_set"});
+        let (a, b) = (run(&newton), run(&active_set));
+        assert_eq!(termination(&a), Termination::Converged, "{enforcement}");
+        assert_eq!(termination(&b), Termination::Converged, "{enforcement}");
+        let (sa, sb) = (
+            a.solution.contact.as_ref().unwrap(),
+            b.solution.contact.as_ref().unwrap(),
+        );
+        assert_eq!(sa.rows.len(), sb.rows.len());
+        let worst = sa
+            .forces
+            .iter()
+            .zip(&sb.forces)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        println!("{enforcement}: Newton vs active set, largest force difference {worst:.1e}");
+        assert!(worst <= 1e-10 * P, "{enforcement}: {worst:e}");
+        assert!(sa.friction.iter().all(Option::is_none));
+    }
+}

@@ -92,6 +92,16 @@
 //! instead makes the matrix indefinite, and the iteration diverged on the patch test). A change of a point's
 //! frictional status (open, stick, slip) counts as a status change of the iteration.
 //!
+//! **In 3D** (the system is generic over the dimension `D`, [`NewtonDimension`]; small strain,
+//! the reference geometry) a point has two tangents `t_1, t_2` and the return map works on the
+//! disc: `lambda_t = sum_a lambda_t,a b_t,a` on the residual, and the tangential block
+//! `-sum_ab (d lambda_t,a / d g_t,b) b_t,a b_t,b^T` is `w_t` times the frame's identity in stick
+//! and, in slip, `w_t mu lambda_n (I - s s^T) / |trial|` (the turn of the slip direction,
+//! symmetric), besides the coupling `mu s_a w b_t,a b_n^T`. A slip counts as a change of
+//! status when its direction turns by more than a right angle. The secant remedy of a cycle
+//! applies to one tangent only (on a disc the slip tangent keeps the stiffness of the
+//! direction's turn), and Lagrange-multiplier friction is 2D only (`run3d` refuses it).
+//!
 //! **Coulomb friction with Lagrange multipliers** (Lagrange rows of a Coulomb pair): each row
 //! with a normal multiplier gains a tangential one, `lambda_t = rho mu_t`, numbered after the
 //! normal ones, and the semi-smooth Newton method of Alart & Curnier (1991) in the active-set
