@@ -9,10 +9,16 @@
 //! and the active-set contact solve with every enforcement method
 //! ([`crate::solver::active_set`]) are the 2D code paths, generic over the dimension. What is
 //! not built in 3D yet is refused here with the reason (an invalid-case error, exit 2), never
-//! computed wrongly: dynamics, finite strain, friction, the Newton scheme and the current
-//! contact geometry, sweeps, exact solutions, load paths, user-defined sets, loads other than
+//! computed wrongly: dynamics, finite strain, the current contact geometry, Coulomb friction
+//! with Lagrange multipliers, sweeps, exact solutions, user-defined sets, loads other than
 //! pressure, checks other than `uniform_stress_3d`; the 3D discretizations refuse what they do
 //! not treat ([`crate::contact::discretization::Discretize`]).
+//!
+//! Coulomb friction (issue 13, build item 4) runs through the 2D code path: the Newton scheme
+//! ([`crate::solver::contact_newton`], generic over the dimension) with the return map on the
+//! disc ([`crate::contact::friction`]) and two tangential rows per node-based pair row
+//! ([`crate::contact::discretization::pair3`]); load paths (`path` on supports and pressures,
+//! steps with committed slip) are the 2D model's ([`crate::model::Model::at_load`]).
 //!
 //! The check `uniform_stress_3d` is the 3D uniform-stress check: the largest difference over
 //! the quadrature points of the stiffness rule and the six components, relative to the
@@ -25,7 +31,9 @@ use crate::fe::ReferenceCell;
 use crate::fe3d::SolidKind;
 use crate::harness::checks::CheckResult;
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
-use crate::io::scene::{Case, Check, ContactGeometry, Kinematics, MeshSpec, Prescribed, Scheme};
+use crate::io::scene::{
+    Case, Check, ContactGeometry, EnforcementSpec, Kinematics, MeshSpec, Prescribed,
+};
 use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
 use crate::model::{Body3, Model3};
@@ -188,14 +196,6 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
             "remove physics.contact_geometry (contact in the reference geometry)",
         ));
     }
-    if case.solver.scheme == Scheme::Newton {
-        return Err(not_built(
-            source,
-            "solver.scheme",
-            "the Newton scheme",
-            "remove solver.scheme (the active-set scheme)",
-        ));
-    }
     if case.sweep.is_some() {
         return Err(not_built(source, "sweep", "a sweep", "remove the sweep"));
     }
@@ -311,12 +311,12 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
     apply_pressures3(&mut model, case)?;
     model.resolve_contact(case)?;
     for (k, pair) in case.contact.iter().enumerate() {
-        if pair.interaction.friction().is_some() {
+        if pair.interaction.friction().is_some() && pair.enforcement == EnforcementSpec::Lagrange {
             return Err(not_built(
                 source,
-                format!("contact[{k}] '{}'.interaction", pair.name),
-                "Coulomb friction",
-                "use a frictionless or tied interaction",
+                format!("contact[{k}] '{}'.enforcement", pair.name),
+                "Coulomb friction with Lagrange multipliers (a tangential multiplier per tangent and the disc's semi-smooth sets)",
+                "use the penalty, the perturbed Lagrangian, the augmented Lagrangian or the perturbed tangent for a frictional pair",
             ));
         }
     }
@@ -396,14 +396,8 @@ fn apply_supports3(model: &mut Model3, case: &Case) -> Result<()> {
         let b = model.find_body(&s.body, &at)?;
         let nodes = model.find_node_set(b, &s.set, &at)?.to_vec();
         let bi = model.body_index(&s.body).expect("found above");
-        if s.path.is_some() {
-            return Err(not_built(
-                &source,
-                format!("{at}.path"),
-                "a load path",
-                "remove \"path\"",
-            ));
-        }
+        let factors = crate::model::load_path_factors(case, s.path.as_deref(), &source, &at)?;
+        let mut path_dofs = Vec::new();
         if s.x.is_none() && s.y.is_none() && s.z.is_none() {
             return Err(Error::invalid(
                 &source,
@@ -435,6 +429,9 @@ fn apply_supports3(model: &mut Model3, case: &Case) -> Result<()> {
             };
             for &n in &nodes {
                 let dof = model.bodies[bi].dof(n, comp);
+                if factors.is_some() {
+                    path_dofs.push(dof);
+                }
                 match model.prescribed[dof] {
                     Some(old) if old != v => {
                         return Err(Error::invalid(
@@ -452,6 +449,13 @@ fn apply_supports3(model: &mut Model3, case: &Case) -> Result<()> {
                 }
             }
         }
+        if let Some(factors) = factors {
+            model.load_path.push(crate::model::PathPart {
+                force: Vec::new(),
+                dofs: path_dofs,
+                factors,
+            });
+        }
         model.support_sets.push((bi, s.set.clone()));
     }
     Ok(())
@@ -462,14 +466,7 @@ fn apply_pressures3(model: &mut Model3, case: &Case) -> Result<()> {
     let source = model.source.clone();
     for (k, load) in case.loads.iter().enumerate() {
         let at = format!("loads[{k}]");
-        if load.path.is_some() {
-            return Err(not_built(
-                &source,
-                format!("{at}.path"),
-                "a load path",
-                "remove \"path\"",
-            ));
-        }
+        let factors = crate::model::load_path_factors(case, load.path.as_deref(), &source, &at)?;
         let (Some(p), None, None, None) =
             (load.pressure, &load.traction, load.body_force, load.force)
         else {
@@ -510,8 +507,16 @@ fn apply_pressures3(model: &mut Model3, case: &Case) -> Result<()> {
                 }
             }
         }
-        for (f, v) in model.external_force.iter_mut().zip(force) {
+        for (f, v) in model.external_force.iter_mut().zip(&force) {
             *f += v;
+        }
+        if let Some(factors) = factors {
+            // a pressure on a path of its own (its force is in the total too)
+            model.load_path.push(crate::model::PathPart {
+                force,
+                dofs: Vec::new(),
+                factors,
+            });
         }
     }
     Ok(())
@@ -553,13 +558,20 @@ fn contact_summary(outcome: &Outcome3) -> Option<serde_json::Value> {
             force[i] += f * r.normal[i];
         }
     }
-    Some(serde_json::json!({
+    let mut summary = serde_json::json!({
         "termination": format!("{:?}", state.termination),
         "iterations": state.iterations,
         "rows": state.rows.len(),
         "active": active,
         "force_on_slaves": force,
-    }))
+    });
+    if let Some(friction) = crate::contact::friction::step_summary(state) {
+        // Coulomb pairs: the tangential force, the open/stick/slip counts and the dissipation
+        // of the last step, and the load steps' totals
+        summary["friction"] = serde_json::to_value(friction).expect("the summary serializes");
+        summary["steps"] = serde_json::to_value(&state.steps).expect("the steps serialize");
+    }
+    Some(summary)
 }
 
 /// Write `summary.json` and one `<body>.vtu` per body into `folder` (replaced as a whole).

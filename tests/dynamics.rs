@@ -655,23 +655,25 @@ fn a_block_sliding_on_a_rigid_floor_loses_momentum_to_coulomb_friction() {
             .friction
             .iter()
             .zip(&state.active)
-            .filter(|(_, &a)| a)
-            .map(|(f, _)| f.expect("a frictional row"))
+            .zip(&state.rows)
+            .filter(|((_, &a), _)| a)
+            .map(|((f, _), r)| (f.expect("a frictional row"), r))
             .collect();
         assert!(!points.is_empty());
-        for p in &points {
+        for (p, r) in &points {
             assert_eq!(
                 p.status,
                 contact_patch::contact::friction::Status::Slip,
                 "{name}"
             );
             // the force on the slave along x (the tangent's direction may point either way)
-            let fx = p.force * p.direction[0];
+            let fx = p.force_vector(&r.tangents)[0];
             assert!(
-                fx < 0.0 && (p.force.abs() - mu * p.normal_force).abs() <= 1e-12 * p.normal_force,
-                "{name}: lambda_t {} along {:?}, lambda_n {}",
+                fx < 0.0
+                    && (p.force_length() - mu * p.normal_force).abs() <= 1e-12 * p.normal_force,
+                "{name}: lambda_t {:?} along {:?}, lambda_n {}",
                 p.force,
-                p.direction,
+                r.tangents[0].direction,
                 p.normal_force
             );
             assert!(
@@ -735,7 +737,7 @@ fn penalty_friction_that_brings_a_block_to_rest_passes_its_slip_reversals() {
         );
         let state = solution.contact.as_ref().unwrap();
         for p in state.friction.iter().flatten() {
-            assert!(p.force.abs() <= p.mu * p.normal_force * (1.0 + 1e-12));
+            assert!(p.force_length() <= p.mu * p.normal_force * (1.0 + 1e-12));
             assert!(p.dissipation >= 0.0);
         }
     }

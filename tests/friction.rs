@@ -164,7 +164,13 @@ fn points(o: &Outcome) -> Vec<(Status, f64, f64, f64, [f64; 2])> {
         .zip(&c.friction)
         .map(|(r, f)| {
             let f = f.expect("a frictional row");
-            (f.status, f.force, f.normal_force, r.area, f.direction)
+            (
+                f.status,
+                f.force[0],
+                f.normal_force,
+                r.area,
+                r.tangents[0].direction,
+            )
         })
         .collect()
 }
@@ -717,7 +723,7 @@ fn a_frictionless_scene_builds_no_tangential_row() {
         .push(json!({"body": "punch", "set": "top_left", "x": 0.0}));
     let o = run(&v);
     let c = o.solution.contact.as_ref().unwrap();
-    assert!(c.rows.iter().all(|r| r.tangent.is_none()));
+    assert!(c.rows.iter().all(|r| r.tangents.is_empty()));
     assert!(c.friction.iter().all(|f| f.is_none()));
     assert!(c.steps.iter().all(|s| s.friction.is_none()));
 }
@@ -844,7 +850,7 @@ fn lagrange_multipliers_pass_the_frictional_patch_test_in_stick_and_in_slip() {
         let state = o.solution.contact.as_ref().unwrap();
         for (f, r) in state.friction.iter().zip(&state.rows) {
             if let Some(f) = f {
-                assert!((f.slip - f.committed).abs() <= 1e-14 * 8.0, "{r:?}");
+                assert!((f.slip[0] - f.committed[0]).abs() <= 1e-14 * 8.0, "{r:?}");
                 assert_eq!(f.dissipation, 0.0);
             }
         }
@@ -1078,7 +1084,7 @@ fn augmented_lagrangian_friction_converges_to_the_lagrange_answer() {
             } else {
                 // stick is exact: the points end where the step started them
                 for f in state.friction.iter().flatten() {
-                    assert!((f.slip - f.committed).abs() <= 1e-12, "{what}: {f:?}");
+                    assert!((f.slip[0] - f.committed[0]).abs() <= 1e-12, "{what}: {f:?}");
                 }
             }
             println!(

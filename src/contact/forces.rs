@@ -161,10 +161,12 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
             nodal.entry((b, n)).or_insert([0.0; 2])[comp] += c * lambda;
         }
         // a frictional row's tangential force acts along its slip gradient
-        if let (Some(t), Some(Some(f))) = (&r.tangent, state.friction.get(i)) {
-            for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
-                let (b, n, comp) = owner(model, d);
-                nodal.entry((b, n)).or_insert([0.0; 2])[comp] += c * f.force;
+        if let Some(Some(f)) = state.friction.get(i) {
+            for (t, &lambda_t) in r.tangents.iter().zip(&f.force) {
+                for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
+                    let (b, n, comp) = owner(model, d);
+                    nodal.entry((b, n)).or_insert([0.0; 2])[comp] += c * lambda_t;
+                }
             }
         }
     }

@@ -35,6 +35,25 @@
 //! stick where it lands. The frictional dissipation of a step is `D = -lambda_t (g_t^p -
 //! g_t^{p,n}) = mu lambda_n (|lambda_t^tr| - mu lambda_n) / w_t >= 0` in slip (zero in stick).
 //!
+//! **The return map on a disc** (3D; Wriggers 2006, s. 5.2; Laursen 2002, ch. 5): a point
+//! has `k = D - 1` orthonormal tangents `t_1, .., t_k` (the rows of [`super::TangentRow`]), and
+//! slip, plastic slip and force are vectors of `k` components in that frame. The cone
+//! `|lambda_t| <= mu lambda_n` is a disc, and the map returns radially:
+//!
+//! ```text
+//! trial:  lambda_t^tr = -w_t (g_t - g_t^{p,n})                       (k components)
+//! stick:  |lambda_t^tr| <= mu lambda_n  =>  lambda_t = lambda_t^tr,   d lambda_t / d g_t = -w_t I
+//! slip:   s = lambda_t^tr / |lambda_t^tr|  =>  lambda_t = mu lambda_n s,  g_t^p = g_t + lambda_t / w_t,
+//!         d lambda_t / d g_t = -w_t mu lambda_n (I - s s^T) / |lambda_t^tr|,
+//!         d lambda_t / d lambda_n = mu s
+//! ```
+//!
+//! The `(I - s s^T)` term is the derivative of the slip direction: it is symmetric, so the
+//! tangent's tangential block stays symmetric and only the normal coupling `mu s w_n b_t b_n^T`
+//! is not. With `k = 1`, `|x| = sqrt(x^2)` and `s = +-1`, so `I - s s^T = 0` and the map is the
+//! scalar one above to the last bit (the 2D path runs through the same function). The
+//! dissipation of a step is `-lambda_t . (g_t^p - g_t^{p,n}) >= 0`.
+//!
 //! **Lagrange multipliers** (no tangential penalty, [`multiplier_status`]): the tangential
 //! force `lambda_t` is an unknown, and the sets of the semi-smooth Newton method follow from the
 //! complementarity function of Alart & Curnier (1991, *Comput. Methods Appl. Mech. Engrg.* 92,
@@ -81,6 +100,14 @@
 
 use serde::Serialize;
 
+/// The most tangent directions a point has: two in 3D (the tangent plane), one in 2D.
+pub const MAX_TANGENTS: usize = 2;
+
+/// A tangential vector (slip, force) as its components along a point's orthonormal tangents
+/// `t_1, t_2` ([`super::TangentRow`]); a point with one tangent (2D) uses the first component
+/// only, the second stays zero.
+pub type Tangential = [f64; MAX_TANGENTS];
+
 /// The frictional status of a contact point.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -90,74 +117,172 @@ pub enum Status {
     Slip,
 }
 
-/// The return map at one point.
+/// The return map at one point with `k` tangents (components past `k` are zero).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct ReturnMap {
     pub status: Status,
-    /// The tangential force `lambda_t` (along the row's tangent, on the slave node).
-    pub force: f64,
+    /// The tangential force `lambda_t` (components along the row's tangents, on the slave node).
+    pub force: Tangential,
     /// The plastic slip after the map, `g_t^p`.
-    pub plastic_slip: f64,
-    /// `d lambda_t / d g_t` (`-w_t` in stick, zero otherwise).
-    pub d_slip: f64,
-    /// `d lambda_t / d lambda_n` (`s mu` in slip, zero otherwise).
-    pub d_normal: f64,
+    pub plastic_slip: Tangential,
+    /// `d lambda_t / d g_t` (`k x k`, symmetric): `-w_t I` in stick, `-w_t mu lambda_n (I - s
+    /// s^T) / |lambda_t^tr|` in slip (zero with one tangent), zero open.
+    pub d_slip: [Tangential; MAX_TANGENTS],
+    /// `d lambda_t / d lambda_n` (`mu s` in slip, zero otherwise).
+    pub d_normal: Tangential,
 }
 
-/// The return map of a point with normal force `lambda_n` (`active`: the normal row carries
-/// force), slip `g_t`, committed plastic slip `committed`, friction coefficient `mu` and
-/// tangential weight `w_t = kappa_t A`. A tensile normal force (a row closed at the start of a
-/// step) bounds nothing: it counts as zero.
+impl ReturnMap {
+    fn open(g_t: Tangential) -> Self {
+        ReturnMap {
+            status: Status::Open,
+            force: [0.0; MAX_TANGENTS],
+            plastic_slip: g_t,
+            d_slip: [[0.0; MAX_TANGENTS]; MAX_TANGENTS],
+            d_normal: [0.0; MAX_TANGENTS],
+        }
+    }
+}
+
+/// The length of the first `k` components of `v` (`|v_1|` for one component, exactly).
+pub fn length(k: usize, v: &Tangential) -> f64 {
+    if k == 1 {
+        v[0].abs()
+    } else {
+        v[..k].iter().map(|x| x * x).sum::<f64>().sqrt()
+    }
+}
+
+/// The first `k` components of `v` as a [`Tangential`] (the rest zero).
+pub fn tangential(v: &[f64]) -> Tangential {
+    assert!(
+        (1..=MAX_TANGENTS).contains(&v.len()),
+        "a point has one or two tangents, not {}",
+        v.len()
+    );
+    let mut out = [0.0; MAX_TANGENTS];
+    out[..v.len()].copy_from_slice(v);
+    out
+}
+
+/// The slip branch of the radial return: the force `bound s` along the unit direction `s`,
+/// `d lambda_t / d lambda_n = mu s` when `couples` (the bound is `mu lambda_n` of a compressed
+/// point), and, when the direction follows the trial force (`trial_length`: `Some(|lambda_t^tr|)`,
+/// `None` when the direction is held), `d lambda_t / d g_t = -w_t bound (I - s s^T) /
+/// |lambda_t^tr|` (the derivative of the direction; zero with one tangent).
+fn slip_branch(
+    k: usize,
+    s: Tangential,
+    bound: f64,
+    w_t: f64,
+    mu: f64,
+    couples: bool,
+    trial_length: Option<f64>,
+) -> (Tangential, [Tangential; MAX_TANGENTS], Tangential) {
+    let mut force = [0.0; MAX_TANGENTS];
+    let mut d_slip = [[0.0; MAX_TANGENTS]; MAX_TANGENTS];
+    let mut d_normal = [0.0; MAX_TANGENTS];
+    for a in 0..k {
+        force[a] = s[a] * bound;
+        if couples {
+            d_normal[a] = s[a] * mu;
+        }
+    }
+    if let (true, Some(length)) = (k > 1, trial_length) {
+        let scale = -w_t * bound / length;
+        for a in 0..k {
+            for b in 0..k {
+                let identity = if a == b { 1.0 } else { 0.0 };
+                d_slip[a][b] = scale * (identity - s[a] * s[b]);
+            }
+        }
+    }
+    (force, d_slip, d_normal)
+}
+
+/// The unit direction of the first `k` components of `v` (`sign(v_1)` for one component).
+fn direction(k: usize, v: &Tangential, length: f64) -> Tangential {
+    let mut s = [0.0; MAX_TANGENTS];
+    if k == 1 {
+        s[0] = v[0].signum();
+    } else {
+        for a in 0..k {
+            s[a] = v[a] / length;
+        }
+    }
+    s
+}
+
+/// The stick branch's `d lambda_t / d g_t = -w_t I`.
+fn stick_derivative(k: usize, w_t: f64) -> [Tangential; MAX_TANGENTS] {
+    let mut d = [[0.0; MAX_TANGENTS]; MAX_TANGENTS];
+    for (a, row) in d.iter_mut().enumerate().take(k) {
+        row[a] = -w_t;
+    }
+    d
+}
+
+/// The return map on the disc (see the module doc) of a point with normal force `lambda_n`
+/// (`active`: the normal row carries force), slip `g_t` and committed plastic slip `committed`
+/// (`k` components each, `k = g_t.len()`, one or two), friction coefficient `mu` and tangential
+/// weight `w_t = kappa_t A`. A tensile normal force (a row closed at the start of a step)
+/// bounds nothing: it counts as zero.
 pub fn return_map(
     mu: f64,
     w_t: f64,
     lambda_n: f64,
     active: bool,
-    g_t: f64,
-    committed: f64,
+    g_t: &[f64],
+    committed: &[f64],
 ) -> ReturnMap {
+    let k = g_t.len();
+    let (g, c) = (tangential(g_t), tangential(committed));
     if !active {
-        return ReturnMap {
-            status: Status::Open,
-            force: 0.0,
-            plastic_slip: g_t,
-            d_slip: 0.0,
-            d_normal: 0.0,
-        };
+        return ReturnMap::open(g);
     }
-    let trial = -w_t * (g_t - committed);
+    let mut trial = [0.0; MAX_TANGENTS];
+    for a in 0..k {
+        trial[a] = -w_t * (g[a] - c[a]);
+    }
     let bound = mu * lambda_n.max(0.0);
-    if trial.abs() <= bound {
+    let trial_length = length(k, &trial);
+    if trial_length <= bound {
         return ReturnMap {
             status: Status::Stick,
             force: trial,
-            plastic_slip: committed,
-            d_slip: -w_t,
-            d_normal: 0.0,
+            plastic_slip: c,
+            d_slip: stick_derivative(k, w_t),
+            d_normal: [0.0; MAX_TANGENTS],
         };
     }
-    let s = trial.signum();
-    let force = s * bound;
+    let s = direction(k, &trial, trial_length);
+    let (force, d_slip, d_normal) =
+        slip_branch(k, s, bound, w_t, mu, lambda_n > 0.0, Some(trial_length));
+    let mut plastic_slip = [0.0; MAX_TANGENTS];
+    for a in 0..k {
+        plastic_slip[a] = g[a] + force[a] / w_t;
+    }
     ReturnMap {
         status: Status::Slip,
         force,
-        plastic_slip: g_t + force / w_t,
-        d_slip: 0.0,
-        d_normal: if lambda_n > 0.0 { s * mu } else { 0.0 },
+        plastic_slip,
+        d_slip,
+        d_normal,
     }
 }
 
 /// The return map of the augmented Lagrangian (see the module doc) at a point with Uzawa
 /// multiplier `lambda_bar_t`, stick point `stick_point` (committed at the end of the last load
-/// step), slip `g_t`, and the bound's normal force `bound_force` (`lambda_n`, or
-/// `lambda_bar_n` for Laursen & Simo's form). `bound_varies`: the bound is the current normal
-/// force `lambda_n = lambda_bar_n - w_n g_n` (a slip then couples `d_normal = s mu`); with the
-/// multiplier held fixed it does not (`d_normal = 0`). The returned `plastic_slip` is the
-/// point's stick point after the map: `stick_point` in stick, `g_t` otherwise.
+/// step), slip `g_t` (`k` components each), and the bound's normal force `bound_force`
+/// (`lambda_n`, or `lambda_bar_n` for Laursen & Simo's form). `bound_varies`: the bound is the
+/// current normal force `lambda_n = lambda_bar_n - w_n g_n` (a slip then couples `d_normal =
+/// mu s`); with the multiplier held fixed it does not (`d_normal = 0`). The returned
+/// `plastic_slip` is the point's stick point after the map: `stick_point` in stick, `g_t`
+/// otherwise.
 ///
-/// `held`: the branch to take regardless of the trial force (stick, or slip with its sign `s`),
-/// as in the Newton iteration right after a Uzawa update (see [`crate::solver::contact_newton`]);
-/// `None` (or open) decides from the trial force.
+/// `held`: the branch to take regardless of the trial force (stick, or slip along the unit
+/// direction `s`), as in the Newton iteration right after a Uzawa update (see
+/// [`crate::solver::contact_newton`]); `None` (or open) decides from the trial force.
 #[allow(clippy::too_many_arguments)]
 pub fn augmented_return_map(
     mu: f64,
@@ -165,58 +290,71 @@ pub fn augmented_return_map(
     bound_force: f64,
     bound_varies: bool,
     active: bool,
-    g_t: f64,
-    stick_point: f64,
-    lambda_bar_t: f64,
-    held: Option<(Status, f64)>,
+    g_t: &[f64],
+    stick_point: &[f64],
+    lambda_bar_t: &[f64],
+    held: Option<(Status, Tangential)>,
 ) -> ReturnMap {
+    let k = g_t.len();
+    let (g, p, lambda_bar) = (
+        tangential(g_t),
+        tangential(stick_point),
+        tangential(lambda_bar_t),
+    );
     if !active {
-        return ReturnMap {
-            status: Status::Open,
-            force: 0.0,
-            plastic_slip: g_t,
-            d_slip: 0.0,
-            d_normal: 0.0,
-        };
+        return ReturnMap::open(g);
     }
-    let trial = lambda_bar_t - w_t * (g_t - stick_point);
+    let mut trial = [0.0; MAX_TANGENTS];
+    for a in 0..k {
+        trial[a] = lambda_bar[a] - w_t * (g[a] - p[a]);
+    }
     let bound = mu * bound_force.max(0.0);
-    let (stick, s) = match held {
-        Some((Status::Stick, _)) => (true, 0.0),
-        Some((Status::Slip, s)) => (false, s),
-        _ => (trial.abs() <= bound, trial.signum()),
+    let trial_length = length(k, &trial);
+    let (stick, s, follows_trial) = match held {
+        Some((Status::Stick, _)) => (true, [0.0; MAX_TANGENTS], false),
+        Some((Status::Slip, s)) => (false, s, false),
+        _ => (
+            trial_length <= bound,
+            direction(k, &trial, trial_length),
+            true,
+        ),
     };
     if stick {
         return ReturnMap {
             status: Status::Stick,
             force: trial,
-            plastic_slip: stick_point,
-            d_slip: -w_t,
-            d_normal: 0.0,
+            plastic_slip: p,
+            d_slip: stick_derivative(k, w_t),
+            d_normal: [0.0; MAX_TANGENTS],
         };
     }
+    let (force, d_slip, d_normal) = slip_branch(
+        k,
+        s,
+        bound,
+        w_t,
+        mu,
+        bound_varies && bound_force > 0.0,
+        follows_trial.then_some(trial_length),
+    );
     ReturnMap {
         status: Status::Slip,
-        force: s * bound,
-        plastic_slip: g_t,
-        d_slip: 0.0,
-        d_normal: if bound_varies && bound_force > 0.0 {
-            s * mu
-        } else {
-            0.0
-        },
+        force,
+        plastic_slip: g,
+        d_slip,
+        d_normal,
     }
 }
 
 /// What a frictional point carries from one load step to the next: its committed slip (the
 /// plastic slip of the penalty map, the stick point of the multiplier methods) and its forces
 /// at the end of the step (the Uzawa multipliers the augmented Lagrangian starts the next step
-/// from; unused by the other methods).
+/// from; unused by the other methods), tangential ones as components along the row's tangents.
 #[derive(Copy, Clone, Debug, Default, PartialEq)]
 pub struct Committed {
-    pub slip: f64,
+    pub slip: Tangential,
     pub normal_force: f64,
-    pub tangential_force: f64,
+    pub tangential_force: Tangential,
 }
 
 /// The frictional status of a point with Lagrange multipliers (see the module doc): normal force
@@ -243,33 +381,53 @@ pub fn multiplier_status(
 }
 
 /// What a solve found at one frictional contact point (aligned with the rows of
-/// [`super::state::ContactState`]).
+/// [`super::state::ContactState`]). Tangential quantities are components along the row's
+/// tangents ([`super::Constraint::tangents`]; one in 2D, the second component zero).
 #[derive(Copy, Clone, Debug, PartialEq, Serialize)]
 pub struct FrictionPoint {
     pub status: Status,
-    /// Tangential force `lambda_t` along the row's tangent `t`, on the slave node.
-    pub force: f64,
-    /// The unit tangent `t`.
-    pub direction: [f64; 2],
+    /// Tangential force `lambda_t` on the slave node.
+    pub force: Tangential,
+    /// The number of tangents of the point (1 in 2D, 2 in 3D).
+    pub tangents: usize,
     /// The friction coefficient of the point's pair.
     pub mu: f64,
     /// The normal force bounding it, `lambda_n` (zero when open).
     pub normal_force: f64,
     /// Slip measure `g_t` and plastic slip `g_t^p` at the end of the step, and the plastic slip
     /// committed at the start of the step.
-    pub slip: f64,
-    pub plastic_slip: f64,
-    pub committed: f64,
-    /// Frictional dissipation of the step, `-lambda_t (g_t^p - g_t^{p,n})` (>= 0; zero open).
+    pub slip: Tangential,
+    pub plastic_slip: Tangential,
+    pub committed: Tangential,
+    /// Frictional dissipation of the step, `-lambda_t . (g_t^p - g_t^{p,n})` (>= 0; zero open).
     pub dissipation: f64,
+}
+
+impl FrictionPoint {
+    /// `|lambda_t|`.
+    pub fn force_length(&self) -> f64 {
+        length(self.tangents, &self.force)
+    }
+
+    /// The tangential force as a vector in space, `sum_a lambda_t,a t_a`, with the row's
+    /// tangents `tangents`.
+    pub fn force_vector<const D: usize>(&self, tangents: &[super::TangentRow<D>]) -> [f64; D] {
+        let mut out = [0.0; D];
+        for (t, f) in tangents.iter().zip(&self.force) {
+            for (o, d) in out.iter_mut().zip(&t.direction) {
+                *o += f * d;
+            }
+        }
+        out
+    }
 }
 
 /// The frictional totals of one pair at the end of a solve.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FrictionSummary {
-    /// Sum of the tangential forces `lambda_t t` on the slave nodes, `[x, y]` (the pair's
-    /// `force_on_slave` holds the normal and the tangential forces together).
-    pub tangential_force: [f64; 2],
+    /// Sum of the tangential forces `lambda_t` on the slave nodes, `[x, y]` (`[x, y, z]` in
+    /// 3D; the pair's `force_on_slave` holds the normal and the tangential forces together).
+    pub tangential_force: Vec<f64>,
     pub open: usize,
     pub stick: usize,
     pub slip: usize,
@@ -299,7 +457,7 @@ fn summarize<const D: usize>(
     pair: Option<usize>,
 ) -> Option<FrictionSummary> {
     let mut out = FrictionSummary {
-        tangential_force: [0.0; 2],
+        tangential_force: vec![0.0; D],
         open: 0,
         stick: 0,
         slip: 0,
@@ -312,8 +470,10 @@ fn summarize<const D: usize>(
             continue;
         };
         any = true;
-        for k in 0..2 {
-            out.tangential_force[k] += f.force * f.direction[k];
+        for (t, &component) in r.tangents.iter().zip(&f.force) {
+            for k in 0..D {
+                out.tangential_force[k] += component * t.direction[k];
+            }
         }
         match f.status {
             Status::Open => out.open += 1,
@@ -321,10 +481,11 @@ fn summarize<const D: usize>(
             Status::Slip => out.slip += 1,
         }
         out.dissipation += f.dissipation;
-        if f.status != Status::Open && f.force != 0.0 {
+        let magnitude = f.force_length();
+        if f.status != Status::Open && magnitude != 0.0 {
             out.max_cone_ratio = out
                 .max_cone_ratio
-                .max(f.force.abs() / (f.mu * f.normal_force.max(0.0)));
+                .max(magnitude / (f.mu * f.normal_force.max(0.0)));
         }
     }
     any.then_some(out)
@@ -336,38 +497,51 @@ mod tests {
 
     #[test]
     fn stick_slip_and_open_branches() {
-        let stick = return_map(0.5, 10.0, 4.0, true, 0.1, 0.0);
+        let stick = return_map(0.5, 10.0, 4.0, true, &[0.1], &[0.0]);
         assert_eq!(stick.status, Status::Stick);
-        assert_eq!(stick.force, -1.0);
-        let slip = return_map(0.5, 10.0, 4.0, true, 0.5, 0.0);
+        assert_eq!(stick.force, [-1.0, 0.0]);
+        let slip = return_map(0.5, 10.0, 4.0, true, &[0.5], &[0.0]);
         assert_eq!(slip.status, Status::Slip);
-        assert_eq!(slip.force, -2.0);
+        assert_eq!(slip.force, [-2.0, 0.0]);
+        // one tangent: the direction cannot turn, the slip branch has no slip stiffness
+        assert_eq!(slip.d_slip, [[0.0; 2]; 2]);
+        assert_eq!(slip.d_normal, [-0.5, 0.0]);
         // the elastic part of the slip carries the force
-        assert!((-10.0 * (0.5 - slip.plastic_slip) - slip.force).abs() < 1e-15);
-        let open = return_map(0.5, 10.0, 0.0, false, 0.5, 0.2);
+        assert!((-10.0 * (0.5 - slip.plastic_slip[0]) - slip.force[0]).abs() < 1e-15);
+        let open = return_map(0.5, 10.0, 0.0, false, &[0.5], &[0.2]);
         assert_eq!(
             (open.status, open.force, open.plastic_slip),
-            (Status::Open, 0.0, 0.5)
+            (Status::Open, [0.0; 2], [0.5, 0.0])
         );
     }
 
     #[test]
     fn the_augmented_map_projects_the_trial_force_onto_the_cone() {
         // trial 1.0 - 10 (0.05 - 0.0) = 0.5 inside mu lambda_n = 2: stick, the point kept
-        let stick = augmented_return_map(0.5, 10.0, 4.0, true, true, 0.05, 0.0, 1.0, None);
+        let stick = augmented_return_map(0.5, 10.0, 4.0, true, true, &[0.05], &[0.0], &[1.0], None);
         assert_eq!(
-            (stick.status, stick.force, stick.plastic_slip, stick.d_slip),
+            (
+                stick.status,
+                stick.force[0],
+                stick.plastic_slip[0],
+                stick.d_slip[0][0]
+            ),
             (Status::Stick, 0.5, 0.0, -10.0)
         );
         // trial 1.0 - 10 (0.5) = -4 outside: slip at -mu lambda_n, the point moves to g_t
-        let slip = augmented_return_map(0.5, 10.0, 4.0, true, true, 0.5, 0.0, 1.0, None);
+        let slip = augmented_return_map(0.5, 10.0, 4.0, true, true, &[0.5], &[0.0], &[1.0], None);
         assert_eq!(
-            (slip.status, slip.force, slip.plastic_slip, slip.d_normal),
+            (
+                slip.status,
+                slip.force[0],
+                slip.plastic_slip[0],
+                slip.d_normal[0]
+            ),
             (Status::Slip, -2.0, 0.5, -0.5)
         );
         // Laursen & Simo: the bound held fixed, no coupling to the normal force
-        let fixed = augmented_return_map(0.5, 10.0, 4.0, false, true, 0.5, 0.0, 1.0, None);
-        assert_eq!((fixed.force, fixed.d_normal), (-2.0, 0.0));
+        let fixed = augmented_return_map(0.5, 10.0, 4.0, false, true, &[0.5], &[0.0], &[1.0], None);
+        assert_eq!((fixed.force[0], fixed.d_normal[0]), (-2.0, 0.0));
         // held in stick the force is the trial's, even outside the cone
         let held = augmented_return_map(
             0.5,
@@ -375,14 +549,141 @@ mod tests {
             4.0,
             true,
             true,
-            0.5,
-            0.0,
-            1.0,
-            Some((Status::Stick, 0.0)),
+            &[0.5],
+            &[0.0],
+            &[1.0],
+            Some((Status::Stick, [0.0; 2])),
         );
-        assert_eq!((held.status, held.force), (Status::Stick, -4.0));
-        let open = augmented_return_map(0.5, 10.0, 4.0, true, false, 0.5, 0.2, 1.0, None);
-        assert_eq!((open.status, open.force), (Status::Open, 0.0));
+        assert_eq!((held.status, held.force[0]), (Status::Stick, -4.0));
+        let open = augmented_return_map(0.5, 10.0, 4.0, true, false, &[0.5], &[0.2], &[1.0], None);
+        assert_eq!((open.status, open.force), (Status::Open, [0.0; 2]));
+    }
+
+    /// Central differences of the map's force in the slip and the normal force against
+    /// `d_slip` and `d_normal`, at `g_t` with committed slip `c`.
+    fn difference_error(map: &dyn Fn(&[f64], f64) -> ReturnMap, g: &[f64], lambda_n: f64) -> f64 {
+        let k = g.len();
+        let at = map(g, lambda_n);
+        let h = 1e-7;
+        let mut worst = 0.0f64;
+        for b in 0..k {
+            let (mut plus, mut minus) = (g.to_vec(), g.to_vec());
+            plus[b] += h;
+            minus[b] -= h;
+            let (fp, fm) = (map(&plus, lambda_n), map(&minus, lambda_n));
+            assert_eq!((fp.status, fm.status), (at.status, at.status), "at {g:?}");
+            for a in 0..k {
+                let fd = (fp.force[a] - fm.force[a]) / (2.0 * h);
+                worst = worst.max((fd - at.d_slip[a][b]).abs());
+            }
+        }
+        let (fp, fm) = (map(g, lambda_n + h), map(g, lambda_n - h));
+        for a in 0..k {
+            let fd = (fp.force[a] - fm.force[a]) / (2.0 * h);
+            worst = worst.max((fd - at.d_normal[a]).abs());
+        }
+        worst
+    }
+
+    #[test]
+    fn the_disc_return_map_derivatives_are_its_differences_in_stick_and_slip() {
+        // mu = 0.4, w_t = 30, lambda_n = 5: the disc of radius 2; the committed slip (0.01,
+        // -0.02); slips in eight directions at radii inside (stick) and outside (slip)
+        let (mu, w_t, lambda_n, committed) = (0.4, 30.0, 5.0, [0.01, -0.02]);
+        let penalty = |g: &[f64], n: f64| return_map(mu, w_t, n, true, g, &committed);
+        let augmented = |g: &[f64], n: f64| {
+            augmented_return_map(mu, w_t, n, true, true, g, &committed, &[0.3, 0.5], None)
+        };
+        for (name, map) in [
+            ("penalty", &penalty as &dyn Fn(&[f64], f64) -> ReturnMap),
+            ("augmented", &augmented),
+        ] {
+            for direction in 0..8 {
+                let angle = 0.3 + direction as f64 * std::f64::consts::PI / 4.0;
+                for (radius, status) in [(0.02, Status::Stick), (0.4, Status::Slip)] {
+                    let g = [
+                        committed[0] + radius * angle.cos(),
+                        committed[1] + radius * angle.sin(),
+                    ];
+                    let at = map(&g, lambda_n);
+                    assert_eq!(at.status, status, "{name} at {g:?}");
+                    let error = difference_error(map, &g, lambda_n);
+                    assert!(
+                        error <= 1e-6 * w_t,
+                        "{name} {status:?} along {angle}: derivative error {error:e}"
+                    );
+                    if status == Status::Slip {
+                        // on the disc, along the trial force, against the slip
+                        let force = at.force;
+                        assert!((length(2, &force) - mu * lambda_n).abs() <= 1e-12);
+                        if name == "penalty" {
+                            let slip = [g[0] - committed[0], g[1] - committed[1]];
+                            let cosine = -(force[0] * slip[0] + force[1] * slip[1])
+                                / (length(2, &force) * length(2, &slip));
+                            assert!((cosine - 1.0).abs() <= 1e-12, "{cosine}");
+                        }
+                        // the direction's derivative is not zero in the plane
+                        assert!(at.d_slip[0][0] != 0.0 && at.d_slip[0][1] != 0.0);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_disc_map_with_one_tangent_is_the_scalar_map() {
+        // with k = 1 the radial return is the signed scalar map: |x| = sqrt(x^2), s = +-1
+        for g in [-0.7, -0.05, 0.0, 0.03, 0.9] {
+            let m = return_map(0.3, 20.0, 4.0, true, &[g], &[0.01]);
+            let trial = -20.0 * (g - 0.01);
+            let bound = 0.3 * 4.0;
+            if trial.abs() <= bound {
+                assert_eq!(
+                    (m.status, m.force[0], m.d_slip[0][0]),
+                    (Status::Stick, trial, -20.0)
+                );
+            } else {
+                let s = trial.signum();
+                assert_eq!(
+                    (m.status, m.force[0], m.plastic_slip[0], m.d_normal[0]),
+                    (Status::Slip, s * bound, g + s * bound / 20.0, s * 0.3)
+                );
+            }
+            assert_eq!(
+                (m.force[1], m.plastic_slip[1], m.d_slip[1]),
+                (0.0, 0.0, [0.0; 2])
+            );
+        }
+    }
+
+    #[test]
+    fn the_disc_dissipates_and_is_isotropic() {
+        // rotating the slip and the committed slip about the normal rotates the force: the
+        // map has no preferred tangent; and the dissipation -lambda_t . dg^p is >= 0
+        let (mu, w_t, lambda_n) = (0.5, 10.0, 4.0);
+        let base = return_map(mu, w_t, lambda_n, true, &[0.5, 0.2], &[0.1, -0.1]);
+        for angle in [0.4f64, 1.7, 3.0, -2.2] {
+            let (c, s) = (angle.cos(), angle.sin());
+            let rotate = |v: [f64; 2]| [c * v[0] - s * v[1], s * v[0] + c * v[1]];
+            let rotated = return_map(
+                mu,
+                w_t,
+                lambda_n,
+                true,
+                &rotate([0.5, 0.2]),
+                &rotate([0.1, -0.1]),
+            );
+            let expected = rotate(base.force);
+            assert_eq!(rotated.status, Status::Slip);
+            for a in 0..2 {
+                assert!((rotated.force[a] - expected[a]).abs() <= 1e-14, "{angle}");
+            }
+            let committed = rotate([0.1, -0.1]);
+            let dissipation = -(0..2)
+                .map(|a| rotated.force[a] * (rotated.plastic_slip[a] - committed[a]))
+                .sum::<f64>();
+            assert!(dissipation > 0.0, "{dissipation}");
+        }
     }
 
     #[test]

@@ -28,8 +28,9 @@
 //!   `lambda_k <- lambda` per Newton iteration or in an outer loop,
 //! * constraint elimination: each active row solved for its own slave dof.
 //!
-//! Coulomb pairs give every row its tangential slip measure too ([`TangentRow`]); the return
-//! map of [`friction`] (penalty regularization, Newton scheme) turns it into a tangential force.
+//! Coulomb pairs give every row its tangential slip measures too ([`TangentRow`], one per
+//! tangent direction); the return map of [`friction`] (penalty regularization, Newton scheme)
+//! turns them into a tangential force.
 //!
 //! All six are written once against [`Constraint`] (Taylor 2004, "1985: Solution Methods":
 //! the augmented perturbed form "can reduce to all other forms").
@@ -80,9 +81,10 @@ pub struct Constraint<const D: usize = 2> {
     /// entries sum to `area`. Only the perturbed Lagrangian uses it (see
     /// [`enforcement`]): `C = A^-1 M A^-1 / kappa`.
     pub mass: Vec<(usize, f64)>,
-    /// The tangential slip measure of a frictional (Coulomb) pair, `None` elsewhere: physics
-    /// is opt-in, a frictionless scene builds no tangential row.
-    pub tangent: Option<TangentRow>,
+    /// The tangential slip measures of a frictional (Coulomb) pair, one per tangent direction
+    /// (`D - 1`: one in 2D, an orthonormal pair of the tangent plane in 3D), empty elsewhere:
+    /// physics is opt-in, a frictionless scene builds no tangential row.
+    pub tangents: Vec<TangentRow<D>>,
     /// Finite kinematics, node-to-surface with master normals between deformable bodies: the
     /// row's nodes and positions for the second derivative of its gap
     /// ([`discretization::node_to_segment`]); `None` elsewhere (small strain builds none).
@@ -122,19 +124,51 @@ pub struct GapHessian {
     pub values: Vec<f64>,
 }
 
-/// The tangential slip of a contact point, `g_t(u) = sum_k c_ik u_{d_ik}` (zero at `u = 0`):
-/// the relative displacement of the slave node against its master point along the unit tangent
-/// `t` (`t = (-n_y, n_x)` for the row's normal `n`), with the normal row's projection weights,
-/// `g_t = t . (u_s - sum_m N_m u_m)` (rigid masters: `t . u_s`).
+/// The tangential slip of a contact point along one tangent, `g_t(u) = sum_k c_ik u_{d_ik}`
+/// (zero at `u = 0`): the relative displacement of the slave node against its master point
+/// along the unit tangent `t`, with the normal row's projection weights, `g_t = t . (u_s -
+/// sum_m N_m u_m)` (rigid masters: `t . u_s`). In 2D `t = (-n_y, n_x)` for the row's normal `n`;
+/// in 3D a point has two, an orthonormal frame `t_1, t_2` of the plane normal to `n`
+/// ([`tangent_frame`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct TangentRow {
+pub struct TangentRow<const D: usize = 2> {
     pub dofs: Vec<usize>,
     pub coeffs: Vec<f64>,
     /// The unit tangent `t`: the row's tangential force on the slave node is `lambda_t t`.
-    pub direction: [f64; 2],
+    pub direction: [f64; D],
 }
 
-impl TangentRow {
+/// An orthonormal frame `t_1, t_2` of the plane normal to the unit vector `n` (3D), with
+/// `t_1 x t_2 = n`: `t_1` is `n x e`, normalized, for the axis `e` least aligned with `n` (so
+/// that the cross product is far from zero), `t_2 = n x t_1`. The frame is a function of `n`
+/// alone, so every row with the same normal has the same tangents.
+pub fn tangent_frame(n: [f64; 3]) -> [[f64; 3]; 2] {
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let least = (1..3).fold(
+        0,
+        |best, i| {
+            if n[i].abs() < n[best].abs() {
+                i
+            } else {
+                best
+            }
+        },
+    );
+    let mut e = [0.0; 3];
+    e[least] = 1.0;
+    let t1 = cross(n, e);
+    let l = t1.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let t1 = t1.map(|v| v / l);
+    [t1, cross(n, t1)]
+}
+
+impl<const D: usize> TangentRow<D> {
     /// The slip measure at `u`.
     pub fn slip(&self, u: &[f64]) -> f64 {
         self.dofs
@@ -187,18 +221,22 @@ impl<const D: usize> Constraint<D> {
                 .sum::<f64>()
     }
 
-    /// The gradients the row restrains: the normal one, then the tangential one (if any).
+    /// The gradients the row restrains: the normal one, then the tangential ones (if any).
     pub fn gradients(&self) -> impl Iterator<Item = (&[usize], &[f64])> {
         std::iter::once((&self.dofs[..], &self.coeffs[..]))
-            .chain(self.tangent.as_ref().map(|t| (&t.dofs[..], &t.coeffs[..])))
+            .chain(self.tangents.iter().map(|t| (&t.dofs[..], &t.coeffs[..])))
     }
 
     /// Every dof of the row's normal and tangential gradients and of its second derivative
     /// (each once).
     pub fn all_dofs(&self) -> Vec<usize> {
         let mut d = self.dofs.clone();
-        if let Some(t) = &self.tangent {
-            d.extend(t.dofs.iter().filter(|x| !self.dofs.contains(x)));
+        for t in &self.tangents {
+            for &x in &t.dofs {
+                if !d.contains(&x) {
+                    d.push(x);
+                }
+            }
         }
         let curvature_dofs = self
             .segment

@@ -197,7 +197,7 @@ fn one_pair(model: &Model, state: &ContactState, u: &[f64], forces: &PairForces)
         }
         found.carries_force |= state.active[i];
         if let Some(Some(fp)) = state.friction.get(i) {
-            found.friction = Some((fp.status, fp.slip, fp.plastic_slip));
+            found.friction = Some((fp.status, fp.slip[0], fp.plastic_slip[0]));
         }
     }
 

@@ -119,8 +119,9 @@ pub struct Departure {
     pub pair: usize,
     pub body: usize,
     pub node: usize,
-    /// Where it was when it left (current configuration of that update).
-    pub point: [f64; 2],
+    /// Where it was when it left (current configuration of that update), `[x, y]` or `[x, y,
+    /// z]`.
+    pub point: Vec<f64>,
     pub update: usize,
 }
 

@@ -1226,28 +1226,7 @@ impl Model {
         path: Option<&[f64]>,
         at: &str,
     ) -> Result<Option<Vec<f64>>> {
-        let Some(path) = path else { return Ok(None) };
-        let n = case.solver.load_steps;
-        if path.len() != n {
-            return Err(Error::invalid(
-                &self.source,
-                format!("{at}.path"),
-                format!(
-                    "a load path has one factor per load step: {} given, solver.load_steps is {n}",
-                    path.len()
-                ),
-                "give solver.load_steps factors, e.g. [0, 1] with \"load_steps\": 2",
-            ));
-        }
-        if let Some(v) = path.iter().find(|v| !v.is_finite()) {
-            return Err(Error::invalid(
-                &self.source,
-                format!("{at}.path"),
-                format!("the load path's factors must be finite, got {v}"),
-                "give finite numbers",
-            ));
-        }
-        Ok(Some(path.to_vec()))
+        load_path_factors(case, path, &self.source, at)
     }
 
     fn apply_loads(&mut self, case: &Case) -> Result<()> {
@@ -1494,6 +1473,38 @@ impl Model {
         }
         Ok(())
     }
+}
+
+/// The factors of a load path (`None`: proportional), one per load step of `case`, checked
+/// (`source` and `at` name the case and the load or support in messages).
+pub(crate) fn load_path_factors(
+    case: &Case,
+    path: Option<&[f64]>,
+    source: &str,
+    at: &str,
+) -> Result<Option<Vec<f64>>> {
+    let Some(path) = path else { return Ok(None) };
+    let n = case.solver.load_steps;
+    if path.len() != n {
+        return Err(Error::invalid(
+            source,
+            format!("{at}.path"),
+            format!(
+                "a load path has one factor per load step: {} given, solver.load_steps is {n}",
+                path.len()
+            ),
+            "give solver.load_steps factors, e.g. [0, 1] with \"load_steps\": 2",
+        ));
+    }
+    if let Some(v) = path.iter().find(|v| !v.is_finite()) {
+        return Err(Error::invalid(
+            source,
+            format!("{at}.path"),
+            format!("the load path's factors must be finite, got {v}"),
+            "give finite numbers",
+        ));
+    }
+    Ok(Some(path.to_vec()))
 }
 
 /// A Coulomb pair: its parameters, and what this slice of friction solves (the Newton scheme,

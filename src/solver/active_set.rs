@@ -204,8 +204,9 @@ pub(crate) fn active_keys<const D: usize>(state: &ContactState<D>) -> HashSet<Ro
 }
 
 /// One load step of a contact solve in the model's dimension (see [`solve`]): in 2D every
-/// scheme (active set or Newton, reference or current geometry, friction); in 3D the active-set
-/// scheme in the reference configuration, the only one the 3D model admits.
+/// scheme (active set or Newton, reference or current geometry, friction); in 3D the
+/// reference configuration, by the active-set scheme or by the Newton scheme (which solves
+/// Coulomb friction).
 pub trait ContactStep<const D: usize>: Discretize<D> {
     fn solve_step(
         model: &Model<D, Self>,
@@ -232,10 +233,17 @@ impl ContactStep<3> for crate::fe3d::SolidKind {
     fn solve_step(
         model: &crate::model::Model3,
         previous: Option<HashSet<RowKey>>,
-        _start: Option<Vec<f64>>,
-        _friction: HashMap<RowKey, crate::contact::friction::Committed>,
+        start: Option<Vec<f64>>,
+        friction: HashMap<RowKey, crate::contact::friction::Committed>,
         progress: &mut dyn FnMut(&str),
     ) -> Result<Solution<3>> {
+        if model.solver.scheme == crate::io::scene::Scheme::Newton {
+            // the Newton scheme in the reference geometry (small strain), frictionless or
+            // with Coulomb friction: the 2D code path, generic over the dimension
+            return crate::solver::contact_newton::solve_step(
+                model, previous, start, friction, progress,
+            );
+        }
         solve_at(model, None, previous.as_ref(), None, progress)
     }
 }
@@ -286,7 +294,7 @@ fn solve_step(
                             pair,
                             body,
                             node,
-                            point: [x[0] + u[b.dof(node, 0)], x[1] + u[b.dof(node, 1)]],
+                            point: vec![x[0] + u[b.dof(node, 0)], x[1] + u[b.dof(node, 1)]],
                             update,
                         };
                         if !departures

@@ -92,6 +92,16 @@
 //! instead makes the matrix indefinite, and the iteration diverged on the patch test). A change of a point's
 //! frictional status (open, stick, slip) counts as a status change of the iteration.
 //!
+//! **In 3D** (the system is generic over the dimension `D`, [`NewtonDimension`]; small strain,
+//! the reference geometry) a point has two tangents `t_1, t_2` and the return map works on the
+//! disc: `lambda_t = sum_a lambda_t,a b_t,a` on the residual, and the tangential block
+//! `-sum_ab (d lambda_t,a / d g_t,b) b_t,a b_t,b^T` is `w_t` times the frame's identity in stick
+//! and, in slip, `w_t mu lambda_n (I - s s^T) / |trial|` (the turn of the slip direction,
+//! symmetric), besides the coupling `mu s_a w b_t,a b_n^T`. A slip counts as a change of
+//! status when its direction turns by more than a right angle. The secant remedy of a cycle
+//! applies to one tangent only (on a disc the slip tangent keeps the stiffness of the
+//! direction's turn), and Lagrange-multiplier friction is 2D only (`run3d` refuses it).
+//!
 //! **Coulomb friction with Lagrange multipliers** (Lagrange rows of a Coulomb pair): each row
 //! with a normal multiplier gains a tangential one, `lambda_t = rho mu_t`, numbered after the
 //! normal ones, and the semi-smooth Newton method of Alart & Curnier (1991) in the active-set
@@ -116,17 +126,17 @@
 //! tensile, which pulls the body onto the surface, and the next evaluation decides their status
 //! from the gaps.
 
-use super::active_set::{reference_areas, row_key, rows_at, ReferenceAreas, RowKey};
+use super::active_set::{reference_areas, row_key, rows_at, ContactStep, ReferenceAreas, RowKey};
 use super::finite_assembly::tangent_and_residual;
 use super::linear::{assemble, finish, max_abs, LinearSystem, Solution, Timings, NO_EQUATION};
 use super::newton::{self, Evaluation, System, Tangent};
 use super::sparse::{GeneralPattern, PatternBuilder, SymmetricPattern};
 use crate::contact::discretization::nodal_normal::RowCurvature;
-use crate::contact::discretization::{gap_second_derivative, row_curvature};
+use crate::contact::discretization::{row_curvature, Discretize};
 use crate::contact::enforcement::{method, Method};
 use crate::contact::friction::{
-    augmented_return_map, multiplier_status, return_map, Committed, FrictionPoint, ReturnMap,
-    Status,
+    augmented_return_map, length, multiplier_status, return_map, Committed, FrictionPoint,
+    ReturnMap, Status, Tangential, MAX_TANGENTS,
 };
 use crate::contact::state::{ContactState, Departure, Termination};
 use crate::contact::Constraint;
@@ -136,6 +146,7 @@ use crate::io::scene::{
 };
 use crate::model::rigid::RigidModes;
 use crate::model::Model;
+use crate::solver::constraints::AffineConstraints;
 use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
@@ -159,9 +170,51 @@ enum RowLaw {
     Multiplier,
 }
 
-/// The frictionless contact problem of one load step.
-pub(crate) struct ContactSystem<'a> {
-    model: &'a Model,
+/// What the Newton contact scheme asks of the model's dimension beyond its discretization
+/// ([`Discretize`]): the solids' tangent and residual under finite kinematics.
+pub trait NewtonDimension<const D: usize>: Discretize<D> + ContactStep<D> {
+    /// The tangent `K_T(u)` on `pattern` and the residual `f_int(u) - f_ext` at the free
+    /// equations of `constraints` (finite kinematics), or why not (an inverted element, or
+    /// finite strain not built in this dimension).
+    fn finite_tangent_and_residual(
+        model: &Model<D, Self>,
+        constraints: &AffineConstraints,
+        pattern: &SymmetricPattern,
+        u: &[f64],
+    ) -> std::result::Result<(Vec<f64>, Vec<f64>), String>;
+}
+
+impl NewtonDimension<2> for crate::fe::ElementKind {
+    fn finite_tangent_and_residual(
+        model: &Model,
+        constraints: &AffineConstraints,
+        pattern: &SymmetricPattern,
+        u: &[f64],
+    ) -> std::result::Result<(Vec<f64>, Vec<f64>), String> {
+        tangent_and_residual(model, constraints, pattern, u).map_err(|e| e.to_string())
+    }
+}
+
+impl NewtonDimension<3> for crate::fe3d::SolidKind {
+    /// Finite strain in 3D is not built: `run3d::build3` refuses `physics.kinematics:
+    /// "finite"` before a solve reaches here.
+    fn finite_tangent_and_residual(
+        _model: &crate::model::Model3,
+        _constraints: &AffineConstraints,
+        _pattern: &SymmetricPattern,
+        _u: &[f64],
+    ) -> std::result::Result<(Vec<f64>, Vec<f64>), String> {
+        Err("finite strain in 3D is not built yet".into())
+    }
+}
+
+/// The contact problem of one load step, in `D` dimensions.
+pub(crate) struct ContactSystem<
+    'a,
+    const D: usize = 2,
+    K: NewtonDimension<D> = crate::fe::ElementKind,
+> {
+    model: &'a Model<D, K>,
     sys: LinearSystem,
     /// The pattern of the unknowns: `K`'s, the rows' blocks, and the multipliers' couplings.
     pattern: SymmetricPattern,
@@ -169,7 +222,7 @@ pub(crate) struct ContactSystem<'a> {
     k_positions: Vec<usize>,
     version: usize,
     /// Rows of the last evaluation (current geometry) or of the reference configuration.
-    rows: Vec<Constraint>,
+    rows: Vec<Constraint<D>>,
     /// The multiplier unknown of each row (Lagrange rows with free equations).
     multiplier: Vec<Option<usize>>,
     /// The tangential multiplier unknown of each frictional Lagrange row with a normal one.
@@ -210,14 +263,14 @@ pub(crate) struct ContactSystem<'a> {
     /// Coulomb pairs: the plastic slip committed at the end of the last load step, by point,
     /// and the frictional status of the last evaluation (with the direction of a slip).
     committed: HashMap<RowKey, Committed>,
-    status: HashMap<RowKey, (Status, bool)>,
+    status: HashMap<RowKey, (Status, Tangential)>,
     /// Finite kinematics: the element found inverted at the last evaluation, or the pair found
     /// without rows there (its residual is then NaN, which ends the Newton solve; the load step
     /// is cut).
     inverted: Option<String>,
     /// Augmented-Lagrangian Coulomb pairs: the tangential Uzawa multiplier `lambda_bar_t` by
     /// point (carried from the last load step, updated with the normal one).
-    tangential_augmentation: HashMap<RowKey, f64>,
+    tangential_augmentation: HashMap<RowKey, Tangential>,
     /// Whether the last evaluation changed no point's status (open, stick, slip).
     sets_settled: bool,
     /// A Uzawa update moved a frictional multiplier: the next evaluation keeps the frictional
@@ -229,11 +282,11 @@ pub(crate) struct ContactSystem<'a> {
     multipliers_current: bool,
 }
 
-impl<'a> ContactSystem<'a> {
+impl<'a, const D: usize, K: NewtonDimension<D>> ContactSystem<'a, D, K> {
     /// The problem at the start of a load step: `previous` are the active points of the last
     /// step, `u` its displacement.
     pub(crate) fn new(
-        model: &'a Model,
+        model: &'a Model<D, K>,
         u: Option<&[f64]>,
         previous: Option<&HashSet<RowKey>>,
         committed: HashMap<RowKey, Committed>,
@@ -337,12 +390,14 @@ impl<'a> ContactSystem<'a> {
     }
 
     /// The committed slip of point `key` (zero for a point the last step did not have).
-    fn committed_slip(&self, key: &RowKey) -> f64 {
-        self.committed.get(key).map_or(0.0, |c| c.slip)
+    fn committed_slip(&self, key: &RowKey) -> Tangential {
+        self.committed
+            .get(key)
+            .map_or([0.0; MAX_TANGENTS], |c| c.slip)
     }
 
     /// How row `r` is enforced.
-    fn law(&self, r: &Constraint) -> RowLaw {
+    fn law(&self, r: &Constraint<D>) -> RowLaw {
         let pair = &self.model.contact[r.pair];
         let share = pair.penalty_share();
         match method(&pair.enforcement).kernel() {
@@ -371,13 +426,15 @@ impl<'a> ContactSystem<'a> {
     }
 
     /// Whether row `r` is enforced by constraint elimination.
-    fn eliminated(&self, r: &Constraint) -> bool {
+    fn eliminated(&self, r: &Constraint<D>) -> bool {
         method(&self.model.contact[r.pair].enforcement).kernel() == Method::Elimination
     }
 
     /// The friction coefficient and tangential weight `w_t = kappa_t A` of a frictional row.
-    fn coulomb(&self, r: &Constraint) -> Option<(f64, f64)> {
-        r.tangent.as_ref()?;
+    fn coulomb(&self, r: &Constraint<D>) -> Option<(f64, f64)> {
+        if r.tangents.is_empty() {
+            return None;
+        }
         let pair = &self.model.contact[r.pair];
         let Interaction::Coulomb { mu, kappa_t } = pair.interaction else {
             return None;
@@ -403,10 +460,10 @@ impl<'a> ContactSystem<'a> {
     ) -> Option<ReturnMap> {
         let r = &self.rows[i];
         let (mu, w_t) = self.coulomb(r)?;
-        let t = r.tangent.as_ref()?;
+        let k = r.tangents.len();
         let key = row_key(r);
         let committed = self.committed_slip(&key);
-        let g_t = t.slip(u);
+        let g_t = slip_of(r, u);
         match self.law(r) {
             RowLaw::Penalty {
                 update: Some(_), ..
@@ -429,24 +486,32 @@ impl<'a> ContactSystem<'a> {
                     .holding
                     .then(|| self.status.get(&key))
                     .flatten()
-                    .map(|&(status, positive)| (status, if positive { 1.0 } else { -1.0 }));
+                    .and_then(|&(status, force)| held_branch(k, status, &force));
                 return Some(augmented_return_map(
                     mu,
                     w_t,
                     if fixed { lambda_bar_n } else { lambda_n },
                     !fixed,
                     on,
-                    g_t,
-                    committed,
-                    self.tangential_augmentation
+                    &g_t[..k],
+                    &committed[..k],
+                    &self
+                        .tangential_augmentation
                         .get(&key)
                         .copied()
-                        .unwrap_or(0.0),
+                        .unwrap_or([0.0; MAX_TANGENTS])[..k],
                     held,
                 ));
             }
             RowLaw::Penalty { .. } => {
-                return Some(return_map(mu, w_t, lambda_n, on, g_t, committed));
+                return Some(return_map(
+                    mu,
+                    w_t,
+                    lambda_n,
+                    on,
+                    &g_t[..k],
+                    &committed[..k],
+                ));
             }
             RowLaw::Multiplier => {}
         }
@@ -462,24 +527,27 @@ impl<'a> ContactSystem<'a> {
                 lambda_n,
                 on,
                 lambda_t,
-                g_t - committed,
+                g_t[0] - committed[0],
                 self.rho * self.friction_c,
             )
         };
         Some(ReturnMap {
             status,
-            force: if status == Status::Open {
-                0.0
-            } else {
-                lambda_t
-            },
+            force: [
+                if status == Status::Open {
+                    0.0
+                } else {
+                    lambda_t
+                },
+                0.0,
+            ],
             plastic_slip: if status == Status::Stick {
                 committed
             } else {
                 g_t
             },
-            d_slip: 0.0,
-            d_normal: s,
+            d_slip: [[0.0; MAX_TANGENTS]; MAX_TANGENTS],
+            d_normal: [s, 0.0],
         })
     }
 
@@ -495,7 +563,7 @@ impl<'a> ContactSystem<'a> {
     }
 
     /// The free equations of row `r` with their coefficients.
-    fn free_terms(&self, r: &Constraint) -> Vec<(usize, f64)> {
+    fn free_terms(&self, r: &Constraint<D>) -> Vec<(usize, f64)> {
         r.dofs
             .iter()
             .zip(&r.coeffs)
@@ -564,7 +632,7 @@ impl<'a> ContactSystem<'a> {
                     }
                 }
                 block.push(*j);
-                if let (Some(jt), Some(t)) = (tangential, &r.tangent) {
+                if let (Some(jt), [t]) = (tangential, &r.tangents[..]) {
                     block.extend(self.free_of(&t.dofs, &t.coeffs).iter().map(|&(e, _)| e));
                     block.push(*jt);
                 }
@@ -680,19 +748,22 @@ impl<'a> ContactSystem<'a> {
             let r = &self.rows[i];
             friction.push(self.friction_at(i, &u, x, f, a).map(|m| {
                 let committed = self.committed_slip(&row_key(r));
+                let k = r.tangents.len();
                 FrictionPoint {
                     status: m.status,
                     force: m.force,
-                    direction: r.tangent.as_ref().expect("frictional").direction,
+                    tangents: k,
                     mu: self.coulomb(r).expect("frictional").0,
                     normal_force: if a { f } else { 0.0 },
-                    slip: r.tangent.as_ref().expect("frictional").slip(&u),
+                    slip: slip_of(r, &u),
                     plastic_slip: m.plastic_slip,
                     committed,
                     dissipation: if m.status == Status::Open {
                         0.0
                     } else {
-                        -m.force * (m.plastic_slip - committed)
+                        -(0..k)
+                            .map(|c| m.force[c] * (m.plastic_slip[c] - committed[c]))
+                            .sum::<f64>()
                     },
                 }
             }));
@@ -726,7 +797,7 @@ impl<'a> ContactSystem<'a> {
                 pair,
                 body,
                 node,
-                point: [x[0] + u[b.dof(node, 0)], x[1] + u[b.dof(node, 1)]],
+                point: (0..D).map(|c| x[c] + u[b.dof(node, c)]).collect(),
                 update: self.evaluations,
             });
         }
@@ -746,7 +817,7 @@ impl<'a> ContactSystem<'a> {
 /// The hook of time integration ([`super::dynamics`]): the inertia `c0 M` joins the
 /// stiffness and `c0 M d_pred` the right-hand side (`R = (K + c0 M) x - f - c0 M d_pred - ...`),
 /// and the rows and their state are read after each step.
-impl ContactSystem<'_> {
+impl<const D: usize, K: NewtonDimension<D>> ContactSystem<'_, D, K> {
     /// Add `values` (on the pattern of [`LinearSystem::pattern`]) to the stiffness. The mass
     /// holds every body, so no row is closed at the start to hold a free one.
     pub(crate) fn add_to_stiffness(&mut self, values: &[f64]) {
@@ -771,12 +842,12 @@ impl ContactSystem<'_> {
         self.sys.rhs = rhs;
     }
 
-    pub(crate) fn rows(&self) -> &[Constraint] {
+    pub(crate) fn rows(&self) -> &[Constraint<D>] {
         &self.rows
     }
 
     /// The penalty weight `w = kappa A` of row `r` (`None` for a multiplier row).
-    pub(crate) fn penalty_weight(&self, r: &Constraint) -> Option<f64> {
+    pub(crate) fn penalty_weight(&self, r: &Constraint<D>) -> Option<f64> {
         match self.law(r) {
             RowLaw::Penalty { w, .. } => Some(w),
             RowLaw::Multiplier => None,
@@ -811,7 +882,7 @@ impl ContactSystem<'_> {
     }
 }
 
-impl System for ContactSystem<'_> {
+impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
     fn pattern(&self) -> &SymmetricPattern {
         &self.pattern
     }
@@ -842,10 +913,10 @@ impl System for ContactSystem<'_> {
         let lagrange_friction = self
             .rows
             .iter()
-            .any(|r| r.tangent.is_some() && matches!(self.law(r), RowLaw::Multiplier));
+            .any(|r| !r.tangents.is_empty() && matches!(self.law(r), RowLaw::Multiplier));
         if !lagrange_friction {
             let penalty_friction = self.rows.iter().any(|r| {
-                r.tangent.is_some()
+                !r.tangents.is_empty()
                     && self.coulomb(r).is_some()
                     && matches!(self.law(r), RowLaw::Penalty { .. })
             });
@@ -882,16 +953,20 @@ impl System for ContactSystem<'_> {
             Some(i) => {
                 let r = &self.rows[i];
                 format!(
-                    "the multiplier of the slave node at ({}, {}) of contact '{}' (pass {})",
-                    r.point[0], r.point[1], self.model.contact[r.pair].name, r.pass
+                    "the multiplier of the slave node at {} of contact '{}' (pass {})",
+                    r.site().at(),
+                    self.model.contact[r.pair].name,
+                    r.pass
                 )
             }
             None => match self.tangential.iter().position(|&m| m == Some(k)) {
                 Some(i) => {
                     let r = &self.rows[i];
                     format!(
-                        "the tangential multiplier of the slave node at ({}, {}) of contact '{}' (pass {})",
-                        r.point[0], r.point[1], self.model.contact[r.pair].name, r.pass
+                        "the tangential multiplier of the slave node at {} of contact '{}' (pass {})",
+                        r.site().at(),
+                        self.model.contact[r.pair].name,
+                        r.pass
                     )
                 }
                 None => format!("multiplier {k}"),
@@ -953,13 +1028,18 @@ impl System for ContactSystem<'_> {
         // finite kinematics: the solids' tangent K_T(u) and residual f_int(u) - f_ext
         let mut solid_residual = None;
         if self.model.physics.kinematics == Kinematics::Finite {
-            match tangent_and_residual(self.model, &self.sys.constraints, &self.sys.pattern, &u) {
+            match K::finite_tangent_and_residual(
+                self.model,
+                &self.sys.constraints,
+                &self.sys.pattern,
+                &u,
+            ) {
                 Ok((k, r)) => {
                     self.sys.k = k;
                     solid_residual = Some(r);
                 }
                 Err(inverted) => {
-                    self.inverted = Some(inverted.to_string());
+                    self.inverted = Some(inverted);
                     residual.iter_mut().for_each(|v| *v = f64::NAN);
                     return Ok(Evaluation {
                         force_scale: 1.0,
@@ -1039,52 +1119,67 @@ impl System for ContactSystem<'_> {
             active.insert(key, on);
             forces.insert(key, shown);
             if let Some(mut map) = self.friction_at(i, &u, x, lambda, on) {
+                let k = r.tangents.len();
                 // the branch of the return map: a slip that reverses is a change too, unless
                 // its force is negligible (mu lambda_n at the force tolerance: with mu -> 0 the
                 // direction of a slip that is zero to round-off flips at random and changes
                 // nothing)
-                let branch = (map.status, map.force > 0.0 && map.status == Status::Slip);
                 let previous = self.status.get(&key);
                 let negligible_reversal = map.status == Status::Slip
                     && previous.is_some_and(|p| p.0 == Status::Slip)
-                    && map.force.abs() <= self.force_tolerance;
-                if self.evaluations > 0 && previous != Some(&branch) && !negligible_reversal {
+                    && length(k, &map.force) <= self.force_tolerance;
+                let changed = previous.is_none_or(|&(status, force)| {
+                    status != map.status
+                        || (status == Status::Slip && slip_reversed(k, &force, &map.force))
+                });
+                if self.evaluations > 0 && changed && !negligible_reversal {
                     eval.status_changes += 1;
                 }
                 if self.secant_on_reversal
                     && map.status == Status::Slip
                     && self.tangential[i].is_none()
+                    && k == 1
                 {
                     // the cycle remedy of a slip that swings from one side of the cone to the
                     // other: the slip tangent has no tangential stiffness, so each step swings
                     // it back. Once a point has slipped both ways, its stiffness becomes the
                     // secant to its last iterate on the other side (regula falsi), which
                     // brings the iterates into the stick range if the answer sticks there.
-                    // Only the tangent changes: the residual, and so the answer, do not.
+                    // Only the tangent changes: the residual, and so the answer, do not. (One
+                    // tangent only: on a disc the slip tangent keeps the stiffness of the
+                    // direction's turn, `(I - s s^T)`, and a reversal is not a swing between
+                    // two sides.)
                     let w_t = self.coulomb(r).expect("frictional").1;
-                    let slip = r.tangent.as_ref().expect("frictional").slip(&u);
+                    let slip = slip_of(r, &u)[0];
                     let last = self.slip_sides.entry(key).or_default();
-                    let side = usize::from(!branch.1);
-                    last[side] = Some((slip, map.force));
+                    let side = usize::from(map.force[0] <= 0.0);
+                    last[side] = Some((slip, map.force[0]));
                     if let Some((s_o, f_o)) = last[1 - side] {
                         if slip != s_o {
-                            map.d_normal = 0.0;
-                            map.d_slip = ((map.force - f_o) / (slip - s_o)).clamp(-w_t, 0.0);
+                            map.d_normal = [0.0; MAX_TANGENTS];
+                            map.d_slip[0][0] =
+                                ((map.force[0] - f_o) / (slip - s_o)).clamp(-w_t, 0.0);
                         }
                     }
                 }
-                status.insert(key, branch);
-                let t = r.tangent.as_ref().expect("frictional");
-                let tangential = self.free_of(&t.dofs, &t.coeffs);
-                for &(e, c) in &tangential {
-                    residual[e] -= map.force * c;
-                    eval.force_scale = eval.force_scale.max((map.force * c).abs());
-                    if let Some(m) = magnitude.get_mut(e) {
-                        *m += (map.force * c).abs();
+                status.insert(key, (map.status, map.force));
+                // the tangential gradients over their free equations: one list of equations
+                // (the tangents of a point share their nodes) with a coefficient per tangent
+                let tangential = tangential_terms(r, |d| self.sys.eq(d));
+                for (e, c) in &tangential {
+                    for a in 0..k {
+                        residual[*e] -= map.force[a] * c[a];
+                        eval.force_scale = eval.force_scale.max((map.force[a] * c[a]).abs());
+                        if let Some(m) = magnitude.get_mut(*e) {
+                            *m += (map.force[a] * c[a]).abs();
+                        }
                     }
                 }
                 if let Some(jt) = self.tangential[i] {
-                    // Lagrange rows: the force -rho x_t b_t, and the row of the set
+                    // Lagrange rows (one tangent): the force -rho x_t b_t, and the row of the
+                    // set
+                    let tangential: Vec<(usize, f64)> =
+                        tangential.iter().map(|(e, c)| (*e, c[0])).collect();
                     let jn = self.multiplier[i].expect("a tangential multiplier has a normal one");
                     match map.status {
                         Status::Open => {
@@ -1096,7 +1191,7 @@ impl System for ContactSystem<'_> {
                             // R_t = -rho dg_t, and the augmentation rho dg_t b_t (zero at the
                             // solution) holds a body that only friction holds
                             let committed = self.committed_slip(&key);
-                            let dg = t.slip(&u) - committed;
+                            let dg = slip_of(r, &u)[0] - committed[0];
                             residual[jt] = -rho * dg;
                             for (a, &(ea, ca)) in tangential.iter().enumerate() {
                                 residual[ea] += rho * dg * ca;
@@ -1113,36 +1208,46 @@ impl System for ContactSystem<'_> {
                             // R_t = -rho (x_t - s mu x_n): the column -rho b_t of the force
                             // only, not its transpose
                             let (mu, _) = self.coulomb(r).expect("frictional");
-                            residual[jt] = -rho * (x[jt] - map.d_normal * mu * x[jn]);
+                            residual[jt] = -rho * (x[jt] - map.d_normal[0] * mu * x[jn]);
                             upper[self.pattern.position(jt, jt).expect("diagonal")] = -rho;
-                            slip_rows.push((jt, jn, rho * map.d_normal * mu));
+                            slip_rows.push((jt, jn, rho * map.d_normal[0] * mu));
                             for &(e, c) in &tangential {
                                 upper[self.pattern.position(e, jt).expect("coupling")] -= rho * c;
                                 slip_rows.push((jt, e, rho * c));
                             }
                         }
                     }
-                } else if map.d_slip != 0.0 {
-                    // stick: -d lambda_t/d g_t b_t b_t^T = w_t b_t b_t^T
-                    for (a, &(ea, ca)) in tangential.iter().enumerate() {
-                        for &(eb, cb) in &tangential[a..] {
+                } else if map.d_slip.iter().flatten().any(|&d| d != 0.0) {
+                    // -sum_ab (d lambda_t,a / d g_t,b) b_a b_b^T: w_t b_t b_t^T in stick, and in
+                    // slip on a disc the turn of the direction, w_t mu lambda_n (I - s s^T) /
+                    // |trial| in the frame (symmetric: the upper triangle holds it)
+                    for (p, (ep, cp)) in tangential.iter().enumerate() {
+                        for (eq, cq) in &tangential[p..] {
+                            let mut v = 0.0;
+                            for a in 0..k {
+                                for b in 0..k {
+                                    v += map.d_slip[a][b] * cp[a] * cq[b];
+                                }
+                            }
                             upper[self
                                 .pattern
-                                .position(ea.min(eb), ea.max(eb))
-                                .expect("covered")] -= map.d_slip * ca * cb;
+                                .position((*ep).min(*eq), (*ep).max(*eq))
+                                .expect("covered")] -= v;
                         }
                     }
                 }
-                if map.d_normal != 0.0 && self.tangential[i].is_none() {
+                if map.d_normal.iter().any(|&d| d != 0.0) && self.tangential[i].is_none() {
                     // slip: -b_t (d lambda_t/d lambda_n) (d lambda_n/du)^T, with
                     // d lambda_n/du = -w b_n for the penalty-type normal law
                     let RowLaw::Penalty { w, .. } = self.law(r) else {
                         unreachable!("the model admits friction with penalty-type methods only")
                     };
                     let normal = self.free_terms(r);
-                    for &(ea, ca) in &tangential {
+                    for (ea, ca) in &tangential {
                         for &(eb, cb) in &normal {
-                            coupling.push((ea, eb, map.d_normal * w * ca * cb));
+                            for a in 0..k {
+                                coupling.push((*ea, eb, map.d_normal[a] * w * ca[a] * cb));
+                            }
                         }
                     }
                 }
@@ -1207,20 +1312,18 @@ impl System for ContactSystem<'_> {
             }
             if geometric && lambda != 0.0 {
                 let b = &self.model.bodies[r.slave_body];
-                let dofs = [b.dof(r.slave_node, 0), b.dof(r.slave_node, 1)];
-                let x_s = [
-                    b.mesh.nodes[r.slave_node][0] + u[dofs[0]],
-                    b.mesh.nodes[r.slave_node][1] + u[dofs[1]],
-                ];
-                if let Some(h) = gap_second_derivative(self.model, r, x_s) {
-                    for a in 0..2 {
-                        for c in a..2 {
+                let dofs: [usize; D] = std::array::from_fn(|c| b.dof(r.slave_node, c));
+                let x_s: [f64; D] =
+                    std::array::from_fn(|c| b.mesh.nodes[r.slave_node][c] + u[dofs[c]]);
+                if let Some(h) = K::slave_curvature(self.model, r, x_s) {
+                    for a in 0..D {
+                        for c in a..D {
                             let (ea, ec) = (self.sys.eq(dofs[a]), self.sys.eq(dofs[c]));
                             if ea != NO_EQUATION && ec != NO_EQUATION {
                                 upper[self
                                     .pattern
                                     .position(ea.min(ec), ea.max(ec))
-                                    .expect("node block")] -= lambda * h[2 * a + c];
+                                    .expect("node block")] -= lambda * h[D * a + c];
                             }
                         }
                     }
@@ -1335,11 +1438,12 @@ impl System for ContactSystem<'_> {
                     .tangential_augmentation
                     .get(&key)
                     .copied()
-                    .unwrap_or(0.0);
-                let fscale = fmax.max(map.force.abs());
-                let t = r.tangent.as_ref().expect("frictional");
-                let at_floor = map.status == Status::Stick
-                    && (t.slip(&u) - self.committed_slip(&key)).abs() <= 1e-15 * size;
+                    .unwrap_or([0.0; MAX_TANGENTS]);
+                let k = r.tangents.len();
+                let fscale = fmax.max(length(k, &map.force));
+                let (slip, committed) = (slip_of(r, &u), self.committed_slip(&key));
+                let increment: Tangential = std::array::from_fn(|a| slip[a] - committed[a]);
+                let at_floor = map.status == Status::Stick && length(k, &increment) <= 1e-15 * size;
                 // the round-off floor of the force itself: a slip or gap at the round-off of
                 // the model size times the weights that turn them into forces (the slip force
                 // mu lambda_n moves with the normal one). Without it a point whose forces are
@@ -1347,7 +1451,7 @@ impl System for ContactSystem<'_> {
                 // multiplier by 1e-17 at every update and never converged
                 let (mu, w_t) = self.coulomb(r).expect("frictional");
                 let force_floor = 1e-15 * size * w_t.max(mu * w);
-                let change = (map.force - old).abs();
+                let change = length(k, &std::array::from_fn(|a| map.force[a] - old[a]));
                 if change > 1e-12 * fscale && change > force_floor && !at_floor {
                     tangential_updates.push((key, map.force));
                 }
@@ -1394,13 +1498,13 @@ impl System for ContactSystem<'_> {
 
 /// One load step by Newton's method, from the active points `previous` and the displacement
 /// `start` of the last step.
-pub(crate) fn solve_step(
-    model: &Model,
+pub(crate) fn solve_step<const D: usize, K: NewtonDimension<D>>(
+    model: &Model<D, K>,
     previous: Option<HashSet<RowKey>>,
     start: Option<Vec<f64>>,
     committed: HashMap<RowKey, Committed>,
     progress: &mut dyn FnMut(&str),
-) -> Result<Solution> {
+) -> Result<Solution<D>> {
     let mut timings = Timings::default();
     let t = Instant::now();
     progress("assembling");
@@ -1457,9 +1561,11 @@ pub(crate) fn solve_step(
         for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
             contact_force[d] += c * f;
         }
-        if let (Some(t), Some(fr)) = (&r.tangent, fr) {
-            for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
-                contact_force[d] += c * fr.force;
+        if let Some(fr) = fr {
+            for (t, &lambda_t) in r.tangents.iter().zip(&fr.force) {
+                for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
+                    contact_force[d] += c * lambda_t;
+                }
             }
         }
     }
@@ -1510,6 +1616,69 @@ pub(crate) fn solve_step(
     Ok(solution)
 }
 
+/// The slip of row `r` at `u` along each of its tangents (components past its tangents zero).
+fn slip_of<const D: usize>(r: &Constraint<D>, u: &[f64]) -> Tangential {
+    let mut out = [0.0; MAX_TANGENTS];
+    for (o, t) in out.iter_mut().zip(&r.tangents) {
+        *o = t.slip(u);
+    }
+    out
+}
+
+/// Whether a slip with force `now` runs against the slip of the last iterate (force `before`):
+/// with one tangent, a change of side (`lambda_t > 0` against not); on a disc, a turn of more
+/// than a right angle.
+fn slip_reversed(k: usize, before: &Tangential, now: &Tangential) -> bool {
+    if k == 1 {
+        (before[0] > 0.0) != (now[0] > 0.0)
+    } else {
+        (0..k).map(|a| before[a] * now[a]).sum::<f64>() < 0.0
+    }
+}
+
+/// The branch an augmented-Lagrangian point is held in after a Uzawa update, from its status
+/// and force at the last evaluation: stick, or slip along the force's direction (one tangent:
+/// its sign, `-1` for a zero force). A slip with no force on a disc has no direction to hold:
+/// `None` (the trial force decides).
+fn held_branch(k: usize, status: Status, force: &Tangential) -> Option<(Status, Tangential)> {
+    if status != Status::Slip {
+        return Some((status, [0.0; MAX_TANGENTS]));
+    }
+    if k == 1 {
+        return Some((status, [if force[0] > 0.0 { 1.0 } else { -1.0 }, 0.0]));
+    }
+    let l = length(k, force);
+    (l > 0.0).then(|| (status, std::array::from_fn(|a| force[a] / l)))
+}
+
+/// The free equations of row `r`'s tangential gradients (`eq` maps a dof to its equation,
+/// [`NO_EQUATION`] when prescribed), in the order of the first tangent's dofs, each with its
+/// coefficient along every tangent (the tangents of a point act on the same nodes; a dof
+/// another tangent has that the first lacks is appended).
+fn tangential_terms<const D: usize>(
+    r: &Constraint<D>,
+    eq: impl Fn(usize) -> usize,
+) -> Vec<(usize, Tangential)> {
+    let mut out: Vec<(usize, Tangential)> = Vec::new();
+    for (a, t) in r.tangents.iter().enumerate() {
+        for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
+            let e = eq(d);
+            if e == NO_EQUATION {
+                continue;
+            }
+            match out.iter_mut().find(|(x, _)| *x == e).filter(|_| a > 0) {
+                Some((_, coeffs)) => coeffs[a] += c,
+                None => {
+                    let mut coeffs = [0.0; MAX_TANGENTS];
+                    coeffs[a] = c;
+                    out.push((e, coeffs));
+                }
+            }
+        }
+    }
+    out
+}
+
 /// Add the second-order part of active row `row`'s linearization ([`RowCurvature`]) to the
 /// tangent: with the row's force `force` along its force direction `f` (the row's `coeffs`) and
 /// the weight `w` of `f f^T` already in the displacement block (`law = (w, force, multiplier)`),
@@ -1517,9 +1686,9 @@ pub(crate) fn solve_step(
 /// multiplier's equation `-rho (grad g - f)^T`, `rho = w`), so that the block is
 /// `w f (grad g)^T - force df/dx`. Symmetric contributions go into the upper triangle `upper` of
 /// `pattern`, the others into `unsymmetric` as (row equation, column equation, value).
-fn add_row_curvature(
+fn add_row_curvature<const D: usize>(
     curvature: &RowCurvature,
-    row: &Constraint,
+    row: &Constraint<D>,
     eq: impl Fn(usize) -> usize,
     (w, force, multiplier): (f64, f64, Option<usize>),
     pattern: &SymmetricPattern,
@@ -1580,8 +1749,8 @@ fn add_row_curvature(
 /// for finite-difference checks of the tangent (`tests/friction.rs`): not part of the solver's
 /// interface.
 #[doc(hidden)]
-pub struct Probe<'a> {
-    system: ContactSystem<'a>,
+pub struct Probe<'a, const D: usize = 2, K: NewtonDimension<D> = crate::fe::ElementKind> {
+    system: ContactSystem<'a, D, K>,
     general: GeneralPattern,
 }
 
@@ -1596,20 +1765,31 @@ pub struct ProbeEvaluation {
     pub statuses: Vec<Status>,
 }
 
-impl<'a> Probe<'a> {
+impl<'a, const D: usize, K: NewtonDimension<D>> Probe<'a, D, K> {
     /// The system of `model`'s first load step, every frictional point with the committed
-    /// plastic slip `committed`.
-    pub fn new(model: &'a Model, committed: f64) -> Result<Self> {
+    /// plastic slip `committed` along each of its tangents.
+    pub fn new(model: &'a Model<D, K>, committed: f64) -> Result<Self> {
+        Self::with_committed(model, |_| [committed; MAX_TANGENTS])
+    }
+
+    /// The same with the committed plastic slip of each frictional point given by its row
+    /// (components along the row's tangents).
+    pub fn with_committed(
+        model: &'a Model<D, K>,
+        committed: impl Fn(&Constraint<D>) -> Tangential,
+    ) -> Result<Self> {
         let mut system = ContactSystem::new(model, None, None, HashMap::new())?;
         system.committed = system
             .rows
             .iter()
-            .filter(|r| r.tangent.is_some())
+            .filter(|r| !r.tangents.is_empty())
             .map(|r| {
+                let mut slip = committed(r);
+                slip[r.tangents.len()..].iter_mut().for_each(|s| *s = 0.0);
                 (
                     row_key(r),
                     Committed {
-                        slip: committed,
+                        slip,
                         ..Committed::default()
                     },
                 )
@@ -1643,7 +1823,7 @@ impl<'a> Probe<'a> {
     /// then the scaled normal and tangential multipliers `lambda / rho` of `state`'s rows; the
     /// rows active in `state` start active. Augmented-Lagrangian rows take the state's forces
     /// as their Uzawa multipliers and its committed stick points.
-    pub fn unknowns_at(&mut self, u: &[f64], state: &ContactState) -> Vec<f64> {
+    pub fn unknowns_at(&mut self, u: &[f64], state: &ContactState<D>) -> Vec<f64> {
         let mut x = self.unknowns(u);
         x.resize(self.general.n, 0.0);
         let system = &mut self.system;
@@ -1675,7 +1855,7 @@ impl<'a> Probe<'a> {
                 x[j] = state.forces[i] / system.rho;
             }
             if let (Some(j), Some(f)) = (system.tangential[k], &state.friction[i]) {
-                x[j] = f.force / system.rho;
+                x[j] = f.force[0] / system.rho;
             }
         }
         x

@@ -741,8 +741,10 @@ impl<'a> Integrator<'a> {
                 if let (Some(Some(point)), Interaction::Coulomb { kappa_t, .. }) =
                     (self.friction.get(i), pair.interaction)
                 {
-                    let elastic = point.slip - point.plastic_slip;
-                    contact += 0.5 * kappa_t.unwrap_or(kappa) * r.area * elastic * elastic;
+                    for a in 0..point.tangents {
+                        let elastic = point.slip[a] - point.plastic_slip[a];
+                        contact += 0.5 * kappa_t.unwrap_or(kappa) * r.area * elastic * elastic;
+                    }
                 }
             }
         }
@@ -814,9 +816,11 @@ impl<'a> Integrator<'a> {
             for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
                 contact_force[d] += c * f;
             }
-            if let (Some(t), Some(fr)) = (&r.tangent, fr) {
-                for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
-                    contact_force[d] += c * fr.force;
+            if let Some(fr) = fr {
+                for (t, &lambda_t) in r.tangents.iter().zip(&fr.force) {
+                    for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
+                        contact_force[d] += c * lambda_t;
+                    }
                 }
             }
         }

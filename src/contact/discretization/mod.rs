@@ -137,11 +137,11 @@ impl Rows<'_> {
                     pass,
                     false,
                 );
-                r.tangent = Some(crate::contact::TangentRow {
+                r.tangents = vec![crate::contact::TangentRow {
                     dofs: s.dofs,
                     coeffs: s.coeffs,
                     direction: t,
-                });
+                }];
             }
             self.out.push(r);
         }
@@ -339,7 +339,7 @@ pub(crate) fn weighted_row(
         pair: 0,
         bilateral,
         mass: Vec::new(),
-        tangent: None,
+        tangents: Vec::new(),
         segment: None,
         nodal_normal: None,
         hessian: None,
@@ -716,7 +716,7 @@ fn attach_nodal_normal(rows: &mut Rows, node: usize, lin: NodalNormalLinearizati
 /// The second-order part of row `row`'s linearization in the current configuration (finite
 /// kinematics between deformable bodies), in the one form the Newton tangent consumes for every
 /// row type (see [`RowCurvature`]); `None` for rows that have none.
-pub fn row_curvature(row: &Constraint) -> Option<RowCurvature> {
+pub fn row_curvature<const D: usize>(row: &Constraint<D>) -> Option<RowCurvature> {
     if let Some(segment) = &row.segment {
         let (_, hessian) = segment.gap_and_hessian();
         return Some(RowCurvature {

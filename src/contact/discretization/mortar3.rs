@@ -963,7 +963,7 @@ fn weighted_row(
         pair: numbering.pair,
         bilateral: false,
         mass: Vec::new(),
-        tangent: None,
+        tangents: Vec::new(),
         segment: None,
         nodal_normal: None,
         hessian: None,

@@ -206,7 +206,7 @@ pub fn node_row<const D: usize, K>(
         pair: settings.pair,
         bilateral: false,
         mass: Vec::new(),
-        tangent: None,
+        tangents: Vec::new(),
         segment: None,
         nodal_normal: None,
         hessian: None,

@@ -17,9 +17,16 @@
 //! from its coefficients on the component where `|nu_i|` is largest (at least `1/sqrt 3`), so
 //! they are exact.
 //!
+//! **Coulomb pairs** give every node-based row two tangential slip measures (Wriggers 2006,
+//! s. 4.3; Laursen 2002, ch. 5), `g_t,a = t_a . (u_s - sum_b w_b u_b)` along an orthonormal
+//! frame `t_1, t_2` of the plane normal to the row's normal ([`crate::contact::tangent_frame`]),
+//! with the row's own weights `w_b` (recovered as for ties): the relative tangential motion of
+//! the slave node against its master point. The return map on the disc turns them into the
+//! tangential force ([`crate::contact::friction`]).
+//!
 //! Small strain: the geometry is taken once in the reference configuration. Slave normals,
-//! Coulomb friction and mortar against rigid surfaces are not built in 3D and are refused with
-//! the reason.
+//! Coulomb friction with mortar rows and mortar against rigid surfaces are not built in 3D and
+//! are refused with the reason.
 
 use super::geometry::Surface3;
 use super::mortar3::{mortar_rows3, FacetSet3, RowNumbering};
@@ -27,15 +34,16 @@ use super::node_based_rows::{
     dominant_component, gradient_coefficients, node_to_node_rows, node_to_surface_rows, rigid_rows,
     RigidMaster, RowSettings,
 };
-use crate::contact::Constraint;
+use crate::contact::{Constraint, TangentRow};
 use crate::io::scene::{DiscretizationSpec, Interaction, NormalChoice, RigidSurface};
 use crate::model::{ContactPair, MasterSide, Model3};
 use std::collections::BTreeMap;
 
 /// The rows of `pair` of the 3D model `model`, or why its discretization does not apply.
 pub fn pair_rows(model: &Model3, pair: &ContactPair) -> Result<Vec<Constraint<3>>, String> {
-    if pair.interaction.friction().is_some() {
-        return Err("Coulomb friction in 3D is not built yet".into());
+    let frictional = pair.interaction.friction().is_some();
+    if frictional && matches!(pair.discretization, DiscretizationSpec::Mortar { .. }) {
+        return Err("Coulomb friction with mortar rows in 3D is not built yet (the weighted tangential slip of the segments is not assembled): use {\"kind\": \"node_to_surface\"} or \"node_to_node\" for a frictional pair".into());
     }
     let tied = pair.interaction == Interaction::Tied;
     let (slave_body, slave_facets) = &pair.slave;
@@ -75,7 +83,87 @@ pub fn pair_rows(model: &Model3, pair: &ContactPair) -> Result<Vec<Constraint<3>
             }
         }
     };
-    Ok(if tied { tie(model, rows) } else { rows })
+    Ok(if tied {
+        tie(model, rows)
+    } else if frictional {
+        with_tangents(model, rows)
+    } else {
+        rows
+    })
+}
+
+/// The weights of a node-based row `g = nu . (u_s - sum_b w_b u_b)`.
+struct RowWeights {
+    /// The slave terms `(node, w)`.
+    slave: Vec<(usize, f64)>,
+    /// The master body (rigid masters: the slave body) and its terms `(node, w_b)` (rigid
+    /// masters: none).
+    master_body: usize,
+    master: Vec<(usize, f64)>,
+}
+
+/// The weights of row `r`, recovered from its coefficients on the component where `|nu_i|` is
+/// largest.
+fn row_weights(model: &Model3, r: &Constraint<3>) -> RowWeights {
+    let i = dominant_component(r.normal);
+    let mut slave_terms: Vec<(usize, f64)> = Vec::new();
+    let mut master_terms: Vec<(usize, usize, f64)> = Vec::new();
+    for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
+        let Some(owner) = model.dof_owner(d) else {
+            continue;
+        };
+        if owner.component != i {
+            continue;
+        }
+        let w = c / r.normal[i];
+        if owner.body == r.slave_body {
+            slave_terms.push((owner.node, w));
+        } else {
+            master_terms.push((owner.body, owner.node, -w));
+        }
+    }
+    RowWeights {
+        slave: slave_terms,
+        master_body: master_terms.first().map_or(r.slave_body, |t| t.0),
+        master: master_terms.iter().map(|t| (t.1, t.2)).collect(),
+    }
+}
+
+/// The gradient of `e . (u_s - sum_b w_b u_b)` with the weights of [`row_weights`].
+fn gradient_along(
+    model: &Model3,
+    r: &Constraint<3>,
+    weights: &RowWeights,
+    e: [f64; 3],
+) -> (Vec<usize>, Vec<f64>) {
+    gradient_coefficients(
+        e,
+        &weights.slave,
+        |n, c| model.bodies[r.slave_body].dof(n, c),
+        (weights.master_body, &weights.master),
+        |b, n, c| model.bodies[b].dof(n, c),
+    )
+}
+
+/// Every row with its two tangential slip measures along the frame of its unit normal.
+fn with_tangents(model: &Model3, mut rows: Vec<Constraint<3>>) -> Vec<Constraint<3>> {
+    for r in &mut rows {
+        let l = r.normal.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let frame = crate::contact::tangent_frame(r.normal.map(|v| v / l));
+        let weights = row_weights(model, r);
+        r.tangents = frame
+            .iter()
+            .map(|&t| {
+                let (dofs, coeffs) = gradient_along(model, r, &weights, t);
+                TangentRow {
+                    dofs,
+                    coeffs,
+                    direction: t,
+                }
+            })
+            .collect();
+    }
+    rows
 }
 
 /// The rigid master of a 3D pair.
@@ -129,36 +217,12 @@ fn mortar(
 fn tie(model: &Model3, rows: Vec<Constraint<3>>) -> Vec<Constraint<3>> {
     let mut out = Vec::with_capacity(3 * rows.len());
     for r in rows {
-        let i = dominant_component(r.normal);
         // the weights of the row's nodes: coefficient on component i over nu_i
-        let mut slave_terms: Vec<(usize, f64)> = Vec::new();
-        let mut master_terms: Vec<(usize, usize, f64)> = Vec::new();
-        for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
-            let Some(owner) = model.dof_owner(d) else {
-                continue;
-            };
-            if owner.component != i {
-                continue;
-            }
-            let w = c / r.normal[i];
-            if owner.body == r.slave_body {
-                slave_terms.push((owner.node, w));
-            } else {
-                master_terms.push((owner.body, owner.node, -w));
-            }
-        }
-        let master_body = master_terms.first().map_or(r.slave_body, |t| t.0);
-        let master: Vec<(usize, f64)> = master_terms.iter().map(|t| (t.1, t.2)).collect();
+        let weights = row_weights(model, &r);
         for axis in 0..3 {
             let mut e = [0.0; 3];
             e[axis] = 1.0;
-            let (dofs, coeffs) = gradient_coefficients(
-                e,
-                &slave_terms,
-                |n, c| model.bodies[r.slave_body].dof(n, c),
-                (master_body, &master),
-                |b, n, c| model.bodies[b].dof(n, c),
-            );
+            let (dofs, coeffs) = gradient_along(model, &r, &weights, e);
             out.push(Constraint {
                 dofs,
                 coeffs,
