@@ -122,7 +122,7 @@ use super::linear::{assemble, finish, max_abs, LinearSystem, Solution, Timings, 
 use super::newton::{self, Evaluation, System, Tangent};
 use super::sparse::{GeneralPattern, PatternBuilder, SymmetricPattern};
 use crate::contact::discretization::nodal_normal::RowCurvature;
-use crate::contact::discretization::{gap_second_derivative, row_curvature};
+use crate::contact::discretization::{row_curvature, Discretize};
 use crate::contact::enforcement::{method, Method};
 use crate::contact::friction::{
     augmented_return_map, multiplier_status, return_map, Committed, FrictionPoint, ReturnMap,
@@ -131,6 +131,7 @@ use crate::contact::friction::{
 use crate::contact::state::{ContactState, Departure, Termination};
 use crate::contact::Constraint;
 use crate::error::Result;
+use crate::fe::ElementKind;
 use crate::io::scene::{
     ContactGeometry, FrictionTangent, Interaction, Kinematics, MultiplierUpdate,
 };
@@ -160,8 +161,8 @@ enum RowLaw {
 }
 
 /// The frictionless contact problem of one load step.
-pub(crate) struct ContactSystem<'a> {
-    model: &'a Model,
+pub(crate) struct ContactSystem<'a, const D: usize = 2, K: Discretize<D> = ElementKind> {
+    model: &'a Model<D, K>,
     sys: LinearSystem,
     /// The pattern of the unknowns: `K`'s, the rows' blocks, and the multipliers' couplings.
     pattern: SymmetricPattern,
@@ -169,7 +170,7 @@ pub(crate) struct ContactSystem<'a> {
     k_positions: Vec<usize>,
     version: usize,
     /// Rows of the last evaluation (current geometry) or of the reference configuration.
-    rows: Vec<Constraint>,
+    rows: Vec<Constraint<D>>,
     /// The multiplier unknown of each row (Lagrange rows with free equations).
     multiplier: Vec<Option<usize>>,
     /// The tangential multiplier unknown of each frictional Lagrange row with a normal one.
@@ -229,11 +230,11 @@ pub(crate) struct ContactSystem<'a> {
     multipliers_current: bool,
 }
 
-impl<'a> ContactSystem<'a> {
+impl<'a, const D: usize, K: Discretize<D>> ContactSystem<'a, D, K> {
     /// The problem at the start of a load step: `previous` are the active points of the last
     /// step, `u` its displacement.
     pub(crate) fn new(
-        model: &'a Model,
+        model: &'a Model<D, K>,
         u: Option<&[f64]>,
         previous: Option<&HashSet<RowKey>>,
         committed: HashMap<RowKey, Committed>,
@@ -342,7 +343,7 @@ impl<'a> ContactSystem<'a> {
     }
 
     /// How row `r` is enforced.
-    fn law(&self, r: &Constraint) -> RowLaw {
+    fn law(&self, r: &Constraint<D>) -> RowLaw {
         let pair = &self.model.contact[r.pair];
         let share = pair.penalty_share();
         match method(&pair.enforcement).kernel() {
@@ -371,12 +372,12 @@ impl<'a> ContactSystem<'a> {
     }
 
     /// Whether row `r` is enforced by constraint elimination.
-    fn eliminated(&self, r: &Constraint) -> bool {
+    fn eliminated(&self, r: &Constraint<D>) -> bool {
         method(&self.model.contact[r.pair].enforcement).kernel() == Method::Elimination
     }
 
     /// The friction coefficient and tangential weight `w_t = kappa_t A` of a frictional row.
-    fn coulomb(&self, r: &Constraint) -> Option<(f64, f64)> {
+    fn coulomb(&self, r: &Constraint<D>) -> Option<(f64, f64)> {
         r.tangent.as_ref()?;
         let pair = &self.model.contact[r.pair];
         let Interaction::Coulomb { mu, kappa_t } = pair.interaction else {
@@ -495,7 +496,7 @@ impl<'a> ContactSystem<'a> {
     }
 
     /// The free equations of row `r` with their coefficients.
-    fn free_terms(&self, r: &Constraint) -> Vec<(usize, f64)> {
+    fn free_terms(&self, r: &Constraint<D>) -> Vec<(usize, f64)> {
         r.dofs
             .iter()
             .zip(&r.coeffs)
@@ -811,7 +812,7 @@ impl ContactSystem<'_> {
     }
 }
 
-impl System for ContactSystem<'_> {
+impl<const D: usize, K: Discretize<D>> System for ContactSystem<'_, D, K> {
     fn pattern(&self) -> &SymmetricPattern {
         &self.pattern
     }
@@ -882,16 +883,20 @@ impl System for ContactSystem<'_> {
             Some(i) => {
                 let r = &self.rows[i];
                 format!(
-                    "the multiplier of the slave node at ({}, {}) of contact '{}' (pass {})",
-                    r.point[0], r.point[1], self.model.contact[r.pair].name, r.pass
+                    "the multiplier of the slave node at {} of contact '{}' (pass {})",
+                    point_in_words(&r.point),
+                    self.model.contact[r.pair].name,
+                    r.pass
                 )
             }
             None => match self.tangential.iter().position(|&m| m == Some(k)) {
                 Some(i) => {
                     let r = &self.rows[i];
                     format!(
-                        "the tangential multiplier of the slave node at ({}, {}) of contact '{}' (pass {})",
-                        r.point[0], r.point[1], self.model.contact[r.pair].name, r.pass
+                        "the tangential multiplier of the slave node at {} of contact '{}' (pass {})",
+                        point_in_words(&r.point),
+                        self.model.contact[r.pair].name,
+                        r.pass
                     )
                 }
                 None => format!("multiplier {k}"),
@@ -1207,20 +1212,18 @@ impl System for ContactSystem<'_> {
             }
             if geometric && lambda != 0.0 {
                 let b = &self.model.bodies[r.slave_body];
-                let dofs = [b.dof(r.slave_node, 0), b.dof(r.slave_node, 1)];
-                let x_s = [
-                    b.mesh.nodes[r.slave_node][0] + u[dofs[0]],
-                    b.mesh.nodes[r.slave_node][1] + u[dofs[1]],
-                ];
-                if let Some(h) = gap_second_derivative(self.model, r, x_s) {
-                    for a in 0..2 {
-                        for c in a..2 {
+                let dofs: [usize; D] = std::array::from_fn(|i| b.dof(r.slave_node, i));
+                let x_s: [f64; D] =
+                    std::array::from_fn(|i| b.mesh.nodes[r.slave_node][i] + u[dofs[i]]);
+                if let Some(h) = K::slave_curvature(self.model, r, x_s) {
+                    for a in 0..D {
+                        for c in a..D {
                             let (ea, ec) = (self.sys.eq(dofs[a]), self.sys.eq(dofs[c]));
                             if ea != NO_EQUATION && ec != NO_EQUATION {
                                 upper[self
                                     .pattern
                                     .position(ea.min(ec), ea.max(ec))
-                                    .expect("node block")] -= lambda * h[2 * a + c];
+                                    .expect("node block")] -= lambda * h[D * a + c];
                             }
                         }
                     }
@@ -1394,13 +1397,13 @@ impl System for ContactSystem<'_> {
 
 /// One load step by Newton's method, from the active points `previous` and the displacement
 /// `start` of the last step.
-pub(crate) fn solve_step(
-    model: &Model,
+pub(crate) fn solve_step<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
     previous: Option<HashSet<RowKey>>,
     start: Option<Vec<f64>>,
     committed: HashMap<RowKey, Committed>,
     progress: &mut dyn FnMut(&str),
-) -> Result<Solution> {
+) -> Result<Solution<D>> {
     let mut timings = Timings::default();
     let t = Instant::now();
     progress("assembling");
@@ -1516,9 +1519,9 @@ pub(crate) fn solve_step(
 /// multiplier's equation `-rho (grad g - f)^T`, `rho = w`), so that the block is
 /// `w f (grad g)^T - force df/dx`. Symmetric contributions go into the upper triangle `upper` of
 /// `pattern`, the others into `unsymmetric` as (row equation, column equation, value).
-fn add_row_curvature(
+fn add_row_curvature<const D: usize>(
     curvature: &RowCurvature,
-    row: &Constraint,
+    row: &Constraint<D>,
     eq: impl Fn(usize) -> usize,
     (w, force, multiplier): (f64, f64, Option<usize>),
     pattern: &SymmetricPattern,
@@ -1575,12 +1578,18 @@ fn add_row_curvature(
     }
 }
 
+/// A slave point in words, `(x, y)` or `(x, y, z)`.
+fn point_in_words<const D: usize>(point: &[f64; D]) -> String {
+    let at: Vec<String> = point.iter().map(|x| x.to_string()).collect();
+    format!("({})", at.join(", "))
+}
+
 /// The residual and the tangent of the Newton scheme's contact system, one evaluation at a time,
 /// for finite-difference checks of the tangent (`tests/friction.rs`): not part of the solver's
 /// interface.
 #[doc(hidden)]
-pub struct Probe<'a> {
-    system: ContactSystem<'a>,
+pub struct Probe<'a, const D: usize = 2, K: Discretize<D> = ElementKind> {
+    system: ContactSystem<'a, D, K>,
     general: GeneralPattern,
 }
 
@@ -1595,10 +1604,10 @@ pub struct ProbeEvaluation {
     pub statuses: Vec<Status>,
 }
 
-impl<'a> Probe<'a> {
+impl<'a, const D: usize, K: Discretize<D>> Probe<'a, D, K> {
     /// The system of `model`'s first load step, every frictional point with the committed
     /// plastic slip `committed`.
-    pub fn new(model: &'a Model, committed: f64) -> Result<Self> {
+    pub fn new(model: &'a Model<D, K>, committed: f64) -> Result<Self> {
         let mut system = ContactSystem::new(model, None, None, HashMap::new())?;
         system.committed = system
             .rows
@@ -1642,7 +1651,7 @@ impl<'a> Probe<'a> {
     /// then the scaled normal and tangential multipliers `lambda / rho` of `state`'s rows; the
     /// rows active in `state` start active. Augmented-Lagrangian rows take the state's forces
     /// as their Uzawa multipliers and its committed stick points.
-    pub fn unknowns_at(&mut self, u: &[f64], state: &ContactState) -> Vec<f64> {
+    pub fn unknowns_at(&mut self, u: &[f64], state: &ContactState<D>) -> Vec<f64> {
         let mut x = self.unknowns(u);
         x.resize(self.general.n, 0.0);
         let system = &mut self.system;

@@ -25,6 +25,7 @@ use super::active_set::{active_keys, RowKey, StepRecord};
 use super::contact_newton::solve_step;
 pub use super::history::{FiniteHistory, FiniteStep};
 use super::linear::Solution;
+use crate::contact::discretization::Discretize;
 use crate::contact::state::{IterationRecord, Termination};
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -38,7 +39,10 @@ use std::collections::{HashMap, HashSet};
 pub const MAX_STEP_CUTS: usize = 10;
 
 /// Solve `model` (finite kinematics) in load steps with automatic cuts.
-pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+pub fn solve<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Solution<D>> {
     solve_observed(model, progress, &mut |_, _| {})
 }
 
@@ -46,11 +50,11 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
 /// state it converged to (displacements, reactions, the contact rows and forces of that step,
 /// and its Newton residual history in `contact.history`), for studies that follow a load path
 /// (`harness::finite_sliding`, `tests/finite_objectivity.rs`).
-pub fn solve_observed(
-    model: &Model,
+pub fn solve_observed<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
     progress: &mut dyn FnMut(&str),
-    on_step: &mut dyn FnMut(f64, &Solution),
-) -> Result<Solution> {
+    on_step: &mut dyn FnMut(f64, &Solution<D>),
+) -> Result<Solution<D>> {
     let n = model.solver.load_steps;
     let nominal = 1.0;
     let (mut done, mut increment) = (0.0f64, nominal);
