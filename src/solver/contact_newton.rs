@@ -1210,7 +1210,9 @@ impl<const D: usize, K: Discretize<D>> System for ContactSystem<'_, D, K> {
                         .expect("covered")] += w * ca * cb;
                 }
             }
-            if geometric && lambda != 0.0 {
+            // the derivative of the force term `-force b`: `-force H` (`force = lambda - rho g`
+            // for a multiplier row, whose `rho g` vanishes only at the solution)
+            if geometric && force != 0.0 {
                 let b = &self.model.bodies[r.slave_body];
                 let dofs: [usize; D] = std::array::from_fn(|i| b.dof(r.slave_node, i));
                 let x_s: [f64; D] =
@@ -1223,7 +1225,7 @@ impl<const D: usize, K: Discretize<D>> System for ContactSystem<'_, D, K> {
                                 upper[self
                                     .pattern
                                     .position(ea.min(ec), ea.max(ec))
-                                    .expect("node block")] -= lambda * h[D * a + c];
+                                    .expect("node block")] -= force * h[D * a + c];
                             }
                         }
                     }
@@ -1265,7 +1267,14 @@ impl<const D: usize, K: Discretize<D>> System for ContactSystem<'_, D, K> {
         // is large against the stiffness (a slave node leaving the master's free end puts the
         // remaining rows under a large force of either sign): the saddle-point matrix has
         // pivots of the wrong sign that are not a dependence of rows
-        tangent.indefinite_block = second_derivatives;
+        //
+        // In 3D under finite kinematics the rows are node-to-rigid ones (one row per slave node,
+        // independent: deformable pairs and two passes are refused there), so a pivot of the
+        // wrong sign is not a dependence of rows either: it is the solid's own geometric
+        // stiffness (compressive stress) at an iterate far from equilibrium (the first iterate of a
+        // load step, whose prescribed values jumped ahead of the interior), factored by LU too.
+        tangent.indefinite_block =
+            second_derivatives || (D == 3 && self.model.physics.kinematics == Kinematics::Finite);
         // constraint elimination (the model admits it only on its own): each active row is
         // solved for its owned dof
         if self.rows.iter().any(|r| self.eliminated(r)) {
