@@ -6,6 +6,10 @@
 //! solved by eliminating each active row's owned dof instead of factoring the saddle point
 //! ([`super::newton::Tangent::elimination`]).
 //!
+//! The system is generic over the dimension (`ContactSystem<D, K>`, the cells `K` supplying
+//! their rows through [`Discretize`]): in 3D it serves finite kinematics against rigid planes
+//! and spheres (the sphere's `(I - n n^T) / |x - c|` through [`Discretize::slave_curvature`]).
+//!
 //! Unknowns: the free displacements `x` (prescribed values folded in, [`LinearSystem`]). Each
 //! contact row `i` (a [`Constraint`]: gap `g_i(u)`, gradient `b_i`, tributary area `A_i`) with
 //! penalty weight `w_i = kappa A_i` and augmentation `lambda_bar_i` (zero for penalty and the

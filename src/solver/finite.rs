@@ -8,8 +8,10 @@
 //! [`crate::solid_finite`] (material + geometric part, the consistent tangent, so Newton
 //! converges quadratically). Contact rows against rigid masters are
 //! added by the contact system unchanged: in the current geometry their gap and normal are
-//! functions of `x = X + u`, searched again at every Newton iterate, and the circle's
-//! second derivative of the gap enters the tangent.
+//! functions of `x = X + u`, searched again at every Newton iterate, and the circle's (2D) or
+//! sphere's (3D) second derivative of the gap enters the tangent. The driver is generic over
+//! the dimension: 3D cases ([`crate::run3d`]) run it with the kernels of
+//! [`crate::solid_finite3`].
 //!
 //! **Load stepping with automatic cuts.** Step `k` of `n` drives the load factor to `k / n`
 //! (load paths at their own factors, [`crate::model::Model::at_load`]). When Newton fails on a
