@@ -56,6 +56,7 @@ pub mod run3d;
 pub mod solid;
 pub mod solid3d;
 pub mod solid_finite;
+pub mod solid_finite3;
 pub mod solver;
 
 pub use error::{Error, Result};

@@ -9,10 +9,21 @@
 //! and the active-set contact solve with every enforcement method
 //! ([`crate::solver::active_set`]) are the 2D code paths, generic over the dimension. What is
 //! not built in 3D yet is refused here with the reason (an invalid-case error, exit 2), never
-//! computed wrongly: dynamics, finite strain, the current contact geometry, Coulomb friction
-//! with Lagrange multipliers, sweeps, exact solutions, user-defined sets, loads other than
-//! pressure, checks other than `uniform_stress_3d`; the 3D discretizations refuse what they do
-//! not treat ([`crate::contact::discretization::Discretize`]).
+//! computed wrongly: dynamics, the current contact geometry under small strain, Coulomb
+//! friction with Lagrange multipliers, sweeps, exact solutions, user-defined sets, loads other
+//! than pressure, checks other than `uniform_stress_3d`; the 3D discretizations refuse what
+//! they do not treat ([`crate::contact::discretization::Discretize`]).
+//!
+//! **Finite strain** (`physics.kinematics: "finite"`, hyperelastic materials
+//! [`crate::solid_finite3`]) runs the 2D driver [`crate::solver::finite`] (load steps of
+//! Newton's method with cuts, the same convergence rules and messages) on the 3D model,
+//! through the dimension-generic Newton contact system
+//! ([`crate::solver::contact_newton`]): frictionless contact against rigid planes and spheres
+//! in the current geometry (the sphere's gap second derivative in the tangent), every
+//! enforcement method of the 2D Newton scheme. Refused with the reason: contact between 3D
+//! bodies and tied pairs under finite kinematics, contact without the Newton scheme, the
+//! current geometry or the geometric stiffness. The stress of the checks and the `.vtu` is
+//! then the Cauchy stress `F S F^T / J`, at the reference positions of the points.
 //!
 //! Coulomb friction (issue 13, build item 4) runs through the 2D code path: the Newton scheme
 //! ([`crate::solver::contact_newton`], generic over the dimension) with the return map on the
@@ -23,7 +34,8 @@
 //! The check `uniform_stress_3d` is the 3D uniform-stress check: the largest difference over
 //! the quadrature points of the stiffness rule and the six components, relative to the
 //! largest component of the expected stress. The `.vtu` holds the displacement (3
-//! components) and the nodal stress `[xx, yy, zz, yz, xz, xy]`, the mean over the cells
+//! components) and the nodal stress `[xx, yy, zz, yz, xz, xy]` (Cauchy under finite
+//! kinematics), the mean over the cells
 //! around each node of the stress at the cell's natural centre.
 
 use crate::error::{Error, Result};
@@ -32,12 +44,15 @@ use crate::fe3d::SolidKind;
 use crate::harness::checks::CheckResult;
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
 use crate::io::scene::{
-    Case, Check, ContactGeometry, EnforcementSpec, Kinematics, MeshSpec, Prescribed,
+    Case, Check, ContactGeometry, EnforcementSpec, Interaction, Kinematics, MaterialModel,
+    MeshSpec, Prescribed, Scheme,
 };
 use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
-use crate::model::{Body3, Model3};
+use crate::model::{Body3, MasterSide, Model3};
 use crate::solid3d::{check_geometry3, facet_traction_load, strain_at3, Elasticity3};
+use crate::solid_finite::Hyperelastic;
+use crate::solid_finite3::displacement_gradient_at3;
 use crate::solver::linear::Solution;
 use std::path::Path;
 
@@ -86,7 +101,9 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
     let model = build3(case, source)?;
     let meshed = start.elapsed().as_secs_f64();
     crate::model::admit::check_rigid_modes(&model)?;
-    let mut solution = if model.contact.is_empty() {
+    let mut solution = if model.physics.kinematics == Kinematics::Finite {
+        crate::solver::finite::solve(&model, &mut |_| {})?
+    } else if model.contact.is_empty() {
         crate::solver::linear::solve_elastic(&model, &mut |_| {})?
     } else {
         crate::solver::active_set::solve(&model, &mut |_| {})?
@@ -143,8 +160,25 @@ pub fn uniform_stress_check3(
     }
 }
 
+/// The stress at the natural point `xi` of a cell with reference nodes `coords` under the
+/// element displacement `u_e`, with the reference position of the point: the small-strain
+/// stress, or the Cauchy stress `F S F^T / J` of a hyperelastic body (finite kinematics).
+fn stress_at(body: &Body3, coords: &[[f64; 3]], u_e: &[f64], xi: [f64; 3]) -> ([f64; 3], [f64; 6]) {
+    let kind = body.mesh.kind;
+    match &body.hyperelastic {
+        Some(law) => {
+            let (h, x) = displacement_gradient_at3(kind, coords, u_e, xi);
+            (x, law.cauchy3(&h))
+        }
+        None => {
+            let (eps, x) = strain_at3(kind, coords, u_e, xi);
+            (x, body.material.stress(eps))
+        }
+    }
+}
+
 /// The stress of the displacement `u` (global) in `body` at every quadrature point of the
-/// stiffness rule, with the point: `(x, sigma)`.
+/// stiffness rule, with the point: `(x, sigma)` (see [`stress_at`]).
 pub fn body_stresses(body: &Body3, u: &[f64]) -> Vec<([f64; 3], [f64; 6])> {
     let kind = body.mesh.kind;
     let rule = kind.stiffness_rule();
@@ -155,8 +189,7 @@ pub fn body_stresses(body: &Body3, u: &[f64]) -> Vec<([f64; 3], [f64; 6])> {
         body.cell_dofs(c, &mut dofs);
         let u_e: Vec<f64> = dofs.iter().map(|&d| u[d]).collect();
         for q in &rule {
-            let (eps, x) = strain_at3(kind, &coords, &u_e, q.xi);
-            out.push((x, body.material.stress(eps)));
+            out.push(stress_at(body, &coords, &u_e, q.xi));
         }
     }
     out
@@ -180,20 +213,13 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
             "remove physics.dynamics",
         ));
     }
-    if case.physics.kinematics == Kinematics::Finite {
-        return Err(not_built(
-            source,
-            "physics.kinematics",
-            "finite strain",
-            "use small strain (remove physics.kinematics)",
-        ));
-    }
-    if case.physics.contact_geometry == ContactGeometry::Current {
+    let finite = case.physics.kinematics == Kinematics::Finite;
+    if !finite && case.physics.contact_geometry == ContactGeometry::Current {
         return Err(not_built(
             source,
             "physics.contact_geometry",
-            "contact in the current geometry",
-            "remove physics.contact_geometry (contact in the reference geometry)",
+            "contact in the current geometry under small strain",
+            "remove physics.contact_geometry (contact in the reference geometry), or use \"kinematics\": \"finite\"",
         ));
     }
     if case.sweep.is_some() {
@@ -250,7 +276,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
                 "use the automatic sets: left/right (x), front/back (y), bottom/top (z), the corners such as bottom_front_left, and all",
             ));
         }
-        let material = material3(case, &spec.material, source, &at)?;
+        let (material, hyperelastic) = material3(case, &spec.material, source, &at)?;
         let (xs, ys, zs) = (block.x.values(), block.y.values(), block.z.values());
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
         if !(finite(&xs) && finite(&ys) && finite(&zs))
@@ -292,7 +318,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
             name: spec.name.clone(),
             material_name: spec.material.clone(),
             material,
-            hyperelastic: None,
+            hyperelastic,
             mesh,
             dof_offset: 0,
         });
@@ -310,6 +336,9 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
     apply_supports3(&mut model, case)?;
     apply_pressures3(&mut model, case)?;
     model.resolve_contact(case)?;
+    if finite {
+        check_finite3(&model, case)?;
+    }
     for (k, pair) in case.contact.iter().enumerate() {
         if pair.interaction.friction().is_some() && pair.enforcement == EnforcementSpec::Lagrange {
             return Err(not_built(
@@ -347,8 +376,69 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
     Ok(model)
 }
 
-/// The linear elastic material `name` of the case, validated.
-fn material3(case: &Case, name: &str, source: &str, at: &str) -> Result<Elasticity3> {
+/// What finite kinematics solves in 3D, refused otherwise with the reason: frictionless
+/// contact against rigid masters, by the Newton scheme in the current geometry with the full
+/// tangent.
+fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
+    let source = &model.source;
+    for (k, pair) in model.contact.iter().enumerate() {
+        let at = format!("contact[{k}] '{}'", pair.name);
+        if let MasterSide::Body { .. } = pair.master {
+            return Err(not_built(
+                source,
+                &at,
+                "contact between deformable bodies under finite kinematics",
+                "use a rigid \"plane\" or \"sphere\" master, or small-strain kinematics",
+            ));
+        }
+        if pair.interaction == Interaction::Tied {
+            return Err(not_built(
+                source,
+                format!("{at}.interaction"),
+                "a tied pair under finite kinematics",
+                "use a frictionless pair, or small-strain kinematics",
+            ));
+        }
+    }
+    if model.contact.is_empty() {
+        return Ok(());
+    }
+    if case.solver.scheme != Scheme::Newton {
+        return Err(Error::invalid(
+            source,
+            "solver.scheme",
+            "finite kinematics with contact is solved by the Newton scheme only",
+            "set \"solver\": {\"scheme\": \"newton\"}",
+        ));
+    }
+    if case.physics.contact_geometry != ContactGeometry::Current {
+        return Err(Error::invalid(
+            source,
+            "physics.contact_geometry",
+            "finite kinematics needs the contact geometry of the current configuration",
+            "set \"physics\": {\"contact_geometry\": \"current\"}",
+        ));
+    }
+    if !case.solver.geometric_stiffness {
+        return Err(Error::invalid(
+            source,
+            "solver.geometric_stiffness",
+            "finite kinematics needs the full tangent of the contact rows",
+            "remove \"geometric_stiffness\": false",
+        ));
+    }
+    Ok(())
+}
+
+/// The material `name` of the case, validated: its small-strain elasticity, and its
+/// hyperelastic energy under finite kinematics (linear elasticity is refused there, a
+/// hyperelastic material under small strain).
+fn material3(
+    case: &Case,
+    name: &str,
+    source: &str,
+    at: &str,
+) -> Result<(Elasticity3, Option<Hyperelastic>)> {
     let Some(mat) = case.materials.get(name) else {
         let known: Vec<&String> = case.materials.keys().collect();
         return Err(Error::invalid(
@@ -377,15 +467,34 @@ fn material3(case: &Case, name: &str, source: &str, at: &str) -> Result<Elastici
             "nu = 0.5 (incompressible) is not supported by displacement elements; use e.g. 0.499",
         ));
     }
-    if !mat.model.is_linear() {
-        return Err(not_built(
-            source,
-            format!("materials.{name}.model"),
-            "a hyperelastic material",
-            "use \"model\": \"linear_elastic\"",
-        ));
-    }
-    Ok(Elasticity3::new(mat.youngs_modulus, mat.nu))
+    let hyperelastic = match (case.physics.kinematics, mat.model) {
+        (Kinematics::Finite, MaterialModel::NeoHookean) => {
+            Some(Hyperelastic::neo_hookean(mat.youngs_modulus, mat.nu))
+        }
+        (Kinematics::Finite, MaterialModel::SaintVenantKirchhoff) => Some(
+            Hyperelastic::saint_venant_kirchhoff(mat.youngs_modulus, mat.nu),
+        ),
+        (Kinematics::Finite, _) => {
+            return Err(Error::invalid(
+                source,
+                format!("{at}.material"),
+                format!(
+                    "finite kinematics needs a hyperelastic material, but '{name}' is linear elastic"
+                ),
+                format!("give materials.{name} \"model\": \"neo_hookean\" or \"saint_venant_kirchhoff\""),
+            ))
+        }
+        (_, model) if !model.is_linear() => {
+            return Err(Error::invalid(
+                source,
+                format!("materials.{name}.model"),
+                format!("the hyperelastic material '{name}' needs finite kinematics"),
+                "set \"physics\": {\"kinematics\": \"finite\"}, or use \"model\": \"linear_elastic\" for small strain",
+            ))
+        }
+        _ => None,
+    };
+    Ok((Elasticity3::new(mat.youngs_modulus, mat.nu), hyperelastic))
 }
 
 /// The supports of the case: prescribed components of node sets.
@@ -533,8 +642,7 @@ fn nodal_stress(body: &Body3, u: &[f64]) -> Vec<[f64; 6]> {
     for c in 0..mesh.cell_count() {
         body.cell_dofs(c, &mut dofs);
         let u_e: Vec<f64> = dofs.iter().map(|&d| u[d]).collect();
-        let (eps, _) = strain_at3(kind, &mesh.cell_coords(c), &u_e, kind.centre());
-        let sigma = body.material.stress(eps);
+        let (_, sigma) = stress_at(body, &mesh.cell_coords(c), &u_e, kind.centre());
         for &n in mesh.cell(c) {
             for i in 0..6 {
                 sum[n][i] += sigma[i];
@@ -611,6 +719,10 @@ pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
     // wrote before)
     if let Some(record) = &outcome.solution.iterative {
         summary["linear_solver"] = serde_json::to_value(record).expect("the record serializes");
+    }
+    if let Some(finite) = outcome.solution.finite.as_deref() {
+        // finite kinematics: every attempted load step and the Newton residual history
+        summary["finite"] = serde_json::json!(finite);
     }
     folder.write(|tmp| {
         let text = serde_json::to_string_pretty(&summary).expect("the summary serializes");

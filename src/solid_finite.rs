@@ -183,19 +183,22 @@ fn inverse2(m: &Matrix2<f64>) -> Matrix2<f64> {
 /// A quadrature point where `J = det F <= 0`: the element is inverted (or degenerate) in the
 /// current configuration.
 #[derive(Copy, Clone, Debug, PartialEq)]
-pub struct Inverted {
+pub struct Inverted<const D: usize = 2> {
     /// The quadrature point (index in the element's rule) and its reference position.
     pub point: usize,
-    pub at: [f64; 2],
+    pub at: [f64; D],
     pub det_f: f64,
 }
 
-impl std::fmt::Display for Inverted {
+impl<const D: usize> std::fmt::Display for Inverted<D> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let at: Vec<String> = self.at.iter().map(|x| x.to_string()).collect();
         write!(
             f,
-            "det F = {:.3e} <= 0 at quadrature point {} (reference position ({}, {}))",
-            self.det_f, self.point, self.at[0], self.at[1]
+            "det F = {:.3e} <= 0 at quadrature point {} (reference position ({}))",
+            self.det_f,
+            self.point,
+            at.join(", ")
         )
     }
 }

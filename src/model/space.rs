@@ -15,6 +15,8 @@ use crate::fe3d::SolidKind;
 use crate::model::Model;
 use crate::solid::{element_internal_force, element_stiffness, Elasticity, Kinematics};
 use crate::solid3d::{element_internal_force3, element_stiffness3, Elasticity3};
+use crate::solid_finite::{element_residual_and_tangent, Hyperelastic, Inverted};
+use crate::solid_finite3::element_residual_and_tangent3;
 
 /// The cell kinds of a `D`-dimensional elastic body.
 pub trait SolidCell<const D: usize>: ReferenceCell<D> + Send + Sync + 'static {
@@ -47,6 +49,25 @@ pub trait SolidCell<const D: usize>: ReferenceCell<D> + Send + Sync + 'static {
         rule: &[QuadPoint<D>],
         out: &mut [f64],
     );
+
+    /// The total-Lagrangian internal force `f_e` (into `force[..D n]`) and, with
+    /// `with_tangent`, the consistent tangent `K_e` (material + geometric, row-major, into
+    /// `k[..(D n)^2]`) of the cell at `coords` under the element displacement `u_e`, for the
+    /// hyperelastic energy `law` ([`crate::solid_finite`] in 2D, plane strain, times the
+    /// thickness; [`crate::solid_finite3`] in 3D); `Err` at a quadrature point with
+    /// `det F <= 0`.
+    #[allow(clippy::too_many_arguments)]
+    fn finite_residual_and_tangent(
+        self,
+        coords: &[[f64; D]],
+        u_e: &[f64],
+        law: &Hyperelastic,
+        thickness: f64,
+        rule: &[QuadPoint<D>],
+        with_tangent: bool,
+        force: &mut [f64],
+        k: &mut [f64],
+    ) -> Result<(), Inverted<D>>;
 
     /// The model as a 2D model, where the physics built only in 2D (finite strain, dynamics,
     /// friction, exact fields) lives; `None` in 3D, where the model refuses those scenes.
@@ -104,6 +125,31 @@ impl SolidCell<2> for ElementKind {
         }
     }
 
+    fn finite_residual_and_tangent(
+        self,
+        coords: &[[f64; 2]],
+        u_e: &[f64],
+        law: &Hyperelastic,
+        thickness: f64,
+        rule: &[QuadPoint<2>],
+        with_tangent: bool,
+        force: &mut [f64],
+        k: &mut [f64],
+    ) -> Result<(), Inverted<2>> {
+        let (f, ke) =
+            element_residual_and_tangent(self, coords, u_e, law, thickness, rule, with_tangent)?;
+        let nd = u_e.len();
+        force[..nd].copy_from_slice(&f.as_slice()[..nd]);
+        if with_tangent {
+            for i in 0..nd {
+                for j in 0..nd {
+                    k[i * nd + j] = ke[(i, j)];
+                }
+            }
+        }
+        Ok(())
+    }
+
     fn as_plane(model: &Model) -> Option<&Model> {
         Some(model)
     }
@@ -144,6 +190,20 @@ impl SolidCell<3> for SolidKind {
         for (o, f) in out.iter_mut().zip(&fe) {
             *o += f;
         }
+    }
+
+    fn finite_residual_and_tangent(
+        self,
+        coords: &[[f64; 3]],
+        u_e: &[f64],
+        law: &Hyperelastic,
+        _thickness: f64,
+        rule: &[QuadPoint<3>],
+        with_tangent: bool,
+        force: &mut [f64],
+        k: &mut [f64],
+    ) -> Result<(), Inverted<3>> {
+        element_residual_and_tangent3(self, coords, u_e, law, rule, with_tangent, force, k)
     }
 
     fn as_plane(_model: &Model<3, SolidKind>) -> Option<&Model> {

@@ -6,6 +6,10 @@
 //! solved by eliminating each active row's owned dof instead of factoring the saddle point
 //! ([`super::newton::Tangent::elimination`]).
 //!
+//! The system is generic over the dimension (`ContactSystem<D, K>`, the cells `K` supplying
+//! their rows through [`Discretize`]): in 3D it serves finite kinematics against rigid planes
+//! and spheres (the sphere's `(I - n n^T) / |x - c|` through [`Discretize::slave_curvature`]).
+//!
 //! Unknowns: the free displacements `x` (prescribed values folded in, [`LinearSystem`]). Each
 //! contact row `i` (a [`Constraint`]: gap `g_i(u)`, gradient `b_i`, tributary area `A_i`) with
 //! penalty weight `w_i = kappa A_i` and augmentation `lambda_bar_i` (zero for penalty and the
@@ -196,15 +200,15 @@ impl NewtonDimension<2> for crate::fe::ElementKind {
 }
 
 impl NewtonDimension<3> for crate::fe3d::SolidKind {
-    /// Finite strain in 3D is not built: `run3d::build3` refuses `physics.kinematics:
-    /// "finite"` before a solve reaches here.
+    /// The hyperelastic kernels of [`crate::solid_finite3`] through the dimension-generic
+    /// finite assembly.
     fn finite_tangent_and_residual(
-        _model: &crate::model::Model3,
-        _constraints: &AffineConstraints,
-        _pattern: &SymmetricPattern,
-        _u: &[f64],
+        model: &crate::model::Model3,
+        constraints: &AffineConstraints,
+        pattern: &SymmetricPattern,
+        u: &[f64],
     ) -> std::result::Result<(Vec<f64>, Vec<f64>), String> {
-        Err("finite strain in 3D is not built yet".into())
+        tangent_and_residual(model, constraints, pattern, u).map_err(|e| e.to_string())
     }
 }
 
@@ -1310,7 +1314,9 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
                         .expect("covered")] += w * ca * cb;
                 }
             }
-            if geometric && lambda != 0.0 {
+            // the derivative of the force term `-force b`: `-force H` (`force = lambda - rho g`
+            // for a multiplier row, whose `rho g` vanishes only at the solution)
+            if geometric && force != 0.0 {
                 let b = &self.model.bodies[r.slave_body];
                 let dofs: [usize; D] = std::array::from_fn(|c| b.dof(r.slave_node, c));
                 let x_s: [f64; D] =
@@ -1323,7 +1329,7 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
                                 upper[self
                                     .pattern
                                     .position(ea.min(ec), ea.max(ec))
-                                    .expect("node block")] -= lambda * h[D * a + c];
+                                    .expect("node block")] -= force * h[D * a + c];
                             }
                         }
                     }
@@ -1365,7 +1371,14 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
         // is large against the stiffness (a slave node leaving the master's free end puts the
         // remaining rows under a large force of either sign): the saddle-point matrix has
         // pivots of the wrong sign that are not a dependence of rows
-        tangent.indefinite_block = second_derivatives;
+        //
+        // In 3D under finite kinematics the rows are node-to-rigid ones (one row per slave node,
+        // independent: deformable pairs and two passes are refused there), so a pivot of the
+        // wrong sign is not a dependence of rows either: it is the solid's own geometric
+        // stiffness (compressive stress) at an iterate far from equilibrium (the first iterate of a
+        // load step, whose prescribed values jumped ahead of the interior), factored by LU too.
+        tangent.indefinite_block =
+            second_derivatives || (D == 3 && self.model.physics.kinematics == Kinematics::Finite);
         // constraint elimination (the model admits it only on its own): each active row is
         // solved for its owned dof
         if self.rows.iter().any(|r| self.eliminated(r)) {

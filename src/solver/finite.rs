@@ -8,8 +8,10 @@
 //! [`crate::solid_finite`] (material + geometric part, the consistent tangent, so Newton
 //! converges quadratically). Contact rows against rigid masters are
 //! added by the contact system unchanged: in the current geometry their gap and normal are
-//! functions of `x = X + u`, searched again at every Newton iterate, and the circle's
-//! second derivative of the gap enters the tangent.
+//! functions of `x = X + u`, searched again at every Newton iterate, and the circle's (2D) or
+//! sphere's (3D) second derivative of the gap enters the tangent. The driver is generic over
+//! the dimension: 3D cases ([`crate::run3d`]) run it with the kernels of
+//! [`crate::solid_finite3`].
 //!
 //! **Load stepping with automatic cuts.** Step `k` of `n` drives the load factor to `k / n`
 //! (load paths at their own factors, [`crate::model::Model::at_load`]). When Newton fails on a
@@ -28,6 +30,7 @@ use super::linear::Solution;
 use crate::contact::state::{IterationRecord, Termination};
 use crate::error::{Error, Result};
 use crate::model::Model;
+use crate::solver::contact_newton::NewtonDimension;
 use std::collections::{HashMap, HashSet};
 
 /// The most cuts of load increments in one solve (each halves the increment; the smallest
@@ -38,7 +41,10 @@ use std::collections::{HashMap, HashSet};
 pub const MAX_STEP_CUTS: usize = 10;
 
 /// Solve `model` (finite kinematics) in load steps with automatic cuts.
-pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+pub fn solve<const D: usize, K: NewtonDimension<D>>(
+    model: &Model<D, K>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Solution<D>> {
     solve_observed(model, progress, &mut |_, _| {})
 }
 
@@ -46,11 +52,11 @@ pub fn solve(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> 
 /// state it converged to (displacements, reactions, the contact rows and forces of that step,
 /// and its Newton residual history in `contact.history`), for studies that follow a load path
 /// (`harness::finite_sliding`, `tests/finite_objectivity.rs`).
-pub fn solve_observed(
-    model: &Model,
+pub fn solve_observed<const D: usize, K: NewtonDimension<D>>(
+    model: &Model<D, K>,
     progress: &mut dyn FnMut(&str),
-    on_step: &mut dyn FnMut(f64, &Solution),
-) -> Result<Solution> {
+    on_step: &mut dyn FnMut(f64, &Solution<D>),
+) -> Result<Solution<D>> {
     let n = model.solver.load_steps;
     let nominal = 1.0;
     let (mut done, mut increment) = (0.0f64, nominal);

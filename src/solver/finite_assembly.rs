@@ -1,27 +1,28 @@
 //! Assembly of finite-kinematics solids: the internal force `f_int(u) = assemble_e f_e(u_e)`
 //! and the tangent `K_T(u) = assemble_e K_e(u_e)` from the total-Lagrangian hyperelastic
-//! kernels of [`crate::solid_finite`] (`f_a = sum_q w F S grad_0 N_a`, material + geometric
-//! tangent), over the free equations of the Dirichlet constraints (prescribed dofs eliminated,
+//! kernels of [`crate::solid_finite`] (plane strain) and [`crate::solid_finite3`] (3D) behind
+//! [`SolidCell::finite_residual_and_tangent`] (`f_a = sum_q w F S grad_0 N_a`, material +
+//! geometric tangent), in 2D and 3D alike, over the free equations of the Dirichlet constraints (prescribed dofs eliminated,
 //! [`crate::solver::constraints::AffineConstraints`]: the residual is `f_int(u) - f_ext`
 //! restricted to the free dofs, `u` holding the prescribed values). An element with
 //! `det F <= 0` at a quadrature point stops the assembly with its body and cell named
 //! ([`InvertedElement`]).
 
+use crate::model::space::SolidCell;
 use crate::model::Model;
-use crate::solid::MAX_DOFS;
-use crate::solid_finite::{element_residual_and_tangent, Inverted};
+use crate::solid_finite::Inverted;
 use crate::solver::constraints::AffineConstraints;
 use crate::solver::sparse::SymmetricPattern;
 
 /// An element inverted at a state: its body, cell and quadrature point.
 #[derive(Clone, Debug)]
-pub struct InvertedElement {
+pub struct InvertedElement<const D: usize = 2> {
     pub body: String,
     pub cell: usize,
-    pub inverted: Inverted,
+    pub inverted: Inverted<D>,
 }
 
-impl std::fmt::Display for InvertedElement {
+impl<const D: usize> std::fmt::Display for InvertedElement<D> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
@@ -33,15 +34,22 @@ impl std::fmt::Display for InvertedElement {
 
 /// Calls `visit(dofs, f_e, K_e)` (`K_e` row-major when `with_tangent`) for every cell of every
 /// body at the displacement `u`; stops at the first inverted cell.
-fn for_each_element(
-    model: &Model,
+fn for_each_element<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
     u: &[f64],
     with_tangent: bool,
     mut visit: impl FnMut(&[usize], &[f64], &[f64]),
-) -> std::result::Result<(), InvertedElement> {
-    let mut dofs = Vec::with_capacity(MAX_DOFS);
-    let mut ue = [0.0; MAX_DOFS];
-    let mut ke = [0.0; MAX_DOFS * MAX_DOFS];
+) -> std::result::Result<(), InvertedElement<D>> {
+    let largest = model
+        .bodies
+        .iter()
+        .map(|b| D * b.mesh.kind.node_count())
+        .max()
+        .unwrap_or(0);
+    let mut dofs = Vec::with_capacity(largest);
+    let mut ue = vec![0.0; largest];
+    let mut fe = vec![0.0; largest];
+    let mut ke = vec![0.0; largest * largest];
     for body in &model.bodies {
         let law = body
             .hyperelastic
@@ -55,35 +63,32 @@ fn for_each_element(
             for (v, &d) in ue.iter_mut().zip(&dofs) {
                 *v = u[d];
             }
-            let (f, k) = element_residual_and_tangent(
-                kind,
+            kind.finite_residual_and_tangent(
                 &body.mesh.cell_coords(c),
                 &ue[..nd],
                 law,
                 model.thickness,
                 &rule,
                 with_tangent,
+                &mut fe,
+                &mut ke,
             )
             .map_err(|inverted| InvertedElement {
                 body: body.name.clone(),
                 cell: c,
                 inverted,
             })?;
-            if with_tangent {
-                for i in 0..nd {
-                    for j in 0..nd {
-                        ke[i * nd + j] = k[(i, j)];
-                    }
-                }
-            }
-            visit(&dofs, &f.as_slice()[..nd], &ke[..nd * nd]);
+            visit(&dofs, &fe[..nd], &ke[..nd * nd]);
         }
     }
     Ok(())
 }
 
 /// The internal force `f_int(u)` of every body at the global displacement `u`.
-pub fn internal_force(model: &Model, u: &[f64]) -> std::result::Result<Vec<f64>, InvertedElement> {
+pub fn internal_force<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    u: &[f64],
+) -> std::result::Result<Vec<f64>, InvertedElement<D>> {
     let mut out = vec![0.0; u.len()];
     for_each_element(model, u, false, |dofs, f, _| {
         for (&d, v) in dofs.iter().zip(f) {
@@ -96,12 +101,12 @@ pub fn internal_force(model: &Model, u: &[f64]) -> std::result::Result<Vec<f64>,
 /// The tangent `K_T(u)` on `pattern` (the free equations of `constraints`) and the residual
 /// `f_int(u) - f_ext` at the free equations, `u` the global displacement (prescribed values
 /// included).
-pub(crate) fn tangent_and_residual(
-    model: &Model,
+pub(crate) fn tangent_and_residual<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
     constraints: &AffineConstraints,
     pattern: &SymmetricPattern,
     u: &[f64],
-) -> std::result::Result<(Vec<f64>, Vec<f64>), InvertedElement> {
+) -> std::result::Result<(Vec<f64>, Vec<f64>), InvertedElement<D>> {
     let mut local = constraints.local();
     let mut k = vec![0.0; pattern.nnz()];
     // the constant part -K_fp u_p of the distribution is not part of the residual

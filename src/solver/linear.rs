@@ -489,12 +489,10 @@ pub fn finish<const D: usize, K: SolidCell<D>>(
 /// The internal force `f_int(u)` of every body at the global displacement `u`, element by
 /// element (small strain: `K u`; finite kinematics: [`crate::solver::finite_assembly::internal_force`]).
 pub fn internal_force<const D: usize, K: SolidCell<D>>(model: &Model<D, K>, u: &[f64]) -> Vec<f64> {
-    if let Some(plane) = K::as_plane(model) {
-        if plane.physics.kinematics == crate::io::scene::Kinematics::Finite {
-            // an inverted element has no internal force: NaN, which every caller refuses by name
-            return crate::solver::finite_assembly::internal_force(plane, u)
-                .unwrap_or_else(|_| vec![f64::NAN; u.len()]);
-        }
+    if model.physics.kinematics == crate::io::scene::Kinematics::Finite {
+        // an inverted element has no internal force: NaN, which every caller refuses by name
+        return crate::solver::finite_assembly::internal_force(model, u)
+            .unwrap_or_else(|_| vec![f64::NAN; u.len()]);
     }
     let mut f = vec![0.0; u.len()];
     let mut dofs = Vec::with_capacity(MAX_DOFS);

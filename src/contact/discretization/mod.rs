@@ -212,12 +212,21 @@ impl Discretize<3> for crate::fe3d::SolidKind {
         pair3::pair_rows(model, pair)
     }
 
+    /// Against a rigid sphere, `(I - n n^T) / |x_s - c|` ([`sphere_gap_hessian`]); rigid
+    /// planes are affine, and rows between 3D bodies carry none (`None`).
     fn slave_curvature(
-        _model: &crate::model::Model3,
-        _row: &Constraint<3>,
-        _x_s: [f64; 3],
+        model: &crate::model::Model3,
+        row: &Constraint<3>,
+        x_s: [f64; 3],
     ) -> Option<Vec<f64>> {
-        None
+        let pair = &model.contact[row.pair];
+        let MasterSide::Rigid(RigidSurface::Sphere { centre, .. }) = pair.master else {
+            return None;
+        };
+        if row.bilateral {
+            return None;
+        }
+        sphere_gap_hessian(centre, x_s).map(|h| h.concat())
     }
 }
 
@@ -788,18 +797,22 @@ pub fn gap_second_derivative(model: &Model, row: &Constraint, x_s: [f64; 2]) -> 
     if row.bilateral {
         return None;
     }
-    let d = [x_s[0] - centre[0], x_s[1] - centre[1]];
-    let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+    sphere_gap_hessian(centre, x_s).map(|[a, b]| [a[0], a[1], b[0], b[1]])
+}
+
+/// The second derivative of the gap `g = |x - c| - R` of a point `x` outside a rigid circle
+/// (2D) or sphere (3D) with centre `c`: `d2g/dx2 = (I - n n^T) / |x - c|`, `n = (x - c) / |x - c|`
+/// (row `i`, column `j`); `None` at the centre, where the normal is undefined.
+pub fn sphere_gap_hessian<const D: usize>(centre: [f64; D], x: [f64; D]) -> Option<[[f64; D]; D]> {
+    let d: [f64; D] = std::array::from_fn(|i| x[i] - centre[i]);
+    let l = d.iter().map(|v| v * v).sum::<f64>().sqrt();
     if l == 0.0 {
         return None;
     }
-    let n = [d[0] / l, d[1] / l];
-    Some([
-        (1.0 - n[0] * n[0]) / l,
-        -n[0] * n[1] / l,
-        -n[1] * n[0] / l,
-        (1.0 - n[1] * n[1]) / l,
-    ])
+    let n = d.map(|v| v / l);
+    Some(std::array::from_fn(|i| {
+        std::array::from_fn(|j| (if i == j { 1.0 } else { 0.0 } - n[i] * n[j]) / l)
+    }))
 }
 
 fn rigid_rows(rows: &mut Rows, slave: &Surface, rigid: &RigidSurface) -> Result<(), String> {

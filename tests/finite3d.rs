@@ -1,0 +1,625 @@
+//! Finite deformation in 3D (total Lagrangian, neo-Hookean and St. Venant-Kirchhoff on Hex8,
+//! Hex27, Tet4 and Tet10): the 2D driver (`solver::finite`, load steps of Newton's method) on
+//! the 3D model, through the dimension-generic Newton contact system, against rigid planes and
+//! spheres in the current geometry.
+//!
+//! * the homogeneous patch test: every boundary node of a distorted mesh prescribed by
+//!   `x = F X`, so `F` and the Cauchy stress are exact at every quadrature point (1e-10), and
+//!   the same with `R F` (objectivity: the stress rotates, `sigma(R F) = R sigma(F) R^T`) and
+//!   with a pure rotation `R` (zero stress);
+//! * the uniaxial neo-Hookean stretch with free lateral faces against its closed form;
+//! * a block compressed onto a rigid plane (the homogeneous uniaxial state is exact) and a
+//!   block pressed against a rigid sphere, penalty and Lagrange multipliers;
+//! * the Newton tangent with a rigid sphere against a central difference of the residual, and
+//!   quadratic convergence in the residual history;
+//! * what is not built refused with the reason.
+
+use contact_patch::model::Model3;
+use contact_patch::run3d::{build3, run_case3, Outcome3};
+use contact_patch::solid_finite::{lame, Hyperelastic};
+use contact_patch::solid_finite3::displacement_gradient_at3;
+use contact_patch::solver::linear::Solution;
+use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
+use serde_json::{json, Value};
+
+const E: f64 = 1000.0;
+const NU: f64 = 0.3;
+const ELEMENTS: [&str; 4] = ["Hex8", "Hex27", "Tet4", "Tet10"];
+const MATERIALS: [&str; 2] = ["neo_hookean", "saint_venant_kirchhoff"];
+
+fn law(material: &str) -> Hyperelastic {
+    match material {
+        "neo_hookean" => Hyperelastic::neo_hookean(E, NU),
+        _ => Hyperelastic::saint_venant_kirchhoff(E, NU),
+    }
+}
+
+/// A unit cube block on breaks `[0, 0.4, 1]` with interior nodes (and, with `faces`, nodes
+/// inside the faces) moved: a distorted mesh.
+fn block(element: &str, faces: bool) -> Value {
+    let mut moves = vec![json!({"from": [0.4, 0.4, 0.4], "to": [0.47, 0.36, 0.43]})];
+    if faces {
+        moves.push(json!({"from": [0.4, 0.4, 1.0], "to": [0.35, 0.46, 1.0]}));
+        moves.push(json!({"from": [0.0, 0.4, 0.4], "to": [0.0, 0.45, 0.33]}));
+    }
+    json!({"block3d": {"element": element, "x": [0, 0.4, 1], "y": [0, 0.4, 1],
+        "z": [0, 0.4, 1], "moves": moves}})
+}
+
+fn scene(element: &str, material: &str, steps: usize, faces: bool) -> Value {
+    json!({
+        "name": "finite-3d",
+        "materials": {"rubber": {"E": E, "nu": NU, "model": material}},
+        "bodies": [{"name": "block", "material": "rubber", "mesh": block(element, faces)}],
+        "physics": {"kinematics": "finite"},
+        "solver": {"load_steps": steps},
+        "supports": [{"body": "block", "set": "bottom", "z": 0.0}]
+    })
+}
+
+fn parse(case: &Value) -> contact_patch::io::scene::Case {
+    contact_patch::model::parse(&case.to_string(), "finite3d").unwrap()
+}
+
+fn run(case: &Value) -> Outcome3 {
+    run_case3(&parse(case), "finite3d").unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn rotation(axis: [f64; 3], angle: f64) -> Matrix3<f64> {
+    Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::from(axis)), angle).into_inner()
+}
+
+fn to_matrix(s: [f64; 6]) -> Matrix3<f64> {
+    Matrix3::new(s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2])
+}
+
+/// `F` and the Cauchy stress (Voigt) at every stiffness quadrature point of every cell.
+fn point_states(model: &Model3, u: &[f64]) -> Vec<(Matrix3<f64>, [f64; 6])> {
+    let body = &model.bodies[0];
+    let law = body.hyperelastic.expect("a hyperelastic body");
+    let kind = body.mesh.kind;
+    let mut dofs = Vec::new();
+    let mut out = Vec::new();
+    for c in 0..body.mesh.cell_count() {
+        body.cell_dofs(c, &mut dofs);
+        let ue: Vec<f64> = dofs.iter().map(|&d| u[d]).collect();
+        let coords = body.mesh.cell_coords(c);
+        for q in kind.stiffness_rule() {
+            let (h, _) = displacement_gradient_at3(kind, &coords, &ue, q.xi);
+            out.push((Matrix3::identity() + h, law.cauchy3(&h)));
+        }
+    }
+    out
+}
+
+/// The solve's residual tolerance under finite kinematics: a residual below it ends the
+/// iteration, so the contraction into it is not measured.
+const TOLERANCE: f64 = contact_patch::solver::contact_newton::FINITE_RESIDUAL_TOLERANCE;
+
+/// The decade above the tolerance is the round-off floor of the stiffest rows (a penalty
+/// `kappa A` ten times the element stiffness stalls near 1e-12): iterations into it are not
+/// judged.
+const FLOOR: f64 = 10.0 * TOLERANCE;
+
+/// Newton's convergence order in the history: once the relative residual `r_k` is below 1e-3
+/// (the asymptotic range), the next one in the same attempt is at most `r_k^1.5` (order 1.5
+/// at least: a quadratic `r_k+1 = C r_k^2` meets it for `C <= r_k^-0.5`, 30 at 1e-3; a linear
+/// rate fails it from `r_k = rate^2` down) unless it is at the floor ([`FLOOR`]). Returns how many
+/// iterations were judged; prints the smallest order `ln r_k+1 / ln r_k` and the largest
+/// `r_k+1 / r_k^2`.
+fn assert_quadratic(solution: &Solution<3>) -> usize {
+    let history = &solution.finite.as_ref().expect("a finite solve").history;
+    let mut seen = 0;
+    let (mut order, mut constant) = (f64::INFINITY, 0.0f64);
+    for w in history.windows(2) {
+        let (r0, r1) = (w[0].residual, w[1].residual);
+        if w[0].step == w[1].step && r0 < 1e-3 {
+            seen += 1;
+            if r1 > FLOOR {
+                order = order.min(r1.ln() / r0.ln());
+                constant = constant.max(r1 / (r0 * r0));
+            }
+            assert!(
+                r1 <= r0.powf(1.5).max(FLOOR),
+                "step {}: residual {r1:e} after {r0:e} is not of order 1.5: {:?}",
+                w[0].step,
+                residuals(solution)
+            );
+        }
+    }
+    println!("  Newton: {seen} iterations judged, smallest order {order:.2}, largest r_k+1 / r_k^2 {constant:.2e}");
+    seen
+}
+
+/// The residual history `attempt:residual`, and the reason of every cut attempt.
+fn residuals(solution: &Solution<3>) -> Vec<String> {
+    let finite = solution.finite.as_ref().unwrap();
+    let mut out: Vec<String> = finite
+        .history
+        .iter()
+        .map(|h| format!("{}:{:.1e}", h.step, h.residual))
+        .collect();
+    for s in finite.steps.iter().filter(|s| !s.accepted) {
+        out.push(format!(
+            "cut {} ({} to {}): {}",
+            s.attempt,
+            s.from,
+            s.to,
+            s.cut_because.as_deref().unwrap_or("")
+        ));
+    }
+    out
+}
+
+/// The model of `element`/`material` with every boundary node prescribed by `x = F X`.
+fn prescribed_everywhere(element: &str, material: &str, f: &Matrix3<f64>) -> Model3 {
+    let mut model = build3(&parse(&scene(element, material, 8, true)), "finite3d").unwrap();
+    let body = &model.bodies[0];
+    let mut boundary: Vec<usize> = Vec::new();
+    for set in ["left", "right", "front", "back", "bottom", "top"] {
+        boundary.extend(&body.mesh.node_sets[set]);
+    }
+    let mut prescribed = vec![None; model.dof_count];
+    for &n in &boundary {
+        let x = Vector3::from(body.mesh.nodes[n]);
+        let u = f * x - x;
+        for i in 0..3 {
+            prescribed[body.dof(n, i)] = Some(u[i]);
+        }
+    }
+    model.prescribed = prescribed;
+    model
+}
+
+/// The finite-strain patch test: every boundary node of a distorted mesh (interior and face
+/// nodes moved) prescribed by the homogeneous deformation `x = F X` (stretches of 20 % and
+/// -15 %, shears of 0.1), in eight load steps: the interior nodes follow, so `F` is exact at
+/// every quadrature point (1e-10) and the stress is the material's Cauchy stress at `F`
+/// (1e-10 relative), every element and both materials; Newton converges quadratically.
+/// Objectivity on the same meshes: `x = R F X` (a rotation of 30 degrees about a skew axis)
+/// gives `R sigma(F) R^T` (1e-10), and a pure rotation of 60 degrees no stress (1e-10 of `E`).
+/// (The cells themselves are checked up to 90 degrees in `solid_finite3`; here the first
+/// iterate of a step leaves the interior behind the rotated boundary, and larger steps invert
+/// cells there and are cut.)
+#[test]
+fn a_homogeneous_deformation_is_exact_and_objective_on_distorted_meshes() {
+    let f = Matrix3::new(1.2, 0.1, 0.0, 0.05, 0.85, 0.1, 0.0, -0.1, 1.1);
+    let r = rotation([0.3, -0.4, 1.0], 30f64.to_radians());
+    let turn = rotation([1.0, 1.0, 1.0], 60f64.to_radians());
+    for material in MATERIALS {
+        let sigma = to_matrix(law(material).cauchy3(&(f - Matrix3::identity())));
+        let scale = sigma.abs().max();
+        for element in ELEMENTS {
+            for (name, target, expected) in [
+                ("F", f, sigma),
+                ("R F", r * f, r * sigma * r.transpose()),
+                ("R", turn, Matrix3::zeros()),
+            ] {
+                let model = prescribed_everywhere(element, material, &target);
+                let solution = contact_patch::solver::finite::solve(&model, &mut |_| {}).unwrap();
+                let (mut f_error, mut s_error) = (0.0f64, 0.0f64);
+                for (fq, s) in point_states(&model, &solution.u) {
+                    f_error = f_error.max((fq - target).abs().max());
+                    s_error = s_error.max((to_matrix(s) - expected).abs().max());
+                }
+                let s_error = s_error / if name == "R" { E } else { scale };
+                println!(
+                    "{element} {material} x = {name} X: |F - F_exact| {f_error:.1e}, |sigma - sigma_exact| {s_error:.1e}, residuals {:?}",
+                    residuals(&solution)
+                );
+                assert!(
+                    f_error < 1e-10,
+                    "{element} {material} {name}: F off by {f_error:e}"
+                );
+                assert!(
+                    s_error < 1e-10,
+                    "{element} {material} {name}: sigma off by {s_error:e}"
+                );
+                assert!(
+                    assert_quadratic(&solution) >= 8,
+                    "{element} {material} {name}: too few iterations to judge: {:?}",
+                    residuals(&solution)
+                );
+            }
+        }
+    }
+}
+
+/// The lateral stretch `b` of a neo-Hookean bar stretched by `a` with free lateral faces:
+/// `sigma_xx = (mu (b^2 - 1) + lambda ln(a b^2)) / J = 0`, by bisection.
+fn lateral_stretch(a: f64) -> f64 {
+    let (lambda, mu) = lame(E, NU);
+    let (mut lo, mut hi) = (0.1, 3.0);
+    for _ in 0..200 {
+        let m = 0.5 * (lo + hi);
+        if mu * (m * m - 1.0) + lambda * (a * m * m).ln() > 0.0 {
+            hi = m;
+        } else {
+            lo = m;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// A neo-Hookean unit cube stretched by 50 % in z (top prescribed, rollers on the bottom,
+/// left and front faces, the other faces free), in three load steps, against the closed form:
+/// `F = diag(b, b, a)` with `b` from `sigma_xx = 0`, `sigma_zz = mu (a^2 - b^2) / (a b^2)`,
+/// judged by the case's `uniform_stress_3d` check (1e-10) on the Cauchy stress of every
+/// quadrature point, and `F` to 1e-10; the same compressed by 30 %.
+#[test]
+fn a_uniaxial_neo_hookean_stretch_has_its_closed_form() {
+    let (_, mu) = lame(E, NU);
+    for a in [1.5, 0.7] {
+        let b = lateral_stretch(a);
+        let sigma_zz = mu * (a * a - b * b) / (a * b * b);
+        for element in ELEMENTS {
+            let mut case = scene(element, "neo_hookean", 3, false);
+            case["supports"] = json!([
+                {"body": "block", "set": "bottom", "z": 0.0},
+                {"body": "block", "set": "left", "x": 0.0},
+                {"body": "block", "set": "front", "y": 0.0},
+                {"body": "block", "set": "top", "z": a - 1.0}
+            ]);
+            case["checks"] = json!([{"check": "uniform_stress_3d",
+                "stress": [0, 0, sigma_zz, 0, 0, 0], "tol": 1e-10}]);
+            let o = run(&case);
+            let target = Matrix3::from_diagonal(&Vector3::new(b, b, a));
+            let f_error = point_states(&o.model, &o.solution.u)
+                .iter()
+                .fold(0.0f64, |m, (f, _)| m.max((f - target).abs().max()));
+            println!(
+                "{element} stretch {a}: b = {b:.12}, sigma_zz = {sigma_zz:.6}, stress error {:.1e}, |F - F_exact| {f_error:.1e}, residuals {:?}",
+                o.checks[0].error,
+                residuals(&o.solution)
+            );
+            assert!(o.passed(), "{element} {a}: {:?}", o.checks);
+            assert!(f_error < 1e-10, "{element} {a}: {f_error:e}");
+            assert_quadratic(&o.solution);
+        }
+    }
+}
+
+fn contact_case(element: &str, master: Value, enforcement: Value, top_z: f64) -> Value {
+    let mut case = scene(element, "neo_hookean", 2, false);
+    case["physics"]["contact_geometry"] = json!("current");
+    case["solver"]["scheme"] = json!("newton");
+    case["supports"] = json!([
+        {"body": "block", "set": "bottom_front_left", "x": 0.0, "y": 0.0},
+        {"body": "block", "set": "bottom_front_right", "y": 0.0},
+        {"body": "block", "set": "top", "z": top_z}
+    ]);
+    case["contact"] = json!([{
+        "name": "ground", "slave": {"body": "block", "set": "bottom"},
+        "master": {"rigid": master},
+        "discretization": {"kind": "node_to_surface", "passes": 1},
+        "enforcement": enforcement
+    }]);
+    case
+}
+
+/// The resultant of the contact forces on the slave nodes.
+fn contact_resultant(o: &Outcome3) -> [f64; 3] {
+    let state = o.solution.contact.as_ref().expect("a contact solve");
+    let mut total = [0.0; 3];
+    for (r, f) in state.rows.iter().zip(&state.forces) {
+        for i in 0..3 {
+            total[i] += f * r.normal[i];
+        }
+    }
+    total
+}
+
+/// A neo-Hookean unit cube between a rigid plane `z = 0` (frictionless node-to-surface
+/// contact of its bottom, current geometry) and a top pushed down by 20 %, held in x and y at
+/// two bottom corners: the homogeneous uniaxial state is exact. With Lagrange multipliers
+/// `F = diag(b, b, 0.8)` (`b` from `sigma_xx = 0`) at every quadrature point to 1e-10; with
+/// the penalty the bottom penetrates uniformly, so `F` is still uniform and diagonal (1e-10)
+/// and `sigma_xx = sigma_yy = 0` (1e-10 of `sigma_zz`). Every element, except Tet10 with the
+/// penalty: the node-based rows' tributary areas on its Tri6 facets are not the consistent
+/// `int N_a dA` (zero at the corners), so a uniform penetration does not give the uniform
+/// pressure and the state is not homogeneous (its spread is printed, 3.7e-3 measured). The
+/// contact force balances the top's reaction (1e-10), and Newton converges quadratically.
+#[test]
+fn a_block_compressed_onto_a_rigid_plane_deforms_homogeneously() {
+    let b = lateral_stretch(0.8);
+    let plane = json!({"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]});
+    for enforcement in [
+        json!({"kind": "lagrange"}),
+        json!({"kind": "penalty", "kappa": 1e6}),
+    ] {
+        for element in ELEMENTS {
+            let o = run(&contact_case(
+                element,
+                plane.clone(),
+                enforcement.clone(),
+                -0.2,
+            ));
+            assert!(o.converged(), "{element}");
+            let states = point_states(&o.model, &o.solution.u);
+            let first = states[0].0;
+            let spread = states
+                .iter()
+                .fold(0.0f64, |m, (f, _)| m.max((f - first).abs().max()));
+            let off_diagonal = (first - Matrix3::from_diagonal(&first.diagonal()))
+                .abs()
+                .max();
+            let lateral = states
+                .iter()
+                .fold(0.0f64, |m, (_, s)| m.max(s[0].abs()).max(s[1].abs()));
+            let axial = states.iter().fold(0.0f64, |m, (_, s)| m.max(s[2].abs()));
+            let exact = if enforcement["kind"] == "lagrange" {
+                (first - Matrix3::from_diagonal(&Vector3::new(b, b, 0.8)))
+                    .abs()
+                    .max()
+            } else {
+                0.0
+            };
+            // the top's reaction balances the contact force
+            let body = &o.model.bodies[0];
+            let reaction: f64 = body.mesh.node_sets["top"]
+                .iter()
+                .map(|&n| o.solution.reactions[body.dof(n, 2)])
+                .sum();
+            let contact = contact_resultant(&o);
+            let balance = (reaction + contact[2]).abs() / contact[2].abs();
+            println!(
+                "{element} {}: F spread {spread:.1e}, |F - F_exact| {exact:.1e}, F_zz {:.12}, sigma_lateral / sigma_zz {:.1e}, balance {balance:.1e}, residuals {:?}",
+                enforcement["kind"],
+                first[(2, 2)],
+                lateral / axial,
+                residuals(&o.solution)
+            );
+            if !(element == "Tet10" && enforcement["kind"] == "penalty") {
+                assert!(
+                    spread < 1e-10 && off_diagonal < 1e-10,
+                    "{element}: {spread:e}"
+                );
+                assert!(exact < 1e-10, "{element}: {exact:e}");
+                assert!(lateral < 1e-10 * axial, "{element}: {lateral:e}");
+            }
+            assert!(axial > 10.0, "{element}: the block is compressed");
+            assert!(balance < 1e-10, "{element}: {balance:e}");
+            assert!(contact[0].abs() < 1e-10 * contact[2] && contact[1].abs() < 1e-10 * contact[2]);
+            assert_quadratic(&o.solution);
+        }
+    }
+}
+
+/// The sphere case: the unit cube pushed up by `lift` (bottom held, prescribed in z) against
+/// a rigid sphere of radius 1 that touches its top face at `(0.5, 0.5, 1)`; the top is the
+/// slave.
+fn sphere_case(element: &str, enforcement: Value, lift: f64, breaks: &[f64]) -> Value {
+    json!({
+        "name": "sphere-on-block",
+        "materials": {"rubber": {"E": E, "nu": NU, "model": "neo_hookean"}},
+        "bodies": [{"name": "block", "material": "rubber", "mesh": {"block3d": {
+            "element": element, "x": breaks, "y": breaks, "z": [0, 0.5, 1]}}}],
+        "physics": {"kinematics": "finite", "contact_geometry": "current"},
+        "solver": {"load_steps": 3, "scheme": "newton"},
+        "supports": [
+            {"body": "block", "set": "bottom", "x": 0.0, "y": 0.0, "z": lift}
+        ],
+        "contact": [{
+            "name": "indenter", "slave": {"body": "block", "set": "top"},
+            "master": {"rigid": {"kind": "sphere", "centre": [0.5, 0.5, 2.0], "radius": 1.0}},
+            "discretization": {"kind": "node_to_surface", "passes": 1},
+            "enforcement": enforcement
+        }]
+    })
+}
+
+/// A rigid sphere pressed 0.1 (10 % of the height) into a neo-Hookean block (current
+/// geometry, the sphere's gap second derivative in the tangent), Hex8 and Tet4: Newton
+/// converges quadratically; the contact force balances the bottom's reaction (1e-10); with
+/// Lagrange multipliers no active node penetrates (1e-10 of the indentation); on the
+/// symmetric Hex8 mesh the x and y resultants vanish (1e-10); the penalty's force approaches
+/// the Lagrange one as `O(1/kappa)`: its difference falls 5 to 20-fold from kappa 1e5 to 1e6.
+#[test]
+fn a_rigid_sphere_pressed_into_a_block_converges_quadratically_and_balances() {
+    let breaks = [0.0, 0.2, 0.35, 0.45, 0.55, 0.65, 0.8, 1.0];
+    let lift = 0.1;
+    for element in ["Hex8", "Tet4"] {
+        let mut forces = Vec::new();
+        for enforcement in [
+            json!({"kind": "lagrange"}),
+            json!({"kind": "penalty", "kappa": 1e5}),
+            json!({"kind": "penalty", "kappa": 1e6}),
+        ] {
+            let o = run(&sphere_case(element, enforcement.clone(), lift, &breaks));
+            assert!(o.converged(), "{element}");
+            let state = o.solution.contact.as_ref().unwrap();
+            let active = state.active.iter().filter(|&&a| a).count();
+            let body = &o.model.bodies[0];
+            let reaction: [f64; 3] = std::array::from_fn(|i| {
+                body.mesh.node_sets["bottom"]
+                    .iter()
+                    .map(|&n| o.solution.reactions[body.dof(n, i)])
+                    .sum()
+            });
+            let contact = contact_resultant(&o);
+            let balance = (0..3)
+                .map(|i| (reaction[i] + contact[i]).abs())
+                .fold(0.0, f64::max)
+                / contact[2].abs();
+            // the gaps of the active rows at the solution (current geometry)
+            let worst_gap = state
+                .gaps
+                .iter()
+                .zip(&state.active)
+                .filter(|(_, &a)| a)
+                .fold(0.0f64, |m, (g, _)| m.max(g.abs()));
+            println!(
+                "{element} {}: active {active} of {}, contact force {contact:?}, balance {balance:.1e}, largest active |gap| {worst_gap:.1e}, residuals {:?}",
+                enforcement,
+                state.rows.len(),
+                residuals(&o.solution)
+            );
+            assert!(active >= 4, "{element}: {active}");
+            assert!(
+                contact[2] < 0.0,
+                "{element}: the sphere pushes the top down"
+            );
+            assert!(balance < 1e-10, "{element}: {balance:e}");
+            if element == "Hex8" {
+                assert!(
+                    contact[0].abs() < 1e-10 * contact[2].abs()
+                        && contact[1].abs() < 1e-10 * contact[2].abs(),
+                    "{element}: {contact:?}"
+                );
+            }
+            if enforcement["kind"] == "lagrange" {
+                assert!(worst_gap < 1e-10 * lift, "{element}: {worst_gap:e}");
+            }
+            assert!(
+                assert_quadratic(&o.solution) >= 3,
+                "{element}: too few iterations to judge"
+            );
+            forces.push(contact[2]);
+        }
+        let difference = |k: usize| (forces[k] - forces[0]).abs() / forces[0].abs();
+        let ratio = difference(1) / difference(2);
+        println!(
+            "{element}: penalty vs Lagrange force {:.2e} (kappa 1e5), {:.2e} (1e6), ratio {ratio:.2}",
+            difference(1),
+            difference(2)
+        );
+        assert!((5.0..20.0).contains(&ratio), "{element}: {ratio}");
+    }
+}
+
+/// The tangent of the whole 3D Newton system (neo-Hookean solid plus penalty rows against a
+/// rigid sphere, with the sphere's gap second derivative) is the central difference of its
+/// residual at a deformed, penetrating state off equilibrium, to 1e-6 of its largest entry;
+/// against a plane too.
+#[test]
+fn the_newton_tangent_with_a_rigid_sphere_is_the_difference_of_the_residual() {
+    use contact_patch::solver::contact_newton::Probe;
+    let breaks = [0.0, 0.3, 0.6, 1.0];
+    for (element, enforcement) in [
+        ("Hex8", json!({"kind": "penalty", "kappa": 1e4})),
+        ("Tet10", json!({"kind": "penalty", "kappa": 1e4})),
+        ("Hex8", json!({"kind": "lagrange"})),
+    ] {
+        let case = sphere_case(element, enforcement.clone(), 0.08, &breaks);
+        let o = run(&case);
+        assert!(o.converged());
+        let model = build3(&parse(&case), "finite3d").unwrap();
+        let mut probe = Probe::new(&model, 0.0).unwrap();
+        // off equilibrium: the solution with a nonuniform disturbance
+        let mut x = probe.unknowns_at(&o.solution.u, o.solution.contact.as_ref().unwrap());
+        let n_u = probe.unknowns(&o.solution.u).len();
+        for (i, v) in x.iter_mut().enumerate().take(n_u) {
+            *v += 1e-3 * (0.7 * i as f64).sin() + 2e-3 * ((i % 3) as f64 - 1.0);
+        }
+        let at = probe.evaluate(&x).unwrap();
+        let n = probe.unknown_count();
+        let scale = at
+            .tangent
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let h = 1e-7;
+        let mut worst = 0.0f64;
+        for j in 0..n {
+            let (mut xp, mut xm) = (x.clone(), x.clone());
+            xp[j] += h;
+            xm[j] -= h;
+            let rp = probe.evaluate(&xp).unwrap().residual;
+            let rm = probe.evaluate(&xm).unwrap().residual;
+            for i in 0..n {
+                let column = (rp[i] - rm[i]) / (2.0 * h);
+                worst = worst.max((column - at.tangent[i][j]).abs() / scale);
+            }
+        }
+        println!(
+            "{element} {}: Newton tangent vs central difference {worst:.1e} of {scale:.3e} ({n} unknowns)",
+            enforcement["kind"]
+        );
+        assert!(worst < 1e-6, "{element}: {worst:e}");
+    }
+}
+
+/// What finite kinematics does not solve in 3D is refused with the reason.
+#[test]
+fn combinations_not_built_are_refused_with_the_reason() {
+    let refused = |case: &Value, location: &str, words: &str| {
+        let err = build3(&parse(case), "finite3d").unwrap_err().to_string();
+        assert!(err.contains(location) && err.contains(words), "{err}");
+    };
+    // a linear elastic body under finite kinematics
+    let mut case = scene("Hex8", "neo_hookean", 1, false);
+    case["materials"]["rubber"]["model"] = json!("linear_elastic");
+    refused(&case, "material", "needs a hyperelastic material");
+    // a hyperelastic body under small strain
+    let mut case = scene("Hex8", "neo_hookean", 1, false);
+    case["physics"] = json!({});
+    refused(&case, "materials.rubber.model", "needs finite kinematics");
+    let plane = json!({"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]});
+    let lagrange = json!({"kind": "lagrange"});
+    // contact without the Newton scheme or the current geometry
+    let mut case = contact_case("Hex8", plane.clone(), lagrange.clone(), -0.1);
+    case["solver"]["scheme"] = json!("active_set");
+    refused(&case, "solver.scheme", "Newton scheme only");
+    let mut case = contact_case("Hex8", plane.clone(), lagrange.clone(), -0.1);
+    case["physics"]["contact_geometry"] = json!("reference");
+    refused(&case, "physics.contact_geometry", "current configuration");
+    // a tied pair
+    let mut case = contact_case("Hex8", plane, lagrange, -0.1);
+    case["contact"][0]["interaction"] = json!("tied");
+    refused(
+        &case,
+        "interaction",
+        "a tied pair under finite kinematics in 3D is not built",
+    );
+    // two deformable bodies
+    let mut case = scene("Hex8", "neo_hookean", 1, false);
+    case["bodies"] = json!([
+        {"name": "base", "material": "rubber", "mesh": block("Hex8", false)},
+        {"name": "punch", "material": "rubber", "mesh": {"block3d": {"element": "Hex8",
+            "x": [0, 1], "y": [0, 1], "z": [1, 2]}}}
+    ]);
+    case["physics"]["contact_geometry"] = json!("current");
+    case["solver"]["scheme"] = json!("newton");
+    case["supports"] = json!([{"body": "base", "set": "bottom", "x": 0, "y": 0, "z": 0},
+        {"body": "punch", "set": "top", "x": 0, "y": 0, "z": -0.1}]);
+    case["contact"] = json!([{"name": "interface", "slave": {"body": "punch", "set": "bottom"},
+        "master": {"body": "base", "set": "top"},
+        "discretization": {"kind": "node_to_surface", "passes": 1},
+        "enforcement": {"kind": "lagrange"}}]);
+    refused(
+        &case,
+        "contact[0] 'interface'",
+        "contact between deformable bodies under finite kinematics in 3D is not built",
+    );
+    // small strain keeps refusing the Newton scheme and the current geometry
+    let mut case = contact_case(
+        "Hex8",
+        json!({"kind": "plane", "point": [0, 0, 0],
+        "normal": [0, 0, 1]}),
+        json!({"kind": "lagrange"}),
+        -0.1,
+    );
+    case["physics"] = json!({"contact_geometry": "current"});
+    case["materials"]["rubber"]["model"] = json!("linear_elastic");
+    refused(&case, "physics.contact_geometry", "under small strain");
+}
+
+/// A compression of 110 % cannot be reached: the load steps are cut until the cuts are spent,
+/// and the error names the load step and the inverted cell (never a NaN answer).
+#[test]
+fn inverting_the_block_is_refused_by_name() {
+    let mut case = scene("Hex8", "neo_hookean", 1, false);
+    case["supports"] = json!([
+        {"body": "block", "set": "bottom", "x": 0.0, "y": 0.0, "z": 0.0},
+        {"body": "block", "set": "top", "z": -1.1}
+    ]);
+    let err = run_case3(&parse(&case), "finite3d")
+        .unwrap_err()
+        .to_string();
+    println!("{err}");
+    assert!(err.contains("load step") && err.contains("cuts"), "{err}");
+    assert!(
+        err.contains("det F") && err.contains("of body 'block' is inverted"),
+        "{err}"
+    );
+}
