@@ -195,7 +195,7 @@ fn mesh(c: &mut Criterion) {
     group.finish();
 }
 
-/// The multigrid solver's hot paths on a 200 x 200 Q4 plane-strain block (80,798 equations):
+/// The multigrid solver's hot paths on a 200 x 200 Q4 plane-strain block (80,400 equations):
 /// one product `y = K x` of the full CSR matrix (rayon row blocks), one V-cycle of the
 /// smoothed-aggregation hierarchy (src/solver/amg.rs), and the hierarchy's setup. Compare the
 /// V-cycle with the product (a V-cycle is worth a handful of products) in one run.
