@@ -623,3 +623,53 @@ fn inverting_the_block_is_refused_by_name() {
         "{err}"
     );
 }
+
+/// `contact-patch run` on the block compressed onto a rigid plane (Hex8, Lagrange): the
+/// `.vtu` holds the Cauchy stress `[xx, yy, zz, yz, xz, xy]` at every node, the uniaxial
+/// closed form to 1e-12 relative, and `summary.json` the load steps and Newton history
+/// (`finite`).
+#[test]
+fn the_run_command_writes_the_cauchy_stress_and_the_newton_history() {
+    let (_, mu) = lame(E, NU);
+    let b = lateral_stretch(0.8);
+    let sigma_zz = mu * (0.64 - b * b) / (0.8 * b * b);
+    let plane = json!({"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]});
+    let case = contact_case("Hex8", plane, json!({"kind": "lagrange"}), -0.2);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.json");
+    std::fs::write(&path, case.to_string()).unwrap();
+    let out = dir.path().join("out");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .arg("run")
+        .arg(&path)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let vtu = std::fs::read_to_string(out.join("block.vtu")).unwrap();
+    let start = vtu.find("Name=\"stress\"").expect("a stress array");
+    let body = &vtu[start..];
+    let values: Vec<f64> = body[body.find('>').unwrap() + 1..body.find("</DataArray>").unwrap()]
+        .split_whitespace()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!(values.len(), 6 * 27);
+    let expected = [0.0, 0.0, sigma_zz, 0.0, 0.0, 0.0];
+    let worst = values
+        .chunks(6)
+        .flat_map(|s| (0..6).map(move |i| (s[i] - expected[i]).abs()))
+        .fold(0.0, f64::max)
+        / sigma_zz.abs();
+    println!("vtu Cauchy stress against the closed form: {worst:.1e}");
+    assert!(worst < 1e-12, "{worst:e}");
+    let summary: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["passed"], true);
+    assert_eq!(summary["finite"]["steps"].as_array().unwrap().len(), 2);
+    assert!(summary["finite"]["history"].as_array().unwrap().len() >= 4);
+}
