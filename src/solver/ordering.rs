@@ -1,7 +1,17 @@
-//! A nested-dissection ordering of a symmetric sparsity pattern, from the graph alone (George
-//! 1973, "Nested dissection of a regular finite element mesh"; George and Liu, *Computer
-//! Solution of Large Sparse Positive Definite Systems*, 1981, chapter 8: the automatic nested
-//! dissection by level structures).
+//! Nested-dissection orderings of a symmetric sparsity pattern, from the graph alone.
+//!
+//! [`dissection_order`] is METIS's multilevel nested dissection ([`metis_nested_dissection`],
+//! Karypis and Kumar 1998) on the quotient graph of supervariables (step 1 below), and the
+//! level-structure dissection below ([`nested_dissection`]; George 1973, "Nested dissection of a
+//! regular finite element mesh"; George and Liu, *Computer Solution of Large Sparse Positive
+//! Definite Systems*, 1981, chapter 8) where METIS cannot take the graph. Their factors'
+//! multiply-adds, against AMD's (`contact-patch run` with `limits.factor_operations` set to 1
+//! prints the kept one): the contact block of `crosscheck/performance.py` (1,002,830 dofs, Q4)
+//! AMD 8.74e10, level structures 9.61e10, METIS 5.25e10; the 3D slab
+//! `cases/large/slab-3d-1m.json` (1,090,824 equations, Hex8) AMD 1.03e13, level structures
+//! 5.35e12, METIS 3.07e12.
+//!
+//! The level-structure dissection:
 //!
 //! 1. **Supervariables.** Consecutive equations with the same neighbours (the `D` dofs of a
 //!    node, coupled to the same nodes) are one vertex of the quotient graph, ordered together.
@@ -256,6 +266,79 @@ pub fn nested_dissection(pattern: &Pattern) -> Vec<usize> {
     order
 }
 
+/// Held for the duration of every METIS call (see [`metis_nested_dissection`]).
+static METIS_CALL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// METIS's multilevel nested dissection of the quotient graph (Karypis and Kumar, "A fast and
+/// high quality multilevel scheme for partitioning irregular graphs", SIAM J. Sci. Comput. 20
+/// (1998) 359-392; METIS 5 `METIS_NodeND`, default options): each supervariable is one vertex
+/// weighted by its number of equations, its equations kept together in the order. The
+/// separators come from coarsened graphs refined on the way back (Fiduccia-Mattheyses), so on
+/// meshes they are near the shortest cuts, where the level structures of
+/// [`nested_dissection`] cut along the fronts of a breadth-first search from a corner. `None`
+/// when the graph does not fit METIS's 32-bit indices or METIS reports an error; the caller then
+/// uses [`nested_dissection`].
+pub fn metis_nested_dissection(pattern: &Pattern) -> Option<Vec<usize>> {
+    let q = quotient(pattern);
+    let nv = q.groups.len();
+    let index = |v: usize| metis_sys::idx_t::try_from(v).ok();
+    let mut nvtxs = index(nv)?;
+    index(q.adjacency.len())?;
+    if nv == 0 {
+        return Some(Vec::new());
+    }
+    let mut xadj: Vec<metis_sys::idx_t> = q.start.iter().map(|&v| v as metis_sys::idx_t).collect();
+    let mut adjncy: Vec<metis_sys::idx_t> =
+        q.adjacency.iter().map(|&v| v as metis_sys::idx_t).collect();
+    let mut vwgt: Vec<metis_sys::idx_t> = q
+        .groups
+        .iter()
+        .map(|g| index(g.len()))
+        .collect::<Option<_>>()?;
+    let mut perm: Vec<metis_sys::idx_t> = vec![0; nv];
+    let mut iperm: Vec<metis_sys::idx_t> = vec![0; nv];
+    // METIS reseeds one process-wide random generator at the start of every call and draws
+    // from it throughout: calls on two threads at once would interleave their draws, and the
+    // order would depend on the timing. One call at a time keeps it a function of the graph.
+    let _one_at_a_time = METIS_CALL
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    // SAFETY: every array has the length METIS_NodeND reads or writes for a graph of `nvtxs`
+    // vertices (xadj nv + 1, adjncy xadj[nv], vwgt, perm and iperm nv); the adjacency is
+    // symmetric without self-loops (the quotient graph); a null options pointer means METIS's
+    // defaults. METIS keeps no pointer past the call.
+    let status = unsafe {
+        metis_sys::METIS_NodeND(
+            &mut nvtxs,
+            xadj.as_mut_ptr(),
+            adjncy.as_mut_ptr(),
+            vwgt.as_mut_ptr(),
+            std::ptr::null_mut(),
+            perm.as_mut_ptr(),
+            iperm.as_mut_ptr(),
+        )
+    };
+    if status != metis_sys::rstatus_et_METIS_OK {
+        return None;
+    }
+    // perm[k] is the vertex eliminated k-th; check it is a permutation before trusting it
+    let mut seen = vec![false; nv];
+    let mut order = Vec::with_capacity(pattern.n);
+    for &v in &perm {
+        let v = usize::try_from(v).ok().filter(|&v| v < nv && !seen[v])?;
+        seen[v] = true;
+        order.extend(q.groups[v].clone());
+    }
+    Some(order)
+}
+
+/// The nested-dissection order of the equations of `pattern`: METIS's
+/// ([`metis_nested_dissection`]), or the level-structure dissection ([`nested_dissection`])
+/// where METIS cannot take the graph.
+pub fn dissection_order(pattern: &Pattern) -> Vec<usize> {
+    metis_nested_dissection(pattern).unwrap_or_else(|| nested_dissection(pattern))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -351,6 +434,66 @@ mod tests {
                 assert!(chunk.windows(2).all(|w| w[1] == w[0] + 1));
             }
         }
+    }
+
+    #[test]
+    fn metis_orders_every_equation_once_keeping_each_node_s_dofs_together() {
+        for (n, dofs) in [(1, 1), (7, 1), (20, 2), (33, 3)] {
+            let p = grid(n, dofs);
+            let order = metis_nested_dissection(&p.view()).expect("METIS orders a grid");
+            let mut sorted = order.clone();
+            sorted.sort_unstable();
+            assert_eq!(sorted, (0..p.n).collect::<Vec<_>>(), "n {n}");
+            for chunk in order.chunks(dofs) {
+                assert_eq!(chunk[0] % dofs, 0);
+                assert!(chunk.windows(2).all(|w| w[1] == w[0] + 1));
+            }
+        }
+        let empty = Owned {
+            n: 0,
+            col_ptr: vec![0],
+            row_idx: Vec::new(),
+        };
+        assert_eq!(metis_nested_dissection(&empty.view()), Some(Vec::new()));
+    }
+
+    #[test]
+    fn metis_s_last_equations_separate_the_grid() {
+        // the top separator of a 41 x 41 grid: at most about two grid lines of vertices
+        // (METIS's vertex separator from a refined edge cut), whose removal leaves two parts
+        let n = 41;
+        let p = grid(n, 1);
+        let order = metis_nested_dissection(&p.view()).unwrap();
+        let (start, adjacency) = full_adjacency(&p.view());
+        // the separator: the shortest tail of the order whose removal disconnects the rest
+        let parts = |tail: usize| {
+            let top: std::collections::HashSet<usize> =
+                order[order.len() - tail..].iter().copied().collect();
+            let mut component = vec![usize::MAX; p.n];
+            let mut count = 0;
+            for s in 0..p.n {
+                if top.contains(&s) || component[s] != usize::MAX {
+                    continue;
+                }
+                let mut stack = vec![s];
+                component[s] = count;
+                while let Some(v) = stack.pop() {
+                    for &w in &adjacency[start[v]..start[v + 1]] {
+                        if !top.contains(&w) && component[w] == usize::MAX {
+                            component[w] = count;
+                            stack.push(w);
+                        }
+                    }
+                }
+                count += 1;
+            }
+            count
+        };
+        let tail = (1..p.n).find(|&t| parts(t) >= 2).unwrap();
+        assert!(
+            tail <= 2 * n,
+            "the top separator has {tail} vertices on a {n} x {n} grid"
+        );
     }
 
     #[test]

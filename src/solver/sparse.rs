@@ -384,8 +384,8 @@ fn original(symbolic: &SymbolicCholesky<usize>, k: usize) -> usize {
     symbolic.perm().map_or(k, |p| p.arrays().0[k])
 }
 
-/// Sparse Cholesky `A = L L^T` with the symbolic analysis (AMD ordering, elimination tree,
-/// supernodes) done once per pattern and shared by every numeric factorization.
+/// Sparse Cholesky `A = L L^T` with the symbolic analysis (AMD or nested-dissection ordering,
+/// elimination tree, supernodes) done once per pattern and shared by every numeric factorization.
 pub struct Cholesky {
     symbolic: Arc<SymbolicCholesky<usize>>,
     /// With [`Cholesky::analyse_with_trailing`], the original equations of the last steps of
@@ -397,7 +397,12 @@ impl Cholesky {
     /// Analyse the pattern (ordering, elimination tree, supernodes); a factor whose work
     /// exceeds `limit` is [`FactorError::TooLarge`].
     pub fn analyse(pattern: &SymmetricPattern, limit: &WorkLimit) -> Result<Self, FactorError> {
-        let symbolic = cheaper_order(pattern)?;
+        let whole = crate::solver::ordering::Pattern {
+            n: pattern.n,
+            col_ptr: &pattern.col_ptr,
+            row_idx: &pattern.row_idx,
+        };
+        let symbolic = cheaper_order(&whole, |order| symbolic_in_order(pattern, order))?;
         FactorWork::of(&symbolic).check(limit)?;
         Ok(Cholesky {
             symbolic: Arc::new(symbolic),
@@ -406,12 +411,13 @@ impl Cholesky {
     }
 
     /// Analyse the pattern with the equations `trailing` eliminated last (in the given order)
-    /// and the others in the AMD order of their own block, so that the factor's trailing block
+    /// and the others in the cheaper of AMD's and the nested-dissection order of their own
+    /// block ([`cheaper_order`]), so that the factor's trailing block
     /// `L_CC` gives the Schur complement `S + P_C = L_CC L_CC^T` of the leading equations
     /// ([`Factor::trailing_block`]): a later matrix that differs from this one in the
     /// `trailing x trailing` block alone is then solved with this factor and a dense
     /// factorization of that block ([`crate::solver::low_rank::TrailingUpdate`]). An empty
-    /// `trailing`, or one that is not a set of distinct equations of the pattern, is the AMD
+    /// `trailing`, or one that is not a set of distinct equations of the pattern, is the
     /// analysis of [`Cholesky::analyse`].
     pub fn analyse_with_trailing(
         pattern: &SymmetricPattern,
@@ -429,63 +435,22 @@ impl Cholesky {
         if trailing.is_empty() || trailing.len() == n {
             return Self::analyse(pattern, limit);
         }
-        fn other(e: impl std::fmt::Debug) -> FactorError {
-            FactorError::Other(format!("{e:?}"))
-        }
-        // the leading equations, renumbered 0..m, and the upper pattern of their block
-        let leading: Vec<usize> = (0..n).filter(|&e| !is_trailing[e]).collect();
-        let mut local = vec![usize::MAX; n];
-        for (k, &e) in leading.iter().enumerate() {
-            local[e] = k;
-        }
+        let (leading, col_ptr, row_idx) = leading_block(pattern, &is_trailing);
         let m = leading.len();
-        let mut col_ptr = Vec::with_capacity(m + 1);
-        let mut row_idx = Vec::with_capacity(pattern.nnz());
-        col_ptr.push(0);
-        for &j in &leading {
-            // rows of column j below it in the original numbering keep their order: the
-            // renumbering is increasing
-            row_idx.extend(
-                pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]]
-                    .iter()
-                    .filter(|&&i| !is_trailing[i])
-                    .map(|&i| local[i]),
-            );
-            col_ptr.push(row_idx.len());
-        }
-        let block = SymbolicSparseColMatRef::new_checked(m, m, &col_ptr, None, &row_idx);
-        let mut order = vec![0usize; m];
-        let mut order_inv = vec![0usize; m];
-        let mut mem = MemBuffer::try_new(faer::sparse::linalg::amd::order_scratch::<usize>(
-            m,
-            row_idx.len(),
-        ))
-        .map_err(other)?;
-        faer::sparse::linalg::amd::order(
-            &mut order,
-            &mut order_inv,
-            block,
-            Default::default(),
-            MemStack::new(&mut mem),
-        )
-        .map_err(other)?;
-        let fwd: Vec<usize> = order
-            .iter()
-            .map(|&k| leading[k])
-            .chain(trailing.iter().copied())
-            .collect();
-        let mut inv = vec![0usize; n];
-        for (k, &e) in fwd.iter().enumerate() {
-            inv[e] = k;
-        }
-        let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
-        let symbolic = factorize_symbolic_cholesky(
-            pattern.symbolic(),
-            Side::Upper,
-            SymmetricOrdering::Custom(perm),
-            Default::default(),
-        )
-        .map_err(other)?;
+        let block = crate::solver::ordering::Pattern {
+            n: m,
+            col_ptr: &col_ptr,
+            row_idx: &row_idx,
+        };
+        // the whole order: the leading block's, then the trailing equations as given
+        let symbolic = cheaper_order(&block, |order| {
+            let fwd: Vec<usize> = order
+                .iter()
+                .map(|&k| leading[k])
+                .chain(trailing.iter().copied())
+                .collect();
+            symbolic_in_order(pattern, &fwd)
+        })?;
         FactorWork::of(&symbolic).check(limit)?;
         // the symbolic analysis may reorder (postorder) the elimination tree: the trailing
         // block is the one it ends with, which must still be the trailing equations
@@ -802,51 +767,124 @@ fn multipliers_after_their_displacements(
 }
 
 /// Above this many multiply-adds of the AMD factor, the nested-dissection order
-/// ([`crate::solver::ordering`]) is analysed too and the cheaper of the two kept: on large 3D
-/// meshes it takes a fraction of AMD's operations; below it the second analysis would cost
-/// more than it could save.
+/// ([`crate::solver::ordering::dissection_order`]) is analysed too and the cheaper of the two
+/// kept: on large meshes it takes a fraction of AMD's operations (about 60% on a 2D block of a
+/// million dofs, far less in 3D); below it the second analysis would cost more than it could
+/// save.
 pub const NESTED_DISSECTION_ABOVE: f64 = 1e10;
 
-/// The symbolic factor of `pattern` for AMD or, on large factors, for nested dissection when
-/// that takes fewer operations.
-fn cheaper_order(pattern: &SymmetricPattern) -> Result<SymbolicCholesky<usize>, FactorError> {
+/// From this many (leading) equations on, the nested-dissection order is computed on a second
+/// thread while AMD's is computed and analysed, whatever AMD's work turns out to be: on such
+/// sizes the dissection usually wins and the two analyses then cost the longer one's time, not
+/// the sum. Below, the dissection is computed only after AMD's work passed
+/// [`NESTED_DISSECTION_ABOVE`].
+pub const CONCURRENT_DISSECTION_FROM: usize = 100_000;
+
+/// The equations not marked trailing (in increasing order) and the upper CSC pattern of their
+/// block, renumbered `0..m` in that order.
+fn leading_block(
+    pattern: &SymmetricPattern,
+    is_trailing: &[bool],
+) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let n = pattern.n;
+    let leading: Vec<usize> = (0..n).filter(|&e| !is_trailing[e]).collect();
+    let mut local = vec![usize::MAX; n];
+    for (k, &e) in leading.iter().enumerate() {
+        local[e] = k;
+    }
+    let mut col_ptr = Vec::with_capacity(leading.len() + 1);
+    let mut row_idx = Vec::with_capacity(pattern.nnz());
+    col_ptr.push(0);
+    for &j in &leading {
+        // rows of column j below it in the original numbering keep their order: the
+        // renumbering is increasing
+        row_idx.extend(
+            pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]]
+                .iter()
+                .filter(|&&i| !is_trailing[i])
+                .map(|&i| local[i]),
+        );
+        col_ptr.push(row_idx.len());
+    }
+    (leading, col_ptr, row_idx)
+}
+
+/// AMD's order of the symmetric pattern `block` (upper CSC): `order[k]` is the equation
+/// eliminated `k`-th (Amestoy, Davis and Duff, "An approximate minimum degree ordering
+/// algorithm", SIAM J. Matrix Anal. Appl. 17 (1996) 886-905; faer's implementation).
+fn amd_order(block: &crate::solver::ordering::Pattern) -> Result<Vec<usize>, FactorError> {
     fn other(e: impl std::fmt::Debug) -> FactorError {
         FactorError::Other(format!("{e:?}"))
     }
-    let amd = factorize_symbolic_cholesky(
-        pattern.symbolic(),
-        Side::Upper,
-        SymmetricOrdering::Amd,
+    let n = block.n;
+    let nnz = block.col_ptr[n];
+    let pattern = SymbolicSparseColMatRef::new_checked(n, n, block.col_ptr, None, block.row_idx);
+    let mut order = vec![0usize; n];
+    let mut order_inv = vec![0usize; n];
+    let mut mem = MemBuffer::try_new(faer::sparse::linalg::amd::order_scratch::<usize>(n, nnz))
+        .map_err(other)?;
+    faer::sparse::linalg::amd::order(
+        &mut order,
+        &mut order_inv,
+        pattern,
         Default::default(),
+        MemStack::new(&mut mem),
     )
     .map_err(other)?;
-    if FactorWork::of(&amd).operations <= NESTED_DISSECTION_ABOVE {
-        return Ok(amd);
-    }
-    let fwd = crate::solver::ordering::nested_dissection(&crate::solver::ordering::Pattern {
-        n: pattern.n,
-        col_ptr: &pattern.col_ptr,
-        row_idx: &pattern.row_idx,
-    });
+    Ok(order)
+}
+
+/// The symbolic factor of `pattern` eliminated in the order `fwd` (`fwd[k]` the equation
+/// eliminated `k`-th).
+fn symbolic_in_order(
+    pattern: &SymmetricPattern,
+    fwd: &[usize],
+) -> Result<SymbolicCholesky<usize>, FactorError> {
     let mut inv = vec![0usize; fwd.len()];
     for (k, &e) in fwd.iter().enumerate() {
         inv[e] = k;
     }
-    let perm = faer::perm::PermRef::new_checked(&fwd, &inv, pattern.n);
-    let nd = factorize_symbolic_cholesky(
+    let perm = faer::perm::PermRef::new_checked(fwd, &inv, pattern.n);
+    factorize_symbolic_cholesky(
         pattern.symbolic(),
         Side::Upper,
         SymmetricOrdering::Custom(perm),
         Default::default(),
     )
-    .map_err(other)?;
-    Ok(
-        if FactorWork::of(&nd).operations < FactorWork::of(&amd).operations {
-            nd
-        } else {
-            amd
-        },
-    )
+    .map_err(|e| FactorError::Other(format!("{e:?}")))
+}
+
+/// The symbolic factor, `whole(order)` for an order of the equations of `block`, of AMD's order
+/// or of the nested-dissection order, whichever takes fewer operations (AMD on a tie); the
+/// dissection is tried only on large factors ([`NESTED_DISSECTION_ABOVE`],
+/// [`CONCURRENT_DISSECTION_FROM`]). A dissection whose analysis fails leaves AMD's.
+fn cheaper_order(
+    block: &crate::solver::ordering::Pattern,
+    whole: impl Fn(&[usize]) -> Result<SymbolicCholesky<usize>, FactorError> + Sync,
+) -> Result<SymbolicCholesky<usize>, FactorError> {
+    let dissection = || whole(&crate::solver::ordering::dissection_order(block));
+    let cheaper = |amd: SymbolicCholesky<usize>, nd: Result<SymbolicCholesky<usize>, _>| match nd {
+        Ok(nd) if FactorWork::of(&nd).operations < FactorWork::of(&amd).operations => nd,
+        _ => amd,
+    };
+    if block.n >= CONCURRENT_DISSECTION_FROM {
+        let (amd, nd) = std::thread::scope(|scope| {
+            let nd = scope.spawn(dissection);
+            let amd = amd_order(block).and_then(|order| whole(&order));
+            (amd, nd.join())
+        });
+        let nd = nd.unwrap_or_else(|_| {
+            Err(FactorError::Other(
+                "the nested-dissection thread stopped".into(),
+            ))
+        });
+        return Ok(cheaper(amd?, nd));
+    }
+    let amd = whole(&amd_order(block)?)?;
+    if FactorWork::of(&amd).operations <= NESTED_DISSECTION_ABOVE {
+        return Ok(amd);
+    }
+    Ok(cheaper(amd, dissection()))
 }
 
 /// The symbolic factor for the order "AMD of the leading `leading x leading` block, then the
@@ -1386,6 +1424,82 @@ mod tests {
     }
 
     /// Repeated or out-of-range trailing equations fall back to the AMD analysis.
+    /// The pattern of plane Q4 elasticity on an `m x m` grid of nodes (2 dofs per node, every
+    /// node coupled to its 8 neighbours).
+    fn q4_grid_pattern(m: usize) -> SymmetricPattern {
+        let mut b = PatternBuilder::new(2 * m * m);
+        for j in 0..m - 1 {
+            for i in 0..m - 1 {
+                let nodes = [
+                    i + m * j,
+                    i + 1 + m * j,
+                    i + m * (j + 1),
+                    i + 1 + m * (j + 1),
+                ];
+                let eqs: Vec<usize> = nodes.iter().flat_map(|&v| [2 * v, 2 * v + 1]).collect();
+                b.add_block(&eqs);
+            }
+        }
+        b.build()
+    }
+
+    /// The work of the factor of `p` for AMD's and for the dissection order of the leading
+    /// block (the equations not in `trailing`), the trailing equations last.
+    fn candidate_work(p: &SymmetricPattern, trailing: &[usize]) -> (f64, f64) {
+        let mut is_trailing = vec![false; p.n];
+        trailing.iter().for_each(|&e| is_trailing[e] = true);
+        let (leading, col_ptr, row_idx) = leading_block(p, &is_trailing);
+        let block = crate::solver::ordering::Pattern {
+            n: leading.len(),
+            col_ptr: &col_ptr,
+            row_idx: &row_idx,
+        };
+        let work = |order: Vec<usize>| {
+            let fwd: Vec<usize> = order
+                .iter()
+                .map(|&k| leading[k])
+                .chain(trailing.iter().copied())
+                .collect();
+            FactorWork::of(&symbolic_in_order(p, &fwd).unwrap()).operations
+        };
+        (
+            work(amd_order(&block).unwrap()),
+            work(crate::solver::ordering::dissection_order(&block)),
+        )
+    }
+
+    #[test]
+    fn the_analysis_keeps_the_cheaper_of_amd_and_the_dissection() {
+        // 230 x 230 nodes: 105,800 equations, analysed with the dissection beside AMD; 60 x 60:
+        // 7,200, whose AMD factor is far below the threshold: AMD without a second analysis
+        for m in [60, 230] {
+            let p = q4_grid_pattern(m);
+            let (amd, nd) = candidate_work(&p, &[]);
+            let tried = p.n >= CONCURRENT_DISSECTION_FROM || amd > NESTED_DISSECTION_ABOVE;
+            assert_eq!(tried, m == 230);
+            let expected = if tried { amd.min(nd) } else { amd };
+            let kept = Cholesky::analyse(&p, &UNLIMITED).unwrap().work().operations;
+            assert_eq!(kept, expected, "m {m}: amd {amd:e}, nd {nd:e}");
+        }
+    }
+
+    #[test]
+    fn a_dissected_trailing_analysis_ends_with_the_trailing_block() {
+        // the trailing equations (the y dofs of a grid line, as contact rows on a boundary) are
+        // eliminated last in their order, after the cheaper order of the leading block
+        let m = 230;
+        let p = q4_grid_pattern(m);
+        let trailing: Vec<usize> = (0..m).rev().map(|i| 2 * i + 1).collect();
+        let chol = Cholesky::analyse_with_trailing(&p, &trailing, &UNLIMITED).unwrap();
+        assert_eq!(chol.trailing.as_deref(), Some(&trailing[..]));
+        let (amd, nd) = candidate_work(&p, &trailing);
+        assert_eq!(
+            chol.work().operations,
+            amd.min(nd),
+            "amd {amd:e}, nd {nd:e}"
+        );
+    }
+
     #[test]
     fn an_invalid_trailing_set_is_the_amd_analysis() {
         let (p, _) = grid_laplacian(5);
