@@ -663,10 +663,9 @@ fn the_3d_lagrange_friction_tangent_is_the_derivative_of_the_residual_in_stick_a
         ];
         for (name, slip, stick) in cases {
             for enforcement in [lagrange(), penalty()] {
-                if name == "rigid plane" || name == "node-to-surface" {
-                    if enforcement == penalty() {
-                        continue; // the penalty's node-based rows: the test above
-                    }
+                if (name == "rigid plane" || name == "node-to-surface") && enforcement == penalty()
+                {
+                    continue; // the penalty's node-based rows: the test above
                 }
                 for (v, status) in [(stick.clone(), Status::Stick), (slip.clone(), Status::Slip)] {
                     let v = with(v, &enforcement);
