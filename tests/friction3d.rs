@@ -13,6 +13,14 @@
 //!   function of the normal alone, not of the mesh).
 //! * Plane strain: a 3D block one element thick with `u_y = 0` reproduces the forces of the
 //!   2D case (the disc with zero slip along y is the scalar map).
+//! * Lagrange multipliers (two tangential multipliers per row, the semi-smooth sets on the
+//!   disc) and mortar rows (standard and dual, the weighted tangential slip): the tangent
+//!   against central differences in stick and slip (the turn of the slip direction included);
+//!   the dragged slab sticks below and slips at `mu N` above the limit; the penalty's forces
+//!   approach the Lagrange ones as `1/kappa`; a punch dragged over its foundation by mortar
+//!   rows slips at `mu N` with the forces on the two bodies in balance; rotation invariance
+//!   of mortar friction; a two-body slab one element thick reproduces 2D plane-strain mortar
+//!   and Lagrange friction.
 
 use contact_patch::contact::friction::Status;
 use contact_patch::contact::state::{ContactState, Termination};
@@ -445,7 +453,7 @@ fn what_3d_friction_does_not_solve_is_refused_with_the_reason() {
         let parsed = contact_patch::model::parse(&v.to_string(), "refused").unwrap();
         let e = build3(&parsed, "refused")
             .and_then(|m| {
-                // the rows are built in the solve: a mortar pair is refused there
+                // what the model admits, the solve may still refuse (the rows are built there)
                 contact_patch::solver::active_set::solve(&m, &mut |_| {}).map(|_| ())
             })
             .expect_err("refused");

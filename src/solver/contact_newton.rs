@@ -107,9 +107,10 @@
 //! direction's turn).
 //!
 //! **Coulomb friction with Lagrange multipliers** (Lagrange rows of a Coulomb pair): each row
-//! with a normal multiplier gains a tangential one, `lambda_t = rho mu_t`, numbered after the
-//! normal ones, and the semi-smooth Newton method of Alart & Curnier (1991) in the active-set
-//! form of Hüeber, Stadler & Wohlmuth (2008) takes each point's set from the last iterate
+//! with a normal multiplier gains a tangential one per tangent (one in 2D, two in 3D: see "On
+//! the disc" below), `lambda_t = rho mu_t`, numbered after the normal ones, and the
+//! semi-smooth Newton method of Alart & Curnier (1991) in the active-set form of Hüeber,
+//! Stadler & Wohlmuth (2008) takes each point's set from the last iterate
 //! ([`crate::contact::friction::multiplier_status`], `c = rho`, the slip increment `dg_t = g_t -
 //! g_t^n` from the tangential position committed at the end of the last load step):
 //!
