@@ -9,8 +9,8 @@
 //! and the active-set contact solve with every enforcement method
 //! ([`crate::solver::active_set`]) are the 2D code paths, generic over the dimension. What is
 //! not built in 3D yet is refused here with the reason (an invalid-case error, exit 2), never
-//! computed wrongly: dynamics, the current contact geometry under small strain, Coulomb
-//! friction with Lagrange multipliers, sweeps, exact solutions, user-defined sets, loads other
+//! computed wrongly: dynamics, the current contact geometry under small strain, sweeps, exact
+//! solutions, user-defined sets, loads other
 //! than pressure, checks other than `uniform_stress_3d`; the 3D discretizations refuse what
 //! they do not treat ([`crate::contact::discretization::Discretize`]).
 //!
@@ -27,9 +27,14 @@
 //!
 //! Coulomb friction (issue 13, build item 4) runs through the 2D code path: the Newton scheme
 //! ([`crate::solver::contact_newton`], generic over the dimension) with the return map on the
-//! disc ([`crate::contact::friction`]) and two tangential rows per node-based pair row
-//! ([`crate::contact::discretization::pair3`]); load paths (`path` on supports and pressures,
-//! steps with committed slip) are the 2D model's ([`crate::model::Model::at_load`]).
+//! disc ([`crate::contact::friction`]) and two tangential rows per pair row, node-based or
+//! mortar, standard and dual (the weighted tangential slip,
+//! [`crate::contact::discretization::pair3`]), with every normal law the 2D scheme takes for
+//! friction: the penalty-type ones and Lagrange multipliers (two tangential multipliers per
+//! row, the semi-smooth stick/slip sets on the disc with the consistent turn of the slip
+//! direction, [`crate::contact::friction::multiplier_status`]); load paths (`path` on supports
+//! and pressures, steps with committed slip) are the 2D model's
+//! ([`crate::model::Model::at_load`]).
 //!
 //! The check `uniform_stress_3d` is the 3D uniform-stress check: the largest difference over
 //! the quadrature points of the stiffness rule and the six components, relative to the
@@ -44,8 +49,8 @@ use crate::fe3d::SolidKind;
 use crate::harness::checks::CheckResult;
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
 use crate::io::scene::{
-    Case, Check, ContactGeometry, EnforcementSpec, Interaction, Kinematics, MaterialModel,
-    MeshSpec, Prescribed, Scheme,
+    Case, Check, ContactGeometry, Interaction, Kinematics, MaterialModel, MeshSpec, Prescribed,
+    Scheme,
 };
 use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
@@ -338,16 +343,6 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
     model.resolve_contact(case)?;
     if finite {
         check_finite3(&model, case)?;
-    }
-    for (k, pair) in case.contact.iter().enumerate() {
-        if pair.interaction.friction().is_some() && pair.enforcement == EnforcementSpec::Lagrange {
-            return Err(not_built(
-                source,
-                format!("contact[{k}] '{}'.enforcement", pair.name),
-                "Coulomb friction with Lagrange multipliers (a tangential multiplier per tangent and the disc's semi-smooth sets)",
-                "use the penalty, the perturbed Lagrangian, the augmented Lagrangian or the perturbed tangent for a frictional pair",
-            ));
-        }
     }
     for (k, check) in case.checks.iter().enumerate() {
         let at = format!("checks[{k}]");

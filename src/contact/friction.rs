@@ -71,6 +71,19 @@
 //! At a solution of the slip branch `tau = s (mu lambda_n + c |dg_t|)`: the slip runs against
 //! the force and the dissipation `-lambda_t dg_t = mu lambda_n |dg_t|` is non-negative.
 //!
+//! On the disc (3D, `k = 2` tangents; Hüeber, Stadler & Wohlmuth 2008; Wriggers 2006,
+//! s. 5.2) the same sets hold with vectors: `tau = lambda_t - c dg_t`, stick `|tau| <= mu
+//! lambda_n` (then `dg_t = 0`), slip `lambda_t = mu lambda_n s` with `s = tau / |tau|` the radial
+//! return of the trial force, whose consistent linearization carries the turn of the direction
+//!
+//! ```text
+//! d (mu lambda_n s) = mu s d lambda_n + T d tau,   T = mu lambda_n (I - s s^T) / |tau|,
+//! d tau = d lambda_t - c d(dg_t)
+//! ```
+//!
+//! ([`MultiplierSet::turn`]). With one tangent `s = sign(tau)`, `I - s s^T = 0`, and the sets are
+//! the scalar ones above to the last bit (one function serves both).
+//!
 //! **Augmented Lagrangian** ([`augmented_return_map`]; Simo & Laursen 1992, *Comput. Struct.*
 //! 42, 97-116; Laursen & Simo 1993, *Int. J. Numer. Meth. Engng.* 36, 3451-3485): the normal
 //! force `lambda_n = max(0, lambda_bar_n - w_n g_n)` and the tangential trial force are
@@ -357,27 +370,61 @@ pub struct Committed {
     pub tangential_force: Tangential,
 }
 
-/// The frictional status of a point with Lagrange multipliers (see the module doc): normal force
-/// `lambda_n` (`active`: the normal row is in the active set), tangential force `lambda_t`, slip
-/// increment `dg_t` of the step and the constant `c` (a stiffness). Returns the status and, in
-/// slip, the sign `s` of the force `lambda_t = s mu lambda_n` (`0.0` otherwise).
+/// The open/stick/slip set of a point with Lagrange multipliers ([`multiplier_status`]).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct MultiplierSet {
+    pub status: Status,
+    /// In slip, the unit direction `s` of the trial force `tau = lambda_t - c dg_t` (`sign(tau)`
+    /// with one tangent); zero otherwise.
+    pub direction: Tangential,
+    /// In slip, `T = mu lambda_n (I - s s^T) / |tau|` (`k x k`, symmetric, zero with one
+    /// tangent): the slip force `mu lambda_n s(tau)` changes by `T d tau` (the turn of the
+    /// direction, `d s / d tau = (I - s s^T) / |tau|`); zero otherwise.
+    pub turn: [Tangential; MAX_TANGENTS],
+}
+
+/// The frictional set of a point with Lagrange multipliers (see the module doc): normal force
+/// `lambda_n` (`active`: the normal row is in the active set), tangential force `lambda_t` and
+/// slip increment `dg_t` of the step (`k` components each, `k = lambda_t.len()`, one or two)
+/// and the constant `c` (a stiffness). With one tangent the disc is the interval and the sets
+/// are the scalar ones to the last bit (`|tau| = sqrt(tau^2)` is not taken, `T = 0`).
 pub fn multiplier_status(
     mu: f64,
     lambda_n: f64,
     active: bool,
-    lambda_t: f64,
-    increment: f64,
+    lambda_t: &[f64],
+    increment: &[f64],
     c: f64,
-) -> (Status, f64) {
+) -> MultiplierSet {
+    let k = lambda_t.len();
+    let mut set = MultiplierSet {
+        status: Status::Open,
+        direction: [0.0; MAX_TANGENTS],
+        turn: [[0.0; MAX_TANGENTS]; MAX_TANGENTS],
+    };
     if !active {
-        return (Status::Open, 0.0);
+        return set;
     }
-    let trial = lambda_t - c * increment;
-    if trial.abs() <= mu * lambda_n.max(0.0) {
-        (Status::Stick, 0.0)
-    } else {
-        (Status::Slip, trial.signum())
+    let (force, dg) = (tangential(lambda_t), tangential(increment));
+    let trial: Tangential = std::array::from_fn(|a| force[a] - c * dg[a]);
+    let trial_length = length(k, &trial);
+    if trial_length <= mu * lambda_n.max(0.0) {
+        set.status = Status::Stick;
+        return set;
     }
+    set.status = Status::Slip;
+    set.direction = direction(k, &trial, trial_length);
+    if k > 1 {
+        let scale = mu * lambda_n / trial_length;
+        let s = set.direction;
+        for a in 0..k {
+            for b in 0..k {
+                let identity = if a == b { 1.0 } else { 0.0 };
+                set.turn[a][b] = scale * (identity - s[a] * s[b]);
+            }
+        }
+    }
+    set
 }
 
 /// What a solve found at one frictional contact point (aligned with the rows of
@@ -688,27 +735,77 @@ mod tests {
 
     #[test]
     fn multiplier_sets_follow_the_trial_force() {
+        let set = |lambda_n, active, lambda_t, increment| {
+            let m = multiplier_status(0.5, lambda_n, active, &[lambda_t], &[increment], 10.0);
+            assert_eq!(
+                m.turn, [[0.0; 2]; 2],
+                "one tangent: the direction cannot turn"
+            );
+            (m.status, m.direction[0])
+        };
         // inside the cone: stick; outside: slip against the motion; no normal force: open
-        assert_eq!(
-            multiplier_status(0.5, 4.0, true, 1.0, 0.0, 10.0),
-            (Status::Stick, 0.0)
-        );
-        assert_eq!(
-            multiplier_status(0.5, 4.0, true, 2.0, 0.5, 10.0),
-            (Status::Slip, -1.0)
-        );
-        assert_eq!(
-            multiplier_status(0.5, 4.0, true, 3.0, 0.0, 10.0),
-            (Status::Slip, 1.0)
-        );
-        assert_eq!(
-            multiplier_status(0.5, 4.0, false, 3.0, 0.0, 10.0),
-            (Status::Open, 0.0)
-        );
+        assert_eq!(set(4.0, true, 1.0, 0.0), (Status::Stick, 0.0));
+        assert_eq!(set(4.0, true, 2.0, 0.5), (Status::Slip, -1.0));
+        assert_eq!(set(4.0, true, 3.0, 0.0), (Status::Slip, 1.0));
+        assert_eq!(set(4.0, false, 3.0, 0.0), (Status::Open, 0.0));
         // a closed point with no compression yet sticks where it is
-        assert_eq!(
-            multiplier_status(0.5, 0.0, true, 0.0, 0.0, 10.0),
-            (Status::Stick, 0.0)
-        );
+        assert_eq!(set(0.0, true, 0.0, 0.0), (Status::Stick, 0.0));
+    }
+
+    #[test]
+    fn multiplier_sets_on_the_disc_return_radially_with_the_turn_of_the_direction() {
+        // mu lambda_n = 2, c = 10: the trial force lambda_t - c dg in eight directions, inside
+        // (stick) and outside (slip) the disc
+        let (mu, lambda_n, c) = (0.5, 4.0, 10.0);
+        for direction in 0..8 {
+            let angle = 0.2 + direction as f64 * std::f64::consts::PI / 4.0;
+            let e = [angle.cos(), angle.sin()];
+            let lambda_t = [0.3, -0.4];
+            for (radius, status) in [(1.5, Status::Stick), (3.0, Status::Slip)] {
+                // dg such that tau = radius e
+                let dg = [
+                    (lambda_t[0] - radius * e[0]) / c,
+                    (lambda_t[1] - radius * e[1]) / c,
+                ];
+                let m = multiplier_status(mu, lambda_n, true, &lambda_t, &dg, c);
+                assert_eq!(m.status, status, "{angle}");
+                if status == Status::Stick {
+                    assert_eq!((m.direction, m.turn), ([0.0; 2], [[0.0; 2]; 2]));
+                    continue;
+                }
+                for a in 0..2 {
+                    assert!((m.direction[a] - e[a]).abs() <= 1e-14);
+                }
+                // T is the derivative of mu lambda_n s(tau) in tau: central differences
+                let slip_force = |tau: [f64; 2]| {
+                    let l = length(2, &tau);
+                    [mu * lambda_n * tau[0] / l, mu * lambda_n * tau[1] / l]
+                };
+                let tau = [radius * e[0], radius * e[1]];
+                let h = 1e-6;
+                for b in 0..2 {
+                    let (mut plus, mut minus) = (tau, tau);
+                    plus[b] += h;
+                    minus[b] -= h;
+                    let (fp, fm) = (slip_force(plus), slip_force(minus));
+                    for a in 0..2 {
+                        let fd = (fp[a] - fm[a]) / (2.0 * h);
+                        assert!(
+                            (fd - m.turn[a][b]).abs() <= 1e-9,
+                            "{angle}: {fd} vs {:?}",
+                            m.turn
+                        );
+                    }
+                }
+                // the direction's own derivative is zero along s: T s = 0
+                for a in 0..2 {
+                    let ts = m.turn[a][0] * e[0] + m.turn[a][1] * e[1];
+                    assert!(ts.abs() <= 1e-15, "{ts}");
+                }
+            }
+        }
+        // a trial force along a tangent slips along it on the disc too, with the scalar's sign
+        let two = multiplier_status(mu, lambda_n, true, &[2.0, 0.0], &[0.5, 0.0], c);
+        assert_eq!((two.status, two.direction), (Status::Slip, [-1.0, 0.0]));
     }
 }

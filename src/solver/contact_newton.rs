@@ -104,12 +104,13 @@
 //! symmetric), besides the coupling `mu s_a w b_t,a b_n^T`. A slip counts as a change of
 //! status when its direction turns by more than a right angle. The secant remedy of a cycle
 //! applies to one tangent only (on a disc the slip tangent keeps the stiffness of the
-//! direction's turn), and Lagrange-multiplier friction is 2D only (`run3d` refuses it).
+//! direction's turn).
 //!
 //! **Coulomb friction with Lagrange multipliers** (Lagrange rows of a Coulomb pair): each row
-//! with a normal multiplier gains a tangential one, `lambda_t = rho mu_t`, numbered after the
-//! normal ones, and the semi-smooth Newton method of Alart & Curnier (1991) in the active-set
-//! form of Hüeber, Stadler & Wohlmuth (2008) takes each point's set from the last iterate
+//! with a normal multiplier gains a tangential one per tangent (one in 2D, two in 3D: see "On
+//! the disc" below), `lambda_t = rho mu_t`, numbered after the normal ones, and the
+//! semi-smooth Newton method of Alart & Curnier (1991) in the active-set form of Hüeber,
+//! Stadler & Wohlmuth (2008) takes each point's set from the last iterate
 //! ([`crate::contact::friction::multiplier_status`], `c = rho`, the slip increment `dg_t = g_t -
 //! g_t^n` from the tangential position committed at the end of the last load step):
 //!
@@ -117,6 +118,18 @@
 //! `R_t = -rho mu_t` (open), `R_t = -rho dg_t` with `R_u += rho dg_t b_t` (stick, the
 //! augmentation that vanishes at the solution and holds a body only friction holds),
 //! `R_t = -rho (mu_t - s mu mu_n)` (slip).
+//!
+//! **On the disc** (3D) a row has two tangential multipliers `mu_t,1, mu_t,2` (unknowns `j, j +
+//! 1`), one per tangent `t_a` of its frame, and the sets of
+//! [`crate::contact::friction::multiplier_status`] on the vectors: stick `R_t,a = -rho dg_t,a`
+//! with `R_u += rho sum_a dg_t,a b_t,a`; slip `R_t = -rho (mu_t - mu mu_n s)` with `s = tau /
+//! |tau|`, `tau = rho mu_t - c dg_t`, whose tangent carries the turn of the direction, `T = mu
+//! lambda_n (I - s s^T) / |tau|`: `dR_t / d mu_t = -rho (I - T)`, `dR_t / du = -c T B_t` (`B_t`
+//! the rows `b_t,a`), `dR_t / d mu_n = rho mu s`. With one tangent `T = 0` and these are the
+//! rows above to the last bit. A tangent whose slip the supports prescribe (no free equation in
+//! its gradient, e.g. `u_y = 0` everywhere in a plane-strain slab) has nothing to hold in stick:
+//! its multiplier is driven to zero there as an open one's (`R_t,a = -rho mu_t,a`), and the
+//! supports carry its force.
 //!
 //! The stick rows keep the saddle-point matrix symmetric; a slip row's equation couples `mu_t`
 //! to `mu_n` alone, not to the displacements its column acts on: the tangent is unsymmetric and
@@ -140,7 +153,7 @@ use crate::contact::discretization::{row_curvature, Discretize};
 use crate::contact::enforcement::{method, Method};
 use crate::contact::friction::{
     augmented_return_map, length, multiplier_status, return_map, Committed, FrictionPoint,
-    ReturnMap, Status, Tangential, MAX_TANGENTS,
+    MultiplierSet, ReturnMap, Status, Tangential, MAX_TANGENTS,
 };
 use crate::contact::state::{ContactState, Departure, Termination};
 use crate::contact::Constraint;
@@ -519,40 +532,64 @@ impl<'a, const D: usize, K: NewtonDimension<D>> ContactSystem<'a, D, K> {
             }
             RowLaw::Multiplier => {}
         }
+        let set = self.lagrange_set(i, u, x, lambda_n, on)?;
         let j = self.tangential[i]?;
-        let lambda_t = self.rho * x[j];
-        let (status, s) = if on && self.evaluations == 0 {
-            // a step starts with zero multipliers: every closed point sticks in its first
-            // iteration (a bound mu lambda_n = 0 would make any round-off slip a slip)
-            (Status::Stick, 0.0)
-        } else {
-            multiplier_status(
-                mu,
-                lambda_n,
-                on,
-                lambda_t,
-                g_t[0] - committed[0],
-                self.rho * self.friction_c,
-            )
-        };
+        let mut force = [0.0; MAX_TANGENTS];
+        if set.status != Status::Open {
+            for (a, f) in force.iter_mut().enumerate().take(k) {
+                *f = self.rho * x[j + a];
+            }
+        }
         Some(ReturnMap {
-            status,
-            force: [
-                if status == Status::Open {
-                    0.0
-                } else {
-                    lambda_t
-                },
-                0.0,
-            ],
-            plastic_slip: if status == Status::Stick {
+            status: set.status,
+            force,
+            plastic_slip: if set.status == Status::Stick {
                 committed
             } else {
                 g_t
             },
             d_slip: [[0.0; MAX_TANGENTS]; MAX_TANGENTS],
-            d_normal: [s, 0.0],
+            d_normal: set.direction,
         })
+    }
+
+    /// The open/stick/slip set of Lagrange friction row `i` at `(u, x)` with normal force
+    /// `lambda_n` (`on`: active): [`multiplier_status`] on the row's `k` tangential multipliers
+    /// `lambda_t = rho x_t` and its slip increment `g_t - g_t^n`, `c = friction_c rho`. `None`
+    /// for a row without tangential multipliers.
+    fn lagrange_set(
+        &self,
+        i: usize,
+        u: &[f64],
+        x: &[f64],
+        lambda_n: f64,
+        on: bool,
+    ) -> Option<MultiplierSet> {
+        let r = &self.rows[i];
+        let (mu, _) = self.coulomb(r)?;
+        let j = self.tangential[i]?;
+        let k = r.tangents.len();
+        if on && self.evaluations == 0 {
+            // a step starts with zero multipliers: every closed point sticks in its first
+            // iteration (a bound mu lambda_n = 0 would make any round-off slip a slip)
+            return Some(MultiplierSet {
+                status: Status::Stick,
+                direction: [0.0; MAX_TANGENTS],
+                turn: [[0.0; MAX_TANGENTS]; MAX_TANGENTS],
+            });
+        }
+        let committed = self.committed_slip(&row_key(r));
+        let g_t = slip_of(r, u);
+        let lambda_t: Vec<f64> = (0..k).map(|a| self.rho * x[j + a]).collect();
+        let increment: Vec<f64> = (0..k).map(|a| g_t[a] - committed[a]).collect();
+        Some(multiplier_status(
+            mu,
+            lambda_n,
+            on,
+            &lambda_t,
+            &increment,
+            self.rho * self.friction_c,
+        ))
     }
 
     /// The free equations of a gradient with their coefficients.
@@ -599,9 +636,10 @@ impl<'a, const D: usize, K: NewtonDimension<D>> ContactSystem<'a, D, K> {
             .iter()
             .zip(&self.multiplier)
             .map(|(r, mult)| {
+                // one unknown per tangent, numbered together: `j, j + 1` in 3D
                 (mult.is_some() && self.coulomb(r).is_some()).then(|| {
-                    m += 1;
-                    n + m - 1
+                    m += r.tangents.len();
+                    n + m - r.tangents.len()
                 })
             })
             .collect();
@@ -636,9 +674,15 @@ impl<'a, const D: usize, K: NewtonDimension<D>> ContactSystem<'a, D, K> {
                     }
                 }
                 block.push(*j);
-                if let (Some(jt), [t]) = (tangential, &r.tangents[..]) {
-                    block.extend(self.free_of(&t.dofs, &t.coeffs).iter().map(|&(e, _)| e));
-                    block.push(*jt);
+                if let Some(jt) = tangential {
+                    for t in &r.tangents {
+                        for (e, _) in self.free_of(&t.dofs, &t.coeffs) {
+                            if !block.contains(&e) {
+                                block.push(e);
+                            }
+                        }
+                    }
+                    block.extend(*jt..*jt + r.tangents.len());
                 }
                 builder.add_block(&block);
             }
@@ -963,11 +1007,19 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
                     r.pass
                 )
             }
-            None => match self.tangential.iter().position(|&m| m == Some(k)) {
-                Some(i) => {
+            None => match self.tangential.iter().enumerate().find_map(|(i, m)| {
+                m.filter(|&j| (j..j + self.rows[i].tangents.len()).contains(&k))
+                    .map(|j| (i, k - j))
+            }) {
+                Some((i, a)) => {
                     let r = &self.rows[i];
+                    let which = if r.tangents.len() > 1 {
+                        format!(" along tangent {} {:?}", a + 1, r.tangents[a].direction)
+                    } else {
+                        String::new()
+                    };
                     format!(
-                        "the tangential multiplier of the slave node at {} of contact '{}' (pass {})",
+                        "the tangential multiplier{which} of the slave node at {} of contact '{}' (pass {})",
                         r.site().at(),
                         self.model.contact[r.pair].name,
                         r.pass
@@ -1180,44 +1232,83 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
                     }
                 }
                 if let Some(jt) = self.tangential[i] {
-                    // Lagrange rows (one tangent): the force -rho x_t b_t, and the row of the
-                    // set
-                    let tangential: Vec<(usize, f64)> =
-                        tangential.iter().map(|(e, c)| (*e, c[0])).collect();
+                    // Lagrange rows: the force -rho sum_a x_t,a b_t,a, and the rows of the set,
+                    // one per tangent (unknowns jt + a)
                     let jn = self.multiplier[i].expect("a tangential multiplier has a normal one");
                     match map.status {
                         Status::Open => {
-                            // R_t = -rho x_t drives the multiplier to zero
-                            residual[jt] = -rho * x[jt];
-                            upper[self.pattern.position(jt, jt).expect("diagonal")] = -rho;
+                            // R_t = -rho x_t drives the multipliers to zero
+                            for a in 0..k {
+                                residual[jt + a] = -rho * x[jt + a];
+                                upper[self.pattern.position(jt + a, jt + a).expect("diagonal")] =
+                                    -rho;
+                            }
                         }
                         Status::Stick => {
-                            // R_t = -rho dg_t, and the augmentation rho dg_t b_t (zero at the
-                            // solution) holds a body that only friction holds
+                            // R_t,a = -rho dg_t,a, and the augmentation rho dg_t,a b_t,a (zero at
+                            // the solution) holds a body that only friction holds
                             let committed = self.committed_slip(&key);
-                            let dg = slip_of(r, &u)[0] - committed[0];
-                            residual[jt] = -rho * dg;
-                            for (a, &(ea, ca)) in tangential.iter().enumerate() {
-                                residual[ea] += rho * dg * ca;
-                                upper[self.pattern.position(ea, jt).expect("coupling")] -= rho * ca;
-                                for &(eb, cb) in &tangential[a..] {
-                                    upper[self
-                                        .pattern
-                                        .position(ea.min(eb), ea.max(eb))
-                                        .expect("covered")] += rho * ca * cb;
+                            let slip = slip_of(r, &u);
+                            for a in 0..k {
+                                let jta = jt + a;
+                                if tangential.iter().all(|(_, c)| c[a] == 0.0) {
+                                    // a tangent whose slip the supports prescribe (no free
+                                    // equation): its stick constrains nothing the solve moves
+                                    // (the row would be zero), the supports carry its force,
+                                    // and its multiplier is driven to zero as an open one's
+                                    residual[jta] = -rho * x[jta];
+                                    upper[self.pattern.position(jta, jta).expect("diagonal")] =
+                                        -rho;
+                                    continue;
+                                }
+                                let dg = slip[a] - committed[a];
+                                residual[jta] = -rho * dg;
+                                for (p, (ep, cp)) in tangential.iter().enumerate() {
+                                    let ca = cp[a];
+                                    residual[*ep] += rho * dg * ca;
+                                    upper[self.pattern.position(*ep, jta).expect("coupling")] -=
+                                        rho * ca;
+                                    for (eq, cq) in &tangential[p..] {
+                                        upper[self
+                                            .pattern
+                                            .position((*ep).min(*eq), (*ep).max(*eq))
+                                            .expect("covered")] += rho * ca * cq[a];
+                                    }
                                 }
                             }
                         }
                         Status::Slip => {
-                            // R_t = -rho (x_t - s mu x_n): the column -rho b_t of the force
-                            // only, not its transpose
+                            // R_t = -rho (x_t - mu x_n s(tau)): the column -rho b_t of the
+                            // force only, not its transpose; on the disc the turn of the
+                            // direction T = mu lambda_n (I - s s^T) / |tau| with tau = rho x_t -
+                            // c dg_t adds rho T in the multipliers' block and -c T b_t in the
+                            // displacements' (zero with one tangent)
                             let (mu, _) = self.coulomb(r).expect("frictional");
-                            residual[jt] = -rho * (x[jt] - map.d_normal[0] * mu * x[jn]);
-                            upper[self.pattern.position(jt, jt).expect("diagonal")] = -rho;
-                            slip_rows.push((jt, jn, rho * map.d_normal[0] * mu));
-                            for &(e, c) in &tangential {
-                                upper[self.pattern.position(e, jt).expect("coupling")] -= rho * c;
-                                slip_rows.push((jt, e, rho * c));
+                            let turn = self
+                                .lagrange_set(i, &u, x, lambda, on)
+                                .expect("a Lagrange friction row")
+                                .turn;
+                            let c = rho * self.friction_c;
+                            for a in 0..k {
+                                let jta = jt + a;
+                                let s_a = map.d_normal[a];
+                                residual[jta] = -rho * (x[jta] - s_a * mu * x[jn]);
+                                upper[self.pattern.position(jta, jta).expect("diagonal")] =
+                                    -rho + rho * turn[a][a];
+                                for b in a + 1..k {
+                                    upper[self.pattern.position(jta, jt + b).expect("block")] =
+                                        rho * turn[a][b];
+                                }
+                                slip_rows.push((jta, jn, rho * s_a * mu));
+                                for (e, cs) in &tangential {
+                                    upper[self.pattern.position(*e, jta).expect("coupling")] -=
+                                        rho * cs[a];
+                                    slip_rows.push((jta, *e, rho * cs[a]));
+                                    let along: f64 = (0..k).map(|b| turn[a][b] * cs[b]).sum();
+                                    if along != 0.0 {
+                                        slip_rows.push((jta, *e, -c * along));
+                                    }
+                                }
                             }
                         }
                     }
@@ -1868,7 +1959,9 @@ impl<'a, const D: usize, K: NewtonDimension<D>> Probe<'a, D, K> {
                 x[j] = state.forces[i] / system.rho;
             }
             if let (Some(j), Some(f)) = (system.tangential[k], &state.friction[i]) {
-                x[j] = f.force[0] / system.rho;
+                for a in 0..r.tangents.len() {
+                    x[j + a] = f.force[a] / system.rho;
+                }
             }
         }
         x

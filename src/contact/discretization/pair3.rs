@@ -24,9 +24,18 @@
 //! the slave node against its master point. The return map on the disc turns them into the
 //! tangential force ([`crate::contact::friction`]).
 //!
-//! Small strain: the geometry is taken once in the reference configuration. Slave normals,
-//! Coulomb friction with mortar rows and mortar against rigid surfaces are not built in 3D and
-//! are refused with the reason.
+//! **Mortar rows of Coulomb pairs** get the weighted tangential slip the same way (Puso &
+//! Laursen 2004, *Comput. Methods Appl. Mech. Engrg.* 193, 4891-4913; Gitterle, Popp, Gee &
+//! Wall 2010, *Int. J. Numer. Meth. Engng.* 84, 543-571; small strain: the tangential slip of
+//! slave node `j` is `t_j,a . (sum_k D_jk u_k - sum_l M_jl u_l) / A_j`, along the tangents
+//! of the frame of its nodal normal): a mortar row `g_j = nu_j . (sum_k D_jk u_k - sum_l M_jl
+//! u_l) / A_j` is a row with several slave terms, and its weights `D_jk / A_j`, `M_jl / A_j` are
+//! recovered from its coefficients on its dominant component as for a node-based row (the
+//! standard multipliers' `D_jk` couple several slave nodes; the dual ones' are diagonal). Its
+//! tributary area is `A_j = sum_k D_jk`, the tangential penalty's `w_t = kappa_t A_j` as in 2D.
+//!
+//! Small strain: the geometry is taken once in the reference configuration. Slave normals and
+//! mortar against rigid surfaces are not built in 3D and are refused with the reason.
 
 use super::geometry::Surface3;
 use super::mortar3::{mortar_rows3, FacetSet3, RowNumbering};
@@ -42,9 +51,6 @@ use std::collections::BTreeMap;
 /// The rows of `pair` of the 3D model `model`, or why its discretization does not apply.
 pub fn pair_rows(model: &Model3, pair: &ContactPair) -> Result<Vec<Constraint<3>>, String> {
     let frictional = pair.interaction.friction().is_some();
-    if frictional && matches!(pair.discretization, DiscretizationSpec::Mortar { .. }) {
-        return Err("Coulomb friction with mortar rows in 3D is not built yet (the weighted tangential slip of the segments is not assembled): use {\"kind\": \"node_to_surface\"} or \"node_to_node\" for a frictional pair".into());
-    }
     let tied = pair.interaction == Interaction::Tied;
     let (slave_body, slave_facets) = &pair.slave;
     let slave =
@@ -78,7 +84,13 @@ pub fn pair_rows(model: &Model3, pair: &ContactPair) -> Result<Vec<Constraint<3>
                 }
                 DiscretizationSpec::NodeToNode => node_to_node_rows(&slave, &master, &settings)?,
                 DiscretizationSpec::Mortar { multiplier } => {
-                    return mortar(model, pair, &slave, *body, facets, *multiplier, tied)
+                    // mortar builds its tied rows itself (the same D and M weights)
+                    let rows = mortar(model, pair, &slave, *body, facets, *multiplier, tied)?;
+                    return Ok(if frictional {
+                        with_tangents(model, rows)
+                    } else {
+                        rows
+                    });
                 }
             }
         }
