@@ -44,8 +44,8 @@ use crate::fe3d::SolidKind;
 use crate::harness::checks::CheckResult;
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
 use crate::io::scene::{
-    Case, Check, ContactGeometry, EnforcementSpec, Interaction, Kinematics, MaterialModel,
-    MeshSpec, Prescribed, Scheme,
+    Case, Check, ContactGeometry, DiscretizationSpec, EnforcementSpec, Interaction, Kinematics,
+    MaterialModel, MeshSpec, Prescribed, Scheme,
 };
 use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
@@ -377,19 +377,32 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
 }
 
 /// What finite kinematics solves in 3D, refused otherwise with the reason: frictionless
-/// contact against rigid masters, by the Newton scheme in the current geometry with the full
-/// tangent.
+/// contact against rigid masters and node-to-surface contact between bodies (master normals,
+/// one or two passes), by the Newton scheme in the current geometry with the full tangent.
 fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
     let source = &model.source;
     for (k, pair) in model.contact.iter().enumerate() {
         let at = format!("contact[{k}] '{}'", pair.name);
         if let MasterSide::Body { .. } = pair.master {
-            return Err(not_built(
-                source,
-                &at,
-                "contact between deformable bodies under finite kinematics",
-                "use a rigid \"plane\" or \"sphere\" master, or small-strain kinematics",
-            ));
+            match pair.discretization {
+                DiscretizationSpec::NodeToSurface { .. } => {}
+                DiscretizationSpec::NodeToNode => {
+                    return Err(not_built(
+                        source,
+                        format!("{at}.discretization"),
+                        "node-to-node contact between deformable bodies under finite kinematics (the variation of the master's nodal normal is not linearized)",
+                        "use {\"kind\": \"node_to_surface\"}, or small-strain kinematics",
+                    ))
+                }
+                DiscretizationSpec::Mortar { .. } => {
+                    return Err(not_built(
+                        source,
+                        format!("{at}.discretization"),
+                        "mortar contact between deformable bodies under finite kinematics (the second derivative of the 3D segments' weighted gap is not built)",
+                        "use {\"kind\": \"node_to_surface\"}, or small-strain kinematics",
+                    ))
+                }
+            }
         }
         if pair.interaction == Interaction::Tied {
             return Err(not_built(

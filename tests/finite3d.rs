@@ -586,10 +586,19 @@ fn combinations_not_built_are_refused_with_the_reason() {
         "master": {"body": "base", "set": "top"},
         "discretization": {"kind": "node_to_surface", "passes": 1},
         "enforcement": {"kind": "lagrange"}}]);
+    assert!(build3(&parse(&case), "finite3d").is_ok());
+    // mortar and node-to-node between the bodies
+    case["contact"][0]["discretization"] = json!({"kind": "mortar"});
     refused(
         &case,
-        "contact[0] 'interface'",
-        "contact between deformable bodies under finite kinematics in 3D is not built",
+        "contact[0] 'interface'.discretization",
+        "mortar contact between deformable bodies under finite kinematics",
+    );
+    case["contact"][0]["discretization"] = json!({"kind": "node_to_node"});
+    refused(
+        &case,
+        "contact[0] 'interface'.discretization",
+        "node-to-node contact between deformable bodies under finite kinematics",
     );
     // small strain keeps refusing the Newton scheme and the current geometry
     let mut case = contact_case(
@@ -672,4 +681,268 @@ fn the_run_command_writes_the_cauchy_stress_and_the_newton_history() {
     assert_eq!(summary["passed"], true);
     assert_eq!(summary["finite"]["steps"].as_array().unwrap().len(), 2);
     assert!(summary["finite"]["history"].as_array().unwrap().len() >= 4);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Contact between two deformable 3D bodies (node-to-surface, master normals, current geometry)
+
+/// A base block `[0, 1]^2 x [0, 1]` of `element` on breaks `base` in x and y and a punch
+/// `[0, 1]^2 x [1, 2]` on breaks `punch`, neo-Hookean (the same material): the base's bottom
+/// held in z (x and y at two corners), the punch's top moved down by `press` (held in x and y
+/// at two corners, where the homogeneous state does not move them); the punch's bottom (slave)
+/// against the base's top (master), node-to-surface with `passes`, `enforcement`.
+fn stacked(
+    element: &str,
+    base: &[f64],
+    punch: &[f64],
+    enforcement: Value,
+    press: f64,
+    passes: u8,
+) -> Value {
+    json!({
+        "name": "stacked-3d",
+        "materials": {"rubber": {"E": E, "nu": NU, "model": "neo_hookean"}},
+        "bodies": [
+            {"name": "base", "material": "rubber", "mesh": {"block3d": {
+                "element": element, "x": base, "y": base, "z": [0, 0.5, 1]}}},
+            {"name": "punch", "material": "rubber", "mesh": {"block3d": {
+                "element": element, "x": punch, "y": punch, "z": [1, 1.5, 2]}}}
+        ],
+        "physics": {"kinematics": "finite", "contact_geometry": "current"},
+        "solver": {"scheme": "newton", "load_steps": 4},
+        "supports": [
+            {"body": "base", "set": "bottom", "z": 0.0},
+            {"body": "base", "set": "bottom_front_left", "x": 0.0, "y": 0.0},
+            {"body": "base", "set": "bottom_front_right", "y": 0.0},
+            {"body": "punch", "set": "top", "z": press},
+            {"body": "punch", "set": "top_front_left", "x": 0.0, "y": 0.0},
+            {"body": "punch", "set": "top_front_right", "y": 0.0}
+        ],
+        "contact": [{
+            "name": "interface", "slave": {"body": "punch", "set": "bottom"},
+            "master": {"body": "base", "set": "top"},
+            "discretization": {"kind": "node_to_surface", "passes": passes},
+            "enforcement": enforcement
+        }]
+    })
+}
+
+/// The Cauchy stress at every stiffness quadrature point of every body.
+fn all_stresses(o: &Outcome3) -> Vec<[f64; 6]> {
+    o.model
+        .bodies
+        .iter()
+        .flat_map(|b| contact_patch::run3d::body_stresses(b, &o.solution.u))
+        .map(|(_, s)| s)
+        .collect()
+}
+
+/// The largest difference of the stresses from `expected`, relative to its largest component.
+fn stress_error(stresses: &[[f64; 6]], expected: &[f64; 6]) -> f64 {
+    let scale = expected.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    stresses
+        .iter()
+        .flat_map(|s| (0..6).map(move |i| (s[i] - expected[i]).abs()))
+        .fold(0.0, f64::max)
+        / scale
+}
+
+const MATCHING3: [f64; 3] = [0.0, 0.5, 1.0];
+/// The punch's nodes on a finer grid than the base's (0.25, 0.8 inside the base's facets) that
+/// holds the base's nodes: the one-pass node-to-surface rows then pass the contact patch test
+/// (the slave nodes' tributary weights integrate the master's shape functions exactly).
+const NESTED3: [f64; 5] = [0.0, 0.25, 0.5, 0.8, 1.0];
+
+/// The finite-strain contact patch test between two deformable blocks: both compressed by
+/// 20 % through a frictionless flat interface, where the homogeneous uniaxial state
+/// `F = diag(b, b, 0.8)` (`b` from `sigma_xx = 0`) is exact in both. With Lagrange multipliers
+/// the Cauchy stress is `sigma_zz` of the closed form at every quadrature point of both bodies
+/// to 1e-10 of it: matching interfaces on Hex8, Hex27, Tet4 and Tet10, and the nested
+/// non-matching interface on Hex8; two passes with the penalty (matching, Hex8) give the
+/// uniform stress of a uniform penetration (spread 1e-10). Newton converges quadratically.
+#[test]
+fn the_two_block_contact_patch_test_transmits_a_uniform_pressure() {
+    let (_, mu) = lame(E, NU);
+    let b = lateral_stretch(0.8);
+    let sigma_zz = mu * (0.64 - b * b) / (0.8 * b * b);
+    let expected = [0.0, 0.0, sigma_zz, 0.0, 0.0, 0.0];
+    let lagrange = json!({"kind": "lagrange"});
+    let cases: [(&str, &[f64], &str); 3] = [
+        ("Hex8", &MATCHING3, "matching"),
+        ("Tet10", &MATCHING3, "matching"),
+        ("Hex8", &NESTED3, "non-matching"),
+    ];
+    for (element, punch, interface) in cases {
+        println!("{element} {interface}:");
+        let o = run(&stacked(
+            element,
+            &MATCHING3,
+            punch,
+            lagrange.clone(),
+            -0.4,
+            1,
+        ));
+        assert!(o.converged(), "{element} {interface}");
+        let error = stress_error(&all_stresses(&o), &expected);
+        println!(
+            "{element} {interface} lagrange: stress error {error:.1e} of sigma_zz {sigma_zz:.4}, residuals {:?}",
+            residuals(&o.solution)
+        );
+        assert!(error < 1e-10, "{element} {interface}: {error:e}");
+    }
+    // the penalty: a uniform penetration, a uniform stress
+    let o = run(&stacked(
+        "Hex8",
+        &MATCHING3,
+        &MATCHING3,
+        json!({"kind": "penalty", "kappa": 1e5}),
+        -0.4,
+        1,
+    ));
+    assert!(o.converged());
+    let stresses = all_stresses(&o);
+    let spread = stress_error(&stresses, &stresses[0]);
+    println!(
+        "Hex8 matching penalty: stress spread {spread:.1e}, sigma_zz {:.4} (Lagrange {sigma_zz:.4})",
+        stresses[0][2]
+    );
+    assert!(spread < 1e-10, "{spread:e}");
+    assert!(stresses[0][0].abs() < 1e-10 * sigma_zz.abs());
+}
+
+/// The whole Newton system's tangent (neo-Hookean solids, node-to-surface rows between the two
+/// bodies with the second derivative of their gaps) against central differences of its
+/// residual, with closest points inside facets, on edges and at a corner of the master
+/// surface: a Hex8 base whose top is deformed into a pyramid (its centre node raised by 0.15:
+/// four convex ridges meeting at a convex apex) and a punch whose bottom nodes sit above the apex (held by
+/// the corner), above the ridges (held by the edges) and, pressed in by 0.19, in the facets;
+/// every node disturbed by a wavy field. Rows active with compressive forces: Lagrange
+/// multipliers and the augmented Lagrangian (Uzawa multipliers given, so the edge and corner
+/// rows, whose gap is a distance, are active too), and the penalty (the penetrating interior
+/// rows). The largest difference relative to the largest tangent entry is below 1e-7.
+#[test]
+fn the_newton_tangent_between_3d_bodies_is_the_difference_of_the_residual() {
+    use contact_patch::contact::discretization::pair3::pair_rows;
+    use contact_patch::contact::state::{ContactState, Termination};
+    use contact_patch::solver::contact_newton::Probe;
+    for enforcement in [
+        json!({"kind": "lagrange"}),
+        json!({"kind": "augmented_lagrange", "kappa": 1e4}),
+        json!({"kind": "penalty", "kappa": 1e4}),
+    ] {
+        let case = json!({
+            "name": "pyramid",
+            "materials": {"rubber": {"E": E, "nu": NU, "model": "neo_hookean"}},
+            "bodies": [
+                {"name": "base", "material": "rubber", "mesh": {"block3d": {"element": "Hex8",
+                    "x": [0, 0.5, 1], "y": [0, 0.5, 1], "z": [0, 0.5, 1]}}},
+                {"name": "punch", "material": "rubber", "mesh": {"block3d": {"element": "Hex8",
+                    "x": [0.2, 0.5, 0.8], "y": [0.2, 0.5, 0.8], "z": [1.2, 1.7]}}}
+            ],
+            "physics": {"kinematics": "finite", "contact_geometry": "current"},
+            "solver": {"scheme": "newton", "load_steps": 1},
+            "supports": [
+                {"body": "base", "set": "bottom", "x": 0.0, "y": 0.0, "z": 0.0},
+                {"body": "punch", "set": "top", "x": 0.0, "y": 0.0, "z": 0.0}
+            ],
+            "contact": [{
+                "name": "pyramid", "slave": {"body": "punch", "set": "bottom"},
+                "master": {"body": "base", "set": "top"},
+                "discretization": {"kind": "node_to_surface", "passes": 1},
+                "enforcement": enforcement,
+                "search_distance": 1.0
+            }]
+        });
+        let model = build3(&parse(&case), "finite3d").unwrap();
+        let mut u = vec![0.0; model.dof_count];
+        for (b, body) in model.bodies.iter().enumerate() {
+            for (n, p) in body.mesh.nodes.iter().enumerate() {
+                let k = (b * 1000 + n) as f64;
+                let wave = [
+                    1e-3 * (1.3 * k).sin(),
+                    1e-3 * (0.7 * k).cos(),
+                    1e-3 * (0.9 * k).sin() + 5e-3 * p[0] * p[1],
+                ];
+                let mut shift = [0.0; 3];
+                if b == 0 && p == &[0.5, 0.5, 1.0] {
+                    // the apex of the pyramid
+                    shift[2] = 0.15;
+                }
+                if b == 1 && p[2] < 1.25 && (p[0] - 0.5).abs() > 0.1 && (p[1] - 0.5).abs() > 0.1 {
+                    // the punch's bottom nodes over the facets, pressed in
+                    shift[2] = -0.19;
+                }
+                for i in 0..3 {
+                    u[body.dof(n, i)] = shift[i] + wave[i];
+                }
+            }
+        }
+        // the rows at u, all active with compressive forces
+        let mut moved = model.clone();
+        for body in &mut moved.bodies {
+            let offset = body.dof_offset;
+            for (n, p) in body.mesh.nodes.iter_mut().enumerate() {
+                for i in 0..3 {
+                    p[i] += u[offset + 3 * n + i];
+                }
+            }
+        }
+        let rows = pair_rows(&moved, &moved.contact[0]).unwrap();
+        // interior rows act on a facet's four nodes, edge rows on two, corner rows on one
+        let master_nodes = |r: &contact_patch::contact::Constraint<3>| r.dofs.len() / 3 - 1;
+        let count = |m: usize| rows.iter().filter(|r| master_nodes(r) == m).count();
+        let (interior, edge, corner) = (count(4), count(2), count(1));
+        assert!(
+            interior >= 4 && edge >= 4 && corner >= 1,
+            "{interior} {edge} {corner}"
+        );
+        assert!(rows.iter().all(|r| r.hessian.is_some()));
+        let n_rows = rows.len();
+        let state = ContactState {
+            rows,
+            active: vec![true; n_rows],
+            forces: (0..n_rows).map(|i| 2.0 + (i as f64).sin()).collect(),
+            gaps: vec![0.0; n_rows],
+            termination: Termination::Converged,
+            iterations: 0,
+            rank_deficiency: None,
+            linear_solver: "",
+            geometry_updates: 0,
+            configuration: None,
+            departures: Vec::new(),
+            steps: Vec::new(),
+            history: Vec::new(),
+            geometry_changes: Vec::new(),
+            friction: vec![None; n_rows],
+        };
+        let mut probe = Probe::new(&model, 0.0).unwrap();
+        let x = probe.unknowns_at(&u, &state);
+        // a first evaluation at x covers the rows found there; the tangent is the second's
+        probe.evaluate(&x).unwrap();
+        let at = probe.evaluate(&x).unwrap();
+        let n = probe.unknown_count();
+        let scale = at
+            .tangent
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let h = 1e-7;
+        let mut worst = 0.0f64;
+        for j in 0..n {
+            let (mut xp, mut xm) = (x.clone(), x.clone());
+            xp[j] += h;
+            xm[j] -= h;
+            let rp = probe.evaluate(&xp).unwrap().residual;
+            let rm = probe.evaluate(&xm).unwrap().residual;
+            for i in 0..n {
+                let column = (rp[i] - rm[i]) / (2.0 * h);
+                worst = worst.max((column - at.tangent[i][j]).abs() / scale);
+            }
+        }
+        println!(
+            "{}: {n} unknowns, rows: {interior} interior, {edge} edge, {corner} corner; tangent vs central difference {worst:.1e} of {scale:.3e}",
+            enforcement["kind"]
+        );
+        assert!(worst < 1e-7, "{}: {worst:e}", enforcement["kind"]);
+    }
 }

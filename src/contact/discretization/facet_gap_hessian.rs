@@ -39,7 +39,7 @@
 //! (the tangent then lacks the turn of `nu`, the gap itself is exact).
 
 use super::facet_projection::{
-    natural_corners, project_onto_facet, shape_second_derivatives, FacetFeature,
+    natural_corners, project_onto_facet, shape_second_derivatives, FacetFeature, FacetProjection,
 };
 use super::geometry::{dot, facet_frame, FacetShape, MAX_FACET_NODES};
 use crate::fe::ElementKind;
@@ -53,9 +53,21 @@ pub fn node_to_facet_gap_hessian(
     coords: &[[f64; 3]],
     x_s: [f64; 3],
 ) -> Option<Vec<f64>> {
+    node_to_facet_gap_hessian_at(kind, coords, x_s, &project_onto_facet(kind, coords, x_s))
+}
+
+/// [`node_to_facet_gap_hessian`] at the closest point `q` of `x_s` on the facet, found by the
+/// caller (an interior point may lie on the facet's extension beyond a free boundary,
+/// [`super::facet_projection::project_onto_extended_facet`]: the same formulas hold there).
+pub fn node_to_facet_gap_hessian_at(
+    kind: ElementKind,
+    coords: &[[f64; 3]],
+    x_s: [f64; 3],
+    q: &FacetProjection,
+) -> Option<Vec<f64>> {
     let n_nodes = coords.len();
     let len = 3 * (n_nodes + 1);
-    let q = project_onto_facet(kind, coords, x_s);
+    let q = *q;
     let mut h = vec![0.0; len * len];
     match q.feature {
         FacetFeature::Interior => {}
@@ -188,7 +200,7 @@ fn edge_gap_hessian(
     kind: ElementKind,
     coords: &[[f64; 3]],
     x_s: [f64; 3],
-    q: &super::facet_projection::FacetProjection,
+    q: &FacetProjection,
     k: usize,
 ) -> Vec<f64> {
     let n_nodes = coords.len();

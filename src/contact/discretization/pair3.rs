@@ -35,7 +35,9 @@ use super::node_based_rows::{
     RigidMaster, RowSettings,
 };
 use crate::contact::{Constraint, TangentRow};
-use crate::io::scene::{DiscretizationSpec, Interaction, NormalChoice, RigidSurface};
+use crate::io::scene::{
+    ContactGeometry, DiscretizationSpec, Interaction, Kinematics, NormalChoice, RigidSurface,
+};
 use crate::model::{ContactPair, MasterSide, Model3};
 use std::collections::BTreeMap;
 
@@ -54,6 +56,11 @@ pub fn pair_rows(model: &Model3, pair: &ContactPair) -> Result<Vec<Constraint<3>
         dofs: &numbering,
         pair: 0,
         search_distance: pair.search_distance,
+        // finite kinematics builds the rows in the current configuration (the model's nodes
+        // moved, `solver::active_set::rows_at`): their gaps' second derivatives for Newton
+        current_finite: model.physics.kinematics == Kinematics::Finite
+            && model.physics.contact_geometry == ContactGeometry::Current
+            && !tied,
     };
     let rows = match (&pair.master, &pair.discretization) {
         (MasterSide::Rigid(rigid), DiscretizationSpec::NodeToSurface { passes, .. }) => {
