@@ -22,6 +22,8 @@ use contact_patch::solver::linear::Solution;
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use serde_json::{json, Value};
 
+mod finite_common;
+
 const E: f64 = 1000.0;
 const NU: f64 = 0.3;
 const ELEMENTS: [&str; 4] = ["Hex8", "Hex27", "Tet4", "Tet10"];
@@ -1104,4 +1106,88 @@ fn the_penalty_approaches_lagrange_multipliers_as_one_over_kappa() {
     );
     assert!((5.0..20.0).contains(&ratios.0), "{ratios:?}");
     assert!((5.0..20.0).contains(&ratios.1), "{ratios:?}");
+}
+
+/// One element thick with every `u_y` held, the 3D node-to-surface rows are the 2D plane-strain
+/// ones: the 2D two-block case of `tests/finite_contact.rs` (a Q4 base `[0, 3] x [0, 1]`, a
+/// narrower top block on non-matching nodes slid by 0.25 and pressed by 0.04 in 3 load steps,
+/// neo-Hookean, Lagrange multipliers) extruded into Hex8 over `y in [0, 1]` (the 2D thickness):
+/// every node's displacement (x, z) is the 2D node's (x, y) to 1e-9 of the largest, and the
+/// contact resultant the 2D one to 1e-9.
+#[test]
+fn one_element_thick_is_the_2d_plane_strain_finite_contact() {
+    let (slide, press, steps) = (0.25, -0.04, 3);
+    let case2 = finite_common::two_blocks(
+        "Q4",
+        &finite_common::NON_MATCHING,
+        json!({"kind": "node_to_surface", "passes": 1}),
+        json!({"kind": "lagrange"}),
+        (slide, press),
+        steps,
+    );
+    let (_dir, path) = finite_common::write(&case2);
+    let two = contact_patch::run::run_case(&path, &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
+    let case3 = json!({
+        "name": "two-blocks-3d",
+        "materials": {"m": {"E": E, "nu": NU, "model": "neo_hookean"}},
+        "bodies": [
+            {"name": "base", "material": "m", "mesh": {"block3d": {"element": "Hex8",
+                "x": [0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0], "y": [0, 1], "z": [0, 0.5, 1]}}},
+            {"name": "top", "material": "m", "mesh": {"block3d": {"element": "Hex8",
+                "x": finite_common::NON_MATCHING, "y": [0, 1], "z": [1, 1.4, 1.8]}}}
+        ],
+        "physics": {"kinematics": "finite", "contact_geometry": "current"},
+        "solver": {"scheme": "newton", "load_steps": steps},
+        "supports": [
+            {"body": "base", "set": "bottom", "x": 0.0, "z": 0.0},
+            {"body": "top", "set": "top", "x": slide, "z": press},
+            {"body": "base", "set": "all", "y": 0.0},
+            {"body": "top", "set": "all", "y": 0.0}
+        ],
+        "contact": [{
+            "name": "interface", "slave": {"body": "top", "set": "bottom"},
+            "master": {"body": "base", "set": "top"},
+            "discretization": {"kind": "node_to_surface", "passes": 1},
+            "enforcement": {"kind": "lagrange"}
+        }]
+    });
+    let three = run(&case3);
+    assert!(three.converged());
+    let scale = two.solution.u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut worst = 0.0f64;
+    for (b3, b2) in three.model.bodies.iter().zip(&two.model.bodies) {
+        for (n, p) in b3.mesh.nodes.iter().enumerate() {
+            let m = b2
+                .mesh
+                .nodes
+                .iter()
+                .position(|q| (q[0] - p[0]).abs() < 1e-12 && (q[1] - p[2]).abs() < 1e-12)
+                .expect("the 2D node under the 3D one");
+            for (i3, i2) in [(0, 0), (2, 1)] {
+                let d = three.solution.u[b3.dof(n, i3)] - two.solution.u[b2.dof(m, i2)];
+                worst = worst.max(d.abs());
+            }
+            assert_eq!(three.solution.u[b3.dof(n, 1)], 0.0);
+        }
+    }
+    let state2 = two.solution.contact.as_ref().unwrap();
+    let resultant2: [f64; 2] = std::array::from_fn(|i| {
+        state2
+            .rows
+            .iter()
+            .zip(&state2.forces)
+            .map(|(r, f)| f * r.normal[i])
+            .sum()
+    });
+    let resultant3 = contact_resultant(&three);
+    let force_error = ((resultant3[0] - resultant2[0]).abs()
+        + (resultant3[2] - resultant2[1]).abs())
+        / resultant2[1].abs();
+    println!(
+        "3D one element thick vs 2D plane strain: displacement {:.1e} of {scale:.3}, resultant {force_error:.1e} ({resultant3:?} vs {resultant2:?})",
+        worst / scale
+    );
+    assert!(resultant2[1].abs() > 1.0, "the blocks are pressed together");
+    assert!(worst < 1e-9 * scale, "{worst:e}");
+    assert!(force_error < 1e-9, "{force_error:e}");
 }
