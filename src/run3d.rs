@@ -19,10 +19,15 @@
 //! Newton's method with cuts, the same convergence rules and messages) on the 3D model,
 //! through the dimension-generic Newton contact system
 //! ([`crate::solver::contact_newton`]): frictionless contact against rigid planes and spheres
-//! in the current geometry (the sphere's gap second derivative in the tangent), every
-//! enforcement method of the 2D Newton scheme. Refused with the reason: contact between 3D
-//! bodies and tied pairs under finite kinematics, contact without the Newton scheme, the
-//! current geometry or the geometric stiffness. The stress of the checks and the `.vtu` is
+//! in the current geometry (the sphere's gap second derivative in the tangent), and between 3D
+//! bodies by node-to-surface with master normals, one or two passes, each row carrying the
+//! second derivative of its gap over the slave node and the master facet's nodes (closest
+//! points inside facets, on edges and at corners,
+//! [`crate::contact::discretization::facet_gap_hessian`]; Wriggers 2006, section 4.3), every
+//! enforcement method of the 2D Newton scheme. Refused with the reason: mortar and node-to-node
+//! between 3D bodies (their second-order terms are not built in 3D) and tied pairs under finite
+//! kinematics, contact without the Newton scheme, the current geometry or the geometric
+//! stiffness. The stress of the checks and the `.vtu` is
 //! then the Cauchy stress `F S F^T / J`, at the reference positions of the points.
 //!
 //! Coulomb friction (issue 13, build item 4) runs through the 2D code path: the Newton scheme

@@ -1,7 +1,7 @@
 //! Finite deformation in 3D (total Lagrangian, neo-Hookean and St. Venant-Kirchhoff on Hex8,
 //! Hex27, Tet4 and Tet10): the 2D driver (`solver::finite`, load steps of Newton's method) on
 //! the 3D model, through the dimension-generic Newton contact system, against rigid planes and
-//! spheres in the current geometry.
+//! spheres and between 3D bodies in the current geometry.
 //!
 //! * the homogeneous patch test: every boundary node of a distorted mesh prescribed by
 //!   `x = F X`, so `F` and the Cauchy stress are exact at every quadrature point (1e-10), and
@@ -12,6 +12,11 @@
 //!   block pressed against a rigid sphere, penalty and Lagrange multipliers;
 //! * the Newton tangent with a rigid sphere against a central difference of the residual, and
 //!   quadratic convergence in the residual history;
+//! * between two deformable bodies (node-to-surface, master normals, the facet gap's second
+//!   derivative in the tangent): the Newton tangent against central differences with interior,
+//!   edge and corner rows; the two-block contact patch test (matching and non-matching); a
+//!   60-degree rigid turn of a clamped, bulging pair (objectivity); the penalty approaching
+//!   Lagrange multipliers as `O(1/kappa)`; one element thick against the 2D plane-strain case;
 //! * what is not built refused with the reason.
 
 use contact_patch::model::Model3;

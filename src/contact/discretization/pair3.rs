@@ -24,7 +24,9 @@
 //! the slave node against its master point. The return map on the disc turns them into the
 //! tangential force ([`crate::contact::friction`]).
 //!
-//! Small strain: the geometry is taken once in the reference configuration. Slave normals,
+//! Small strain: the geometry is taken once in the reference configuration. Finite kinematics
+//! builds the rows in the current configuration (the model's nodes moved), and node-to-surface
+//! rows then carry their gap's second derivative ([`super::facet_gap_hessian`]). Slave normals,
 //! Coulomb friction with mortar rows and mortar against rigid surfaces are not built in 3D and
 //! are refused with the reason.
 
