@@ -1196,3 +1196,37 @@ fn one_element_thick_is_the_2d_plane_strain_finite_contact() {
     assert!(worst < 1e-9 * scale, "{worst:e}");
     assert!(force_error < 1e-9, "{force_error:e}");
 }
+
+/// Two passes (penalty, kappa 1e5) between the blocks compressed by 20 % with the punch's
+/// nodes off the base's ([`OFFSET3`]): Newton converges, the contact forces of both passes
+/// balance the punch top's reaction (1e-10), and the stress is near the uniform one (printed).
+#[test]
+fn two_passes_converge_and_balance() {
+    let (_, mu) = lame(E, NU);
+    let b = lateral_stretch(0.8);
+    let sigma_zz = mu * (0.64 - b * b) / (0.8 * b * b);
+    let penalty = json!({"kind": "penalty", "kappa": 1e5});
+    let o = run(&stacked("Hex8", &MATCHING3, &OFFSET3, penalty, -0.4, 2));
+    assert!(o.converged());
+    let state = o.solution.contact.as_ref().unwrap();
+    let passes: Vec<u8> = state.rows.iter().map(|r| r.pass).collect();
+    assert!(passes.contains(&1) && passes.contains(&2));
+    // the force on the punch: pass-1 rows push its nodes, pass-2 rows push the base's
+    let mut on_punch = 0.0;
+    for (r, f) in state.rows.iter().zip(&state.forces) {
+        let sign = if r.pass == 1 { 1.0 } else { -1.0 };
+        on_punch += sign * f * r.normal[2];
+    }
+    let punch = &o.model.bodies[1];
+    let reaction: f64 = punch.mesh.node_sets["top"]
+        .iter()
+        .map(|&n| o.solution.reactions[punch.dof(n, 2)])
+        .sum();
+    let balance = (reaction + on_punch).abs() / reaction.abs();
+    let error = stress_error(&all_stresses(&o), &[0.0, 0.0, sigma_zz, 0.0, 0.0, 0.0]);
+    println!(
+        "Hex8 two passes, penalty 1e5: punch force {on_punch:.6}, top reaction {reaction:.6}, balance {balance:.1e}, stress off the uniform Lagrange state {error:.1e}, residuals {:?}",
+        residuals(&o.solution)
+    );
+    assert!(balance < 1e-10, "{balance:e}");
+}
