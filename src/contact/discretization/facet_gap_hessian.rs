@@ -391,6 +391,38 @@ mod tests {
         assert_eq!((corners, edges), (1, 3), "one corner and three edge cases");
     }
 
+    /// A slave node on a facet's edge or corner itself (distance zero, where an edge or corner
+    /// gap has no direction) projects as an interior point (the boundary is inside to
+    /// `INSIDE`): its Hessian is the interior one, finite; just off the facet beyond the edge
+    /// the edge's is finite too.
+    #[test]
+    fn a_node_on_an_edge_or_a_corner_gets_the_interior_hessian() {
+        let quad4 = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.2],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.2],
+        ];
+        let on_edge = [1.0, 0.5, 0.1];
+        let on_corner = quad4[2];
+        for x_s in [on_edge, on_corner] {
+            let q = project_onto_facet(ElementKind::Q4, &quad4, x_s);
+            assert_eq!(q.feature, FacetFeature::Interior, "{x_s:?}");
+            assert!(q.distance < 1e-12);
+            let h = node_to_facet_gap_hessian(ElementKind::Q4, &quad4, x_s).expect("interior");
+            assert!(h.iter().all(|v| v.is_finite()));
+        }
+        let beyond = [1.0 + 1e-6, 0.5, 0.1];
+        let q = project_onto_facet(ElementKind::Q4, &quad4, beyond);
+        assert!(
+            matches!(q.feature, FacetFeature::Edge(_)),
+            "{:?}",
+            q.feature
+        );
+        let h = node_to_facet_gap_hessian(ElementKind::Q4, &quad4, beyond).expect("edge");
+        assert!(h.iter().all(|v| v.is_finite()));
+    }
+
     /// A curved Quad9 below its slave point (the gap is negative: penetration).
     fn quad9_below() -> Vec<[f64; 3]> {
         let mut c: Vec<[f64; 3]> = ElementKind::Q9
