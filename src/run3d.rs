@@ -19,10 +19,15 @@
 //! Newton's method with cuts, the same convergence rules and messages) on the 3D model,
 //! through the dimension-generic Newton contact system
 //! ([`crate::solver::contact_newton`]): frictionless contact against rigid planes and spheres
-//! in the current geometry (the sphere's gap second derivative in the tangent), every
-//! enforcement method of the 2D Newton scheme. Refused with the reason: contact between 3D
-//! bodies and tied pairs under finite kinematics, contact without the Newton scheme, the
-//! current geometry or the geometric stiffness. The stress of the checks and the `.vtu` is
+//! in the current geometry (the sphere's gap second derivative in the tangent), and between 3D
+//! bodies by node-to-surface with master normals, one or two passes, each row carrying the
+//! second derivative of its gap over the slave node and the master facet's nodes (closest
+//! points inside facets, on edges and at corners,
+//! [`crate::contact::discretization::facet_gap_hessian`]; Wriggers 2006, section 4.3), every
+//! enforcement method of the 2D Newton scheme. Refused with the reason: mortar and node-to-node
+//! between 3D bodies (their second-order terms are not built in 3D) and tied pairs under finite
+//! kinematics, contact without the Newton scheme, the current geometry or the geometric
+//! stiffness. The stress of the checks and the `.vtu` is
 //! then the Cauchy stress `F S F^T / J`, at the reference positions of the points.
 //!
 //! Coulomb friction (issue 13, build item 4) runs through the 2D code path: the Newton scheme
@@ -49,8 +54,8 @@ use crate::fe3d::SolidKind;
 use crate::harness::checks::CheckResult;
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
 use crate::io::scene::{
-    Case, Check, ContactGeometry, Interaction, Kinematics, MaterialModel, MeshSpec, Prescribed,
-    Scheme,
+    Case, Check, ContactGeometry, DiscretizationSpec, Interaction, Kinematics, MaterialModel,
+    MeshSpec, Prescribed, Scheme,
 };
 use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
@@ -372,19 +377,32 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
 }
 
 /// What finite kinematics solves in 3D, refused otherwise with the reason: frictionless
-/// contact against rigid masters, by the Newton scheme in the current geometry with the full
-/// tangent.
+/// contact against rigid masters and node-to-surface contact between bodies (master normals,
+/// one or two passes), by the Newton scheme in the current geometry with the full tangent.
 fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
     let source = &model.source;
     for (k, pair) in model.contact.iter().enumerate() {
         let at = format!("contact[{k}] '{}'", pair.name);
         if let MasterSide::Body { .. } = pair.master {
-            return Err(not_built(
-                source,
-                &at,
-                "contact between deformable bodies under finite kinematics",
-                "use a rigid \"plane\" or \"sphere\" master, or small-strain kinematics",
-            ));
+            match pair.discretization {
+                DiscretizationSpec::NodeToSurface { .. } => {}
+                DiscretizationSpec::NodeToNode => {
+                    return Err(not_built(
+                        source,
+                        format!("{at}.discretization"),
+                        "node-to-node contact between deformable bodies under finite kinematics (the variation of the master's nodal normal is not linearized)",
+                        "use {\"kind\": \"node_to_surface\"}, or small-strain kinematics",
+                    ))
+                }
+                DiscretizationSpec::Mortar { .. } => {
+                    return Err(not_built(
+                        source,
+                        format!("{at}.discretization"),
+                        "mortar contact between deformable bodies under finite kinematics (the second derivative of the 3D segments' weighted gap is not built)",
+                        "use {\"kind\": \"node_to_surface\"}, or small-strain kinematics",
+                    ))
+                }
+            }
         }
         if pair.interaction == Interaction::Tied {
             return Err(not_built(

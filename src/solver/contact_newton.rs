@@ -8,7 +8,9 @@
 //!
 //! The system is generic over the dimension (`ContactSystem<D, K>`, the cells `K` supplying
 //! their rows through [`Discretize`]): in 3D it serves finite kinematics against rigid planes
-//! and spheres (the sphere's `(I - n n^T) / |x - c|` through [`Discretize::slave_curvature`]).
+//! and spheres (the sphere's `(I - n n^T) / |x - c|` through [`Discretize::slave_curvature`])
+//! and node-to-surface between bodies (each row's facet gap second derivative, carried as its
+//! `Constraint::hessian`, [`crate::contact::discretization::facet_gap_hessian`]).
 //!
 //! Unknowns: the free displacements `x` (prescribed values folded in, [`LinearSystem`]). Each
 //! contact row `i` (a [`Constraint`]: gap `g_i(u)`, gradient `b_i`, tributary area `A_i`) with
@@ -1463,11 +1465,10 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
         // remaining rows under a large force of either sign): the saddle-point matrix has
         // pivots of the wrong sign that are not a dependence of rows
         //
-        // In 3D under finite kinematics the rows are node-to-rigid ones (one row per slave node,
-        // independent: deformable pairs and two passes are refused there), so a pivot of the
-        // wrong sign is not a dependence of rows either: it is the solid's own geometric
-        // stiffness (compressive stress) at an iterate far from equilibrium (the first iterate of a
-        // load step, whose prescribed values jumped ahead of the interior), factored by LU too.
+        // In 3D under finite kinematics a pivot of the wrong sign may also be the solid's own
+        // geometric stiffness (compressive stress) at an iterate far from equilibrium (the first
+        // iterate of a load step, whose prescribed values jumped ahead of the interior), with
+        // rows against rigid masters too: factored by LU as well.
         tangent.indefinite_block =
             second_derivatives || (D == 3 && self.model.physics.kinematics == Kinematics::Finite);
         // constraint elimination (the model admits it only on its own): each active row is

@@ -1,7 +1,9 @@
 //! The second derivative of the 3D node-to-surface gap with respect to the nodal positions, for
-//! finite kinematics. **Not wired**: no solver consumes it yet (the small-strain rows of
-//! [`super::node_based_rows`] do not need it); it is here, checked against finite differences
-//! of the gap's gradient, for the 3D counterpart of [`super::node_to_segment`].
+//! finite kinematics: the 3D counterpart of [`super::node_to_segment`], attached to every
+//! node-to-surface row between deformable bodies built in the current configuration
+//! ([`super::node_based_rows`], `Constraint::hessian`) and consumed by the Newton tangent
+//! ([`crate::solver::contact_newton`]); checked here against finite differences of the gap's
+//! gradient.
 //!
 //! The gap of slave node `x_s` against the closest point `x(xi)` inside a master facet
 //! `x(xi) = sum_a N_a(xi) x_a` is `g = n . (x_s - x(xi))`, `n` the facet's unit normal at `xi`,
@@ -17,11 +19,28 @@
 //! * so `D(dg) = Dn . dr~ - (n . T_a dq) Dxi_a`
 //!   `= -m^ab (n . T_a Dq + h_ac Dxi_c)(t_b . dr~) - (n . T_a dq) Dxi_a`.
 //!
-//! At a corner held by the corner condition, `g = |x_s - x_v|` and the second derivative is
-//! `(I - nu nu^T) / g` on `x_s` and `-` that between `x_s` and `x_v`. Edge points are not
-//! provided (`None`).
+//! **Edges** (the closest point strictly inside edge `k` of the facet, the node outside a convex
+//! edge): the gap is the distance to the edge curve `c(tau) = x(A + tau (B - A))` between the
+//! natural corners `A`, `B`, `g = |r|`, `r = x_s - c(tau)`, `nu = r / g`, with `r . c' = 0`
+//! (`c' = t_a d_a`, `c'' = x_,ab d_a d_b`, `d = B - A`, `T dq = sum_b N_b,a d_a dx_b`). Its
+//! gradient is `nu . dr~`; the closest point moves by `m Dtau = c' . Dr~ + g nu . T Dq`,
+//! `m = c' . c' - g nu . c''`, and `Dnu = (I - nu nu^T)(Dr~ - c' Dtau) / g`, so
+//!
+//! `D(dg) = dr~ . (I - nu nu^T) Dr~ / g - (c' . dr~ + g nu . T dq)(c' . Dr~ + g nu . T Dq) / (g m)`
+//!
+//! (symmetric; `(I - nu nu^T) c' = c'`). The edge's shape functions are those of the facet at
+//! the edge point (zero on the facet's other nodes). **Corners**: `g = |x_s - x_v|` and the
+//! second derivative is `(I - nu nu^T) / g` on `x_s` and `-` that between `x_s` and `x_v`.
+//!
+//! Edge and corner points are points outside the facet's natural domain (a point on its
+//! boundary is interior, to [`super::facet_projection::INSIDE`]), so their distance is positive
+//! unless the node sits on the edge or the vertex itself, where the direction `nu` and so the
+//! second derivative are undefined: `None` there, and the row keeps its first-order part only
+//! (the tangent then lacks the turn of `nu`, the gap itself is exact).
 
-use super::facet_projection::{project_onto_facet, shape_second_derivatives, FacetFeature};
+use super::facet_projection::{
+    natural_corners, project_onto_facet, shape_second_derivatives, FacetFeature, FacetProjection,
+};
 use super::geometry::{dot, facet_frame, FacetShape, MAX_FACET_NODES};
 use crate::fe::ElementKind;
 
@@ -34,13 +53,30 @@ pub fn node_to_facet_gap_hessian(
     coords: &[[f64; 3]],
     x_s: [f64; 3],
 ) -> Option<Vec<f64>> {
+    node_to_facet_gap_hessian_at(kind, coords, x_s, &project_onto_facet(kind, coords, x_s))
+}
+
+/// [`node_to_facet_gap_hessian`] at the closest point `q` of `x_s` on the facet, found by the
+/// caller (an interior point may lie on the facet's extension beyond a free boundary,
+/// [`super::facet_projection::project_onto_extended_facet`]: the same formulas hold there).
+pub fn node_to_facet_gap_hessian_at(
+    kind: ElementKind,
+    coords: &[[f64; 3]],
+    x_s: [f64; 3],
+    q: &FacetProjection,
+) -> Option<Vec<f64>> {
     let n_nodes = coords.len();
     let len = 3 * (n_nodes + 1);
-    let q = project_onto_facet(kind, coords, x_s);
+    let q = *q;
     let mut h = vec![0.0; len * len];
     match q.feature {
         FacetFeature::Interior => {}
-        FacetFeature::Edge(_) => return None,
+        FacetFeature::Edge(k) => {
+            if q.distance == 0.0 {
+                return None;
+            }
+            return Some(edge_gap_hessian(kind, coords, x_s, &q, k));
+        }
         FacetFeature::Corner(k) => {
             if q.distance == 0.0 {
                 return None;
@@ -158,12 +194,92 @@ pub fn node_to_facet_gap_hessian(
     Some(h)
 }
 
+/// The second derivative of the gap of `x_s` against the edge `k` of the facet that holds its
+/// closest point `q` at a positive distance (module notes, **Edges**).
+fn edge_gap_hessian(
+    kind: ElementKind,
+    coords: &[[f64; 3]],
+    x_s: [f64; 3],
+    q: &FacetProjection,
+    k: usize,
+) -> Vec<f64> {
+    let n_nodes = coords.len();
+    let len = 3 * (n_nodes + 1);
+    let corners = natural_corners(kind);
+    let (from, to) = (corners[k], corners[(k + 1) % corners.len()]);
+    let d = [to[0] - from[0], to[1] - from[1]];
+    let g = q.distance;
+    let nu: [f64; 3] = std::array::from_fn(|i| (x_s[i] - q.point[i]) / g);
+    let mut shape = [0.0; MAX_FACET_NODES];
+    let mut dshape = [[0.0; 2]; MAX_FACET_NODES];
+    FacetShape::<3>::shape(
+        kind,
+        q.natural,
+        &mut shape[..n_nodes],
+        &mut dshape[..n_nodes],
+    );
+    let mut ddshape = [[[0.0; 2]; 2]; MAX_FACET_NODES];
+    shape_second_derivatives(kind, q.natural, &mut ddshape);
+    // c' and c'' along the edge, and the edge derivative of each shape function
+    let along: Vec<f64> = (0..n_nodes)
+        .map(|a| dshape[a][0] * d[0] + dshape[a][1] * d[1])
+        .collect();
+    let mut c1 = [0.0; 3];
+    let mut c2 = [0.0; 3];
+    for (a, p) in coords.iter().enumerate() {
+        let second: f64 = (0..2)
+            .flat_map(|al| (0..2).map(move |be| (al, be)))
+            .map(|(al, be)| ddshape[a][al][be] * d[al] * d[be])
+            .sum();
+        for i in 0..3 {
+            c1[i] += along[a] * p[i];
+            c2[i] += second * p[i];
+        }
+    }
+    let m = dot(c1, c1) - g * dot(nu, c2);
+    // R~ (3 x len): e_i on the slave, -N_a e_i on node a
+    let r_tilde = |i: usize, j: usize| -> f64 {
+        let (node, comp) = (j / 3, j % 3);
+        if comp != i {
+            0.0
+        } else if node == 0 {
+            1.0
+        } else {
+            -shape[node - 1]
+        }
+    };
+    // c' . R~ + g nu . T, over q
+    let w: Vec<f64> = (0..len)
+        .map(|j| {
+            let (node, comp) = (j / 3, j % 3);
+            let turn = if node == 0 {
+                0.0
+            } else {
+                along[node - 1] * nu[comp]
+            };
+            c1[comp] * r_tilde(comp, j) + g * turn
+        })
+        .collect();
+    let mut h = vec![0.0; len * len];
+    for i in 0..len {
+        for j in 0..len {
+            // R~^T (I - nu nu^T) R~: both columns act on one component each
+            let (ci, cj) = (i % 3, j % 3);
+            let projector = f64::from(u8::from(ci == cj)) - nu[ci] * nu[cj];
+            let sides = r_tilde(ci, i) * r_tilde(cj, j);
+            h[i * len + j] = projector * sides / g - w[i] * w[j] / (g * m);
+        }
+    }
+    h
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     /// The gap's gradient over `q = [x_s, x_1, .., x_n]` at these positions (re-projected):
-    /// `n` on the slave, `-N_a n` on node `a` inside; `nu`, `-nu` at a corner.
+    /// `n` on the slave, `-N_a n` on node `a` inside; `nu`, `-N_a nu` on an edge, `nu`, `-nu`
+    /// at a corner (`nu` the unit direction from the closest point to the slave).
     fn gradient(kind: ElementKind, coords: &[[f64; 3]], x_s: [f64; 3]) -> Vec<f64> {
         let q = project_onto_facet(kind, coords, x_s);
         let mut out = vec![0.0; 3 * (coords.len() + 1)];
@@ -181,7 +297,16 @@ mod tests {
                     .map(|a| f64::from(u8::from(a == c)))
                     .collect(),
             ),
-            FacetFeature::Edge(_) => unreachable!("the test points avoid edges"),
+            FacetFeature::Edge(_) => {
+                let mut shape = [0.0; MAX_FACET_NODES];
+                let mut dshape = [[0.0; 2]; MAX_FACET_NODES];
+                let k = coords.len();
+                FacetShape::<3>::shape(kind, q.natural, &mut shape[..k], &mut dshape[..k]);
+                (
+                    std::array::from_fn(|i| (x_s[i] - q.point[i]) / q.distance),
+                    shape[..k].to_vec(),
+                )
+            }
         };
         for i in 0..3 {
             out[i] = nu[i];
@@ -215,14 +340,26 @@ mod tests {
             (ElementKind::T6, tri6.clone(), [0.5, 0.4, 0.35]),
             (ElementKind::T6, tri6, [0.4, 0.3, -0.1]),
             (ElementKind::Q4, warped_quad4.clone(), [0.6, 0.3, 0.5]),
-            (ElementKind::Q4, warped_quad4, [1.3, 1.2, 0.3]),
+            (ElementKind::Q4, warped_quad4.clone(), [1.3, 1.2, 0.3]),
+            // edges: beyond a straight edge of a warped Quad4, a curved edge of a Quad9 and of
+            // a Tri6 (the hypotenuse)
+            (ElementKind::Q4, warped_quad4, [1.4, 0.4, 0.3]),
+            (ElementKind::Q9, quad9_below(), [0.3, 1.35, 0.25]),
+            (
+                ElementKind::T6,
+                super::super::facet_projection::tests::curved_tri6(),
+                [1.0, 1.0, 0.2],
+            ),
         ];
         let h = 1e-6;
-        let mut corners = 0;
+        let (mut corners, mut edges) = (0, 0);
         for (kind, coords, x_s) in cases {
-            let hessian = node_to_facet_gap_hessian(kind, &coords, x_s).expect("not on an edge");
-            if project_onto_facet(kind, &coords, x_s).feature != FacetFeature::Interior {
-                corners += 1;
+            let hessian =
+                node_to_facet_gap_hessian(kind, &coords, x_s).expect("off the facet's boundary");
+            match project_onto_facet(kind, &coords, x_s).feature {
+                FacetFeature::Corner(_) => corners += 1,
+                FacetFeature::Edge(_) => edges += 1,
+                FacetFeature::Interior => {}
             }
             let len = 3 * (coords.len() + 1);
             let largest = hessian.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -251,7 +388,39 @@ mod tests {
                 }
             }
         }
-        assert_eq!(corners, 1, "one corner case");
+        assert_eq!((corners, edges), (1, 3), "one corner and three edge cases");
+    }
+
+    /// A slave node on a facet's edge or corner itself (distance zero, where an edge or corner
+    /// gap has no direction) projects as an interior point (the boundary is inside to
+    /// `INSIDE`): its Hessian is the interior one, finite; just off the facet beyond the edge
+    /// the edge's is finite too.
+    #[test]
+    fn a_node_on_an_edge_or_a_corner_gets_the_interior_hessian() {
+        let quad4 = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.2],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.2],
+        ];
+        let on_edge = [1.0, 0.5, 0.1];
+        let on_corner = quad4[2];
+        for x_s in [on_edge, on_corner] {
+            let q = project_onto_facet(ElementKind::Q4, &quad4, x_s);
+            assert_eq!(q.feature, FacetFeature::Interior, "{x_s:?}");
+            assert!(q.distance < 1e-12);
+            let h = node_to_facet_gap_hessian(ElementKind::Q4, &quad4, x_s).expect("interior");
+            assert!(h.iter().all(|v| v.is_finite()));
+        }
+        let beyond = [1.0 + 1e-6, 0.5, 0.1];
+        let q = project_onto_facet(ElementKind::Q4, &quad4, beyond);
+        assert!(
+            matches!(q.feature, FacetFeature::Edge(_)),
+            "{:?}",
+            q.feature
+        );
+        let h = node_to_facet_gap_hessian(ElementKind::Q4, &quad4, beyond).expect("edge");
+        assert!(h.iter().all(|v| v.is_finite()));
     }
 
     /// A curved Quad9 below its slave point (the gap is negative: penetration).

@@ -327,6 +327,35 @@ pub fn project_onto_facet(kind: ElementKind, coords: &[[f64; 3]], p: [f64; 3]) -
     finish(natural, feature)
 }
 
+/// The stationary point of `|x(s) - p|^2 / 2` over the facet's interpolation extended beyond
+/// its natural domain by `margin` natural units (the domain grown by `margin`, the
+/// interpolation extrapolated), as an interior point (the gap along the facet's normal there);
+/// `None` when Newton finds none within it. Finite kinematics holds a slave node that has slid
+/// just past the free boundary of the master surface against it
+/// ([`super::node_based_rows`]).
+pub fn project_onto_extended_facet(
+    kind: ElementKind,
+    coords: &[[f64; 3]],
+    p: [f64; 3],
+    margin: f64,
+) -> Option<FacetProjection> {
+    let s = interior_newton(kind, coords, p)?;
+    if !natural_inside(kind, s, margin) {
+        return None;
+    }
+    let (x, t) = facet_frame(kind, coords, s);
+    let n = cross(t[0], t[1]);
+    let l = dot(n, n).sqrt();
+    let r = difference(p, x);
+    Some(FacetProjection {
+        natural: s,
+        feature: FacetFeature::Interior,
+        point: x,
+        distance: dot(r, r).sqrt(),
+        normal: n.map(|c| c / l),
+    })
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;

@@ -213,7 +213,8 @@ impl Discretize<3> for crate::fe3d::SolidKind {
     }
 
     /// Against a rigid sphere, `(I - n n^T) / |x_s - c|` ([`sphere_gap_hessian`]); rigid
-    /// planes are affine, and rows between 3D bodies carry none (`None`).
+    /// planes are affine, and rows between 3D bodies carry theirs over all their nodes on the
+    /// row (`Constraint::hessian`, finite kinematics, [`facet_gap_hessian`]): `None` here.
     fn slave_curvature(
         model: &crate::model::Model3,
         row: &Constraint<3>,

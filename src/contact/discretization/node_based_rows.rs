@@ -22,7 +22,14 @@
 //!   `nu` on the slave and `-N_a(xi) nu` on the edge's nodes (`-nu` on the vertex): the 3D
 //!   corner condition. A slave node whose closest point is on the free boundary of the master
 //!   surface (an edge of one facet only, or a vertex on such an edge) lies beyond it and gets
-//!   no row (the 2D rows extrapolate a free end by a quarter facet; these do not).
+//!   no row under small strain; under finite kinematics (rows built in the current
+//!   configuration) a node within a quarter facet ([`FREE_BOUNDARY_EXTENSION`]) beyond it is
+//!   held against the facet's interpolation extrapolated, as an interior point (the 2D rows'
+//!   free-end extension, [`super::END_EXTENSION`]): a slave node of a patch test whose surface
+//!   ends where the master's does leaves it by round-off of the iterates otherwise.
+//!   **Finite kinematics**: every node-to-surface row also carries the second derivative of its
+//!   gap over the slave node and the facet's nodes ([`super::facet_gap_hessian`], interior,
+//!   edge and corner points; `Constraint::hessian`), which the Newton tangent consumes.
 //!   **Two-pass** appends the rows with the roles swapped (`pass` 2).
 //! * **Node-to-node**: slave node `s` against the master node `m` at the same place (to
 //!   `1e-9` of the master surface's size), `g = n_m . (x_s - x_m)` with the master's nodal
@@ -40,10 +47,13 @@
 //! corner) and are dropped. The global dof of `(body, node, component)` comes from a
 //! [`DofNumbering`] (any closure `Fn(usize, usize, usize) -> usize`).
 
-use super::facet_projection::{project_onto_facet, FacetFeature, FacetProjection};
+use super::facet_gap_hessian::node_to_facet_gap_hessian_at;
+use super::facet_projection::{
+    project_onto_extended_facet, project_onto_facet, FacetFeature, FacetProjection,
+};
 use super::geometry::{dot, FacetShape, Surface, Surface3, MAX_FACET_NODES};
 use super::search::BucketGrid;
-use crate::contact::Constraint;
+use crate::contact::{Constraint, GapHessian};
 use std::collections::{BTreeSet, HashMap};
 
 /// The global dof of component `component` of node `node` of body `body`.
@@ -65,6 +75,12 @@ pub struct RowSettings<'a> {
     /// How far from the master surface a slave node is still a candidate (default: the
     /// largest master facet).
     pub search_distance: Option<f64>,
+    /// Finite kinematics, the rows built in the current configuration: every node-to-surface
+    /// row carries the second derivative of its gap
+    /// ([`super::facet_gap_hessian::node_to_facet_gap_hessian`], `Constraint::hessian`) for
+    /// the Newton tangent, and a slave node just past the free boundary of the master surface
+    /// is held against the facet extended by [`FREE_BOUNDARY_EXTENSION`] (module notes).
+    pub current_finite: bool,
 }
 
 /// A rigid analytic master surface in `D` dimensions.
@@ -334,6 +350,28 @@ fn node_to_surface_pass(
         };
         let facet = &master.facets[f];
         let nodes = facet.len();
+        let beyond_free_boundary = match q.feature {
+            FacetFeature::Interior => false,
+            FacetFeature::Edge(k) => {
+                let (a, b) = (facet[k], facet[(k + 1) % corners]);
+                edge_facets[&(a.min(b), a.max(b))] == 1
+            }
+            FacetFeature::Corner(k) => free_vertices.contains(&facet[k]),
+        };
+        let q = if beyond_free_boundary {
+            // finite kinematics: the facet extended (a node that slid just past the end of the
+            // master surface); small strain, or farther out: the node has left it
+            let extended = settings.current_finite.then(|| {
+                let margin = FREE_BOUNDARY_EXTENSION * natural_span(kind);
+                project_onto_extended_facet(kind, &master.coords[f], p, margin)
+            });
+            match extended.flatten() {
+                Some(q) => q,
+                None => continue,
+            }
+        } else {
+            q
+        };
         let mut n = [0.0; MAX_FACET_NODES];
         let mut dn = [[0.0; 2]; MAX_FACET_NODES];
         kind.shape(q.natural, &mut n[..nodes], &mut dn[..nodes]);
@@ -341,22 +379,11 @@ fn node_to_surface_pass(
         let d: [f64; 3] = std::array::from_fn(|i| p[i] - q.point[i]);
         let (nu, terms) = match q.feature {
             FacetFeature::Interior => (q.normal, terms),
-            FacetFeature::Edge(k) => {
-                let (a, b) = (facet[k], facet[(k + 1) % corners]);
-                if edge_facets[&(a.min(b), a.max(b))] == 1 {
-                    continue;
-                }
-                (away(d, q.distance, q.normal, tol), terms)
-            }
-            FacetFeature::Corner(k) => {
-                if free_vertices.contains(&facet[k]) {
-                    continue;
-                }
-                (away(d, q.distance, q.normal, tol), vec![(facet[k], 1.0)])
-            }
+            FacetFeature::Edge(_) => (away(d, q.distance, q.normal, tol), terms),
+            FacetFeature::Corner(k) => (away(d, q.distance, q.normal, tol), vec![(facet[k], 1.0)]),
         };
         let g0 = dot(nu, d);
-        rows.push(node_row(
+        let mut row = node_row(
             settings,
             slave,
             s,
@@ -364,9 +391,37 @@ fn node_to_surface_pass(
             g0,
             Some((master.body, &terms)),
             pass,
-        ));
+        );
+        if settings.current_finite {
+            // over the slave node and every node of the facet (zero rows for the nodes off
+            // the edge or the corner); none where the node sits on the edge or vertex itself
+            row.hessian =
+                node_to_facet_gap_hessian_at(kind, &master.coords[f], p, &q).map(|values| {
+                    let dofs_of = settings.dofs;
+                    let mut dofs: Vec<usize> =
+                        (0..3).map(|i| dofs_of.dof(slave.body, s, i)).collect();
+                    for &m in facet {
+                        dofs.extend((0..3).map(|i| dofs_of.dof(master.body, m, i)));
+                    }
+                    GapHessian { dofs, values }
+                });
+        }
+        rows.push(row);
     }
     rows
+}
+
+/// How far beyond the free boundary of the master surface a slave node is still held against
+/// the boundary facet's extension under finite kinematics, as a fraction of the facet's natural
+/// span (a quarter facet, as the 2D rows' [`super::END_EXTENSION`]).
+pub const FREE_BOUNDARY_EXTENSION: f64 = 0.25;
+
+/// The natural span of a facet: 2 for the quadrilaterals (`[-1, 1]`), 1 for the triangles.
+fn natural_span(kind: crate::fe::ElementKind) -> f64 {
+    match kind {
+        crate::fe::ElementKind::Q4 | crate::fe::ElementKind::Q9 => 2.0,
+        crate::fe::ElementKind::T3 | crate::fe::ElementKind::T6 => 1.0,
+    }
 }
 
 /// The unit direction of `d` (of length `length`), or `fallback` when it is shorter than `tol`.
@@ -467,6 +522,7 @@ mod tests {
             dofs,
             pair: 0,
             search_distance: None,
+            current_finite: false,
         }
     }
 

@@ -34,8 +34,10 @@
 //! standard multipliers' `D_jk` couple several slave nodes; the dual ones' are diagonal). Its
 //! tributary area is `A_j = sum_k D_jk`, the tangential penalty's `w_t = kappa_t A_j` as in 2D.
 //!
-//! Small strain: the geometry is taken once in the reference configuration. Slave normals and
-//! mortar against rigid surfaces are not built in 3D and are refused with the reason.
+//! Small strain: the geometry is taken once in the reference configuration. Finite kinematics
+//! builds the rows in the current configuration (the model's nodes moved), and node-to-surface
+//! rows then carry their gap's second derivative ([`super::facet_gap_hessian`]). Slave normals
+//! and mortar against rigid surfaces are not built in 3D and are refused with the reason.
 
 use super::geometry::Surface3;
 use super::mortar3::{mortar_rows3, FacetSet3, RowNumbering};
@@ -44,7 +46,9 @@ use super::node_based_rows::{
     RigidMaster, RowSettings,
 };
 use crate::contact::{Constraint, TangentRow};
-use crate::io::scene::{DiscretizationSpec, Interaction, NormalChoice, RigidSurface};
+use crate::io::scene::{
+    ContactGeometry, DiscretizationSpec, Interaction, Kinematics, NormalChoice, RigidSurface,
+};
 use crate::model::{ContactPair, MasterSide, Model3};
 use std::collections::BTreeMap;
 
@@ -60,6 +64,11 @@ pub fn pair_rows(model: &Model3, pair: &ContactPair) -> Result<Vec<Constraint<3>
         dofs: &numbering,
         pair: 0,
         search_distance: pair.search_distance,
+        // finite kinematics builds the rows in the current configuration (the model's nodes
+        // moved, `solver::active_set::rows_at`): their gaps' second derivatives for Newton
+        current_finite: model.physics.kinematics == Kinematics::Finite
+            && model.physics.contact_geometry == ContactGeometry::Current
+            && !tied,
     };
     let rows = match (&pair.master, &pair.discretization) {
         (MasterSide::Rigid(rigid), DiscretizationSpec::NodeToSurface { passes, .. }) => {
