@@ -382,3 +382,25 @@ fn rigid_body_modes_are_the_null_space_of_a_free_body() {
     free3["supports"] = json!([]);
     check("Hex8", &model3_of(&free3));
 }
+
+/// The coarsest level is factored within the case's `limits.factor_*`: above them the run
+/// stops with the levels' sizes and what to change, instead of factoring at any cost.
+#[test]
+fn a_coarsest_level_above_the_case_limits_is_refused() {
+    let mut case = with_cg(&elastic_case("Q4", 40, 20), 1e-10);
+    case["limits"] = json!({"factor_gigabytes": 1e-7});
+    let e = solve_static(&model_of(&case), &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    for part in [
+        "coarsest level of the multigrid hierarchy",
+        "too large to factor",
+        "limits.factor_gigabytes",
+        "\"linear_solver\": \"direct\"",
+    ] {
+        assert!(e.contains(part), "{e}");
+    }
+    // the default limits let it through
+    case.as_object_mut().unwrap().remove("limits");
+    assert!(solve_static(&model_of(&case), &mut |_| {}).is_ok());
+}

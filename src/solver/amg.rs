@@ -23,9 +23,18 @@
 //!   `||A_IJ||_F >= theta_l (||A_II||_F ||A_JJ||_F)^(1/2)`, `theta_l = 0.08 (1/2)^l`
 //!   (Vanek et al., eq. 3.1 with their `epsilon`, halved per level).
 //! * Aggregation (Vanek et al., alg. 5.1): (1) every block whose strong neighbourhood is
-//!   still free forms an aggregate with it; (2) every left-over block joins the aggregate of
-//!   its strongest aggregated neighbour; (3) what is still left forms aggregates of its free
-//!   strong neighbourhoods.
+//!   non-empty and still free forms an aggregate with it; (2) every left-over block joins the
+//!   aggregate of a strong neighbour aggregated in (1); (3) what is still left with strong
+//!   neighbours forms aggregates of its free strong neighbourhoods; (4) the blocks without
+//!   strong neighbours, which Vanek et al. leave out of the coarse space (right for a
+//!   Dirichlet row), are aggregated among themselves by (1) and (2) on the graph of their
+//!   couplings `||A_IJ||_F >= theta_l (m_I m_J)^(1/2)`, `m_I = max_{K != I} ||A_IK||_F`
+//!   (strength relative to the largest coupling instead of the diagonal), and what is left
+//!   joins the aggregate of its most strongly coupled aggregated neighbour. A contact node
+//!   under a large penalty has a dominant diagonal block through its normal dof alone, its
+//!   tangential dofs need the coarse correction: as a one-node aggregate it would stay a
+//!   block of its own on every level and stall the coarsening (the 3D slab: 1,090,824 ->
+//!   202,404 -> 127,812 equations); the contact layer aggregates as a layer.
 //! * Tentative prolongator: on each aggregate `a` with rows `E_a`, the thin QR factorization
 //!   `B_0[E_a, :] = Q_a R_a` (modified Gram-Schmidt, twice, dropping columns whose remainder
 //!   is below `1e-10` of their norm: a one-node aggregate holds fewer dofs than modes);
@@ -43,14 +52,18 @@
 //!   while the smoother contracts in the energy norm (`|1 - lambda p(lambda)| < 1` on the
 //!   spectrum, which holds on `(0, u]` and up to about 10 % beyond it for degree 2).
 //! * Coarsest level (at most [`AmgOptions::coarsest_size`] equations, or when coarsening
-//!   stalls): the sparse Cholesky factorization of [`crate::solver::sparse`].
+//!   stalls): the sparse Cholesky factorization of [`crate::solver::sparse`], within the
+//!   case's `limits.factor_*` ([`AmgOptions::factor_limit`]; above them the setup is refused
+//!   with the levels' sizes, [`AmgError::CoarsestTooLarge`]).
 //! * Preconditioned CG ([`conjugate_gradient`]) with the V-cycle `M`: stops when
 //!   `||b - A x||_2 <= tol ||b||_2`; the final relative residual is recomputed from `x`.
 //!
 //! Matrix-vector products, the smoother's vector updates and the sparse products of the
 //! setup run on all cores (rayon, row blocks).
 
-use crate::solver::sparse::{Cholesky, Factor, SymmetricPattern, UNLIMITED};
+use crate::solver::sparse::{
+    Cholesky, Factor, FactorError, SymmetricPattern, WorkLimit, UNLIMITED,
+};
 use rayon::prelude::*;
 
 /// Power iterations of the spectral-radius estimates (Rayleigh quotients, whose error is the
@@ -455,6 +468,10 @@ pub struct AmgOptions {
     /// A level with at most this many equations is solved by Cholesky.
     pub coarsest_size: usize,
     pub max_levels: usize,
+    /// The most the Cholesky factorization of the coarsest level may cost (the case's
+    /// `limits.factor_*`): a coarsening that stalls leaves a large coarsest level, which is
+    /// refused ([`AmgError::CoarsestTooLarge`]) rather than factored at any cost.
+    pub factor_limit: WorkLimit,
 }
 
 impl Default for AmgOptions {
@@ -464,6 +481,7 @@ impl Default for AmgOptions {
             smoother_degree: 2,
             coarsest_size: 2000,
             max_levels: 20,
+            factor_limit: UNLIMITED,
         }
     }
 }
@@ -606,6 +624,13 @@ pub enum AmgError {
     /// The Cholesky factorization of the coarsest level failed (the matrix is not positive
     /// definite: a mechanism).
     Coarsest(String),
+    /// The coarsest level's factor would exceed the case's limits: the coarsening stalled.
+    CoarsestTooLarge {
+        /// Equations of each level, finest first (the coarsest last).
+        levels: Vec<usize>,
+        /// The factor's size and the limits ([`crate::solver::sparse::FactorWork::refusal`]).
+        refusal: String,
+    },
 }
 
 impl std::fmt::Display for AmgError {
@@ -615,6 +640,10 @@ impl std::fmt::Display for AmgError {
             AmgError::Coarsest(why) => write!(
                 f,
                 "the coarsest level of the multigrid hierarchy cannot be factored ({why})"
+            ),
+            AmgError::CoarsestTooLarge { levels, refusal } => write!(
+                f,
+                "the coarsest level of the multigrid hierarchy (levels of {levels:?} equations) is too large to factor: {refusal}; a coarsening that stalls leaves a large coarsest level; raise limits.factor_gigabytes and limits.factor_operations if the machine has the memory, or use \"linear_solver\": \"direct\""
             ),
         }
     }
@@ -641,8 +670,24 @@ pub struct Hierarchy {
     operator_complexity: f64,
 }
 
-/// Blocks `I != J` strongly connected to each block (see the module doc).
-fn strong_neighbours(a: &CsrMatrix, blocks: &NodalBlocks, theta: f64) -> Vec<Vec<usize>> {
+/// The block graph of one level: the strong neighbours of each block and, for a block with
+/// none (its diagonal block dominates every coupling, e.g. a contact node under a large
+/// penalty), its neighbours from the strongest relative coupling down.
+#[derive(Clone, Debug, PartialEq)]
+struct BlockStrength {
+    strong: Vec<Vec<usize>>,
+    /// Empty unless `strong[i]` is empty.
+    weak_by_strength: Vec<Vec<usize>>,
+    /// For a block without strong neighbours, those of its neighbours without strong
+    /// neighbours whose coupling is strong relative to the largest off-diagonal blocks:
+    /// `||A_IJ||_F >= theta (m_I m_J)^(1/2)`, `m_I = max_{K != I} ||A_IK||_F`.
+    layer: Vec<Vec<usize>>,
+}
+
+/// Blocks `I != J` strongly connected to each block (see the module doc), and the neighbours
+/// of the blocks that have no strong one, by decreasing `||A_IJ||_F / (||A_II||_F
+/// ||A_JJ||_F)^(1/2)`.
+fn strong_neighbours(a: &CsrMatrix, blocks: &NodalBlocks, theta: f64) -> BlockStrength {
     let nb = blocks.count();
     let mut block_of = vec![0usize; a.rows];
     for b in 0..nb {
@@ -686,29 +731,106 @@ fn strong_neighbours(a: &CsrMatrix, blocks: &NodalBlocks, theta: f64) -> Vec<Vec
                 .map_or(0.0, |(_, s)| s.sqrt())
         })
         .collect();
-    norms
+    // relative coupling of each off-diagonal block with a nonzero norm
+    let relative: Vec<Vec<(usize, f64)>> = norms
+        .par_iter()
+        .enumerate()
+        .map(|(bi, row)| {
+            row.iter()
+                .filter(|&&(bj, s)| bj != bi && s > 0.0)
+                .map(|&(bj, s)| {
+                    let scale = (diagonal[bi] * diagonal[bj]).sqrt();
+                    let r = if scale > 0.0 {
+                        s.sqrt() / scale
+                    } else {
+                        f64::INFINITY
+                    };
+                    (bj, r)
+                })
+                .collect()
+        })
+        .collect();
+    let strong: Vec<Vec<usize>> = relative
+        .iter()
+        .map(|row| {
+            row.iter()
+                .filter(|&&(_, r)| r >= theta)
+                .map(|&(bj, _)| bj)
+                .collect()
+        })
+        .collect();
+    let weak_by_strength = relative
+        .into_iter()
+        .zip(&strong)
+        .map(|(mut row, strong)| {
+            if !strong.is_empty() {
+                return Vec::new();
+            }
+            row.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
+            row.into_iter().map(|(bj, _)| bj).collect()
+        })
+        .collect();
+    // the largest off-diagonal block norm of each block, and among the blocks without strong
+    // neighbours those coupled strongly relative to it
+    let off_diagonal: Vec<f64> = norms
         .iter()
         .enumerate()
         .map(|(bi, row)| {
             row.iter()
+                .filter(|(bj, _)| *bj != bi)
+                .fold(0.0, |m: f64, &(_, s)| m.max(s.sqrt()))
+        })
+        .collect();
+    let isolated: Vec<bool> = strong.iter().map(|s| s.is_empty()).collect();
+    let layer = norms
+        .iter()
+        .enumerate()
+        .map(|(bi, row)| {
+            if !isolated[bi] {
+                return Vec::new();
+            }
+            row.iter()
                 .filter(|&&(bj, s)| {
-                    bj != bi && s.sqrt() >= theta * (diagonal[bi] * diagonal[bj]).sqrt() && s > 0.0
+                    bj != bi
+                        && isolated[bj]
+                        && s > 0.0
+                        && s.sqrt() >= theta * (off_diagonal[bi] * off_diagonal[bj]).sqrt()
                 })
                 .map(|&(bj, _)| bj)
                 .collect()
         })
-        .collect()
+        .collect();
+    BlockStrength {
+        strong,
+        weak_by_strength,
+        layer,
+    }
 }
 
-/// Vanek et al.'s three-phase aggregation; returns the aggregate of each block.
-fn aggregate(strong: &[Vec<usize>]) -> (Vec<usize>, usize) {
+/// Vanek et al.'s aggregation (alg. 5.1), with the blocks that have no strong neighbour set
+/// aside as they set them aside; returns the aggregate of each block and their count.
+///
+/// 1. Every block with strong neighbours, all still free, forms an aggregate with them.
+/// 2. Every free block with a strong neighbour aggregated in phase 1 joins its aggregate.
+/// 3. Every block still free with strong neighbours forms an aggregate with those of them
+///    still free.
+/// 4. The blocks without strong neighbours: phases 1 and 2 on their layer graph
+///    ([`BlockStrength::layer`]); then each one still free joins the aggregate of its most
+///    strongly coupled aggregated neighbour (swept until nothing changes: a chain of such
+///    blocks reaches an aggregate); one without any neighbour is an aggregate of its own.
+///    Vanek et al. leave these blocks out of the coarse space, which is right for a Dirichlet
+///    row but not for a contact node under a large penalty: only its normal dof is dominated,
+///    its tangential dofs need the coarse correction; as a singleton aggregate it would stay
+///    a block of its own on every level (the coarsening stalls).
+fn aggregate(strength: &BlockStrength) -> (Vec<usize>, usize) {
     const FREE: usize = usize::MAX;
+    let strong = &strength.strong;
     let n = strong.len();
     let mut of = vec![FREE; n];
     let mut count = 0;
     // phase 1: whole free neighbourhoods
     for i in 0..n {
-        if of[i] == FREE && strong[i].iter().all(|&j| of[j] == FREE) {
+        if of[i] == FREE && !strong[i].is_empty() && strong[i].iter().all(|&j| of[j] == FREE) {
             of[i] = count;
             for &j in &strong[i] {
                 of[j] = count;
@@ -716,8 +838,8 @@ fn aggregate(strong: &[Vec<usize>]) -> (Vec<usize>, usize) {
             count += 1;
         }
     }
-    // phase 2: join an aggregate of phase 1 (the first strong neighbour's in the order of the
-    // strongest block norm is not needed: any neighbour gives a connected aggregate)
+    // phase 2: join an aggregate of phase 1 (any strong neighbour's: the aggregate stays
+    // connected)
     let phase1 = of.clone();
     for i in 0..n {
         if of[i] == FREE {
@@ -728,13 +850,58 @@ fn aggregate(strong: &[Vec<usize>]) -> (Vec<usize>, usize) {
     }
     // phase 3: the free neighbourhoods of what is left
     for i in 0..n {
-        if of[i] == FREE {
+        if of[i] == FREE && !strong[i].is_empty() {
             of[i] = count;
             for &j in &strong[i] {
                 if of[j] == FREE {
                     of[j] = count;
                 }
             }
+            count += 1;
+        }
+    }
+    // phase 4: blocks without strong neighbours aggregate among themselves (phases 1 and 2
+    // on the layer graph) ...
+    let layer = &strength.layer;
+    for i in 0..n {
+        if of[i] == FREE && !layer[i].is_empty() && layer[i].iter().all(|&j| of[j] == FREE) {
+            of[i] = count;
+            for &j in &layer[i] {
+                of[j] = count;
+            }
+            count += 1;
+        }
+    }
+    let phase4 = of.clone();
+    for i in 0..n {
+        if of[i] == FREE {
+            if let Some(&j) = layer[i].iter().find(|&&j| phase4[j] != FREE) {
+                of[i] = phase4[j];
+            }
+        }
+    }
+    // ... and what is left joins the aggregate of its most strongly coupled aggregated
+    // neighbour
+    loop {
+        let mut changed = false;
+        for i in 0..n {
+            if of[i] == FREE {
+                if let Some(&j) = strength.weak_by_strength[i]
+                    .iter()
+                    .find(|&&j| of[j] != FREE)
+                {
+                    of[i] = of[j];
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    for o in of.iter_mut() {
+        if *o == FREE {
+            *o = count;
             count += 1;
         }
     }
@@ -854,6 +1021,16 @@ fn smooth_prolongator(a: &CsrMatrix, tentative: &CsrMatrix) -> Result<CsrMatrix,
     let inverse: Vec<f64> = diagonal.iter().map(|d| 1.0 / d).collect();
     let rho = largest_eigenvalue(a, &inverse, POWER_STEPS).max(f64::MIN_POSITIVE);
     let omega = 4.0 / (3.0 * rho);
+    Ok(damped_jacobi_product(a, &inverse, omega, tentative))
+}
+
+/// `(I - omega D^-1 A) P_tent`, `D^-1 = inverse_diagonal`.
+fn damped_jacobi_product(
+    a: &CsrMatrix,
+    inverse: &[f64],
+    omega: f64,
+    tentative: &CsrMatrix,
+) -> CsrMatrix {
     let ap = a.product(tentative);
     let mut row_ptr = vec![0usize];
     let mut col_idx = Vec::with_capacity(ap.nnz());
@@ -886,13 +1063,13 @@ fn smooth_prolongator(a: &CsrMatrix, tentative: &CsrMatrix) -> Result<CsrMatrix,
         }
         row_ptr.push(col_idx.len());
     }
-    Ok(CsrMatrix {
+    CsrMatrix {
         rows: a.rows,
         cols: tentative.cols,
         row_ptr,
         col_idx,
         values,
-    })
+    }
 }
 
 impl Hierarchy {
@@ -932,9 +1109,19 @@ impl Hierarchy {
         let (pattern, values) = a.symmetric_upper();
         let coarsest_size = a.rows;
         let single = levels.is_empty().then_some(a);
-        let coarsest = Cholesky::analyse(&pattern, &UNLIMITED)
+        let coarsest = Cholesky::analyse(&pattern, &options.factor_limit)
             .and_then(|c| c.factor(&pattern, &values))
-            .map_err(|e| AmgError::Coarsest(format!("{e:?}")))?;
+            .map_err(|e| match e {
+                FactorError::TooLarge { work, limit } => AmgError::CoarsestTooLarge {
+                    levels: levels
+                        .iter()
+                        .map(|l: &Level| l.a.rows)
+                        .chain([coarsest_size])
+                        .collect(),
+                    refusal: work.refusal(&limit),
+                },
+                other => AmgError::Coarsest(format!("{other:?}")),
+            })?;
         Ok(Hierarchy {
             levels,
             single,
@@ -1101,6 +1288,498 @@ pub fn conjugate_gradient(
                 relative_residual: dot(&r, &r).sqrt() / b_norm,
                 converged: false,
             };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The kernels of the hierarchy against dense linear algebra (nalgebra) on small matrices:
+    //! strength of connection, aggregation, tentative and smoothed prolongators, the Galerkin
+    //! operator, the Chebyshev smoother and the V-cycle's error propagation `I - M A`.
+    use super::*;
+    use nalgebra::DMatrix;
+
+    fn csr_from_dense(d: &DMatrix<f64>) -> CsrMatrix {
+        let mut row_ptr = vec![0];
+        let (mut col_idx, mut values) = (Vec::new(), Vec::new());
+        for i in 0..d.nrows() {
+            for j in 0..d.ncols() {
+                if d[(i, j)] != 0.0 {
+                    col_idx.push(j);
+                    values.push(d[(i, j)]);
+                }
+            }
+            row_ptr.push(col_idx.len());
+        }
+        CsrMatrix {
+            rows: d.nrows(),
+            cols: d.ncols(),
+            row_ptr,
+            col_idx,
+            values,
+        }
+    }
+
+    fn dense(m: &CsrMatrix) -> DMatrix<f64> {
+        let mut d = DMatrix::zeros(m.rows, m.cols);
+        for i in 0..m.rows {
+            for k in m.row_ptr[i]..m.row_ptr[i + 1] {
+                d[(i, m.col_idx[k])] += m.values[k];
+            }
+        }
+        d
+    }
+
+    fn null_dense(null: &NearNullSpace) -> DMatrix<f64> {
+        DMatrix::from_row_slice(null.values.len() / null.modes, null.modes, &null.values)
+    }
+
+    fn max_abs(d: &DMatrix<f64>) -> f64 {
+        d.iter().fold(0.0, |m, v| m.max(v.abs()))
+    }
+
+    /// Plane-strain bilinear quadrilaterals (E = 1, nu = 0.3, 2 x 2 Gauss points) on an
+    /// `nx x ny` grid of `2 x 1`, the left edge clamped, and `penalty` added to the vertical
+    /// dof of every bottom node (a node-to-rigid-line contact layer under a penalty); equations
+    /// numbered node by node. Returns the matrix, nodal blocks and rigid-body modes.
+    fn plane_strain(nx: usize, ny: usize, penalty: f64) -> (CsrMatrix, NodalBlocks, NearNullSpace) {
+        let (hx, hy) = (2.0 / nx as f64, 1.0 / ny as f64);
+        let (e, nu) = (1.0, 0.3);
+        let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        let d = [
+            [c * (1.0 - nu), c * nu, 0.0],
+            [c * nu, c * (1.0 - nu), 0.0],
+            [0.0, 0.0, c * (1.0 - 2.0 * nu) / 2.0],
+        ];
+        let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+        let g = 1.0 / 3f64.sqrt();
+        let mut ke = [[0.0; 8]; 8];
+        for (xi, eta) in [(-g, -g), (g, -g), (g, g), (-g, g)] {
+            let mut b = [[0.0; 8]; 3];
+            for (a, &(xa, ya)) in corners.iter().enumerate() {
+                let dx = 0.25 * xa * (1.0 + eta * ya) * 2.0 / hx;
+                let dy = 0.25 * ya * (1.0 + xi * xa) * 2.0 / hy;
+                b[0][2 * a] = dx;
+                b[1][2 * a + 1] = dy;
+                b[2][2 * a] = dy;
+                b[2][2 * a + 1] = dx;
+            }
+            let det = hx * hy / 4.0;
+            for p in 0..8 {
+                for q in 0..8 {
+                    let mut s = 0.0;
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            s += b[i][p] * d[i][j] * b[j][q];
+                        }
+                    }
+                    ke[p][q] += s * det;
+                }
+            }
+        }
+        // free nodes: i >= 1
+        let node = |i: usize, j: usize| (i >= 1).then(|| j * nx + (i - 1));
+        let n = 2 * nx * (ny + 1);
+        let mut k = DMatrix::zeros(n, n);
+        for j in 0..ny {
+            for i in 0..nx {
+                let nodes = [
+                    node(i, j),
+                    node(i + 1, j),
+                    node(i + 1, j + 1),
+                    node(i, j + 1),
+                ];
+                for (a, na) in nodes.iter().enumerate() {
+                    for (b, nb) in nodes.iter().enumerate() {
+                        if let (Some(na), Some(nb)) = (na, nb) {
+                            for ca in 0..2 {
+                                for cb in 0..2 {
+                                    k[(2 * na + ca, 2 * nb + cb)] += ke[2 * a + ca][2 * b + cb];
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let mut points = Vec::new();
+        let mut components = Vec::new();
+        let mut block_of = Vec::new();
+        for j in 0..=ny {
+            for i in 1..=nx {
+                let p = node(i, j).expect("free");
+                for c in 0..2 {
+                    points.push([i as f64 * hx, j as f64 * hy, 0.0]);
+                    components.push(c);
+                    block_of.push(p);
+                }
+                if j == 0 {
+                    k[(2 * p + 1, 2 * p + 1)] += penalty;
+                }
+            }
+        }
+        (
+            csr_from_dense(&k),
+            NodalBlocks::from_block_of(&block_of),
+            rigid_body_modes(&points, &components, 2),
+        )
+    }
+
+    fn options(coarsest_size: usize) -> AmgOptions {
+        AmgOptions {
+            coarsest_size,
+            ..AmgOptions::default()
+        }
+    }
+
+    /// Four blocks of two equations, block `b` holding equations `b` and `b + 4`; block 3's
+    /// diagonal is 100 times the others' (a penalized contact node). Relative couplings
+    /// `||A_IJ|| / (||A_II|| ||A_JJ||)^(1/2)`: (0, 1) 0.25, (1, 2) 0.05, (1, 3) 0.05,
+    /// (2, 3) 0.025.
+    fn four_blocks() -> (CsrMatrix, NodalBlocks) {
+        let identity = DMatrix::<f64>::identity(2, 2);
+        let mut blocks = vec![vec![DMatrix::<f64>::zeros(2, 2); 4]; 4];
+        for b in 0..3 {
+            blocks[b][b] = &identity * 4.0;
+        }
+        blocks[3][3] = &identity * 400.0;
+        for (i, j, v) in [(0, 1, 1.0), (1, 2, 0.2), (1, 3, 2.0), (2, 3, 1.0)] {
+            blocks[i][j] = &identity * v;
+            blocks[j][i] = &identity * v;
+        }
+        let mut a = DMatrix::zeros(8, 8);
+        for bi in 0..4 {
+            for bj in 0..4 {
+                for c in 0..2 {
+                    for d in 0..2 {
+                        a[(bi + 4 * c, bj + 4 * d)] = blocks[bi][bj][(c, d)];
+                    }
+                }
+            }
+        }
+        let block_of: Vec<usize> = (0..8).map(|e| e % 4).collect();
+        (csr_from_dense(&a), NodalBlocks::from_block_of(&block_of))
+    }
+
+    fn sorted(mut v: Vec<usize>) -> Vec<usize> {
+        v.sort_unstable();
+        v
+    }
+
+    #[test]
+    fn strength_of_connection_compares_block_norms() {
+        let (a, blocks) = four_blocks();
+        let s = strong_neighbours(&a, &blocks, 0.08);
+        let strong: Vec<Vec<usize>> = s.strong.iter().cloned().map(sorted).collect();
+        assert_eq!(strong, vec![vec![1], vec![0], vec![], vec![]]);
+        // the blocks without strong neighbours list theirs, strongest first
+        assert_eq!(
+            s.weak_by_strength,
+            vec![vec![], vec![], vec![1, 3], vec![1, 2]]
+        );
+        let s = strong_neighbours(&a, &blocks, 0.04);
+        let strong: Vec<Vec<usize>> = s.strong.iter().cloned().map(sorted).collect();
+        assert_eq!(strong, vec![vec![1], vec![0, 2, 3], vec![1], vec![1]]);
+        assert!(s.weak_by_strength.iter().all(|w| w.is_empty()));
+    }
+
+    #[test]
+    fn blocks_without_strong_neighbours_aggregate_as_a_layer_or_join_a_neighbour() {
+        let (a, blocks) = four_blocks();
+        let strength = strong_neighbours(&a, &blocks, 0.08);
+        // relative to the largest couplings (block 2: ||A_23||, block 3: ||A_31||), the
+        // coupling (2, 3) is 2^(-1/2)
+        assert_eq!(strength.layer, vec![vec![], vec![], vec![3], vec![2]]);
+        assert_eq!(aggregate(&strength), (vec![0, 0, 1, 1], 2));
+        // without a layer: the most strongly coupled aggregated neighbour's aggregate, through
+        // a chain (block 2 reaches it through block 3) ; a block without any neighbour is an
+        // aggregate of its own
+        let chain = BlockStrength {
+            strong: vec![vec![1], vec![0], vec![], vec![], vec![]],
+            weak_by_strength: vec![vec![], vec![], vec![3], vec![1, 2], vec![]],
+            layer: vec![vec![]; 5],
+        };
+        assert_eq!(aggregate(&chain), (vec![0, 0, 0, 0, 1], 2));
+    }
+
+    /// Each block in exactly one aggregate, no aggregate empty, each connected in the graph of
+    /// the nonzero block couplings; under a penalty on the bottom layer no bottom node is left
+    /// as an aggregate of its own (that stalled the coarsening of the 3D slab).
+    #[test]
+    fn aggregation_covers_every_block_once_with_connected_aggregates() {
+        for penalty in [0.0, 1e6] {
+            let (a, blocks, _) = plane_strain(24, 12, penalty);
+            let strength = strong_neighbours(&a, &blocks, 0.08);
+            let (of, count) = aggregate(&strength);
+            assert_eq!(of.len(), blocks.count());
+            let mut members = vec![Vec::new(); count];
+            for (b, &g) in of.iter().enumerate() {
+                assert!(g < count, "block {b} has no aggregate");
+                members[g].push(b);
+            }
+            let coupled = strong_neighbours(&a, &blocks, 0.0).strong;
+            for (g, m) in members.iter().enumerate() {
+                assert!(m.len() >= 2, "penalty {penalty}: aggregate {g} is {m:?}");
+                // breadth-first search inside the aggregate
+                let mut seen = vec![m[0]];
+                let mut next = 0;
+                while next < seen.len() {
+                    let b = seen[next];
+                    next += 1;
+                    for &c in &coupled[b] {
+                        if of[c] == g && !seen.contains(&c) {
+                            seen.push(c);
+                        }
+                    }
+                }
+                assert_eq!(seen.len(), m.len(), "aggregate {g} is not connected");
+            }
+            // a 2D aggregate is about a 3 x 3 patch of nodes
+            assert!(
+                count * 5 <= blocks.count(),
+                "penalty {penalty}: {count} aggregates of {} blocks",
+                blocks.count()
+            );
+        }
+    }
+
+    #[test]
+    fn tentative_prolongator_reproduces_the_near_null_space_with_orthonormal_columns() {
+        let (a, blocks, null) = plane_strain(12, 6, 1e3);
+        let (mut of, mut count) = aggregate(&strong_neighbours(&a, &blocks, 0.08));
+        // and one aggregate of a single node: two dofs for three modes, one column dropped
+        let lone = of[5];
+        of[5] = count;
+        count += 1;
+        assert!(
+            of.contains(&lone),
+            "the aggregate block 5 left is not empty"
+        );
+        let (p, coarse_null, coarse_blocks) =
+            tentative_prolongator(&blocks, &null, &of, count, a.rows);
+        let (p, b, bc) = (dense(&p), null_dense(&null), null_dense(&coarse_null));
+        assert!(max_abs(&(&p * &bc - &b)) <= 1e-13 * max_abs(&b));
+        let gram = p.transpose() * &p;
+        assert!(max_abs(&(gram - DMatrix::identity(p.ncols(), p.ncols()))) <= 1e-13);
+        // three columns per aggregate, two for the single node; the coarse blocks are the
+        // aggregates' columns
+        assert_eq!(coarse_blocks.count(), count);
+        for g in 0..count {
+            let expected = if g == count - 1 { 2 } else { 3 };
+            assert_eq!(coarse_blocks.block(g).len(), expected, "aggregate {g}");
+        }
+        // each row lies in the columns of its own aggregate only
+        let mut block_of = vec![0; a.rows];
+        for bl in 0..blocks.count() {
+            for &e in blocks.block(bl) {
+                block_of[e] = bl;
+            }
+        }
+        for i in 0..a.rows {
+            let own = coarse_blocks.block(of[block_of[i]]);
+            for j in 0..p.ncols() {
+                assert!(own.contains(&j) || p[(i, j)] == 0.0, "P_tent({i}, {j})");
+            }
+        }
+    }
+
+    #[test]
+    fn smoothed_prolongator_is_damped_jacobi_on_the_tentative_one_and_lowers_its_energy() {
+        let (a, blocks, null) = plane_strain(12, 6, 1e3);
+        let (of, count) = aggregate(&strong_neighbours(&a, &blocks, 0.08));
+        let (tentative, _, _) = tentative_prolongator(&blocks, &null, &of, count, a.rows);
+        let (ad, pt) = (dense(&a), dense(&tentative));
+        let inverse: Vec<f64> = a.diagonal().iter().map(|d| 1.0 / d).collect();
+        let d_inv = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(inverse.clone()));
+        let omega = 0.7;
+        let expected = &pt - (&d_inv * &ad * &pt) * omega;
+        let p = dense(&damped_jacobi_product(&a, &inverse, omega, &tentative));
+        assert!(max_abs(&(&p - &expected)) <= 1e-13 * max_abs(&expected));
+        // the power estimate of rho(D^-1 A) is a lower bound within 10 %
+        let d_half = d_inv.map(f64::sqrt);
+        let rho = (&d_half * &ad * &d_half)
+            .symmetric_eigen()
+            .eigenvalues
+            .max();
+        let estimate = largest_eigenvalue(&a, &inverse, POWER_STEPS);
+        assert!(
+            estimate <= rho * (1.0 + 1e-12) && estimate >= 0.9 * rho,
+            "estimate {estimate}, rho {rho}"
+        );
+        // omega = 4 / (3 rho): every column's energy p^T A p decreases
+        let p = dense(&smooth_prolongator(&a, &tentative).unwrap());
+        for j in 0..p.ncols() {
+            let energy = |m: &DMatrix<f64>| (m.column(j).transpose() * &ad * m.column(j))[(0, 0)];
+            assert!(
+                energy(&p) < energy(&pt),
+                "column {j}: {} >= {}",
+                energy(&p),
+                energy(&pt)
+            );
+        }
+    }
+
+    #[test]
+    fn coarse_operators_are_the_galerkin_products() {
+        let (a, blocks, null) = plane_strain(24, 12, 1e3);
+        let h = Hierarchy::build(a, blocks, null, &options(20)).unwrap();
+        assert!(h.levels.len() >= 2, "levels {:?}", h.level_sizes());
+        for l in 0..h.levels.len() {
+            let level = &h.levels[l];
+            let (p, fine) = (dense(&level.p), dense(&level.a));
+            let galerkin = p.transpose() * fine * &p;
+            let coarse = match h.levels.get(l + 1) {
+                Some(next) => dense(&next.a),
+                None => {
+                    // the coarsest level: its factor solves with P^T A P
+                    let n = galerkin.nrows();
+                    let mut x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+                    let b = &galerkin * nalgebra::DVector::from_vec(x.clone());
+                    let solution = x.clone();
+                    x.copy_from_slice(b.as_slice());
+                    h.coarsest.solve_in_place(&mut x);
+                    let err = x
+                        .iter()
+                        .zip(&solution)
+                        .map(|(p, q)| (p - q).abs())
+                        .fold(0.0, f64::max);
+                    assert!(err <= 1e-8, "coarsest solve error {err}");
+                    continue;
+                }
+            };
+            assert!(
+                max_abs(&(&coarse - &galerkin)) <= 1e-12 * max_abs(&galerkin),
+                "level {}",
+                l + 1
+            );
+            assert_eq!(dense(&level.r), p.transpose());
+        }
+    }
+
+    /// On the eigenvectors of `D_l1^-1 A` with eigenvalues in the smoother's interval
+    /// `[lower, upper]`, degree-2 Chebyshev multiplies the error by at most
+    /// `1 / T_2(theta / delta)` (Saad, sec. 12.3.2) in the energy norm; the smoothest
+    /// eigenvector is barely touched.
+    #[test]
+    fn chebyshev_damps_the_high_frequency_error() {
+        let (a, _, _) = plane_strain(16, 8, 1e3);
+        let smoother = Chebyshev::new(&a, 2).unwrap();
+        let ad = dense(&a);
+        let scale =
+            nalgebra::DVector::from_iterator(a.rows, smoother.inverse_l1.iter().map(|m| m.sqrt()));
+        let s = DMatrix::from_diagonal(&scale);
+        let eigen = (&s * &ad * &s).symmetric_eigen();
+        let energy = |e: &[f64]| {
+            let v = nalgebra::DVector::from_column_slice(e);
+            (v.transpose() * &ad * &v)[(0, 0)].sqrt()
+        };
+        let smooth_error = |e: &[f64]| {
+            // A x = 0 from x = e: the new x is the new error
+            let mut x = e.to_vec();
+            smoother.smooth(&a, &vec![0.0; e.len()], &mut x, false);
+            energy(&x) / energy(e)
+        };
+        let (theta, delta) = (
+            0.5 * (smoother.upper + smoother.lower),
+            0.5 * (smoother.upper - smoother.lower),
+        );
+        let sigma = theta / delta;
+        let bound = 1.0 / (2.0 * sigma * sigma - 1.0);
+        let mut high = nalgebra::DVector::zeros(a.rows);
+        let mut smoothest = (f64::INFINITY, 0);
+        for (k, &lambda) in eigen.eigenvalues.iter().enumerate() {
+            if lambda < smoothest.0 {
+                smoothest = (lambda, k);
+            }
+            if lambda >= smoother.lower && lambda <= smoother.upper {
+                // D_l1^-1 A w = lambda w with w = D_l1^-1/2 v
+                high += (&s * eigen.eigenvectors.column(k)) * (1.0 + (k as f64).sin());
+            }
+        }
+        let ratio = smooth_error(high.as_slice());
+        assert!(
+            ratio <= bound * (1.0 + 1e-10),
+            "high frequencies: {ratio} > {bound}"
+        );
+        assert!(bound < 0.51);
+        let low = &s * eigen.eigenvectors.column(smoothest.1);
+        let ratio = smooth_error(low.as_slice());
+        assert!(ratio > 0.9, "the smoothest error shrank to {ratio}");
+    }
+
+    /// The V-cycle's error propagation `E = I - M A` is self-adjoint in the energy inner
+    /// product, so `||E||_A = max |1 - lambda(M A)|` over the eigenvalues of the symmetric
+    /// `L^T M L` (`A = L L^T`): at most 0.5 on the clamped plane-strain strip with and without
+    /// a stiff contact layer, on two meshes.
+    #[test]
+    fn the_v_cycle_contracts_the_error_in_the_energy_norm() {
+        for (nx, ny) in [(16, 8), (32, 16)] {
+            for penalty in [0.0, 1e4] {
+                let (a, blocks, null) = plane_strain(nx, ny, penalty);
+                let n = a.rows;
+                let ad = dense(&a);
+                let h = Hierarchy::build(a, blocks, null, &options(30)).unwrap();
+                let sizes = h.level_sizes();
+                assert!(sizes.len() >= 3, "levels {sizes:?}");
+                assert!(
+                    sizes.windows(2).all(|w| 2 * w[1] <= w[0]),
+                    "the coarsening stalls: levels {sizes:?}"
+                );
+                let mut m = DMatrix::zeros(n, n);
+                let mut unit = vec![0.0; n];
+                let mut column = vec![0.0; n];
+                for j in 0..n {
+                    unit[j] = 1.0;
+                    h.apply(&unit, &mut column);
+                    m.column_mut(j).copy_from_slice(&column);
+                    unit[j] = 0.0;
+                }
+                let asymmetry = max_abs(&(&m - m.transpose()));
+                assert!(
+                    asymmetry <= 1e-12 * max_abs(&m),
+                    "M is not symmetric: {asymmetry}"
+                );
+                let l = ad.clone().cholesky().expect("SPD").l();
+                let eigenvalues = (l.transpose() * &m * &l).symmetric_eigen().eigenvalues;
+                let (least, most) = (eigenvalues.min(), eigenvalues.max());
+                let contraction = (1.0 - least).abs().max((1.0 - most).abs());
+                eprintln!(
+                    "{nx} x {ny}, penalty {penalty}: levels {:?}, lambda(MA) in [{least:.3}, {most:.3}], ||I - MA||_A = {contraction:.3}",
+                    h.level_sizes()
+                );
+                assert!(least > 0.0, "M A is not positive definite: {least}");
+                assert!(contraction <= 0.5, "||I - M A||_A = {contraction}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_coarsest_level_above_the_factor_limit_is_refused_with_the_levels() {
+        let (a, blocks, null) = plane_strain(24, 12, 0.0);
+        let tight = AmgOptions {
+            coarsest_size: 100_000,
+            factor_limit: WorkLimit {
+                gigabytes: 1e-6,
+                operations: 1e12,
+            },
+            ..AmgOptions::default()
+        };
+        let rows = a.rows;
+        let e = Hierarchy::build(a, blocks, null, &tight)
+            .err()
+            .expect("refused");
+        let AmgError::CoarsestTooLarge { levels, .. } = &e else {
+            panic!("{e}");
+        };
+        assert_eq!(levels, &vec![rows]);
+        let message = e.to_string();
+        for part in [
+            "too large to factor",
+            "limits.factor_gigabytes",
+            "\"direct\"",
+        ] {
+            assert!(message.contains(part), "{message}");
         }
     }
 }

@@ -89,8 +89,9 @@ impl IterativeRecord {
     /// One line for the messages.
     pub fn describe(&self) -> String {
         format!(
-            "CG + smoothed-aggregation AMG ({} levels, operator complexity {:.2}): {} solve(s), {} iterations (at most {} in one), relative residual {:.2e} (tolerance {:.0e}), {} setup(s) {:.2} s, CG {:.2} s",
+            "CG + smoothed-aggregation AMG ({} levels of {:?} equations, operator complexity {:.2}): {} solve(s), {} iterations (at most {} in one), relative residual {:.2e} (tolerance {:.0e}), {} setup(s) {:.2} s, CG {:.2} s",
             self.levels.len(),
+            self.levels,
             self.operator_complexity,
             self.solves,
             self.iterations,
@@ -221,7 +222,10 @@ impl AmgSolver {
         AmgSolver {
             blocks: NodalBlocks::from_block_of(&block_of),
             null: rigid_body_modes(&points, &components, D),
-            options: AmgOptions::default(),
+            options: AmgOptions {
+                factor_limit: model.factor_limit,
+                ..AmgOptions::default()
+            },
             tolerance: model.solver.linear_tolerance,
             max_iterations: model.solver.linear_max_iterations,
             hierarchy: None,
