@@ -11,7 +11,8 @@
 //! A facet is `(cell, local edge)`; only boundary facets (edges owned by one cell) enter facet
 //! sets. Every body gets the sets `left`, `right`, `bottom`, `top` (nodes and boundary facets on
 //! the sides of its bounding box), the corner node sets `bottom_left`, `bottom_right`,
-//! `top_left`, `top_right`, and `all` (nodes).
+//! `top_left`, `top_right`, and `all` (nodes). The 3D block takes these sets on its unmoved
+//! grid, so they are the block's sides whatever its moves do to the coordinates.
 
 use crate::fe::{ElementKind, ReferenceCell};
 use crate::fe3d::SolidKind;
@@ -503,6 +504,9 @@ const KUHN_TETRAHEDRA: [[[usize; 3]; 4]; 6] = [
 /// vertex moves, the higher-order nodes placed from the moved vertices (mid-edge nodes at
 /// edge midpoints, Hex27 face and body centres at the mean of their corners, so every element
 /// keeps straight edges), then moves of single higher-order nodes as in [`block`].
+/// The automatic sets (sides, corners, `all`) are those of the unmoved grid: `top` is the
+/// nodes and boundary facets of the last layer of cells in z, also where a move lifts a node
+/// off the plane of the face, or rotates the whole block (a block's sides are its topology).
 /// Hexahedra are the grid cells; tetrahedra split each cell into six (see
 /// `KUHN_TETRAHEDRA`), conformingly.
 pub fn block3(
@@ -544,12 +548,26 @@ pub fn block3(
     let lattice = [q * cells[0] + 1, q * cells[1] + 1, q * cells[2] + 1];
     let mut id = vec![usize::MAX; lattice[0] * lattice[1] * lattice[2]];
     let mut nodes: Vec<[f64; 3]> = Vec::new();
+    // where each node lies on the unmoved grid: the automatic sets are taken there
+    let mut unmoved: Vec<[f64; 3]> = Vec::new();
+    let breaks = [xs, ys, zs];
+    let unmoved_point = |l: [usize; 3]| -> [f64; 3] {
+        [0, 1, 2].map(|a| {
+            let b = breaks[a];
+            if q == 1 || l[a].is_multiple_of(2) {
+                b[l[a] / q]
+            } else {
+                0.5 * (b[l[a] / 2] + b[l[a] / 2 + 1])
+            }
+        })
+    };
     let v = |p: [usize; 3]| vertex[vertex_index(p[0], p[1], p[2])];
     let mut node_at = |l: [usize; 3], place: &dyn Fn() -> [f64; 3], nodes: &mut Vec<[f64; 3]>| {
         let k = (l[2] * lattice[1] + l[1]) * lattice[0] + l[0];
         if id[k] == usize::MAX {
             id[k] = nodes.len();
             nodes.push(place());
+            unmoved.push(unmoved_point(l));
         }
         id[k]
     };
@@ -629,7 +647,11 @@ pub fn block3(
             .ok_or(Block3Error::NoNodeAt { from })?;
         nodes[k] = to;
     }
-    Ok(Mesh::new(kind, nodes, conn))
+    // the sides and corners of the block's topology (its first and last layers of cells),
+    // whatever the moves did to the coordinates
+    let mut mesh = Mesh::new(kind, unmoved, conn);
+    mesh.nodes = nodes;
+    Ok(mesh)
 }
 
 #[cfg(test)]
@@ -679,6 +701,33 @@ mod tests {
             ),
             Err(Block3Error::NoNodeAt { .. })
         ));
+    }
+
+    /// The automatic sets of a 3D block are its topology's: a move that lifts a top-face
+    /// vertex off the face (above the rest of the block, so the bounding box's top is that
+    /// node alone) or lowers it into the block leaves `top` and every other set as on the
+    /// unmoved grid, and the moved node is where the move put it.
+    #[test]
+    fn block3_sets_survive_moves_off_the_faces() {
+        let (xs, ys, zs) = ([0.0, 0.5, 1.0], [0.0, 0.5, 1.0], [0.0, 0.4, 1.0]);
+        for kind in [
+            SolidKind::Hex8,
+            SolidKind::Hex27,
+            SolidKind::Tet4,
+            SolidKind::Tet10,
+        ] {
+            let plain = block3(kind, &xs, &ys, &zs, &[]).unwrap();
+            for to in [[0.5, 0.5, 1.1], [0.45, 0.55, 0.9]] {
+                let moved = block3(kind, &xs, &ys, &zs, &[([0.5, 0.5, 1.0], to)]).unwrap();
+                assert_eq!(moved.facet_sets, plain.facet_sets, "{kind:?} to {to:?}");
+                assert_eq!(moved.node_sets, plain.node_sets, "{kind:?} to {to:?}");
+                let per_face = if kind.is_hexahedron() { 1 } else { 2 };
+                assert_eq!(moved.facet_sets["top"].len(), 4 * per_face, "{kind:?}");
+                let lifted = moved.nearest_node(to).unwrap();
+                assert!(lifted.1 < 1e-14, "{kind:?}: no node at {to:?}");
+                assert!(moved.node_sets["top"].contains(&lifted.0), "{kind:?}");
+            }
+        }
     }
 
     #[test]

@@ -260,6 +260,28 @@ fn contact_with_a_missing_set_is_named() {
     assert_rejected(&text, &["contact[0] 'c'.master", "no facet set 'rim'"]);
 }
 
+/// A 2D block's side sets are geometric (the sides of its bounding box): a move that lifts
+/// the base's top vertex above the rest leaves `top` without facets, which the pair refuses
+/// at the set (which set, which body, why empty, how to fix), not later as a pair out of
+/// reach.
+#[test]
+fn contact_on_an_empty_facet_set_is_named_at_the_set() {
+    let text = CONTACT.replace(
+        "\"x\": [0, 1, 2], \"y\": [0, 1]}",
+        "\"x\": [0, 1, 2], \"y\": [0, 1], \"moves\": [{\"from\": [1, 1], \"to\": [1, 1.05]}]}",
+    );
+    assert_ne!(text, CONTACT);
+    assert_rejected(
+        &text,
+        &[
+            "contact[0] 'c'.master",
+            "facet set 'top' of body 'base' is empty",
+            "a node moved off it drops its facets",
+            "\"facet_sets\"",
+        ],
+    );
+}
+
 #[test]
 fn contact_with_an_unknown_enforcement_is_named() {
     let text = CONTACT.replace("{\"kind\": \"lagrange\"}", "{\"kind\": \"nitsche\"}");

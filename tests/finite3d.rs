@@ -819,6 +819,71 @@ fn the_two_block_contact_patch_test_transmits_a_uniform_pressure() {
     assert!(stresses[0][0].abs() < 1e-10 * sigma_zz.abs());
 }
 
+/// `contact-patch run` on `case`: the exit code and stderr; a panic fails the test.
+fn run_binary(case: &Value) -> (Option<i32>, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.json");
+    std::fs::write(&path, case.to_string()).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .args(["run", path.to_str().unwrap(), "--out"])
+        .arg(dir.path().join("out"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!stderr.contains("panicked"), "a panic:\n{stderr}");
+    (out.status.code(), stderr)
+}
+
+/// The two-block Tet4 scene on the matching interface (finite strain, node-to-surface between
+/// the bodies, Lagrange multipliers, 20 % compression), which the patch test leaves out: it
+/// runs out of load-step cuts (Newton's iterates swap facets at the master nodes the slave
+/// nodes sit on), and the binary says so with exit code 2 and a hint, without a panic.
+#[test]
+fn the_tet4_two_block_scene_that_runs_out_of_cuts_is_an_error_not_a_panic() {
+    let case = stacked(
+        "Tet4",
+        &MATCHING3,
+        &MATCHING3,
+        json!({"kind": "lagrange"}),
+        -0.4,
+        1,
+    );
+    let (code, stderr) = run_binary(&case);
+    assert_eq!(code, Some(2), "{stderr}");
+    for needle in ["error:", "load step", "cuts of the load increment", "hint:"] {
+        assert!(stderr.contains(needle), "lacks {needle:?}:\n{stderr}");
+    }
+}
+
+/// A block3d move that lifts a top-face node of the master off the face (above the rest of
+/// the block) keeps the automatic `top` set: it is the block's top layer, not the top of the
+/// bounding box. The pair's master surface has the four facets of the unmoved top and the
+/// lifted node is on it, where the move put it.
+#[test]
+fn a_move_off_the_top_face_keeps_the_automatic_top_set() {
+    let mut case = stacked(
+        "Hex8",
+        &MATCHING3,
+        &MATCHING3,
+        json!({"kind": "lagrange"}),
+        -0.4,
+        1,
+    );
+    case["bodies"][0]["mesh"]["block3d"]["moves"] =
+        json!([{"from": [0.5, 0.5, 1.0], "to": [0.5, 0.5, 1.05]}]);
+    let model = build3(&parse(&case), "finite3d").unwrap_or_else(|e| panic!("{e}"));
+    let contact_patch::model::MasterSide::Body { body, facets } = &model.contact[0].master else {
+        panic!("the master is body 'base'");
+    };
+    assert_eq!(facets.len(), 4);
+    let mesh = &model.bodies[*body].mesh;
+    let lifted = mesh.nearest_node([0.5, 0.5, 1.05]).unwrap();
+    assert!(lifted.1 < 1e-14);
+    assert!(facets
+        .iter()
+        .any(|&f| mesh.facet_nodes(f).contains(&lifted.0)));
+}
+
 /// The whole Newton system's tangent (neo-Hookean solids, node-to-surface rows between the two
 /// bodies with the second derivative of their gaps) against central differences of its
 /// residual, with closest points inside facets, on edges and at a corner of the master

@@ -463,6 +463,30 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
             })
     }
 
+    /// A contact surface needs facets: an empty facet set (a geometric set whose facets all
+    /// left the side of the bounding box it selects, say) is refused at the set, not later
+    /// as a pair that finds no slave node within reach.
+    fn refuse_empty_surface(
+        &self,
+        body: &Body<D, K>,
+        set: &str,
+        facets: &[Facet],
+        location: &str,
+    ) -> Result<()> {
+        if !facets.is_empty() {
+            return Ok(());
+        }
+        Err(Error::invalid(
+            &self.source,
+            location,
+            format!(
+                "facet set '{set}' of body '{}' is empty, so the pair has no contact surface (an automatic side set holds the boundary facets whose nodes all lie on that side of the body's bounding box; a node moved off it drops its facets)",
+                body.name
+            ),
+            "give the body a facet set with the surface's facets under \"facet_sets\", or keep the moved nodes on the side",
+        ))
+    }
+
     fn find_pair(&self, name: &str, location: &str) -> Result<usize> {
         self.contact
             .iter()
@@ -493,6 +517,12 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
             let slave_facets = self
                 .find_facet_set(slave_body, &spec.slave.set, &format!("{at}.slave"))?
                 .to_vec();
+            self.refuse_empty_surface(
+                slave_body,
+                &spec.slave.set,
+                &slave_facets,
+                &format!("{at}.slave"),
+            )?;
             let slave = (
                 self.body_index(&spec.slave.body).expect("found"),
                 slave_facets,
@@ -502,6 +532,7 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
                 (Some(b), Some(set), None) => {
                     let body = self.find_body(b, &format!("{at}.master"))?;
                     let facets = self.find_facet_set(body, set, &format!("{at}.master"))?.to_vec();
+                    self.refuse_empty_surface(body, set, &facets, &format!("{at}.master"))?;
                     let body = self.body_index(b).expect("found");
                     if body == slave.0 {
                         return Err(Error::invalid(&self.source, format!("{at}.master"), "self-contact (slave and master on one body) is not supported", "use two bodies"));
