@@ -814,6 +814,86 @@ mod tests {
         }
     }
 
+    /// `R(x) = atan(x)` in one unknown, the classic cycle of Newton's method: from the root
+    /// `x_c` of `2 x = (1 + x^2) atan(x)` (1.3917...) the full step goes to `-x_c` and back.
+    /// The sign of `x` stands for a point's status (a flip is a status change), so the cycle
+    /// detector sees it; `search` is what [`System::line_search`] answers.
+    struct Arctan {
+        pattern: SymmetricPattern,
+        search: bool,
+        last_sign: Option<bool>,
+    }
+
+    impl System for Arctan {
+        fn pattern(&self) -> &SymmetricPattern {
+            &self.pattern
+        }
+        fn evaluate(
+            &mut self,
+            x: &[f64],
+            general: &GeneralPattern,
+            residual: &mut [f64],
+            tangent: &mut Tangent,
+        ) -> Result<Evaluation> {
+            residual[0] = x[0].atan();
+            tangent.values[general.position(0, 0).unwrap()] = 1.0 / (1.0 + x[0] * x[0]);
+            let sign = x[0] > 0.0;
+            let changed = self.last_sign.is_some_and(|s| s != sign);
+            self.last_sign = Some(sign);
+            Ok(Evaluation {
+                force_scale: 1.0,
+                status_changes: usize::from(changed),
+                ..Evaluation::default()
+            })
+        }
+        fn line_search(&self) -> bool {
+            self.search
+        }
+    }
+
+    #[test]
+    fn a_newton_cycle_restarts_with_the_line_search_and_converges() {
+        // x_c by Newton on h(x) = (1 + x^2) atan(x) - 2 x, h' = 2 x atan(x) - 1
+        let mut x_c = 1.4f64;
+        for _ in 0..50 {
+            x_c -= ((1.0 + x_c * x_c) * x_c.atan() - 2.0 * x_c) / (2.0 * x_c * x_c.atan() - 1.0);
+        }
+        let settings = Settings {
+            max_iterations: 50,
+            tolerance: 1e-12,
+            factor_limit: UNLIMITED,
+            iteration_dofs: u64::MAX,
+        };
+        let arctan = |search| Arctan {
+            pattern: PatternBuilder::new(1).build(),
+            search,
+            last_sign: None,
+        };
+        let mut x = vec![x_c];
+        let plain = solve(&mut arctan(false), &mut x, settings).unwrap();
+        assert!(
+            matches!(plain.termination, Termination::ActiveSetCycling(_)),
+            "{:?}",
+            plain.termination
+        );
+        let mut x = vec![x_c];
+        let searched = solve(&mut arctan(true), &mut x, settings).unwrap();
+        assert_eq!(searched.termination, Termination::Converged);
+        assert!(x[0].abs() <= 1e-12, "{}", x[0]);
+        // the cycle is seen after CYCLE_ITERATIONS iterations, the restart converges from x_c
+        // with shortened steps, then quadratically with full ones
+        assert!(
+            searched.iterations > CYCLE_ITERATIONS,
+            "{}",
+            searched.iterations
+        );
+        assert!(
+            searched.iterations <= CYCLE_ITERATIONS + 12,
+            "{}",
+            searched.iterations
+        );
+    }
+
     fn cubic(n: usize, c: f64, unsymmetric: f64) -> Cubic {
         let mut b = PatternBuilder::new(n);
         for i in 0..n - 1 {
