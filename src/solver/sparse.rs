@@ -766,19 +766,23 @@ fn multipliers_after_their_displacements(
     Ok((fwd, inv))
 }
 
-/// Above this many multiply-adds of the AMD factor, the nested-dissection order
+/// Above this many multiply-adds of the AMD factor, and above
+/// [`DISSECTION_WORK_PER_EQUATION`] per equation, the nested-dissection order
 /// ([`crate::solver::ordering::dissection_order`]) is analysed too and the cheaper of the two
-/// kept: on large meshes it takes a fraction of AMD's operations (about 60% on a 2D block of a
-/// million dofs, far less in 3D); below it the second analysis would cost more than it could
-/// save.
+/// kept; below either the second analysis would cost more than it could save.
 pub const NESTED_DISSECTION_ABOVE: f64 = 1e10;
 
-/// From this many (leading) equations on, the nested-dissection order is computed on a second
-/// thread while AMD's is computed and analysed, whatever AMD's work turns out to be: on such
-/// sizes the dissection usually wins and the two analyses then cost the longer one's time, not
-/// the sum. Below, the dissection is computed only after AMD's work passed
-/// [`NESTED_DISSECTION_ABOVE`].
-pub const CONCURRENT_DISSECTION_FROM: usize = 100_000;
+/// The AMD factor's multiply-adds per equation above which METIS's dissection can repay its
+/// own time. Measured on the 1M-dof contact block of `crosscheck/performance.py` (2026-11-25,
+/// quiet machine): METIS took 2.65 s for its 501,415 vertices (about 2.6 microseconds per
+/// equation) and cut the factor from 8.74e10 to 5.25e10 multiply-adds, while the numeric
+/// factorization ran at about 6e-11 s per multiply-add, so it saved about 2 s of factorization
+/// for 2.65 s of ordering plus a second symbolic analysis: AMD's 8.7e4 multiply-adds per
+/// equation are below the break-even (about 1e5 for a 40 % cut) and AMD is kept there. On the
+/// 3D slab `cases/large/slab-3d-1m.json` (9.4e6 per equation) the dissection cut 1.03e13 to
+/// 3.07e12 and the whole run from 233 s to 107 s. Twice the break-even, since the dissection
+/// does not always cut 40 %.
+pub const DISSECTION_WORK_PER_EQUATION: f64 = 2e5;
 
 /// The equations not marked trailing (in increasing order) and the upper CSC pattern of their
 /// block, renumbered `0..m` in that order.
@@ -857,34 +861,20 @@ fn symbolic_in_order(
 /// The symbolic factor, `whole(order)` for an order of the equations of `block`, of AMD's order
 /// or of the nested-dissection order, whichever takes fewer operations (AMD on a tie); the
 /// dissection is tried only on large factors ([`NESTED_DISSECTION_ABOVE`],
-/// [`CONCURRENT_DISSECTION_FROM`]). A dissection whose analysis fails leaves AMD's.
+/// [`DISSECTION_WORK_PER_EQUATION`]). A dissection whose analysis fails leaves AMD's.
 fn cheaper_order(
     block: &crate::solver::ordering::Pattern,
-    whole: impl Fn(&[usize]) -> Result<SymbolicCholesky<usize>, FactorError> + Sync,
+    whole: impl Fn(&[usize]) -> Result<SymbolicCholesky<usize>, FactorError>,
 ) -> Result<SymbolicCholesky<usize>, FactorError> {
-    let dissection = || whole(&crate::solver::ordering::dissection_order(block));
-    let cheaper = |amd: SymbolicCholesky<usize>, nd: Result<SymbolicCholesky<usize>, _>| match nd {
-        Ok(nd) if FactorWork::of(&nd).operations < FactorWork::of(&amd).operations => nd,
-        _ => amd,
-    };
-    if block.n >= CONCURRENT_DISSECTION_FROM {
-        let (amd, nd) = std::thread::scope(|scope| {
-            let nd = scope.spawn(dissection);
-            let amd = amd_order(block).and_then(|order| whole(&order));
-            (amd, nd.join())
-        });
-        let nd = nd.unwrap_or_else(|_| {
-            Err(FactorError::Other(
-                "the nested-dissection thread stopped".into(),
-            ))
-        });
-        return Ok(cheaper(amd?, nd));
-    }
     let amd = whole(&amd_order(block)?)?;
-    if FactorWork::of(&amd).operations <= NESTED_DISSECTION_ABOVE {
+    let work = FactorWork::of(&amd).operations;
+    if work <= NESTED_DISSECTION_ABOVE || work <= DISSECTION_WORK_PER_EQUATION * block.n as f64 {
         return Ok(amd);
     }
-    Ok(cheaper(amd, dissection()))
+    match whole(&crate::solver::ordering::dissection_order(block)) {
+        Ok(nd) if FactorWork::of(&nd).operations < work => Ok(nd),
+        _ => Ok(amd),
+    }
 }
 
 /// The symbolic factor for the order "AMD of the leading `leading x leading` block, then the
@@ -1468,36 +1458,58 @@ mod tests {
         )
     }
 
+    /// The pattern of 3D Hex8 elasticity on an `m x m x m` grid of nodes (3 dofs per node,
+    /// every node coupled to the nodes of its cells).
+    fn hex8_grid_pattern(m: usize) -> SymmetricPattern {
+        let node = |i: usize, j: usize, k: usize| i + m * (j + m * k);
+        let mut b = PatternBuilder::new(3 * m * m * m);
+        for k in 0..m - 1 {
+            for j in 0..m - 1 {
+                for i in 0..m - 1 {
+                    let eqs: Vec<usize> = (0..8)
+                        .map(|c| node(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2)))
+                        .flat_map(|v| [3 * v, 3 * v + 1, 3 * v + 2])
+                        .collect();
+                    b.add_block(&eqs);
+                }
+            }
+        }
+        b.build()
+    }
+
     #[test]
     fn the_analysis_keeps_the_cheaper_of_amd_and_the_dissection() {
-        // 230 x 230 nodes: 105,800 equations, analysed with the dissection beside AMD; 60 x 60:
-        // 7,200, whose AMD factor is far below the threshold: AMD without a second analysis
-        for m in [60, 230] {
-            let p = q4_grid_pattern(m);
+        // a 2D grid whose AMD factor is cheap per equation (AMD kept without a second
+        // analysis) and a 3D grid whose AMD factor is far above both thresholds (the cheaper
+        // of the two kept)
+        for (p, tried) in [(q4_grid_pattern(230), false), (hex8_grid_pattern(24), true)] {
             let (amd, nd) = candidate_work(&p, &[]);
-            let tried = p.n >= CONCURRENT_DISSECTION_FROM || amd > NESTED_DISSECTION_ABOVE;
-            assert_eq!(tried, m == 230);
+            let expensive =
+                amd > NESTED_DISSECTION_ABOVE && amd > DISSECTION_WORK_PER_EQUATION * p.n as f64;
+            assert_eq!(expensive, tried, "n {}: amd {amd:e}", p.n);
             let expected = if tried { amd.min(nd) } else { amd };
             let kept = Cholesky::analyse(&p, &UNLIMITED).unwrap().work().operations;
-            assert_eq!(kept, expected, "m {m}: amd {amd:e}, nd {nd:e}");
+            assert_eq!(kept, expected, "n {}: amd {amd:e}, nd {nd:e}", p.n);
+            if tried {
+                // in 3D the dissection is the one kept, well below AMD
+                assert!(nd < 0.8 * amd, "amd {amd:e}, nd {nd:e}");
+            }
         }
     }
 
     #[test]
     fn a_dissected_trailing_analysis_ends_with_the_trailing_block() {
-        // the trailing equations (the y dofs of a grid line, as contact rows on a boundary) are
-        // eliminated last in their order, after the cheaper order of the leading block
-        let m = 230;
-        let p = q4_grid_pattern(m);
-        let trailing: Vec<usize> = (0..m).rev().map(|i| 2 * i + 1).collect();
+        // the trailing equations (the z dofs of the bottom layer, as contact rows on a
+        // boundary) are eliminated last in their order, after the cheaper order of the
+        // leading block
+        let m = 24;
+        let p = hex8_grid_pattern(m);
+        let trailing: Vec<usize> = (0..m * m).rev().map(|v| 3 * v + 2).collect();
         let chol = Cholesky::analyse_with_trailing(&p, &trailing, &UNLIMITED).unwrap();
         assert_eq!(chol.trailing.as_deref(), Some(&trailing[..]));
         let (amd, nd) = candidate_work(&p, &trailing);
-        assert_eq!(
-            chol.work().operations,
-            amd.min(nd),
-            "amd {amd:e}, nd {nd:e}"
-        );
+        assert!(nd < amd, "amd {amd:e}, nd {nd:e}");
+        assert_eq!(chol.work().operations, nd, "amd {amd:e}, nd {nd:e}");
     }
 
     #[test]
