@@ -457,57 +457,12 @@ mod tests {
         assert_eq!(metis_nested_dissection(&empty.view()), Some(Vec::new()));
     }
 
-    #[test]
-    fn metis_s_last_equations_separate_the_grid() {
-        // the top separator of a 41 x 41 grid: at most about two grid lines of vertices
-        // (METIS's vertex separator from a refined edge cut), whose removal leaves two parts
-        let n = 41;
-        let p = grid(n, 1);
-        let order = metis_nested_dissection(&p.view()).unwrap();
+    /// The number of connected parts of the pattern's graph without the last `tail`
+    /// vertices of `order`.
+    fn parts_without_tail(p: &Owned, order: &[usize], tail: usize) -> usize {
         let (start, adjacency) = full_adjacency(&p.view());
-        // the separator: the shortest tail of the order whose removal disconnects the rest
-        let parts = |tail: usize| {
-            let top: std::collections::HashSet<usize> =
-                order[order.len() - tail..].iter().copied().collect();
-            let mut component = vec![usize::MAX; p.n];
-            let mut count = 0;
-            for s in 0..p.n {
-                if top.contains(&s) || component[s] != usize::MAX {
-                    continue;
-                }
-                let mut stack = vec![s];
-                component[s] = count;
-                while let Some(v) = stack.pop() {
-                    for &w in &adjacency[start[v]..start[v + 1]] {
-                        if !top.contains(&w) && component[w] == usize::MAX {
-                            component[w] = count;
-                            stack.push(w);
-                        }
-                    }
-                }
-                count += 1;
-            }
-            count
-        };
-        let tail = (1..p.n).find(|&t| parts(t) >= 2).unwrap();
-        assert!(
-            tail <= 2 * n,
-            "the top separator has {tail} vertices on a {n} x {n} grid"
-        );
-    }
-
-    #[test]
-    fn the_last_equations_separate_the_grid() {
-        // on a 41 x 41 grid the top separator is a line of about 41 nodes whose removal
-        // leaves two parts with no edge between them
-        let n = 41;
-        let p = grid(n, 1);
-        let order = nested_dissection(&p.view());
-        let (start, adjacency) = full_adjacency(&p.view());
-        // the last eliminated set: the vertices after the position where the last leaf ends
         let top: std::collections::HashSet<usize> =
-            order[order.len() - n..].iter().copied().collect();
-        // the rest splits into at least two components
+            order[order.len() - tail..].iter().copied().collect();
         let mut component = vec![usize::MAX; p.n];
         let mut count = 0;
         for s in 0..p.n {
@@ -526,6 +481,34 @@ mod tests {
             }
             count += 1;
         }
+        count
+    }
+
+    #[test]
+    fn metis_s_last_equations_separate_the_grid() {
+        // the top separator of a 41 x 41 grid: at most about two grid lines of vertices
+        // (METIS's vertex separator from a refined edge cut), whose removal leaves two parts;
+        // the separator is the shortest tail of the order whose removal disconnects the rest
+        let n = 41;
+        let p = grid(n, 1);
+        let order = metis_nested_dissection(&p.view()).unwrap();
+        let tail = (1..p.n)
+            .find(|&t| parts_without_tail(&p, &order, t) >= 2)
+            .unwrap();
+        assert!(
+            tail <= 2 * n,
+            "the top separator has {tail} vertices on a {n} x {n} grid"
+        );
+    }
+
+    #[test]
+    fn the_last_equations_separate_the_grid() {
+        // on a 41 x 41 grid the top separator is a line of about 41 nodes whose removal
+        // leaves two parts with no edge between them
+        let n = 41;
+        let p = grid(n, 1);
+        let order = nested_dissection(&p.view());
+        let count = parts_without_tail(&p, &order, n);
         assert!(
             count >= 2,
             "the last {n} vertices separate the grid ({count} part)"

@@ -774,13 +774,14 @@ pub const NESTED_DISSECTION_ABOVE: f64 = 1e10;
 
 /// The AMD factor's multiply-adds per equation above which METIS's dissection can repay its
 /// own time. Measured on the 1M-dof contact block of `crosscheck/performance.py` (2026-11-25,
-/// quiet machine): METIS took 2.65 s for its 501,415 vertices (about 2.6 microseconds per
+/// load average below 2): METIS took 2.65 s for its 501,415 vertices (about 2.6 microseconds per
 /// equation) and cut the factor from 8.74e10 to 5.25e10 multiply-adds, while the numeric
 /// factorization ran at about 6e-11 s per multiply-add, so it saved about 2 s of factorization
 /// for 2.65 s of ordering plus a second symbolic analysis: AMD's 8.7e4 multiply-adds per
 /// equation are below the break-even (about 1e5 for a 40 % cut) and AMD is kept there. On the
 /// 3D slab `cases/large/slab-3d-1m.json` (9.4e6 per equation) the dissection cut 1.03e13 to
-/// 3.07e12 and the whole run from 233 s to 107 s. Twice the break-even, since the dissection
+/// 3.07e12 and the whole run from 233 s to 107-118 s (two runs of
+/// `crosscheck/performance.sh 1000000`). Twice the break-even, since the dissection
 /// does not always cut 40 %.
 pub const DISSECTION_WORK_PER_EQUATION: f64 = 2e5;
 
