@@ -520,24 +520,7 @@ fn the_newton_tangent_with_a_rigid_sphere_is_the_difference_of_the_residual() {
         }
         let at = probe.evaluate(&x).unwrap();
         let n = probe.unknown_count();
-        let scale = at
-            .tangent
-            .iter()
-            .flatten()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-        let h = 1e-7;
-        let mut worst = 0.0f64;
-        for j in 0..n {
-            let (mut xp, mut xm) = (x.clone(), x.clone());
-            xp[j] += h;
-            xm[j] -= h;
-            let rp = probe.evaluate(&xp).unwrap().residual;
-            let rm = probe.evaluate(&xm).unwrap().residual;
-            for i in 0..n {
-                let column = (rp[i] - rm[i]) / (2.0 * h);
-                worst = worst.max((column - at.tangent[i][j]).abs() / scale);
-            }
-        }
+        let (worst, scale) = finite_common::tangent_difference(&mut probe, &x, &at);
         println!(
             "{element} {}: Newton tangent vs central difference {worst:.1e} of {scale:.3e} ({n} unknowns)",
             enforcement["kind"]
@@ -995,24 +978,7 @@ fn the_newton_tangent_between_3d_bodies_is_the_difference_of_the_residual() {
         probe.evaluate(&x).unwrap();
         let at = probe.evaluate(&x).unwrap();
         let n = probe.unknown_count();
-        let scale = at
-            .tangent
-            .iter()
-            .flatten()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-        let h = 1e-7;
-        let mut worst = 0.0f64;
-        for j in 0..n {
-            let (mut xp, mut xm) = (x.clone(), x.clone());
-            xp[j] += h;
-            xm[j] -= h;
-            let rp = probe.evaluate(&xp).unwrap().residual;
-            let rm = probe.evaluate(&xm).unwrap().residual;
-            for i in 0..n {
-                let column = (rp[i] - rm[i]) / (2.0 * h);
-                worst = worst.max((column - at.tangent[i][j]).abs() / scale);
-            }
-        }
+        let (worst, scale) = finite_common::tangent_difference(&mut probe, &x, &at);
         println!(
             "{}: {n} unknowns, rows: {interior} interior, {edge} edge, {corner} corner; tangent vs central difference {worst:.1e} of {scale:.3e}",
             enforcement["kind"]

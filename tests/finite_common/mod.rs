@@ -96,11 +96,14 @@ pub fn assert_closed_where_pressed(o: &Outcome, rows: &[Constraint]) {
 /// The Newton tangent of `probe` at `x` (its evaluation `at`) against central differences of
 /// the residual (step `1e-7`): the largest difference relative to the largest tangent entry,
 /// and that entry.
-pub fn tangent_difference(
-    probe: &mut contact_patch::solver::contact_newton::Probe,
+pub fn tangent_difference<const D: usize, K>(
+    probe: &mut contact_patch::solver::contact_newton::Probe<'_, D, K>,
     x: &[f64],
     at: &contact_patch::solver::contact_newton::ProbeEvaluation,
-) -> (f64, f64) {
+) -> (f64, f64)
+where
+    K: contact_patch::solver::contact_newton::NewtonDimension<D>,
+{
     let n = x.len();
     let scale = at
         .tangent
