@@ -486,7 +486,12 @@ impl Cholesky {
         let mut l = Vec::new();
         l.try_reserve_exact(sym.len_val())
             .map_err(|e| FactorError::Other(format!("{e}")))?;
-        l.resize(sym.len_val(), 0.0);
+        // the first write to each page of a large factor makes the kernel zero it; written
+        // by rayon's threads, that cost is shared by the cores instead of paid by one
+        {
+            use rayon::iter::ParallelExtend;
+            l.par_extend(rayon::iter::repeat_n(0.0, sym.len_val()));
+        }
         let par = faer::get_global_parallelism();
         let mut mem =
             MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()))
