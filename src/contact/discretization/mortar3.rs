@@ -44,9 +44,9 @@
 //!    Quad9 (a quadratic multiplier times a quadratic, bilinear or linear shape function:
 //!    degree at most 4), degree 8 (the collapsed 5 x 5 Gauss product,
 //!    [`collapsed_triangle_rule`]) where a Quad9 takes part (two biquadratic functions, total
-//!    degree 8). A Tri6 whose projected mid-edge nodes are not the midpoints of its corners
-//!    (a curved facet) is not affine either and takes the collapsed 8 x 8 product below. A Quad4 facet that is not a parallelogram
-//!    (its projection onto the auxiliary plane) has a bilinear map that is not affine; the
+//!    degree 8). A Quad4 facet that is not a parallelogram (its projection onto the
+//!    auxiliary plane) has a bilinear map that is not affine, and a Tri6 whose projected
+//!    mid-edge nodes are not the midpoints of its corners (curved) a quadratic one; the
 //!    natural coordinates of a plane point are then not polynomials in it, no triangle rule is
 //!    exact, and the pair is integrated with the collapsed 8 x 8 product (degree 14,
 //!    [`NON_AFFINE_POINTS`]): its integrals agree with a 20 x 20 product to round-off on
@@ -74,8 +74,9 @@
 //! B_j`. Dual: `Phi_j = Psi_j = sum_k a_jk B_k` per slave facet, `A_e = D_e M_e^-1` with `D_e
 //! = diag(int_e B_k dA)` and `M_e = [int_e B_j B_k dA]` over the whole facet in the same
 //! (auxiliary-plane) measure (Gauss 3x3 for Quad4, 4x4 for Quad9, degree 2 for Tri3, the
-//! collapsed 4 x 4 product (degree 6) for Tri6), so `int_e Psi_j B_k dA = delta_jk int_e B_k dA`; where the basis is the shape
-//! basis `D` is then diagonal where the slave facet is covered. On affine facets this is
+//! collapsed 4 x 4 product (degree 6) for Tri6), so `int_e Psi_j B_k dA = delta_jk int_e B_k
+//! dA`; where the basis is the shape basis `D` is then diagonal where the slave facet is
+//! covered. On affine facets this is
 //! `Psi_j = 4 N_j - 1` (Tri3) and `a = [[4, -2, 1, -2], ...]` (Quad4, the nodal pattern of
 //! `4 N_j - 2 N_{j+1} + N_{j+2} - 2 N_{j+3}`). On facets whose map is not affine the cell
 //! quadrature of `D` is not exact, so biorthogonality then holds to the quadrature error only.
@@ -632,7 +633,7 @@ fn cell_rule(slave: ElementKind, master: ElementKind) -> Vec<QuadPoint> {
 }
 
 /// Points per direction of the collapsed Gauss product for cells where a Quad4 facet that is
-/// not a parallelogram takes part (module notes, step 4).
+/// not a parallelogram or a curved Tri6 takes part (module notes, step 4).
 pub const NON_AFFINE_POINTS: usize = 8;
 
 /// Whether a facet's projected map (node positions `q` on the auxiliary plane) is affine: a
@@ -702,7 +703,8 @@ pub fn mortar_integrals3(
 }
 
 /// [`mortar_integrals3`] with `non_affine_points` points per direction of the collapsed Gauss
-/// product on the cells of non-affine Quad4 pairs (module notes, step 4), to study that rule.
+/// product on the cells of non-affine Quad4 and Tri6 pairs (module notes, step 4), to study
+/// that rule.
 pub fn mortar_integrals3_with_points(
     slave: &FacetSet3,
     master: &FacetSet3,
