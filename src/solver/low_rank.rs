@@ -186,10 +186,32 @@ impl TrailingUpdate {
         let l = &self.block.factor;
         self.base.solve_in_place_with_trailing(b, |y| {
             let c = y.len();
-            let y_c = MatRef::from_column_major_slice(y, c, 1);
-            let z = self.llt.solve(l.as_ref() * y_c);
-            let x_c = l.transpose() * z;
-            y.iter_mut().enumerate().for_each(|(k, v)| *v = x_c[(k, 0)]);
+            let par = faer::get_global_parallelism();
+            // `L_CC y` and `L_CC^T z` read only the stored triangle
+            let mut t = Mat::<f64>::zeros(c, 1);
+            matmul(
+                t.as_mut(),
+                BlockStructure::Rectangular,
+                Accum::Replace,
+                l.as_ref(),
+                BlockStructure::TriangularLower,
+                MatRef::from_column_major_slice(y, c, 1),
+                BlockStructure::Rectangular,
+                1.0,
+                par,
+            );
+            let z = self.llt.solve(&t);
+            matmul(
+                faer::MatMut::from_column_major_slice_mut(y, c, 1),
+                BlockStructure::Rectangular,
+                Accum::Replace,
+                l.transpose(),
+                BlockStructure::TriangularUpper,
+                z.as_ref(),
+                BlockStructure::Rectangular,
+                1.0,
+                par,
+            );
         });
     }
 }
