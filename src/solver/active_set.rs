@@ -76,7 +76,9 @@ use crate::error::{Error, Result};
 use crate::io::scene::{ContactGeometry, CyclingRemedy, FactorUpdate, MultiplierUpdate};
 use crate::model::rigid::{FreeMode, RigidModes};
 use crate::model::Model;
-use crate::solver::conditioning::{condition_estimate_symmetric, EQUILIBRIUM_ROUND_OFF};
+use crate::solver::conditioning::{
+    condition_estimate_symmetric, condition_estimate_symmetric_columns, EQUILIBRIUM_ROUND_OFF,
+};
 use crate::solver::constraints::{ConstraintBuilder, ConstraintError};
 use crate::solver::dense::symmetric_eigen;
 use crate::solver::linear::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
@@ -1100,8 +1102,9 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
         }
         let t = Instant::now();
         let values = self.augmented(&active, &w);
-        let estimate =
-            condition_estimate_symmetric(&self.sys.pattern, &values, |b| f.solve_in_place(b));
+        let estimate = condition_estimate_symmetric_columns(&self.sys.pattern, &values, |b| {
+            f.solve_columns_in_place(b, b.len() / self.sys.n.max(1))
+        });
         if let Some(last) = self.history.last_mut() {
             last.condition_estimate = Some(estimate);
         }

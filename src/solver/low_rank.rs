@@ -61,6 +61,18 @@ impl Operator {
         }
     }
 
+    /// `B <- M^-1 B` for the `columns` columns of `b` (`b.len() / columns` values each, one
+    /// after the other): one pass over the factor for a factorization or a trailing-block
+    /// update, a solve per column for a Woodbury update.
+    pub fn solve_columns_in_place(&self, b: &mut [f64], columns: usize) {
+        let n = b.len() / columns.max(1);
+        match self {
+            Operator::Factored(f) => f.solve_columns_with_trailing(b, columns, |_| {}),
+            Operator::Updated(u) => b.chunks_mut(n.max(1)).for_each(|c| u.solve_in_place(c)),
+            Operator::Trailing(u) => u.solve_columns_in_place(b, columns),
+        }
+    }
+
     /// The rank of the update (0 for a factorization of `M` itself): the rows whose weight
     /// changed.
     pub fn rank(&self) -> usize {
@@ -183,8 +195,13 @@ pub struct TrailingUpdate {
 impl TrailingUpdate {
     /// `b <- M^-1 b`.
     pub fn solve_in_place(&self, b: &mut [f64]) {
+        self.solve_columns_in_place(b, 1)
+    }
+
+    /// `B <- M^-1 B` for the `columns` columns of `b`, one pass over the base factor.
+    pub fn solve_columns_in_place(&self, b: &mut [f64], columns: usize) {
         let l = &self.block.factor;
-        self.base.solve_in_place_with_trailing(b, |y| {
+        self.base.solve_columns_with_trailing(b, columns, |y| {
             let c = y.len();
             let par = faer::get_global_parallelism();
             // `L_CC y` and `L_CC^T z` read only the stored triangle
