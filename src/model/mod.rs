@@ -401,6 +401,25 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
         })
     }
 
+    /// The point (reference coordinates, zero past `D`) of the node of global dof `d`;
+    /// `None` for a dof of no node.
+    pub fn dof_point(&self, d: usize) -> Option<[f64; 3]> {
+        self.dof_owner(d).map(|owner| {
+            let mut point = [0.0; 3];
+            point[..D].copy_from_slice(&self.bodies[owner.body].mesh.nodes[owner.node]);
+            point
+        })
+    }
+
+    /// The point of each free equation's node ([`Model::dof_point`] of `free_dofs[e]`; NaN for
+    /// an equation of no node), for orderings that use the geometry.
+    pub fn equation_points(&self, free_dofs: &[usize]) -> Vec<[f64; 3]> {
+        free_dofs
+            .iter()
+            .map(|&d| self.dof_point(d).unwrap_or([f64::NAN; 3]))
+            .collect()
+    }
+
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)
     }

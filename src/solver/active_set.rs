@@ -79,9 +79,9 @@ use crate::model::Model;
 use crate::solver::conditioning::{
     condition_estimate_symmetric, condition_estimate_symmetric_columns, EQUILIBRIUM_ROUND_OFF,
 };
-use crate::solver::constraints::{ConstraintBuilder, ConstraintError};
+use crate::solver::constraints::{AffineConstraints, ConstraintBuilder, ConstraintError};
 use crate::solver::dense::symmetric_eigen;
-use crate::solver::linear::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
+use crate::solver::linear::{assemble_with, finish, LinearSystem, Solution, Timings, NO_EQUATION};
 use crate::solver::low_rank::{LowRankBase, Operator};
 use crate::solver::sparse::{Cholesky, PatternBuilder};
 use std::collections::{HashMap, HashSet};
@@ -516,7 +516,53 @@ fn solve_at<const D: usize, K: Discretize<D>>(
     let method = method(&model.contact[0].enforcement).kernel();
     progress("assembling");
     let blocks: Vec<Vec<usize>> = rows.iter().map(|r| r.dofs.clone()).collect();
-    let mut sys = assemble(model, &blocks);
+    let constraints = AffineConstraints::dirichlet(&model.prescribed);
+    let mut eq_rows: Vec<EqRow> = rows
+        .iter()
+        .map(|r| {
+            let mut out = EqRow {
+                eqs: Vec::new(),
+                coeffs: Vec::new(),
+                g0: r.g0,
+            };
+            for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
+                match constraints.equations()[d] {
+                    NO_EQUATION => out.g0 += c * constraints.constants()[d],
+                    e => {
+                        out.eqs.push(e);
+                        out.coeffs.push(c);
+                    }
+                }
+            }
+            // a row whose free part is round-off of its full gradient acts on prescribed dofs only
+            let full = r.coeffs.iter().fold(0.0f64, |a, c| a.max(c.abs()));
+            let free = out.coeffs.iter().fold(0.0f64, |a, c| a.max(c.abs()));
+            if free <= 1e-12 * full {
+                out.eqs.clear();
+                out.coeffs.clear();
+            }
+            out
+        })
+        .collect();
+    // the factor's ordering and symbolic analysis run beside the assembly of the values
+    // (with CG + AMG nothing is factored: no symbolic analysis, no updates of a factor)
+    let use_amg = model.solver.linear_solver == crate::io::scene::LinearSolver::CgAmg;
+    let trailing = trailing_equations(
+        &eq_rows,
+        model.solver.factor_update,
+        constraints.free_count(),
+    );
+    let points = (!use_amg).then(|| model.equation_points(constraints.free_dofs()));
+    let (mut sys, analysis) = assemble_with(model, constraints, &blocks, |pattern| {
+        points.map(|points| {
+            Cholesky::analyse_with_trailing_at(
+                pattern,
+                &trailing,
+                Some(&points),
+                &model.factor_limit,
+            )
+        })
+    });
     sys.check_assembled(model)?;
     if let Some(r) = rows
         .iter()
@@ -536,33 +582,6 @@ fn solve_at<const D: usize, K: Discretize<D>>(
     if let (Some(u), Some(forces), true) = (u, previous_forces, model.solver.geometric_stiffness) {
         add_geometric_stiffness(model, &rows, u, forces, &mut sys);
     }
-    let mut eq_rows: Vec<EqRow> = rows
-        .iter()
-        .map(|r| {
-            let mut out = EqRow {
-                eqs: Vec::new(),
-                coeffs: Vec::new(),
-                g0: r.g0,
-            };
-            for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
-                match sys.eq(d) {
-                    NO_EQUATION => out.g0 += c * sys.constraints.constants()[d],
-                    e => {
-                        out.eqs.push(e);
-                        out.coeffs.push(c);
-                    }
-                }
-            }
-            // a row whose free part is round-off of its full gradient acts on prescribed dofs only
-            let full = r.coeffs.iter().fold(0.0f64, |a, c| a.max(c.abs()));
-            let free = out.coeffs.iter().fold(0.0f64, |a, c| a.max(c.abs()));
-            if free <= 1e-12 * full {
-                out.eqs.clear();
-                out.coeffs.clear();
-            }
-            out
-        })
-        .collect();
     // A row on prescribed dofs only holds by itself when its gap is zero (e.g. a tie row along
     // a roller); it is dropped, since as a constraint it would only make the multiplier system
     // singular. If its gap is not zero the data contradict each other.
@@ -592,22 +611,14 @@ fn solve_at<const D: usize, K: Discretize<D>>(
 
     let t = Instant::now();
     progress("contact iterations");
-    // with CG + AMG nothing is factored: no symbolic analysis, no updates of a factor
-    let amg = (model.solver.linear_solver == crate::io::scene::LinearSolver::CgAmg)
+    let amg = use_amg
         .then(|| crate::solver::iterative::AmgSolver::new(model, sys.constraints.free_dofs()));
     if amg.is_some() && coupled {
         return Err(crate::solver::iterative::refuse_saddle_point(model));
     }
-    let chol = match amg {
-        Some(_) => None,
-        None => {
-            let trailing = trailing_equations(&eq_rows, model.solver.factor_update, sys.n);
-            Some(
-                Cholesky::analyse_with_trailing(&sys.pattern, &trailing, &model.factor_limit)
-                    .map_err(|e| sys.factor_error(model, e))?,
-            )
-        }
-    };
+    let chol = analysis
+        .transpose()
+        .map_err(|e| sys.factor_error(model, e))?;
     let update_rank = match amg {
         Some(_) => 0,
         None => update_rank(model.solver.factor_update, sys.n),
@@ -983,10 +994,45 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
     }
 
     /// `max |K x - f - B^T lambda|` over the free equations relative to the largest of `|f|`
-    /// and `|B^T lambda|` (forces of inactive rows are zero).
+    /// and `|B^T lambda|` (forces of inactive rows are zero). The product `K x` rounded in
+    /// working precision carries an error of about `|K| |x| eps`, itself of the order of
+    /// [`EQUILIBRIUM_ROUND_OFF`] on ill-conditioned systems; a residual above that bound is
+    /// therefore computed again with `K x` accumulated in twice the precision
+    /// ([`SymmetricPattern::residual_accurate`](crate::solver::sparse::SymmetricPattern::residual_accurate)),
+    /// so that an iterate the refinement brought to round-off is not reported above it by the
+    /// rounding of its own check.
     fn equilibrium_residual(&self, x: &[f64], forces: &[f64], active: &[bool]) -> f64 {
+        let plain = self.equilibrium_residual_in(x, forces, active, false);
+        if plain > EQUILIBRIUM_ROUND_OFF {
+            self.equilibrium_residual_in(x, forces, active, true)
+        } else {
+            plain
+        }
+    }
+
+    /// [`Kernel::equilibrium_residual`] with `K x` in working precision, or `accurate`ly.
+    fn equilibrium_residual_in(
+        &self,
+        x: &[f64],
+        forces: &[f64],
+        active: &[bool],
+        accurate: bool,
+    ) -> f64 {
         let mut r = vec![0.0; self.sys.n];
-        self.sys.pattern.mul(&self.sys.k, x, &mut r);
+        if accurate {
+            // rest = f - K x accurately, then K x = f - rest rounded once (an error of
+            // eps |K x|, far below the bound, where the plain sum's is eps |K| |x|)
+            let mut rest = vec![0.0; self.sys.n];
+            self.sys
+                .pattern
+                .residual_accurate(&self.sys.k, x, &self.sys.rhs, &mut rest);
+            r.iter_mut()
+                .zip(&self.sys.rhs)
+                .zip(&rest)
+                .for_each(|((v, f), q)| *v = f - q);
+        } else {
+            self.sys.pattern.mul(&self.sys.k, x, &mut r);
+        }
         let mut contact = vec![0.0; self.sys.n];
         for (i, row) in self.rows.iter().enumerate() {
             if active[i] {

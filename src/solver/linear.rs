@@ -30,10 +30,12 @@ use std::time::Instant;
 pub struct Timings {
     /// Reading, validating and meshing the case.
     pub mesh: f64,
-    /// Sparsity pattern, element kernels and scatter.
+    /// Sparsity pattern, element kernels and scatter; for the static linear and active-set
+    /// solves also the factor's ordering and symbolic analysis, which run on a second thread
+    /// beside the element kernels ([`assemble_with`]).
     pub assembly: f64,
-    /// Symbolic analysis and numeric Cholesky factorization (with `"cg_amg"`: the multigrid
-    /// setups).
+    /// Numeric Cholesky factorization, and the symbolic analysis where it is not overlapped
+    /// with the assembly (with `"cg_amg"`: the multigrid setups).
     pub factorization: f64,
     /// Triangular solves and reactions (with `"cg_amg"`: the CG iterations).
     pub solve: f64,
@@ -282,6 +284,18 @@ pub fn assemble<const D: usize, K: SolidCell<D>>(
     extra_blocks: &[Vec<usize>],
 ) -> LinearSystem {
     let constraints = AffineConstraints::dirichlet(&model.prescribed);
+    assemble_with(model, constraints, extra_blocks, |_| ()).0
+}
+
+/// [`assemble`] under the Dirichlet `constraints`, with `analyse` run on the sparsity pattern
+/// on a second thread while the element values are assembled on this one (the ordering and
+/// symbolic analysis of a sparse factorization need the pattern only), and its result.
+pub fn assemble_with<const D: usize, K: SolidCell<D>, R: Send>(
+    model: &Model<D, K>,
+    constraints: AffineConstraints,
+    extra_blocks: &[Vec<usize>],
+    analyse: impl FnOnce(&SymmetricPattern) -> R + Send,
+) -> (LinearSystem, R) {
     let n = constraints.free_count();
     let mut local = constraints.local();
     let mut builder = PatternBuilder::new(n);
@@ -296,18 +310,26 @@ pub fn assemble<const D: usize, K: SolidCell<D>>(
         local.add_pattern(block, &mut builder);
     }
     let pattern = builder.build();
-    let mut k = vec![0.0; pattern.nnz()];
-    let mut rhs = constraints.reduce_vector(&model.external_force);
-    for_each_element_stiffness(model, |dofs, ke| {
-        local.distribute(dofs, ke, &pattern, &mut k, &mut rhs);
+    let (k, rhs, analysis) = std::thread::scope(|scope| {
+        let analysis = scope.spawn(|| analyse(&pattern));
+        let mut k = vec![0.0; pattern.nnz()];
+        let mut rhs = constraints.reduce_vector(&model.external_force);
+        for_each_element_stiffness(model, |dofs, ke| {
+            local.distribute(dofs, ke, &pattern, &mut k, &mut rhs);
+        });
+        let analysis = analysis
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (k, rhs, analysis)
     });
-    LinearSystem {
+    let sys = LinearSystem {
         constraints,
         n,
         pattern,
         k,
         rhs,
-    }
+    };
+    (sys, analysis)
 }
 
 /// Solve the static elastic problem without contact (see [`crate::solver`] for the entry that
@@ -319,11 +341,18 @@ pub fn solve_elastic<const D: usize, K: SolidCell<D>>(
     let mut timings = Timings::default();
     let t = Instant::now();
     progress("assembling");
-    let sys = assemble(model, &[]);
+    // the factor's ordering and symbolic analysis run beside the assembly of the values
+    let use_amg = model.solver.linear_solver == crate::io::scene::LinearSolver::CgAmg;
+    let constraints = AffineConstraints::dirichlet(&model.prescribed);
+    let points = (!use_amg && constraints.free_count() > 0)
+        .then(|| model.equation_points(constraints.free_dofs()));
+    let (sys, analysis) = assemble_with(model, constraints, &[], |pattern| {
+        points.map(|points| Cholesky::analyse_at(pattern, Some(&points), &model.factor_limit))
+    });
     sys.check_assembled(model)?;
     timings.assembly = t.elapsed().as_secs_f64();
 
-    if model.solver.linear_solver == crate::io::scene::LinearSolver::CgAmg {
+    if use_amg {
         crate::solver::iterative::refuse_unless_admitted(model)?;
         progress("multigrid setup and CG");
         let mut amg = crate::solver::iterative::AmgSolver::new(model, sys.constraints.free_dofs());
@@ -349,9 +378,8 @@ pub fn solve_elastic<const D: usize, K: SolidCell<D>>(
     let t = Instant::now();
     progress("factorizing");
     let mut x = sys.rhs.clone();
-    if sys.n > 0 {
-        let chol = Cholesky::analyse(&sys.pattern, &model.factor_limit)
-            .map_err(|e| sys.factor_error(model, e))?;
+    if let Some(analysis) = analysis {
+        let chol = analysis.map_err(|e| sys.factor_error(model, e))?;
         let factor = chol
             .factor(&sys.pattern, &sys.k)
             .map_err(|e| sys.factor_error(model, e))?;

@@ -397,12 +397,22 @@ impl Cholesky {
     /// Analyse the pattern (ordering, elimination tree, supernodes); a factor whose work
     /// exceeds `limit` is [`FactorError::TooLarge`].
     pub fn analyse(pattern: &SymmetricPattern, limit: &WorkLimit) -> Result<Self, FactorError> {
+        Self::analyse_at(pattern, None, limit)
+    }
+
+    /// [`Cholesky::analyse`] with `points[e]` the point of equation `e` (its node), which lets
+    /// large systems try the geometric dissection too ([`cheaper_order`]).
+    pub fn analyse_at(
+        pattern: &SymmetricPattern,
+        points: Option<&[[f64; 3]]>,
+        limit: &WorkLimit,
+    ) -> Result<Self, FactorError> {
         let whole = crate::solver::ordering::Pattern {
             n: pattern.n,
             col_ptr: &pattern.col_ptr,
             row_idx: &pattern.row_idx,
         };
-        let symbolic = cheaper_order(&whole, |order| symbolic_in_order(pattern, order))?;
+        let symbolic = cheaper_order(&whole, points, |order| symbolic_in_order(pattern, order))?;
         FactorWork::of(&symbolic).check(limit)?;
         Ok(Cholesky {
             symbolic: Arc::new(symbolic),
@@ -424,16 +434,27 @@ impl Cholesky {
         trailing: &[usize],
         limit: &WorkLimit,
     ) -> Result<Self, FactorError> {
+        Self::analyse_with_trailing_at(pattern, trailing, None, limit)
+    }
+
+    /// [`Cholesky::analyse_with_trailing`] with `points[e]` the point of equation `e`, as in
+    /// [`Cholesky::analyse_at`].
+    pub fn analyse_with_trailing_at(
+        pattern: &SymmetricPattern,
+        trailing: &[usize],
+        points: Option<&[[f64; 3]]>,
+        limit: &WorkLimit,
+    ) -> Result<Self, FactorError> {
         let n = pattern.n;
         let mut is_trailing = vec![false; n];
         for &e in trailing {
             if e >= n || is_trailing[e] {
-                return Self::analyse(pattern, limit);
+                return Self::analyse_at(pattern, points, limit);
             }
             is_trailing[e] = true;
         }
         if trailing.is_empty() || trailing.len() == n {
-            return Self::analyse(pattern, limit);
+            return Self::analyse_at(pattern, points, limit);
         }
         let (leading, col_ptr, row_idx) = leading_block(pattern, &is_trailing);
         let m = leading.len();
@@ -442,8 +463,10 @@ impl Cholesky {
             col_ptr: &col_ptr,
             row_idx: &row_idx,
         };
+        let leading_points: Option<Vec<[f64; 3]>> =
+            points.map(|p| leading.iter().map(|&e| p[e]).collect());
         // the whole order: the leading block's, then the trailing equations as given
-        let symbolic = cheaper_order(&block, |order| {
+        let symbolic = cheaper_order(&block, leading_points.as_deref(), |order| {
             let fwd: Vec<usize> = order
                 .iter()
                 .map(|&k| leading[k])
@@ -884,24 +907,47 @@ fn symbolic_in_order(
     .map_err(|e| FactorError::Other(format!("{e:?}")))
 }
 
-/// The symbolic factor, `whole(order)` for an order of the equations of `block`, of AMD's order
-/// or of the nested-dissection order, whichever takes fewer operations (AMD on a tie); the
-/// dissection is tried only on large factors ([`NESTED_DISSECTION_ABOVE`],
-/// [`DISSECTION_WORK_PER_EQUATION`]). A dissection whose analysis fails leaves AMD's.
+/// The symbolic factor, `whole(order)` for an order of the equations of `block`, of the
+/// cheapest of three orders (the first of equals in this list): AMD's; on systems of at least
+/// [`COORDINATE_DISSECTION_FROM`] equations with `points` (each equation's point), the
+/// geometric dissection ([`crate::solver::ordering::coordinate_dissection`]), analysed on a
+/// second thread while AMD runs; and METIS's dissection, tried only on large factors
+/// ([`NESTED_DISSECTION_ABOVE`], [`DISSECTION_WORK_PER_EQUATION`]). A dissection whose analysis
+/// fails is passed over.
 fn cheaper_order(
     block: &crate::solver::ordering::Pattern,
-    whole: impl Fn(&[usize]) -> Result<SymbolicCholesky<usize>, FactorError>,
+    points: Option<&[[f64; 3]]>,
+    whole: impl Fn(&[usize]) -> Result<SymbolicCholesky<usize>, FactorError> + Sync,
 ) -> Result<SymbolicCholesky<usize>, FactorError> {
-    let amd = whole(&amd_order(block)?)?;
-    let work = FactorWork::of(&amd).operations;
+    let points = points.filter(|_| block.n >= COORDINATE_DISSECTION_FROM);
+    let (amd, geometric) = rayon::join(
+        || whole(&amd_order(block)?),
+        || {
+            points
+                .and_then(|p| crate::solver::ordering::coordinate_dissection(block, p))
+                .and_then(|order| whole(&order).ok())
+        },
+    );
+    let mut best = amd?;
+    if let Some(g) = geometric {
+        if FactorWork::of(&g).operations < FactorWork::of(&best).operations {
+            best = g;
+        }
+    }
+    let work = FactorWork::of(&best).operations;
     if work <= NESTED_DISSECTION_ABOVE || work <= DISSECTION_WORK_PER_EQUATION * block.n as f64 {
-        return Ok(amd);
+        return Ok(best);
     }
     match whole(&crate::solver::ordering::dissection_order(block)) {
         Ok(nd) if FactorWork::of(&nd).operations < work => Ok(nd),
-        _ => Ok(amd),
+        _ => Ok(best),
     }
 }
+
+/// Systems of at least this many equations with points also try the geometric dissection
+/// ([`cheaper_order`]); below, AMD's analysis takes a few milliseconds and the orders of the
+/// small scenes of the tables stay AMD's.
+pub const COORDINATE_DISSECTION_FROM: usize = 50_000;
 
 /// The symbolic factor for the order "AMD of the leading `leading x leading` block, then the
 /// remaining equations (the multipliers) in order".
@@ -1501,6 +1547,118 @@ mod tests {
             }
         }
         b.build()
+    }
+
+    /// The pattern of plane Q4 elasticity on an `nx x ny` grid of unit-spaced nodes (2 dofs
+    /// per node, numbered along x first) and the point of each equation.
+    fn q4_rectangle(nx: usize, ny: usize) -> (SymmetricPattern, Vec<[f64; 3]>) {
+        let mut b = PatternBuilder::new(2 * nx * ny);
+        let mut points = vec![[0.0; 3]; 2 * nx * ny];
+        for j in 0..ny {
+            for i in 0..nx {
+                let v = i + nx * j;
+                points[2 * v] = [i as f64, j as f64, 0.0];
+                points[2 * v + 1] = points[2 * v];
+                if i + 1 < nx && j + 1 < ny {
+                    let nodes = [v, v + 1, v + nx, v + nx + 1];
+                    let eqs: Vec<usize> = nodes.iter().flat_map(|&w| [2 * w, 2 * w + 1]).collect();
+                    b.add_block(&eqs);
+                }
+            }
+        }
+        (b.build(), points)
+    }
+
+    /// Values on `p`: -1 off the diagonal and one more than the row's count of them on it
+    /// (symmetric, strictly diagonally dominant, so positive definite).
+    fn diagonally_dominant(p: &SymmetricPattern) -> Vec<f64> {
+        let mut off = vec![0.0; p.n];
+        for j in 0..p.n {
+            for &i in &p.row_idx[p.col_ptr[j]..p.col_ptr[j + 1]] {
+                if i != j {
+                    off[i] += 1.0;
+                    off[j] += 1.0;
+                }
+            }
+        }
+        let mut values = vec![0.0; p.nnz()];
+        for j in 0..p.n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                values[k] = if p.row_idx[k] == j {
+                    off[j] + 1.0
+                } else {
+                    -1.0
+                };
+            }
+        }
+        values
+    }
+
+    #[test]
+    fn a_large_system_with_points_keeps_the_geometric_dissection_where_it_is_cheaper() {
+        // 400 x 80 nodes, 64,000 equations (above COORDINATE_DISSECTION_FROM): the grid-line
+        // separators of the coordinate bisection beat AMD's order, and the analysis keeps them;
+        // without points, or below the size, the order is AMD's
+        let (p, points) = q4_rectangle(400, 80);
+        assert!(p.n >= COORDINATE_DISSECTION_FROM);
+        let block = crate::solver::ordering::Pattern {
+            n: p.n,
+            col_ptr: &p.col_ptr,
+            row_idx: &p.row_idx,
+        };
+        let work =
+            |order: &[usize]| FactorWork::of(&symbolic_in_order(&p, order).unwrap()).operations;
+        let amd = work(&amd_order(&block).unwrap());
+        let geometric =
+            work(&crate::solver::ordering::coordinate_dissection(&block, &points).unwrap());
+        assert!(geometric < amd, "AMD {amd:e}, geometric {geometric:e}");
+        let kept = Cholesky::analyse_at(&p, Some(&points), &UNLIMITED).unwrap();
+        assert_eq!(kept.work().operations, geometric);
+        assert_eq!(
+            Cholesky::analyse(&p, &UNLIMITED).unwrap().work().operations,
+            amd
+        );
+        // the kept order factors and solves an SPD matrix on the pattern
+        let values = diagonally_dominant(&p);
+        let factor = kept.factor(&p, &values).unwrap();
+        let x_true: Vec<f64> = (0..p.n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let mut b = vec![0.0; p.n];
+        p.mul(&values, &x_true, &mut b);
+        factor.solve_in_place(&mut b);
+        let err = b
+            .iter()
+            .zip(&x_true)
+            .fold(0.0f64, |m, (a, t)| m.max((a - t).abs()));
+        assert!(err < 1e-10, "solution error {err:e}");
+        // a small system keeps AMD's order even with points
+        let (small, small_points) = q4_rectangle(40, 20);
+        assert_eq!(
+            Cholesky::analyse_at(&small, Some(&small_points), &UNLIMITED)
+                .unwrap()
+                .work()
+                .operations,
+            Cholesky::analyse(&small, &UNLIMITED)
+                .unwrap()
+                .work()
+                .operations
+        );
+    }
+
+    #[test]
+    fn the_trailing_analysis_with_points_keeps_the_trailing_equations_last() {
+        // the bottom row's y dofs (contact rows on a boundary) last, the rest by the cheaper
+        // of AMD and the geometric dissection
+        let (p, points) = q4_rectangle(400, 80);
+        let trailing: Vec<usize> = (0..400).map(|i| 2 * i + 1).collect();
+        let chol =
+            Cholesky::analyse_with_trailing_at(&p, &trailing, Some(&points), &UNLIMITED).unwrap();
+        assert_eq!(chol.trailing.as_deref(), Some(&trailing[..]));
+        let (amd, _) = candidate_work(&p, &trailing);
+        assert!(
+            chol.work().operations < amd,
+            "kept {:e}, AMD {amd:e}",
+            chol.work().operations
+        );
     }
 
     #[test]
