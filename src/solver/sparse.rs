@@ -907,41 +907,50 @@ fn symbolic_in_order(
     .map_err(|e| FactorError::Other(format!("{e:?}")))
 }
 
-/// The symbolic factor, `whole(order)` for an order of the equations of `block`, of the
-/// cheapest of three orders (the first of equals in this list): AMD's; on systems of at least
-/// [`COORDINATE_DISSECTION_FROM`] equations with `points` (each equation's point), the
-/// geometric dissection ([`crate::solver::ordering::coordinate_dissection`]), analysed on a
-/// second thread while AMD runs; and METIS's dissection, tried only on large factors
-/// ([`NESTED_DISSECTION_ABOVE`], [`DISSECTION_WORK_PER_EQUATION`]). A dissection whose analysis
-/// fails is passed over.
+/// The symbolic factor, `whole(order)` for an order of the equations of `block`:
+///
+/// - on systems of at least [`COORDINATE_DISSECTION_FROM`] equations with `points` (each
+///   equation's point), the geometric dissection
+///   ([`crate::solver::ordering::coordinate_dissection`]) first; where its factor is cheap
+///   ([`NESTED_DISSECTION_ABOVE`] multiply-adds, or [`DISSECTION_WORK_PER_EQUATION`] per
+///   equation), it is kept without analysing another order, since AMD's analysis would then cost
+///   about as much as the factorization it might shorten (on the 1M-dof contact block of the
+///   performance report AMD took longer than the dissection and its symbolic analysis together,
+///   for a factor 1.7 times as expensive);
+/// - otherwise AMD's order, and where the cheapest so far is expensive by both bounds, METIS's
+///   dissection too: the order of fewest multiply-adds is kept (the first of equals in the
+///   order geometric, AMD, METIS). A dissection whose analysis fails is passed over.
 fn cheaper_order(
     block: &crate::solver::ordering::Pattern,
     points: Option<&[[f64; 3]]>,
-    whole: impl Fn(&[usize]) -> Result<SymbolicCholesky<usize>, FactorError> + Sync,
+    whole: impl Fn(&[usize]) -> Result<SymbolicCholesky<usize>, FactorError>,
 ) -> Result<SymbolicCholesky<usize>, FactorError> {
-    let points = points.filter(|_| block.n >= COORDINATE_DISSECTION_FROM);
-    let (amd, geometric) = rayon::join(
-        || whole(&amd_order(block)?),
-        || {
-            points
-                .and_then(|p| crate::solver::ordering::coordinate_dissection(block, p))
-                .and_then(|order| whole(&order).ok())
-        },
-    );
-    let mut best = amd?;
-    if let Some(g) = geometric {
-        if FactorWork::of(&g).operations < FactorWork::of(&best).operations {
-            best = g;
-        }
-    }
+    let cheap = |work: f64| {
+        work <= NESTED_DISSECTION_ABOVE || work <= DISSECTION_WORK_PER_EQUATION * block.n as f64
+    };
+    let geometric = points
+        .filter(|_| block.n >= COORDINATE_DISSECTION_FROM)
+        .and_then(|p| crate::solver::ordering::coordinate_dissection(block, p))
+        .and_then(|order| whole(&order).ok());
+    let geometric = match geometric {
+        Some(g) if cheap(FactorWork::of(&g).operations) => return Ok(g),
+        other => other,
+    };
+    let amd = whole(&amd_order(block)?)?;
+    let mut best = match geometric {
+        Some(g) if FactorWork::of(&g).operations <= FactorWork::of(&amd).operations => g,
+        _ => amd,
+    };
     let work = FactorWork::of(&best).operations;
-    if work <= NESTED_DISSECTION_ABOVE || work <= DISSECTION_WORK_PER_EQUATION * block.n as f64 {
+    if cheap(work) {
         return Ok(best);
     }
-    match whole(&crate::solver::ordering::dissection_order(block)) {
-        Ok(nd) if FactorWork::of(&nd).operations < work => Ok(nd),
-        _ => Ok(best),
+    if let Ok(nd) = whole(&crate::solver::ordering::dissection_order(block)) {
+        if FactorWork::of(&nd).operations < work {
+            best = nd;
+        }
     }
+    Ok(best)
 }
 
 /// Systems of at least this many equations with points also try the geometric dissection
@@ -1595,10 +1604,11 @@ mod tests {
     }
 
     #[test]
-    fn a_large_system_with_points_keeps_the_geometric_dissection_where_it_is_cheaper() {
-        // 400 x 80 nodes, 64,000 equations (above COORDINATE_DISSECTION_FROM): the grid-line
-        // separators of the coordinate bisection beat AMD's order, and the analysis keeps them;
-        // without points, or below the size, the order is AMD's
+    fn a_large_system_with_points_keeps_a_cheap_geometric_dissection() {
+        // 400 x 80 nodes, 64,000 equations (above COORDINATE_DISSECTION_FROM): the factor of
+        // the coordinate bisection's order is cheap by both bounds and kept without another
+        // analysis (its grid-line separators beat AMD's order here too); without points, or
+        // below the size, the order is AMD's
         let (p, points) = q4_rectangle(400, 80);
         assert!(p.n >= COORDINATE_DISSECTION_FROM);
         let block = crate::solver::ordering::Pattern {
@@ -1641,6 +1651,46 @@ mod tests {
                 .unwrap()
                 .work()
                 .operations
+        );
+    }
+
+    #[test]
+    fn an_expensive_geometric_factor_is_compared_with_amd_and_metis() {
+        // a 26^3 Hex8 grid (52,728 equations): the geometric dissection's factor is above both
+        // bounds, so AMD and METIS are analysed too and the cheapest of the three kept
+        let m = 26;
+        let p = hex8_grid_pattern(m);
+        assert!(p.n >= COORDINATE_DISSECTION_FROM);
+        let points: Vec<[f64; 3]> = (0..p.n)
+            .map(|e| {
+                let v = e / 3;
+                [(v % m) as f64, ((v / m) % m) as f64, (v / (m * m)) as f64]
+            })
+            .collect();
+        let block = crate::solver::ordering::Pattern {
+            n: p.n,
+            col_ptr: &p.col_ptr,
+            row_idx: &p.row_idx,
+        };
+        let work =
+            |order: &[usize]| FactorWork::of(&symbolic_in_order(&p, order).unwrap()).operations;
+        let geometric =
+            work(&crate::solver::ordering::coordinate_dissection(&block, &points).unwrap());
+        assert!(
+            geometric > NESTED_DISSECTION_ABOVE
+                && geometric > DISSECTION_WORK_PER_EQUATION * p.n as f64,
+            "geometric {geometric:e}"
+        );
+        let amd = work(&amd_order(&block).unwrap());
+        let metis = work(&crate::solver::ordering::dissection_order(&block));
+        let kept = Cholesky::analyse_at(&p, Some(&points), &UNLIMITED)
+            .unwrap()
+            .work()
+            .operations;
+        assert_eq!(
+            kept,
+            geometric.min(amd).min(metis),
+            "geometric {geometric:e}, AMD {amd:e}, METIS {metis:e}"
         );
     }
 
