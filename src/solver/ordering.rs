@@ -1,4 +1,5 @@
-//! Nested-dissection orderings of a symmetric sparsity pattern, from the graph alone.
+//! Nested-dissection orderings of a symmetric sparsity pattern, from the graph alone or, in
+//! [`coordinate_dissection`], from the graph and the points of its equations.
 //!
 //! [`dissection_order`] is METIS's multilevel nested dissection ([`metis_nested_dissection`],
 //! Karypis and Kumar 1998) on the quotient graph of supervariables (step 1 below), and the
@@ -7,9 +8,10 @@
 //! Definite Systems*, 1981, chapter 8) where METIS cannot take the graph. Their factors'
 //! multiply-adds, against AMD's (`contact-patch run` with `limits.factor_operations` set to 1
 //! prints the kept one): the contact block of `crosscheck/performance.py` (1,002,830 dofs, Q4)
-//! AMD 8.74e10, level structures 9.61e10, METIS 5.25e10; the 3D slab
+//! AMD 8.74e10, level structures 9.61e10, METIS 5.25e10, the geometric dissection
+//! ([`coordinate_dissection`]) 5.13e10; the 3D slab
 //! `cases/large/slab-3d-1m.json` (1,090,824 equations, Hex8) AMD 1.03e13, level structures
-//! 5.35e12, METIS 3.07e12.
+//! 5.35e12, METIS 3.07e12, geometric 2.85e12.
 //!
 //! The level-structure dissection:
 //!
