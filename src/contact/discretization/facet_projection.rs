@@ -55,6 +55,24 @@ pub struct FacetProjection {
     pub distance: f64,
     /// Unit outward normal of the facet at `natural`.
     pub normal: [f64; 3],
+    /// For an interior point: how far (in natural units, [`natural_excess`]) the stationary
+    /// point lay outside the natural domain before it was clamped onto it (zero when inside;
+    /// at most [`INSIDE`] for [`project_onto_facet`], up to the margin for
+    /// [`project_onto_extended_facet`]); zero on edges and corners. Of two facets that hold a
+    /// node at the same distance, the one it is truly inside has the smaller excess.
+    pub excess: f64,
+}
+
+/// How far the natural point `s` lies outside the facet's natural domain: the largest
+/// violation of its bounds (`|s_k| <= 1` on the quadrilaterals; `s, t >= 0`, `s + t <= 1` on
+/// the triangles), zero inside.
+pub fn natural_excess(kind: ElementKind, s: [f64; 2]) -> f64 {
+    let violation = if is_quadrilateral(kind) {
+        (s[0].abs() - 1.0).max(s[1].abs() - 1.0)
+    } else {
+        (-s[0]).max(-s[1]).max(s[0] + s[1] - 1.0)
+    };
+    violation.max(0.0)
 }
 
 /// Natural coordinates of the facet's corners, counter-clockwise.
@@ -285,7 +303,7 @@ fn edge_minimum(
 /// The closest point of `p` on the facet of kind `kind` (Q4, Q9, T3 or T6) with node
 /// positions `coords` (module notes).
 pub fn project_onto_facet(kind: ElementKind, coords: &[[f64; 3]], p: [f64; 3]) -> FacetProjection {
-    let finish = |natural: [f64; 2], feature: FacetFeature| {
+    let finish = |natural: [f64; 2], feature: FacetFeature, excess: f64| {
         let (x, t) = facet_frame(kind, coords, natural);
         let n = cross(t[0], t[1]);
         let l = dot(n, n).sqrt();
@@ -296,11 +314,16 @@ pub fn project_onto_facet(kind: ElementKind, coords: &[[f64; 3]], p: [f64; 3]) -
             point: x,
             distance: dot(r, r).sqrt(),
             normal: n.map(|c| c / l),
+            excess,
         }
     };
     if let Some(s) = interior_newton(kind, coords, p) {
         if natural_inside(kind, s, INSIDE) {
-            return finish(clamp_natural(kind, s), FacetFeature::Interior);
+            return finish(
+                clamp_natural(kind, s),
+                FacetFeature::Interior,
+                natural_excess(kind, s),
+            );
         }
     }
     let corners = natural_corners(kind);
@@ -324,7 +347,7 @@ pub fn project_onto_facet(kind: ElementKind, coords: &[[f64; 3]], p: [f64; 3]) -
         best = Some((squared, natural, feature));
     }
     let (_, natural, feature) = best.expect("a facet has edges");
-    finish(natural, feature)
+    finish(natural, feature, 0.0)
 }
 
 /// The stationary point of `|x(s) - p|^2 / 2` over the facet's interpolation extended beyond
@@ -353,6 +376,7 @@ pub fn project_onto_extended_facet(
         point: x,
         distance: dot(r, r).sqrt(),
         normal: n.map(|c| c / l),
+        excess: natural_excess(kind, s),
     })
 }
 

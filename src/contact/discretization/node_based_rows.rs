@@ -285,15 +285,40 @@ pub fn node_to_surface_rows(
     checked(rows, settings.search_distance)
 }
 
+/// How far outside its facet (natural units) an interior closest point may have been clamped
+/// and still count as inside in a tie ([`closest_facet`]): a hundred times the round-off of
+/// the projection, and below the solve's relative tolerance (the row weights, and so the
+/// residual, are off by about this much relative to the row's force).
+pub const TIE_EXCESS: f64 = 1e-13;
+
 /// Which facet of `master` a slave node at `p` is held against, and where: the closest point
-/// among the candidates, an interior point winning a tie (within `tol`) against an edge or a
-/// corner.
+/// among the candidates; in a tie (distances within `tol`) an interior point wins against an
+/// edge or a corner, and of two interior points the one the node is inside (the smaller
+/// [`FacetProjection::excess`], all below [`TIE_EXCESS`] counting as inside; then the first
+/// candidate). A node on or next to an edge shared by two facets (a slave node on a master
+/// node or edge of a matching mesh) is so held by a facet whose closest-point gap is the one
+/// at its position: the other facet's point, clamped onto its boundary from up to
+/// [`super::facet_projection::INSIDE`] outside, gives row weights off by that much (Newton's
+/// residual stalled at 1e-10 on the Tet4 stacked blocks, taking the first candidate); and a
+/// node within round-off of the edge keeps one facet from one iterate to the next instead of
+/// swapping facets with the round-off of its natural coordinates (which stalled the penalty
+/// at 1e-11 on the Hex8 stacked blocks, taking the smallest excess).
 fn closest_facet(
     master: &Surface3,
     candidates: &[usize],
     p: [f64; 3],
     tol: f64,
 ) -> Option<(usize, FacetProjection)> {
+    let rank = |q: &FacetProjection| {
+        (
+            q.feature != FacetFeature::Interior,
+            if q.excess <= TIE_EXCESS {
+                0.0
+            } else {
+                q.excess
+            },
+        )
+    };
     let mut best: Option<(usize, FacetProjection)> = None;
     for &f in candidates {
         let q = project_onto_facet(master.kind, &master.coords[f], p);
@@ -301,9 +326,7 @@ fn closest_facet(
             None => true,
             Some((_, b)) => {
                 q.distance < b.distance - tol
-                    || (q.distance <= b.distance + tol
-                        && q.feature == FacetFeature::Interior
-                        && b.feature != FacetFeature::Interior)
+                    || (q.distance <= b.distance + tol && rank(&q) < rank(b))
             }
         };
         if better {
@@ -880,6 +903,42 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A slave node next to the edge shared by two flat Tri3 master facets (the unit square
+    /// cut along its diagonal, the upper facet first among the candidates), pressed in by
+    /// 1e-3: a node inside the lower facet by 1e-11 (natural) is held by the lower facet,
+    /// whose gap is the one at its position, not by the upper one it lies 1e-11 outside of
+    /// (clamped onto its edge); a node inside the lower facet by 1e-15 (round-off of its
+    /// natural coordinates, below [`TIE_EXCESS`]) keeps the first candidate either way.
+    #[test]
+    fn a_node_beside_a_shared_edge_is_held_by_the_facet_it_is_inside() {
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        // upper facet (0, 2, 3) first, lower facet (0, 1, 2) second
+        let facets = vec![vec![0, 2, 3], vec![0, 1, 2]];
+        let master = surface(1, ElementKind::T3, &positions, &facets);
+        let held = |offset: f64| {
+            // below the diagonal x = y by `offset` (the lower facet's side)
+            let p = [0.4 + offset, 0.4, -1e-3];
+            let tol = 1e-12 * surface_extent(&master);
+            let (f, q) = closest_facet(&master, &[0, 1], p, tol).unwrap();
+            (f, q.feature, q.excess)
+        };
+        let (f, feature, excess) = held(1e-11);
+        assert_eq!((f, feature), (1, FacetFeature::Interior), "{excess:e}");
+        assert_eq!(excess, 0.0);
+        // and the other way round: above the diagonal, the upper facet
+        let (f, _, excess) = held(-1e-11);
+        assert_eq!(f, 0, "{excess:e}");
+        // within round-off of the edge: the first candidate, clamped by less than TIE_EXCESS
+        let (f, feature, excess) = held(1e-15);
+        assert_eq!((f, feature), (0, FacetFeature::Interior));
+        assert!(excess <= TIE_EXCESS, "{excess:e}");
     }
 
     #[test]
