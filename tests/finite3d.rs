@@ -494,6 +494,35 @@ fn a_rigid_sphere_pressed_into_a_block_converges_quadratically_and_balances() {
     }
 }
 
+/// The rigid sphere at kappa 1e7 (Tet4, the scene of the test above): Newton stalls at a
+/// relative residual near 1e-11 with a fixed active set (measured 3.6e-11 to 6.6e-11), above
+/// the finite-strain tolerance 1e-12, until the load-step cuts are spent; no active row opens
+/// or closes (not a flip-flop). The error says that the residual stalled with a fixed active
+/// set and what to do (a smaller kappa, or Lagrange multipliers), not only that the iteration
+/// limit was hit.
+#[test]
+fn a_penalty_far_stiffer_than_the_block_stalls_and_the_error_says_what_to_do() {
+    let breaks = [0.0, 0.2, 0.35, 0.45, 0.55, 0.65, 0.8, 1.0];
+    let case = sphere_case(
+        "Tet4",
+        json!({"kind": "penalty", "kappa": 1e7}),
+        0.1,
+        &breaks,
+    );
+    let err = run_case3(&parse(&case), "finite3d")
+        .unwrap_err()
+        .to_string();
+    println!("{err}");
+    for needle in [
+        "cuts of the load increment",
+        "Newton did not converge in 200 iterations: the relative residual stalled",
+        "with a fixed active set",
+        "a smaller kappa, or Lagrange multipliers",
+    ] {
+        assert!(err.contains(needle), "lacks {needle:?}: {err}");
+    }
+}
+
 /// The tangent of the whole 3D Newton system (neo-Hookean solid plus penalty rows against a
 /// rigid sphere, with the sphere's gap second derivative) is the central difference of its
 /// residual at a deformed, penetrating state off equilibrium, to 1e-6 of its largest entry;
