@@ -57,22 +57,44 @@ pub struct FacetProjection {
     pub normal: [f64; 3],
     /// For an interior point: how far (in natural units, [`natural_excess`]) the stationary
     /// point lay outside the natural domain before it was clamped onto it (zero when inside;
-    /// at most [`INSIDE`] for [`project_onto_facet`], up to the margin for
+    /// at most [`INSIDE`] past each bound for [`project_onto_facet`], up to the margin for
     /// [`project_onto_extended_facet`]); zero on edges and corners. Of two facets that hold a
     /// node at the same distance, the one it is truly inside has the smaller excess.
     pub excess: f64,
 }
 
-/// How far the natural point `s` lies outside the facet's natural domain: the largest
-/// violation of its bounds (`|s_k| <= 1` on the quadrilaterals; `s, t >= 0`, `s + t <= 1` on
-/// the triangles), zero inside.
-pub fn natural_excess(kind: ElementKind, s: [f64; 2]) -> f64 {
-    let violation = if is_quadrilateral(kind) {
-        (s[0].abs() - 1.0).max(s[1].abs() - 1.0)
+/// The bounds of the natural domain, one per edge (edge `k` from corner `k` to corner
+/// `k + 1` of [`natural_corners`]): how far `s` lies past edge `k`'s line (negative inside).
+/// Quadrilaterals: `-1 - t`, `s - 1`, `t - 1`, `-1 - s`; triangles: `-t`, `s + t - 1`, `-s`.
+fn edge_violations(kind: ElementKind, s: [f64; 2]) -> [f64; 4] {
+    if is_quadrilateral(kind) {
+        [-1.0 - s[1], s[0] - 1.0, s[1] - 1.0, -1.0 - s[0]]
     } else {
-        (-s[0]).max(-s[1]).max(s[0] + s[1] - 1.0)
-    };
-    violation.max(0.0)
+        [-s[1], s[0] + s[1] - 1.0, -s[0], f64::NEG_INFINITY]
+    }
+}
+
+/// How far the natural point `s` lies outside the facet's natural domain: the sum of the
+/// violations of its bounds (`|s_k| <= 1` on the quadrilaterals; `s, t >= 0`, `s + t <= 1` on
+/// the triangles), zero inside. A sum, not the largest violation: of two facets that a node
+/// just past the free boundary of the master surface lies beyond by the same amount, the one
+/// it is inside across their shared edge has the smaller excess.
+pub fn natural_excess(kind: ElementKind, s: [f64; 2]) -> f64 {
+    edge_violations(kind, s)
+        .iter()
+        .filter(|v| **v > 0.0)
+        .fold(0.0, |sum, v| sum + v)
+}
+
+/// The edges of the facet (edge `k` from corner `k` to corner `k + 1`) whose bound the natural
+/// point `s` violates by more than `tol`.
+pub fn violated_edges(kind: ElementKind, s: [f64; 2], tol: f64) -> Vec<usize> {
+    edge_violations(kind, s)
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| **v > tol)
+        .map(|(k, _)| k)
+        .collect()
 }
 
 /// Natural coordinates of the facet's corners, counter-clockwise.

@@ -49,7 +49,7 @@
 
 use super::facet_gap_hessian::node_to_facet_gap_hessian_at;
 use super::facet_projection::{
-    project_onto_extended_facet, project_onto_facet, FacetFeature, FacetProjection,
+    project_onto_extended_facet, project_onto_facet, violated_edges, FacetFeature, FacetProjection,
 };
 use super::geometry::{dot, FacetShape, Surface, Surface3, MAX_FACET_NODES};
 use super::search::BucketGrid;
@@ -373,24 +373,37 @@ fn node_to_surface_pass(
         };
         let facet = &master.facets[f];
         let nodes = facet.len();
+        let free_edge = |k: usize| {
+            let (a, b) = (facet[k], facet[(k + 1) % corners]);
+            edge_facets[&(a.min(b), a.max(b))] == 1
+        };
         let beyond_free_boundary = match q.feature {
             FacetFeature::Interior => false,
-            FacetFeature::Edge(k) => {
-                let (a, b) = (facet[k], facet[(k + 1) % corners]);
-                edge_facets[&(a.min(b), a.max(b))] == 1
-            }
+            FacetFeature::Edge(k) => free_edge(k),
             FacetFeature::Corner(k) => free_vertices.contains(&facet[k]),
         };
+        let margin = FREE_BOUNDARY_EXTENSION * natural_span(kind);
         let q = if beyond_free_boundary {
             // finite kinematics: the facet extended (a node that slid just past the end of the
             // master surface); small strain, or farther out: the node has left it
-            let extended = settings.current_finite.then(|| {
-                let margin = FREE_BOUNDARY_EXTENSION * natural_span(kind);
-                project_onto_extended_facet(kind, &master.coords[f], p, margin)
-            });
+            let extended = settings
+                .current_finite
+                .then(|| project_onto_extended_facet(kind, &master.coords[f], p, margin));
             match extended.flatten() {
                 Some(q) => q,
                 None => continue,
+            }
+        } else if settings.current_finite && q.excess > 0.0 {
+            // finite kinematics, an interior point clamped onto the facet from past its free
+            // boundary by less than INSIDE: held against the facet extended too, as a node
+            // farther past, not at the clamped point (whose row weights stay fixed while the
+            // node moves, a residual error of the clamped distance times the row's force: the
+            // penalty on the Tet4 stacked blocks stalled at 1.5e-11 with the slave nodes on
+            // the free boundary wandering 1e-10 past it); clamped from past an edge shared
+            // with another facet (a node on a convex kink), the clamped point stays
+            match project_onto_extended_facet(kind, &master.coords[f], p, margin) {
+                Some(e) if held_past_free_edges(kind, e.natural, free_edge) => e,
+                _ => q,
             }
         } else {
             q
@@ -432,6 +445,21 @@ fn node_to_surface_pass(
         rows.push(row);
     }
     rows
+}
+
+/// Whether the natural point `s` of a facet (of kind `kind`, `free_edge(k)` telling which of
+/// its edges lie on the free boundary of the master surface) lies past a free edge and past no
+/// other edge by more than [`TIE_EXCESS`] (round-off at a vertex the free edge shares with an
+/// edge between two facets): the facet extended holds the node.
+fn held_past_free_edges(
+    kind: crate::fe::ElementKind,
+    s: [f64; 2],
+    free_edge: impl Fn(usize) -> bool,
+) -> bool {
+    violated_edges(kind, s, 0.0).into_iter().any(&free_edge)
+        && violated_edges(kind, s, TIE_EXCESS)
+            .into_iter()
+            .all(free_edge)
 }
 
 /// How far beyond the free boundary of the master surface a slave node is still held against
@@ -939,6 +967,57 @@ mod tests {
         let (f, feature, excess) = held(1e-15);
         assert_eq!((f, feature), (0, FacetFeature::Interior));
         assert!(excess <= TIE_EXCESS, "{excess:e}");
+    }
+
+    /// A slave node just past the free edge `y = 0` of two flat Quad4 master facets (by
+    /// `offset`, natural `2 offset`), pressed in by 1e-3, under finite kinematics: held by the
+    /// facet extended at its natural point `t = -1 - 2 offset`, whatever the offset, so the
+    /// far nodes' weights `(1 - s)(1 + t) / 4 = -offset / 2` follow the node (below
+    /// [`super::super::facet_projection::INSIDE`], before, the point was clamped onto the
+    /// edge and they were zero); under small strain a node within INSIDE stays clamped.
+    #[test]
+    fn a_node_just_past_the_free_boundary_is_held_by_the_facet_extended() {
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+        ];
+        let master = surface(
+            1,
+            ElementKind::Q4,
+            &positions,
+            &[vec![0, 1, 2, 3], vec![1, 4, 5, 2]],
+        );
+        // the weight of master node 3 (across the facet from the free edge) in the row of
+        // slave node 0 at (0.5, -offset, -1e-3)
+        let far_weight = |offset: f64, current_finite: bool| {
+            let slave_positions = [[0.5, -offset, -1e-3], [0.9, 0.6, -1e-3], [0.2, 0.7, -1e-3]];
+            let slave = surface(0, ElementKind::T3, &slave_positions, &[vec![0, 1, 2]]);
+            let settings = RowSettings {
+                current_finite,
+                ..settings(&dof)
+            };
+            let rows = node_to_surface_rows(&slave, &master, 1, &settings).unwrap();
+            let row = rows.iter().find(|r| r.slave_node == 0).unwrap();
+            let z3 = dof(1, 3, 2);
+            // the row's coefficient on u_z of node 3 is -N_3 nu_z
+            row.dofs
+                .iter()
+                .position(|&d| d == z3)
+                .map_or(0.0, |k| -row.coeffs[k] / row.normal[2])
+        };
+        for offset in [1e-10, 1e-8, 1e-3] {
+            let weight = far_weight(offset, true);
+            assert!(
+                (weight + 0.5 * offset).abs() < 1e-6 * offset,
+                "{offset:e}: {weight:e}"
+            );
+        }
+        // small strain: clamped onto the edge within INSIDE
+        assert_eq!(far_weight(1e-10, false), 0.0);
     }
 
     #[test]
