@@ -1041,6 +1041,86 @@ fn the_newton_tangent_between_3d_bodies_is_the_difference_of_the_residual() {
     }
 }
 
+/// The Newton tangent against central differences of the residual where slave nodes hang past
+/// the master surface's free boundary and are held by its boundary facets extended: the
+/// stacked Hex8 and Tet4 pair with the punch shifted by 0.05 along x (its last row of bottom
+/// nodes 0.05 past the base's top), pressed in by 0.01 and disturbed by a wavy field; every
+/// row active (Lagrange multipliers with given forces; the penalty's rows penetrate). The
+/// largest difference relative to the largest tangent entry is below 1e-7.
+#[test]
+fn the_newton_tangent_past_the_free_boundary_is_the_difference_of_the_residual() {
+    use contact_patch::contact::discretization::pair3::pair_rows;
+    use contact_patch::contact::state::{ContactState, Termination};
+    use contact_patch::solver::contact_newton::Probe;
+    let shifted = [0.05, 0.55, 1.05];
+    for element in ["Hex8", "Tet4"] {
+        for enforcement in [
+            json!({"kind": "lagrange"}),
+            json!({"kind": "penalty", "kappa": 1e4}),
+        ] {
+            let mut case = stacked(element, &MATCHING3, &MATCHING3, enforcement.clone(), 0.0, 1);
+            case["bodies"][1]["mesh"]["block3d"]["x"] = json!(shifted);
+            let model = build3(&parse(&case), "finite3d").unwrap();
+            let mut u = vec![0.0; model.dof_count];
+            for (b, body) in model.bodies.iter().enumerate() {
+                for (n, p) in body.mesh.nodes.iter().enumerate() {
+                    let k = (b * 1000 + n) as f64;
+                    let press = if b == 1 { -0.01 } else { 0.0 };
+                    let wave = [
+                        1e-3 * (1.3 * k).sin(),
+                        1e-3 * (0.7 * k).cos(),
+                        press + 1e-3 * (0.9 * k).sin() * p[2] * (2.0 - p[2]),
+                    ];
+                    for (i, w) in wave.iter().enumerate() {
+                        u[body.dof(n, i)] = *w;
+                    }
+                }
+            }
+            let mut moved = model.clone();
+            for body in &mut moved.bodies {
+                let offset = body.dof_offset;
+                for (n, p) in body.mesh.nodes.iter_mut().enumerate() {
+                    for i in 0..3 {
+                        p[i] += u[offset + 3 * n + i];
+                    }
+                }
+            }
+            let rows = pair_rows(&moved, &moved.contact[0]).unwrap();
+            // the slave nodes past x = 1 have rows (held by the facets extended)
+            let past = rows.iter().filter(|r| r.point[0] > 1.02).count();
+            assert!(past >= 3, "{element}: {past} rows past the free boundary");
+            let n_rows = rows.len();
+            let state = ContactState {
+                rows,
+                active: vec![true; n_rows],
+                forces: (0..n_rows).map(|i| 2.0 + (i as f64).sin()).collect(),
+                gaps: vec![0.0; n_rows],
+                termination: Termination::Converged,
+                iterations: 0,
+                rank_deficiency: None,
+                linear_solver: "",
+                geometry_updates: 0,
+                configuration: None,
+                departures: Vec::new(),
+                steps: Vec::new(),
+                history: Vec::new(),
+                geometry_changes: Vec::new(),
+                friction: vec![None; n_rows],
+            };
+            let mut probe = Probe::new(&model, 0.0).unwrap();
+            let x = probe.unknowns_at(&u, &state);
+            probe.evaluate(&x).unwrap();
+            let at = probe.evaluate(&x).unwrap();
+            let (worst, scale) = finite_common::tangent_difference(&mut probe, &x, &at);
+            println!(
+                "{element} {}: {n_rows} rows, {past} past the free boundary; tangent vs central difference {worst:.1e} of {scale:.3e}",
+                enforcement["kind"]
+            );
+            assert!(worst < 1e-7, "{element} {}: {worst:e}", enforcement["kind"]);
+        }
+    }
+}
+
 /// The punch's nodes off the base's: none on a master facet's edge (where the node-to-surface
 /// gap has a kink across facets, and Newton's iterates swap facets at round-off).
 const OFFSET3: [f64; 4] = [0.0, 0.3, 0.7, 1.0];
