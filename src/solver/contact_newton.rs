@@ -287,6 +287,9 @@ pub(crate) struct ContactSystem<
     /// without rows there (its residual is then NaN, which ends the Newton solve; the load step
     /// is cut).
     inverted: Option<String>,
+    /// The displacement of the first evaluation (the step's start): how far a diverging
+    /// iterate has moved is measured from it.
+    step_start: Vec<f64>,
     /// Augmented-Lagrangian Coulomb pairs: the tangential Uzawa multiplier `lambda_bar_t` by
     /// point (carried from the last load step, updated with the normal one).
     tangential_augmentation: HashMap<RowKey, Tangential>,
@@ -375,6 +378,7 @@ impl<'a, const D: usize, K: NewtonDimension<D>> ContactSystem<'a, D, K> {
             committed,
             status: HashMap::new(),
             inverted: None,
+            step_start: Vec::new(),
             tangential_augmentation: HashMap::new(),
             sets_settled: false,
             hold_next: false,
@@ -1079,6 +1083,7 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
         let n = self.sys.n;
         if self.evaluations == 0 {
             self.remember_multipliers();
+            self.step_start = self.sys.expand(&x[..n]);
         }
         self.holding = std::mem::take(&mut self.hold_next);
         let u = self.sys.expand(&x[..n]);
@@ -1088,9 +1093,17 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
             self.rows = match rows_at(self.model, Some((&u, &self.reference_areas))) {
                 Ok(rows) => rows,
                 // finite kinematics: an iterate that carried a pair off its master (a Newton
-                // step far from the solution) fails the step, which is then cut
+                // step far from the solution) fails the step, which is then cut. The pair had
+                // rows at the step's start, so the reason is the diverging iterate, not
+                // surfaces that never meet: say so, with how far the iterate moved
                 Err(e) if self.model.physics.kinematics == Kinematics::Finite => {
-                    self.inverted = Some(format!("at a Newton iterate, {e}"));
+                    self.inverted = Some(diverged_off_master(
+                        &e,
+                        self.evaluations,
+                        &self.step_start,
+                        &u,
+                        self.model.size(),
+                    ));
                     residual.iter_mut().for_each(|v| *v = f64::NAN);
                     return Ok(Evaluation {
                         force_scale: 1.0,
@@ -1743,6 +1756,33 @@ pub(crate) fn solve_step<const D: usize, K: NewtonDimension<D>>(
         friction,
     });
     Ok(solution)
+}
+
+/// Why a load step failed when the rows of a contact pair could not be built at Newton
+/// iterate `evaluation` (`error`, from [`rows_at`]): the pair had rows at the step's start
+/// (`start`), so the iterate `u` carried its slave nodes out of reach of the master: the
+/// iteration diverged. The message says so and how far the iterate moved (largest nodal
+/// displacement change, and as a fraction of the model size `size`), rather than the
+/// discretization's "could never act", which is about surfaces that never meet.
+fn diverged_off_master(
+    error: &crate::error::Error,
+    evaluation: usize,
+    start: &[f64],
+    u: &[f64],
+    size: f64,
+) -> String {
+    let moved = u
+        .iter()
+        .zip(start)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    let pair = match error {
+        crate::error::Error::Invalid { location, .. } => location.clone(),
+        other => format!("a contact pair ({other})"),
+    };
+    format!(
+        "Newton's iteration diverged: iterate {evaluation} moved nodes by up to {moved:.3e} ({:.2} of the model size) from the load step's start and carried every slave node of {pair} beyond the search distance of its master, so the pair has no rows there (it had at the step's start); a smaller load increment keeps the iterates near the surface",
+        moved / size
+    )
 }
 
 /// The slip of row `r` at `u` along each of its tangents (components past its tangents zero).

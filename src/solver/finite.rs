@@ -92,8 +92,9 @@ pub fn solve_observed<const D: usize, K: NewtonDimension<D>>(
         let why = match &state.termination {
             Termination::Converged => None,
             Termination::IterationLimit => Some(format!(
-                "Newton did not converge in {} iterations",
-                model.solver.max_iterations
+                "Newton did not converge in {} iterations: {}",
+                model.solver.max_iterations,
+                why_not_converged(&state.history)
             )),
             Termination::Singular(why) => Some(why.clone()),
             other => Some(format!("{other:?}")),
@@ -149,4 +150,42 @@ pub fn solve_observed<const D: usize, K: NewtonDimension<D>>(
         start = Some(solution.u);
         increment = (increment * 2.0).min(nominal);
     }
+}
+
+/// How many of the last iterations [`why_not_converged`] looks at.
+const LAST_ITERATIONS: usize = 20;
+
+/// What the residual history of a load step that ran out of Newton iterations shows, for its
+/// failure message: rows still opening and closing in the last [`LAST_ITERATIONS`]
+/// iterations (the active set cycles), or a residual that stalled (the last residual within a
+/// decade of the best one: Newton has reached what the evaluation of the residual resolves,
+/// e.g. a penalty far stiffer than the bodies), or one that did not settle (its first, best
+/// and last values).
+fn why_not_converged(history: &[IterationRecord]) -> String {
+    let (Some(first), Some(last)) = (history.first(), history.last()) else {
+        return "no iteration was recorded".into();
+    };
+    let best = history
+        .iter()
+        .map(|h| h.residual)
+        .fold(f64::INFINITY, f64::min);
+    let recent = &history[history.len().saturating_sub(LAST_ITERATIONS)..];
+    let changing = recent.iter().filter(|h| h.status_changes > 0).count();
+    if changing > 0 {
+        return format!(
+            "the active set was still changing ({changing} of the last {} iterations opened or closed a contact row; relative residual {:.1e}, best {best:.1e}): rows at the edge of the contact open and close in turn",
+            recent.len(),
+            last.residual
+        );
+    }
+    if last.residual <= 10.0 * best {
+        return format!(
+            "the relative residual stalled at {:.1e} (best {best:.1e}, from {:.1e}) with a fixed active set: Newton reached what the residual resolves, above the tolerance (a penalty far stiffer than the bodies lifts that floor: a smaller kappa, or Lagrange multipliers, which reach the tolerance on the same rigid sphere)",
+            last.residual, first.residual
+        );
+    }
+    format!(
+        "the relative residual went from {:.1e} to {:.1e} (best {best:.1e}) with a fixed active set",
+        first.residual, last.residual
+    )
 }

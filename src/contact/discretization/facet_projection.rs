@@ -55,6 +55,46 @@ pub struct FacetProjection {
     pub distance: f64,
     /// Unit outward normal of the facet at `natural`.
     pub normal: [f64; 3],
+    /// For an interior point: how far (in natural units, [`natural_excess`]) the stationary
+    /// point lay outside the natural domain before it was clamped onto it (zero when inside;
+    /// at most [`INSIDE`] past each bound for [`project_onto_facet`], up to the margin for
+    /// [`project_onto_extended_facet`]); zero on edges and corners. Of two facets that hold a
+    /// node at the same distance, the one it is truly inside has the smaller excess.
+    pub excess: f64,
+}
+
+/// The bounds of the natural domain, one per edge (edge `k` from corner `k` to corner
+/// `k + 1` of [`natural_corners`]): how far `s` lies past edge `k`'s line (negative inside).
+/// Quadrilaterals: `-1 - t`, `s - 1`, `t - 1`, `-1 - s`; triangles: `-t`, `s + t - 1`, `-s`.
+fn edge_violations(kind: ElementKind, s: [f64; 2]) -> [f64; 4] {
+    if is_quadrilateral(kind) {
+        [-1.0 - s[1], s[0] - 1.0, s[1] - 1.0, -1.0 - s[0]]
+    } else {
+        [-s[1], s[0] + s[1] - 1.0, -s[0], f64::NEG_INFINITY]
+    }
+}
+
+/// How far the natural point `s` lies outside the facet's natural domain: the sum of the
+/// violations of its bounds (`|s_k| <= 1` on the quadrilaterals; `s, t >= 0`, `s + t <= 1` on
+/// the triangles), zero inside. A sum, not the largest violation: of two facets that a node
+/// just past the free boundary of the master surface lies beyond by the same amount, the one
+/// it is inside across their shared edge has the smaller excess.
+pub fn natural_excess(kind: ElementKind, s: [f64; 2]) -> f64 {
+    edge_violations(kind, s)
+        .iter()
+        .filter(|v| **v > 0.0)
+        .fold(0.0, |sum, v| sum + v)
+}
+
+/// The edges of the facet (edge `k` from corner `k` to corner `k + 1`) whose bound the natural
+/// point `s` violates by more than `tol`.
+pub fn violated_edges(kind: ElementKind, s: [f64; 2], tol: f64) -> Vec<usize> {
+    edge_violations(kind, s)
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| **v > tol)
+        .map(|(k, _)| k)
+        .collect()
 }
 
 /// Natural coordinates of the facet's corners, counter-clockwise.
@@ -285,7 +325,7 @@ fn edge_minimum(
 /// The closest point of `p` on the facet of kind `kind` (Q4, Q9, T3 or T6) with node
 /// positions `coords` (module notes).
 pub fn project_onto_facet(kind: ElementKind, coords: &[[f64; 3]], p: [f64; 3]) -> FacetProjection {
-    let finish = |natural: [f64; 2], feature: FacetFeature| {
+    let finish = |natural: [f64; 2], feature: FacetFeature, excess: f64| {
         let (x, t) = facet_frame(kind, coords, natural);
         let n = cross(t[0], t[1]);
         let l = dot(n, n).sqrt();
@@ -296,11 +336,16 @@ pub fn project_onto_facet(kind: ElementKind, coords: &[[f64; 3]], p: [f64; 3]) -
             point: x,
             distance: dot(r, r).sqrt(),
             normal: n.map(|c| c / l),
+            excess,
         }
     };
     if let Some(s) = interior_newton(kind, coords, p) {
         if natural_inside(kind, s, INSIDE) {
-            return finish(clamp_natural(kind, s), FacetFeature::Interior);
+            return finish(
+                clamp_natural(kind, s),
+                FacetFeature::Interior,
+                natural_excess(kind, s),
+            );
         }
     }
     let corners = natural_corners(kind);
@@ -324,7 +369,7 @@ pub fn project_onto_facet(kind: ElementKind, coords: &[[f64; 3]], p: [f64; 3]) -
         best = Some((squared, natural, feature));
     }
     let (_, natural, feature) = best.expect("a facet has edges");
-    finish(natural, feature)
+    finish(natural, feature, 0.0)
 }
 
 /// The stationary point of `|x(s) - p|^2 / 2` over the facet's interpolation extended beyond
@@ -353,6 +398,7 @@ pub fn project_onto_extended_facet(
         point: x,
         distance: dot(r, r).sqrt(),
         normal: n.map(|c| c / l),
+        excess: natural_excess(kind, s),
     })
 }
 

@@ -49,7 +49,7 @@
 
 use super::facet_gap_hessian::node_to_facet_gap_hessian_at;
 use super::facet_projection::{
-    project_onto_extended_facet, project_onto_facet, FacetFeature, FacetProjection,
+    project_onto_extended_facet, project_onto_facet, violated_edges, FacetFeature, FacetProjection,
 };
 use super::geometry::{dot, FacetShape, Surface, Surface3, MAX_FACET_NODES};
 use super::search::BucketGrid;
@@ -285,15 +285,40 @@ pub fn node_to_surface_rows(
     checked(rows, settings.search_distance)
 }
 
+/// How far outside its facet (natural units) an interior closest point may have been clamped
+/// and still count as inside in a tie ([`closest_facet`]): a hundred times the round-off of
+/// the projection, and below the solve's relative tolerance (the row weights, and so the
+/// residual, are off by about this much relative to the row's force).
+pub const TIE_EXCESS: f64 = 1e-13;
+
 /// Which facet of `master` a slave node at `p` is held against, and where: the closest point
-/// among the candidates, an interior point winning a tie (within `tol`) against an edge or a
-/// corner.
+/// among the candidates; in a tie (distances within `tol`) an interior point wins against an
+/// edge or a corner, and of two interior points the one the node is inside (the smaller
+/// [`FacetProjection::excess`], all below [`TIE_EXCESS`] counting as inside; then the first
+/// candidate). A node on or next to an edge shared by two facets (a slave node on a master
+/// node or edge of a matching mesh) is so held by a facet whose closest-point gap is the one
+/// at its position: the other facet's point, clamped onto its boundary from up to
+/// [`super::facet_projection::INSIDE`] outside, gives row weights off by that much (Newton's
+/// residual stalled at 1e-10 on the Tet4 stacked blocks, taking the first candidate); and a
+/// node within round-off of the edge keeps one facet from one iterate to the next instead of
+/// swapping facets with the round-off of its natural coordinates (which stalled the penalty
+/// at 1e-11 on the Hex8 stacked blocks, taking the smallest excess).
 fn closest_facet(
     master: &Surface3,
     candidates: &[usize],
     p: [f64; 3],
     tol: f64,
 ) -> Option<(usize, FacetProjection)> {
+    let rank = |q: &FacetProjection| {
+        (
+            q.feature != FacetFeature::Interior,
+            if q.excess <= TIE_EXCESS {
+                0.0
+            } else {
+                q.excess
+            },
+        )
+    };
     let mut best: Option<(usize, FacetProjection)> = None;
     for &f in candidates {
         let q = project_onto_facet(master.kind, &master.coords[f], p);
@@ -301,9 +326,7 @@ fn closest_facet(
             None => true,
             Some((_, b)) => {
                 q.distance < b.distance - tol
-                    || (q.distance <= b.distance + tol
-                        && q.feature == FacetFeature::Interior
-                        && b.feature != FacetFeature::Interior)
+                    || (q.distance <= b.distance + tol && rank(&q) < rank(b))
             }
         };
         if better {
@@ -350,24 +373,37 @@ fn node_to_surface_pass(
         };
         let facet = &master.facets[f];
         let nodes = facet.len();
+        let free_edge = |k: usize| {
+            let (a, b) = (facet[k], facet[(k + 1) % corners]);
+            edge_facets[&(a.min(b), a.max(b))] == 1
+        };
         let beyond_free_boundary = match q.feature {
             FacetFeature::Interior => false,
-            FacetFeature::Edge(k) => {
-                let (a, b) = (facet[k], facet[(k + 1) % corners]);
-                edge_facets[&(a.min(b), a.max(b))] == 1
-            }
+            FacetFeature::Edge(k) => free_edge(k),
             FacetFeature::Corner(k) => free_vertices.contains(&facet[k]),
         };
+        let margin = FREE_BOUNDARY_EXTENSION * natural_span(kind);
         let q = if beyond_free_boundary {
             // finite kinematics: the facet extended (a node that slid just past the end of the
             // master surface); small strain, or farther out: the node has left it
-            let extended = settings.current_finite.then(|| {
-                let margin = FREE_BOUNDARY_EXTENSION * natural_span(kind);
-                project_onto_extended_facet(kind, &master.coords[f], p, margin)
-            });
+            let extended = settings
+                .current_finite
+                .then(|| project_onto_extended_facet(kind, &master.coords[f], p, margin));
             match extended.flatten() {
                 Some(q) => q,
                 None => continue,
+            }
+        } else if settings.current_finite && q.excess > 0.0 {
+            // finite kinematics, an interior point clamped onto the facet from past its free
+            // boundary by less than INSIDE: held against the facet extended too, as a node
+            // farther past, not at the clamped point (whose row weights stay fixed while the
+            // node moves, a residual error of the clamped distance times the row's force: the
+            // penalty on the Tet4 stacked blocks stalled at 1.5e-11 with the slave nodes on
+            // the free boundary wandering 1e-10 past it); clamped from past an edge shared
+            // with another facet (a node on a convex kink), the clamped point stays
+            match project_onto_extended_facet(kind, &master.coords[f], p, margin) {
+                Some(e) if held_past_free_edges(kind, e.natural, free_edge) => e,
+                _ => q,
             }
         } else {
             q
@@ -409,6 +445,21 @@ fn node_to_surface_pass(
         rows.push(row);
     }
     rows
+}
+
+/// Whether the natural point `s` of a facet (of kind `kind`, `free_edge(k)` telling which of
+/// its edges lie on the free boundary of the master surface) lies past a free edge and past no
+/// other edge by more than [`TIE_EXCESS`] (round-off at a vertex the free edge shares with an
+/// edge between two facets): the facet extended holds the node.
+fn held_past_free_edges(
+    kind: crate::fe::ElementKind,
+    s: [f64; 2],
+    free_edge: impl Fn(usize) -> bool,
+) -> bool {
+    violated_edges(kind, s, 0.0).into_iter().any(&free_edge)
+        && violated_edges(kind, s, TIE_EXCESS)
+            .into_iter()
+            .all(free_edge)
 }
 
 /// How far beyond the free boundary of the master surface a slave node is still held against
@@ -880,6 +931,93 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A slave node next to the edge shared by two flat Tri3 master facets (the unit square
+    /// cut along its diagonal, the upper facet first among the candidates), pressed in by
+    /// 1e-3: a node inside the lower facet by 1e-11 (natural) is held by the lower facet,
+    /// whose gap is the one at its position, not by the upper one it lies 1e-11 outside of
+    /// (clamped onto its edge); a node inside the lower facet by 1e-15 (round-off of its
+    /// natural coordinates, below [`TIE_EXCESS`]) keeps the first candidate either way.
+    #[test]
+    fn a_node_beside_a_shared_edge_is_held_by_the_facet_it_is_inside() {
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        // upper facet (0, 2, 3) first, lower facet (0, 1, 2) second
+        let facets = vec![vec![0, 2, 3], vec![0, 1, 2]];
+        let master = surface(1, ElementKind::T3, &positions, &facets);
+        let held = |offset: f64| {
+            // below the diagonal x = y by `offset` (the lower facet's side)
+            let p = [0.4 + offset, 0.4, -1e-3];
+            let tol = 1e-12 * surface_extent(&master);
+            let (f, q) = closest_facet(&master, &[0, 1], p, tol).unwrap();
+            (f, q.feature, q.excess)
+        };
+        let (f, feature, excess) = held(1e-11);
+        assert_eq!((f, feature), (1, FacetFeature::Interior), "{excess:e}");
+        assert_eq!(excess, 0.0);
+        // and the other way round: above the diagonal, the upper facet
+        let (f, _, excess) = held(-1e-11);
+        assert_eq!(f, 0, "{excess:e}");
+        // within round-off of the edge: the first candidate, clamped by less than TIE_EXCESS
+        let (f, feature, excess) = held(1e-15);
+        assert_eq!((f, feature), (0, FacetFeature::Interior));
+        assert!(excess <= TIE_EXCESS, "{excess:e}");
+    }
+
+    /// A slave node just past the free edge `y = 0` of two flat Quad4 master facets (by
+    /// `offset`, natural `2 offset`), pressed in by 1e-3, under finite kinematics: held by the
+    /// facet extended at its natural point `t = -1 - 2 offset`, whatever the offset, so the
+    /// far nodes' weights `(1 - s)(1 + t) / 4 = -offset / 2` follow the node (below
+    /// [`super::super::facet_projection::INSIDE`], before, the point was clamped onto the
+    /// edge and they were zero); under small strain a node within INSIDE stays clamped.
+    #[test]
+    fn a_node_just_past_the_free_boundary_is_held_by_the_facet_extended() {
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+        ];
+        let master = surface(
+            1,
+            ElementKind::Q4,
+            &positions,
+            &[vec![0, 1, 2, 3], vec![1, 4, 5, 2]],
+        );
+        // the weight of master node 3 (across the facet from the free edge) in the row of
+        // slave node 0 at (0.5, -offset, -1e-3)
+        let far_weight = |offset: f64, current_finite: bool| {
+            let slave_positions = [[0.5, -offset, -1e-3], [0.9, 0.6, -1e-3], [0.2, 0.7, -1e-3]];
+            let slave = surface(0, ElementKind::T3, &slave_positions, &[vec![0, 1, 2]]);
+            let settings = RowSettings {
+                current_finite,
+                ..settings(&dof)
+            };
+            let rows = node_to_surface_rows(&slave, &master, 1, &settings).unwrap();
+            let row = rows.iter().find(|r| r.slave_node == 0).unwrap();
+            let z3 = dof(1, 3, 2);
+            // the row's coefficient on u_z of node 3 is -N_3 nu_z
+            row.dofs
+                .iter()
+                .position(|&d| d == z3)
+                .map_or(0.0, |k| -row.coeffs[k] / row.normal[2])
+        };
+        for offset in [1e-10, 1e-8, 1e-3] {
+            let weight = far_weight(offset, true);
+            assert!(
+                (weight + 0.5 * offset).abs() < 1e-6 * offset,
+                "{offset:e}: {weight:e}"
+            );
+        }
+        // small strain: clamped onto the edge within INSIDE
+        assert_eq!(far_weight(1e-10, false), 0.0);
     }
 
     #[test]
