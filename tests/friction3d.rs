@@ -1232,13 +1232,12 @@ fn mortar_friction_on_triangular_facets_sticks_below_and_slips_at_mu_n_above() {
                             .zip(state.friction.iter().zip(&state.forces))
                         {
                             let f = f.unwrap();
-                            let gradients = std::iter::once((&r.dofs, &r.coeffs, lambda_n))
-                                .chain(
-                                    r.tangents
-                                        .iter()
-                                        .zip(&f.force)
-                                        .map(|(t, &l)| (&t.dofs, &t.coeffs, l)),
-                                );
+                            let gradients = std::iter::once((&r.dofs, &r.coeffs, lambda_n)).chain(
+                                r.tangents
+                                    .iter()
+                                    .zip(&f.force)
+                                    .map(|(t, &l)| (&t.dofs, &t.coeffs, l)),
+                            );
                             for (dofs, coeffs, l) in gradients {
                                 for (&dof, &c) in dofs.iter().zip(coeffs) {
                                     let owner = o.model.dof_owner(dof).unwrap();
