@@ -80,7 +80,20 @@ fn the_nodal_value_of_a_quadratic_is_its_value_plus_h2_over_3() {
 
 #[test]
 fn stick_radius_and_tractions_converge_to_cattaneo_mindlin() {
-    let levels: Vec<_> = [2.0, 3.0, 4.0]
+    judge(&[2.0, 3.0, 4.0]);
+}
+
+/// The larger study (`cargo test --release --test cattaneo3d -- --ignored`): h = a_t/4, a_t/6,
+/// judged alike.
+#[test]
+#[ignore = "a larger study: the a_t/6 level takes minutes"]
+fn finer_levels_converge_to_cattaneo_mindlin() {
+    judge(&[4.0, 6.0]);
+}
+
+/// Solve the levels `h = a_t / k` for each `k` and judge them (see the notes at the top).
+fn judge(divisions: &[f64]) {
+    let levels: Vec<_> = divisions
         .iter()
         .map(|k| level(TARGET_RADIUS / k, &Scene::STUDY).unwrap())
         .collect();
