@@ -23,6 +23,9 @@
 //!   rows slips at `mu N` with the forces on the two bodies in balance; rotation invariance
 //!   of mortar friction; a two-body slab one element thick reproduces 2D plane-strain mortar
 //!   and Lagrange friction.
+//! * Mortar friction on triangular facets: the dragged punch with Tet4 (Tri3) and Tet10 (Tri6,
+//!   the modified multiplier basis) bodies sticks below and slips at `mu N` above the limit,
+//!   with the dissipation never negative and the forces on the two bodies in balance.
 
 use contact_patch::contact::friction::Status;
 use contact_patch::contact::state::{ContactState, Termination};
@@ -1134,4 +1137,121 @@ fn a_slab_interface_one_element_thick_reproduces_plane_strain_mortar_and_lagrang
         }
     }
     println!("largest difference {worst_all:.1e}");
+}
+
+#[test]
+fn mortar_friction_on_triangular_facets_sticks_below_and_slips_at_mu_n_above() {
+    // `rotated_punch` with Tet4 (Tri3 facets) and Tet10 (Tri6 facets, the modified multiplier
+    // basis of mortar3) bodies: a punch (3 x 3 blocks) on a foundation (2 x 2), non-matching,
+    // standard and dual multipliers, penalty and Lagrange; pressed, then dragged along three
+    // directions: below the limit every closed point sticks and the tangential force is below
+    // mu N; above it every point slips and the force along the drag is mu N; the dissipation
+    // of every step is never negative and no point leaves the cone; the contact forces on the
+    // two bodies balance
+    for element in ["Tet4", "Tet10"] {
+        for multiplier in ["standard", "dual"] {
+            for enforcement in [penalty(), lagrange()] {
+                for angle in [0.0f64, 0.9, -2.4] {
+                    let e = [angle.cos(), angle.sin()];
+                    for (d, expect) in [(1e-7, Status::Stick), (1.0, Status::Slip)] {
+                        let mut v = rotated_punch(
+                            json!({"kind": "mortar", "multiplier": multiplier}),
+                            enforcement.clone(),
+                            (3, 0.0),
+                            0.0,
+                            angle,
+                            d,
+                        );
+                        for body in 0..2 {
+                            let mesh = &mut v["bodies"][body]["mesh"]["block3d"];
+                            mesh["element"] = json!(element);
+                            mesh.as_object_mut().unwrap().remove("moves");
+                        }
+                        let o = run(&v);
+                        let what = format!("{element} {multiplier} {enforcement} {angle} {d}");
+                        assert_eq!(termination(&o), Termination::Converged, "{what}");
+                        let state = o.solution.contact.as_ref().unwrap();
+                        let (t, n, statuses) = totals(state);
+                        assert!((n - P).abs() <= 1e-9 * P, "{what}: {n}");
+                        assert!(!statuses.is_empty(), "{what}: no closed point");
+                        assert!(
+                            statuses.iter().all(|&s| s == expect),
+                            "{what}: {statuses:?}"
+                        );
+                        let along = -(t[0] * e[0] + t[1] * e[1]);
+                        let across = t[0] * e[1] - t[1] * e[0];
+                        println!(
+                            "{what}: {expect:?} at {} points, along {along:.12}, across {across:.1e}, mu N = {:.12}, along / (mu N) - 1 = {:.1e}",
+                            statuses.len(),
+                            MU * n,
+                            along / (MU * n) - 1.0
+                        );
+                        assert!(t[2].abs() <= 1e-12 * P, "{what}: {t:?}");
+                        for step in &state.steps {
+                            let f = step.friction.as_ref().unwrap();
+                            assert!(f.dissipation >= 0.0, "{what}: {f:?}");
+                        }
+                        // inside the cone to the Newton tolerance (an absolute one: a ratio
+                        // |lambda_t| / (mu lambda_n) at a point of small lambda_n magnifies it)
+                        for f in state.friction.iter().flatten() {
+                            assert!(
+                                f.force_length() <= MU * f.normal_force + 1e-10 * P,
+                                "{what}: {f:?}"
+                            );
+                        }
+                        let last = state.steps.last().unwrap().friction.as_ref().unwrap();
+                        if expect == Status::Slip {
+                            // as on Quad4 facets: each point slips along its own direction,
+                            // turned from the drag by the foundation's deformation; the Kuhn
+                            // split is symmetric about no vertical plane, so the turn is not
+                            // zero even along x. Its bound: the foundation's top moves by at
+                            // most what the traction mu P / A shears its depth H to,
+                            // mu P H / (G A) = 0.3 * 10 * 1 / 500 = 6e-3 (nu = 0, G = E / 2),
+                            // against the drag d = 1: the turn theta <= 6e-3, the force across
+                            // the drag <= mu N sin(theta), along it >= mu N cos(theta)
+                            let theta = MU * P * 1.0 / 500.0 / d;
+                            let magnitude = (t[0] * t[0] + t[1] * t[1]).sqrt();
+                            assert!(magnitude <= MU * n * (1.0 + 1e-10), "{what}: {magnitude}");
+                            assert!(along >= MU * n * theta.cos(), "{what}: {along}");
+                            assert!(across.abs() <= MU * n * theta.sin(), "{what}: {across:e}");
+                            assert!(last.dissipation > 0.0, "{what}: {last:?}");
+                            for f in state.friction.iter().flatten() {
+                                assert!(
+                                    (f.force_length() - MU * f.normal_force).abs() <= 1e-10 * P,
+                                    "{what}"
+                                );
+                            }
+                        } else {
+                            assert!(along > 0.0 && along < MU * n, "{what}: {along}");
+                            assert_eq!(last.dissipation, 0.0, "{what}");
+                        }
+                        let mut on_body = [[0.0f64; 3]; 2];
+                        for (r, (f, &lambda_n)) in state
+                            .rows
+                            .iter()
+                            .zip(state.friction.iter().zip(&state.forces))
+                        {
+                            let f = f.unwrap();
+                            let gradients = std::iter::once((&r.dofs, &r.coeffs, lambda_n)).chain(
+                                r.tangents
+                                    .iter()
+                                    .zip(&f.force)
+                                    .map(|(t, &l)| (&t.dofs, &t.coeffs, l)),
+                            );
+                            for (dofs, coeffs, l) in gradients {
+                                for (&dof, &c) in dofs.iter().zip(coeffs) {
+                                    let owner = o.model.dof_owner(dof).unwrap();
+                                    on_body[owner.body][owner.component] += l * c;
+                                }
+                            }
+                        }
+                        let net = (0..3)
+                            .map(|k| (on_body[0][k] + on_body[1][k]).abs())
+                            .fold(0.0, f64::max);
+                        assert!(net <= 1e-12 * P, "{what}: {on_body:?}");
+                    }
+                }
+            }
+        }
+    }
 }

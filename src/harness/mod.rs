@@ -32,6 +32,7 @@
 pub mod baseline;
 pub mod block_drop;
 pub mod cattaneo;
+pub mod cattaneo3d;
 pub mod checks;
 pub(crate) mod exact;
 pub mod finite_patch;
