@@ -387,12 +387,16 @@ fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
             match pair.discretization {
                 DiscretizationSpec::NodeToSurface { .. } => {}
                 DiscretizationSpec::NodeToNode => {
-                    return Err(not_built(
-                        source,
-                        format!("{at}.discretization"),
-                        "node-to-node contact between deformable bodies under finite kinematics (the variation of the master's nodal normal is not linearized)",
-                        "use {\"kind\": \"node_to_surface\"}, or small-strain kinematics",
-                    ))
+                    // the current configuration pairs the nodes by proximity: the reference
+                    // configuration must match node for node
+                    if let Err(reason) = reference_nodes_match(model, pair) {
+                        return Err(Error::invalid(
+                            source,
+                            format!("{at}.discretization"),
+                            format!("the discretization does not apply: {reason}"),
+                            "choose another discretization for this pair",
+                        ));
+                    }
                 }
                 DiscretizationSpec::Mortar { .. } => {
                     return Err(not_built(
@@ -441,6 +445,31 @@ fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// Whether the node-to-node pair `pair` between bodies matches node for node in the reference
+/// configuration (the small-strain pairing, to `1e-9` of the master surface's size), the reason
+/// where it does not.
+fn reference_nodes_match(
+    model: &Model3,
+    pair: &crate::model::ContactPair,
+) -> std::result::Result<(), String> {
+    use crate::contact::discretization::geometry::Surface3;
+    use crate::contact::discretization::node_based_rows::{node_to_node_rows, RowSettings};
+    let MasterSide::Body { body, facets } = &pair.master else {
+        return Ok(());
+    };
+    let (slave_body, slave_facets) = &pair.slave;
+    let slave = Surface3::from_solid_mesh(*slave_body, &model.bodies[*slave_body].mesh, slave_facets);
+    let master = Surface3::from_solid_mesh(*body, &model.bodies[*body].mesh, facets);
+    let numbering = |b: usize, n: usize, c: usize| model.bodies[b].dof(n, c);
+    let settings = RowSettings {
+        dofs: &numbering,
+        pair: 0,
+        search_distance: pair.search_distance,
+        current_finite: false,
+    };
+    node_to_node_rows(&slave, &master, &settings).map(|_| ())
 }
 
 /// The material `name` of the case, validated: its small-strain elasticity, and its

@@ -42,6 +42,7 @@ pub(crate) mod mortar;
 pub mod mortar3;
 pub(crate) mod mortar_linearization;
 pub mod nodal_normal;
+pub mod nodal_normal3;
 pub mod node_based_rows;
 pub mod node_to_segment;
 pub mod pair3;

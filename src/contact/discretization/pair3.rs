@@ -41,6 +41,7 @@
 
 use super::geometry::Surface3;
 use super::mortar3::{mortar_rows3, FacetSet3, RowNumbering};
+use super::nodal_normal3::node_to_node_current_rows;
 use super::node_based_rows::{
     dominant_component, gradient_coefficients, node_to_node_rows, node_to_surface_rows, rigid_rows,
     RigidMaster, RowSettings,
@@ -90,6 +91,9 @@ pub fn pair_rows(model: &Model3, pair: &ContactPair) -> Result<Vec<Constraint<3>
                         return Err("slave normals in 3D are not built yet: use \"normal\": \"master\"".into());
                     }
                     node_to_surface_rows(&slave, &master, *passes, &settings)?
+                }
+                DiscretizationSpec::NodeToNode if settings.current_finite => {
+                    node_to_node_current_rows(&slave, &master, &settings)?
                 }
                 DiscretizationSpec::NodeToNode => node_to_node_rows(&slave, &master, &settings)?,
                 DiscretizationSpec::Mortar { multiplier } => {
