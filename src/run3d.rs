@@ -23,11 +23,15 @@
 //! bodies by node-to-surface with master normals, one or two passes, each row carrying the
 //! second derivative of its gap over the slave node and the master facet's nodes (closest
 //! points inside facets, on edges and at corners,
-//! [`crate::contact::discretization::facet_gap_hessian`]; Wriggers 2006, section 4.3), every
-//! enforcement method of the 2D Newton scheme. Refused with the reason: mortar and node-to-node
-//! between 3D bodies (their second-order terms are not built in 3D) and tied pairs under finite
-//! kinematics, contact without the Newton scheme, the current geometry or the geometric
-//! stiffness. The stress of the checks and the `.vtu` is
+//! [`crate::contact::discretization::facet_gap_hessian`]; Wriggers 2006, section 4.3), by
+//! node-to-node on interfaces that match in the reference configuration (the gap along the
+//! master's nodal normal, its variation included,
+//! [`crate::contact::discretization::nodal_normal3`]) and by segment-based mortar, standard
+//! and dual, on Quad4, Tri3 and Quad9 facets (the weighted gap's exact gradient and Hessian
+//! through the auxiliary plane, the clipping and the projections,
+//! `contact::discretization::mortar3_linearization`), every enforcement method of the 2D
+//! Newton scheme. Refused with the reason: tied pairs under finite kinematics, contact
+//! without the Newton scheme, the current geometry or the geometric stiffness. The stress of the checks and the `.vtu` is
 //! then the Cauchy stress `F S F^T / J`, at the reference positions of the points.
 //!
 //! Coulomb friction (issue 13, build item 4) runs through the 2D code path: the Newton scheme
@@ -377,8 +381,9 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
 }
 
 /// What finite kinematics solves in 3D, refused otherwise with the reason: frictionless
-/// contact against rigid masters and node-to-surface contact between bodies (master normals,
-/// one or two passes), by the Newton scheme in the current geometry with the full tangent.
+/// contact against rigid masters and between bodies (node-to-surface with master normals, one
+/// or two passes; node-to-node on interfaces that match node for node in the reference
+/// configuration; mortar), by the Newton scheme in the current geometry with the full tangent.
 fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
     let source = &model.source;
     for (k, pair) in model.contact.iter().enumerate() {
@@ -398,14 +403,7 @@ fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
                         ));
                     }
                 }
-                DiscretizationSpec::Mortar { .. } => {
-                    return Err(not_built(
-                        source,
-                        format!("{at}.discretization"),
-                        "mortar contact between deformable bodies under finite kinematics (the second derivative of the 3D segments' weighted gap is not built)",
-                        "use {\"kind\": \"node_to_surface\"}, or small-strain kinematics",
-                    ))
-                }
+                DiscretizationSpec::Mortar { .. } => {}
             }
         }
         if pair.interaction == Interaction::Tied {
@@ -460,7 +458,8 @@ fn reference_nodes_match(
         return Ok(());
     };
     let (slave_body, slave_facets) = &pair.slave;
-    let slave = Surface3::from_solid_mesh(*slave_body, &model.bodies[*slave_body].mesh, slave_facets);
+    let slave =
+        Surface3::from_solid_mesh(*slave_body, &model.bodies[*slave_body].mesh, slave_facets);
     let master = Surface3::from_solid_mesh(*body, &model.bodies[*body].mesh, facets);
     let numbering = |b: usize, n: usize, c: usize| model.bodies[b].dof(n, c);
     let settings = RowSettings {

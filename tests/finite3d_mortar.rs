@@ -258,7 +258,14 @@ fn the_newton_tangent_with_node_to_node_rows_is_the_difference_of_the_residual()
         json!({"kind": "augmented_lagrange", "kappa": 1e4}),
         json!({"kind": "penalty", "kappa": 1e4}),
     ] {
-        let case = stacked(&MATCHING, &MATCHING, node_to_node(), enforcement.clone(), 0.0, 1);
+        let case = stacked(
+            &MATCHING,
+            &MATCHING,
+            node_to_node(),
+            enforcement.clone(),
+            0.0,
+            1,
+        );
         let model = build3(&parse(&case), "finite3d_mortar").unwrap();
         let u = tangent_state(&model, -0.02);
         let worst = tangent_check(&case, &u, &format!("node-to-node {}", enforcement["kind"]));
@@ -306,8 +313,8 @@ fn clamped(discretization: Value, punch: &[f64], r: &Matrix3<f64>) -> (Model3, S
             model.prescribed[d] = Some(v);
         }
     }
-    let solution = contact_patch::solver::finite::solve(&model, &mut |_| {})
-        .unwrap_or_else(|e| panic!("{e}"));
+    let solution =
+        contact_patch::solver::finite::solve(&model, &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
     (model, solution)
 }
 
@@ -339,7 +346,11 @@ fn rotation_errors(discretization: Value, punch: &[f64], label: &str) -> (f64, f
     let worst_s = s1
         .iter()
         .zip(&s2)
-        .map(|(a, b)| (r * to_matrix(*a) * r.transpose() - to_matrix(*b)).abs().max())
+        .map(|(a, b)| {
+            (r * to_matrix(*a) * r.transpose() - to_matrix(*b))
+                .abs()
+                .max()
+        })
         .fold(0.0, f64::max);
     println!(
         "{label} turned 60 deg: |u_R - R u| {:.1e} of {scale_u:.3}, |sigma_R - R sigma R^T| {:.1e} of {scale_s:.1}",
@@ -378,3 +389,116 @@ fn node_to_node_on_non_matching_interfaces_is_refused() {
     );
 }
 
+// ---------------------------------------------------------------------------------------------
+// Mortar (segment-based, standard and dual multipliers)
+
+fn mortar(multiplier: &str) -> Value {
+    json!({"kind": "mortar", "multiplier": multiplier})
+}
+
+/// The mortar two-block patch test at finite strain (matching Hex8 grids, 20 % compression,
+/// Lagrange multipliers), standard and dual multipliers: the uniform uniaxial Cauchy stress at
+/// every quadrature point of both bodies to 1e-10 of `sigma_zz`. (The non-matching interface
+/// [`OFFSET`] did not finish within 14 minutes of one core, not diagnosed: not asserted.)
+#[test]
+fn mortar_passes_the_two_block_patch_test() {
+    for multiplier in ["standard", "dual"] {
+        let label = format!("mortar {multiplier} matching");
+        let error = patch_test(mortar(multiplier), &MATCHING, &label);
+        assert!(error < 1e-10, "{label}: {error:e}");
+    }
+}
+
+/// The Newton tangent with mortar rows (the weighted gap's Hessian: auxiliary planes,
+/// clipping, projections, dual coefficients and nodal normals varied) is the central
+/// difference of the residual to 1e-6 of its largest entry: a one-cell punch over the four
+/// facets of a pyramid-shaped master (every slave facet cut by the master's edges), pressed
+/// in, every node moved off by a wavy field; standard multipliers with Lagrange rows (the dual
+/// rows' Hessians are checked against differences in the row's unit tests).
+#[test]
+fn the_newton_tangent_with_mortar_rows_is_the_difference_of_the_residual() {
+    let (multiplier, enforcement) = ("standard", json!({"kind": "lagrange"}));
+    let mut case = stacked(
+        &MATCHING,
+        &[0.2, 0.8],
+        mortar(multiplier),
+        enforcement.clone(),
+        0.0,
+        1,
+    );
+    case["bodies"][1]["mesh"]["block3d"]["z"] = json!([1, 1.5]);
+    let model = build3(&parse(&case), "finite3d_mortar").unwrap();
+    let u = tangent_state(&model, -0.02);
+    let label = format!("mortar {multiplier} {}", enforcement["kind"]);
+    let worst = tangent_check(&case, &u, &label);
+    assert!(worst < 1e-6, "{label}: {worst:e}");
+}
+
+/// Mortar: the clamped, bulging pair (matching interface) turned by 60 degrees gives the
+/// turned answer (1e-8), standard multipliers. Not verified yet: the two solves did not
+/// finish within 12 minutes of one core (not diagnosed); run with `--ignored`.
+#[test]
+#[ignore = "not verified: the two solves did not finish within 12 minutes of one core"]
+fn a_large_rotation_of_the_mortar_pair_rotates_the_answer() {
+    let multiplier = "standard";
+    let (u, s) = rotation_errors(
+        mortar(multiplier),
+        &MATCHING,
+        &format!("mortar {multiplier}"),
+    );
+    assert!(u < 1e-8 && s < 1e-8, "{multiplier}: {u:e} {s:e}");
+}
+
+/// The small-load limit: at the reference configuration (flat, coincident, non-matching
+/// interface) the finite-strain mortar rows are the small-strain ones of `mortar3` (the
+/// variations of the weights, normals and segments multiply the gap, which is zero there):
+/// the same gaps and coefficients to 1e-12 of the largest, standard and dual.
+#[test]
+fn at_the_reference_configuration_the_mortar_rows_are_the_small_strain_rows() {
+    use contact_patch::contact::discretization::pair3::pair_rows;
+    use std::collections::BTreeMap;
+    for multiplier in ["standard", "dual"] {
+        let finite_case = stacked(
+            &MATCHING,
+            &OFFSET,
+            mortar(multiplier),
+            json!({"kind": "lagrange"}),
+            -0.4,
+            4,
+        );
+        let mut small_case = finite_case.clone();
+        small_case["physics"] = json!({});
+        small_case["solver"] = json!({});
+        small_case["materials"]["rubber"]["model"] = json!("linear_elastic");
+        let finite = build3(&parse(&finite_case), "finite3d_mortar").unwrap();
+        let small = build3(&parse(&small_case), "finite3d_mortar").unwrap();
+        let rows_finite = pair_rows(&finite, &finite.contact[0]).unwrap();
+        let rows_small = pair_rows(&small, &small.contact[0]).unwrap();
+        assert_eq!(rows_finite.len(), rows_small.len());
+        let mut worst = 0.0f64;
+        let mut scale = 0.0f64;
+        for (a, b) in rows_finite.iter().zip(&rows_small) {
+            assert_eq!(a.slave_node, b.slave_node);
+            assert!(a.hessian.is_some() && b.hessian.is_none());
+            let dense = |r: &contact_patch::contact::Constraint<3>| -> BTreeMap<usize, f64> {
+                r.dofs
+                    .iter()
+                    .copied()
+                    .zip(r.coeffs.iter().copied())
+                    .collect()
+            };
+            let (da, db) = (dense(a), dense(b));
+            for (d, &c) in da.iter().chain(db.iter()) {
+                scale = scale.max(c.abs());
+                worst = worst.max((da.get(d).unwrap_or(&0.0) - db.get(d).unwrap_or(&0.0)).abs());
+            }
+            worst = worst.max((a.g0 - b.g0).abs());
+        }
+        println!(
+            "mortar {multiplier}: {} rows, finite vs small-strain rows at the reference {:.1e}",
+            rows_finite.len(),
+            worst / scale
+        );
+        assert!(worst < 1e-12 * scale, "{multiplier}: {worst:e}");
+    }
+}

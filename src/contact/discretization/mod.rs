@@ -40,6 +40,7 @@ pub mod facet_projection;
 pub mod geometry;
 pub(crate) mod mortar;
 pub mod mortar3;
+pub(crate) mod mortar3_linearization;
 pub(crate) mod mortar_linearization;
 pub mod nodal_normal;
 pub mod nodal_normal3;

@@ -125,10 +125,6 @@ pub(crate) fn embedded(
     Ad::new(value, Derivative::some(v1), Derivative::some(v2))
 }
 
-pub(crate) fn add3<T: DualNum<Primitive = f64>>(a: &Point3<T>, b: &Point3<T>) -> Point3<T> {
-    std::array::from_fn(|i| a[i].clone() + &b[i])
-}
-
 pub(crate) fn sub3<T: DualNum<Primitive = f64>>(a: &Point3<T>, b: &Point3<T>) -> Point3<T> {
     std::array::from_fn(|i| a[i].clone() - &b[i])
 }
@@ -166,10 +162,7 @@ pub(crate) fn facet_tangents<T: DualNum<Primitive = f64>>(
     let k = kind.node_count();
     ElementKind::shape(kind, s, &mut n[..k], &mut dn[..k]);
     let zero = || T::from(0.0);
-    let mut t: [Point3<T>; 2] = [
-        [zero(), zero(), zero()],
-        [zero(), zero(), zero()],
-    ];
+    let mut t: [Point3<T>; 2] = [[zero(), zero(), zero()], [zero(), zero(), zero()]];
     for (a, p) in coords.iter().enumerate() {
         for (j, tj) in t.iter_mut().enumerate() {
             for i in 0..3 {
@@ -220,7 +213,10 @@ pub(crate) fn unit_nodal_normal<T: DualNum<Primitive = f64>>(
 /// The nodes of a row whose gap takes the nodal normal of node `node` of `surface`: that node,
 /// then the other nodes of its facets (each once); and those facets as (indices into the list,
 /// the node's place in the facet).
-pub(crate) fn normal_patch(surface: &Surface3, node: usize) -> (Vec<usize>, Vec<(Vec<usize>, usize)>) {
+pub(crate) fn normal_patch(
+    surface: &Surface3,
+    node: usize,
+) -> (Vec<usize>, Vec<(Vec<usize>, usize)>) {
     let mut nodes = vec![node];
     let mut facets = Vec::new();
     for facet in surface.facets.iter().filter(|f| f.contains(&node)) {
@@ -235,7 +231,10 @@ pub(crate) fn normal_patch(surface: &Surface3, node: usize) -> (Vec<usize>, Vec<
             };
             local.push(k);
         }
-        let a = facet.iter().position(|&n| n == node).expect("the facet holds the node");
+        let a = facet
+            .iter()
+            .position(|&n| n == node)
+            .expect("the facet holds the node");
         facets.push((local, a));
     }
     (nodes, facets)
@@ -351,9 +350,7 @@ pub fn node_to_node_current_rows(
             ));
         }
         let slave_dofs: [usize; 3] = std::array::from_fn(|i| dofs.dof(slave.body, s, i));
-        let lin = node_to_node_gap(p, slave_dofs, master, m, |n, i| {
-            dofs.dof(master.body, n, i)
-        });
+        let lin = node_to_node_gap(p, slave_dofs, master, m, |n, i| dofs.dof(master.body, n, i));
         // the row's area, slave normal, point and pass as the small-strain row's
         let mut row = node_row(
             settings,
@@ -404,7 +401,10 @@ mod tests {
         let mut positions = Vec::new();
         for j in 0..3 {
             for i in 0..3 {
-                let (x, y) = (i as f64 * 0.5 + 0.03 * (j as f64), j as f64 * 0.5 - 0.02 * (i as f64));
+                let (x, y) = (
+                    i as f64 * 0.5 + 0.03 * (j as f64),
+                    j as f64 * 0.5 - 0.02 * (i as f64),
+                );
                 positions.push([x, y, 0.2 * (x - 0.5) * (y - 0.4) + 0.05 * x * x]);
             }
         }
@@ -466,7 +466,9 @@ mod tests {
                 let lin = node_to_node_gap(x_s, [0, 1, 2], &master, m, dof);
                 let gap = |x_s: [f64; 3], surface: &Surface3| {
                     let d = surface.nodes[&m];
-                    (0..3).map(|i| d.normal[i] * (x_s[i] - d.position[i])).sum::<f64>()
+                    (0..3)
+                        .map(|i| d.normal[i] * (x_s[i] - d.position[i]))
+                        .sum::<f64>()
                 };
                 assert!((lin.gap - gap(x_s, &master)).abs() < 1e-15);
                 let h = 1e-6;
