@@ -13,13 +13,18 @@ const PRESSURE: f64 = 10.0;
 /// [0, 2]^2 x [1, 2] on breaks `punch`, pressure on the punch's top, supports that hold the
 /// rigid motions without restraining the uniform strain.
 fn patch(element: &str, foundation: &[f64], punch: &[f64], contact: Value) -> Value {
+    patch_of([element, element], foundation, punch, contact)
+}
+
+/// [`patch`] with the foundation's and the punch's elements (in that order).
+fn patch_of(elements: [&str; 2], foundation: &[f64], punch: &[f64], contact: Value) -> Value {
     json!({
         "name": "patch-3d",
         "materials": {"m": {"E": 1000.0, "nu": 0.3}},
         "bodies": [
-            {"name": "foundation", "material": "m", "mesh": {"block3d": {"element": element,
+            {"name": "foundation", "material": "m", "mesh": {"block3d": {"element": elements[0],
                 "x": foundation, "y": foundation, "z": [0, 0.5, 1]}}},
-            {"name": "punch", "material": "m", "mesh": {"block3d": {"element": element,
+            {"name": "punch", "material": "m", "mesh": {"block3d": {"element": elements[1],
                 "x": punch, "y": punch, "z": [1, 1.5, 2]}}}
         ],
         "supports": [
@@ -122,6 +127,31 @@ fn mortar_passes_on_non_matching_interfaces_where_one_pass_node_to_surface_fails
     );
     let e = stress_error(&run(&patch("Hex8", &MATCHING, &NON_MATCHING, two)));
     assert!(e < 1e-12, "two passes: {e:e}");
+}
+
+#[test]
+fn mortar_on_tri6_facets_passes_the_patch_test() {
+    // Tet10 bodies (Tri6 facets, multipliers on the modified basis) on Tet10 matching and
+    // non-matching, on Hex8 and Hex27 foundations, and a Hex8 punch on a Tet10 foundation
+    let mut worst = 0.0f64;
+    for (elements, punch) in [
+        (["Tet10", "Tet10"], &MATCHING[..]),
+        (["Tet10", "Tet10"], &NON_MATCHING[..]),
+        (["Hex8", "Tet10"], &NON_MATCHING[..]),
+        (["Hex27", "Tet10"], &NON_MATCHING[..]),
+        (["Tet10", "Hex8"], &NON_MATCHING[..]),
+    ] {
+        for multiplier in ["standard", "dual"] {
+            let c = pair(
+                json!({"kind": "mortar", "multiplier": multiplier}),
+                json!({"kind": "lagrange"}),
+            );
+            let e = stress_error(&run(&patch_of(elements, &MATCHING, punch, c)));
+            worst = worst.max(e);
+            assert!(e < 1e-10, "{elements:?} {punch:?} {multiplier}: {e:e}");
+        }
+    }
+    println!("largest stress error (relative to p): {worst:e}");
 }
 
 #[test]

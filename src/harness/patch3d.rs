@@ -33,8 +33,8 @@
 //! (the largest difference over the quadrature points of both bodies and the six components,
 //! relative to `p`) is at most `1e-10`; `fail` when it converges with a larger error; `stops`
 //! when it does not converge; `n/a` when the model refuses the combination, with the model's
-//! reason (node-to-node on grids whose nodes do not match, mortar on Tri6 facets, elimination
-//! where two rows share their slave dof). Each cell reports the error, the linear solves of the
+//! reason (node-to-node on grids whose nodes do not match, elimination where two rows share
+//! their slave dof). Each cell reports the error, the linear solves of the
 //! active-set loop, the active rows and the rank deficiency of the active rows. Penalty-type
 //! cells are judged at their own `kappa` as the brief of the table asks; their stress error is
 //! the consistency error (a uniform penetration `p / kappa` is a rigid offset of the punch and

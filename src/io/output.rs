@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::harness::checks::CheckResult;
 use crate::io::contact_output::{body_point_arrays, pair_file_names, write_pair_files};
 use crate::io::paths::{file_name, OutputFolder};
-use crate::io::vtu::PointArray;
+use crate::io::vtu::{lines_in_parallel, PointArray};
 use crate::model::Body;
 use crate::post::{cell_stresses, nodal_stresses};
 use crate::run::Outcome;
@@ -461,43 +461,6 @@ pub fn write_run(folder: &OutputFolder, outcome: &Outcome) -> Result<()> {
 pub fn write_vtu(path: &Path, body: &Body, u: &[f64], nodal_stress: &[[f64; 3]]) -> Result<()> {
     write_vtu_with(path, body, u, nodal_stress, &[])
 }
-
-/// The text `line(0, ..) + line(1, ..) + .. + line(count - 1, ..)`, formatted in as many
-/// consecutive chunks as the machine has threads, each on its own thread (formatting numbers
-/// is most of the cost of writing a large mesh's `.vtu`); the text is the same whatever the
-/// number of threads.
-fn lines_in_parallel(count: usize, line: impl Fn(usize, &mut String) + Sync) -> String {
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(count / PARALLEL_LINES_MIN + 1);
-    let chunk = count.div_ceil(threads.max(1)).max(1);
-    let format = |range: std::ops::Range<usize>| {
-        let mut t = String::new();
-        for k in range {
-            line(k, &mut t);
-        }
-        t
-    };
-    if threads <= 1 {
-        return format(0..count);
-    }
-    std::thread::scope(|scope| {
-        let parts: Vec<_> = (0..count)
-            .step_by(chunk)
-            .map(|start| {
-                let format = &format;
-                scope.spawn(move || format(start..(start + chunk).min(count)))
-            })
-            .collect();
-        parts
-            .into_iter()
-            .map(|p| p.join().expect("formatting thread"))
-            .collect()
-    })
-}
-
-/// Below this many lines per thread, [`lines_in_parallel`] formats on one thread.
-const PARALLEL_LINES_MIN: usize = 20_000;
 
 /// [`write_vtu`] with more point data (`extra`, e.g. the contact fields).
 pub fn write_vtu_with(

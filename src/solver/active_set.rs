@@ -76,7 +76,9 @@ use crate::error::{Error, Result};
 use crate::io::scene::{ContactGeometry, CyclingRemedy, FactorUpdate, MultiplierUpdate};
 use crate::model::rigid::{FreeMode, RigidModes};
 use crate::model::Model;
-use crate::solver::conditioning::{condition_estimate_symmetric, EQUILIBRIUM_ROUND_OFF};
+use crate::solver::conditioning::{
+    condition_estimate_symmetric, condition_estimate_symmetric_columns, EQUILIBRIUM_ROUND_OFF,
+};
 use crate::solver::constraints::{ConstraintBuilder, ConstraintError};
 use crate::solver::dense::symmetric_eigen;
 use crate::solver::linear::{assemble, finish, LinearSystem, Solution, Timings, NO_EQUATION};
@@ -656,6 +658,7 @@ fn solve_at<const D: usize, K: Discretize<D>>(
         deferred_condition: update_rank > 0,
         amg,
         last_iterate: None,
+        unrefined: None,
         factorizations: 0.0,
         estimate_condition: true,
     };
@@ -850,6 +853,14 @@ impl Saddle {
     }
 }
 
+/// An iterate of the penalty family solved with `operator` for the Uzawa forces `lambda_k`,
+/// neither judged by its accurate equilibrium residual nor refined yet.
+struct Unrefined {
+    operator: Rc<Operator>,
+    lambda_k: Vec<f64>,
+    x: Vec<f64>,
+}
+
 struct Kernel<'a, const D: usize, K: Discretize<D>> {
     /// Whether [`Kernel::factor`] estimates the condition number of what it factors (not for
     /// the penalty predictor, whose systems are never the answer's).
@@ -881,6 +892,9 @@ struct Kernel<'a, const D: usize, K: Discretize<D>> {
     amg: Option<crate::solver::iterative::AmgSolver>,
     /// The last iterate of the CG path, the start of the next solve.
     last_iterate: Option<Vec<f64>>,
+    /// An iterate of the penalty family whose iterative refinement was put off (see
+    /// [`Kernel::regularized`]): refined only if its active set turns out stable.
+    unrefined: Option<Unrefined>,
     /// Built only for Lagrange multipliers and for perturbed Lagrangian rows with a consistent
     /// multiplier mass.
     saddle: Option<Saddle>,
@@ -1058,7 +1072,13 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
         let Some(update) = update else {
             return self.factor(active, w);
         };
-        let values = self.augmented(active, w);
+        // the matrix itself only for an estimate of its condition now (a deferred estimate
+        // forms it once, at the end)
+        let values = if self.estimate_condition && !self.deferred_condition {
+            self.augmented(active, w)
+        } else {
+            Vec::new()
+        };
         let f = Rc::new(update);
         self.finish_operator(active, w, &values, &f, t);
         Ok(f)
@@ -1082,8 +1102,9 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
         }
         let t = Instant::now();
         let values = self.augmented(&active, &w);
-        let estimate =
-            condition_estimate_symmetric(&self.sys.pattern, &values, |b| f.solve_in_place(b));
+        let estimate = condition_estimate_symmetric_columns(&self.sys.pattern, &values, |b| {
+            f.solve_columns_in_place(b, b.len() / self.sys.n.max(1))
+        });
         if let Some(last) = self.history.last_mut() {
             last.condition_estimate = Some(estimate);
         }
@@ -1091,7 +1112,8 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
         self.factorizations += t.elapsed().as_secs_f64();
     }
 
-    /// The condition estimate of a new operator (when asked for), its time, and the cache.
+    /// The condition estimate of a new operator (when asked for; `values` is its matrix, read
+    /// only then), its time, and the cache.
     fn finish_operator(
         &mut self,
         active: &[bool],
@@ -1365,13 +1387,42 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
 
     /// Penalty-type solve: `M u = rhs + sum_active b_i (lambda_k,i - w_i g0_i)`, refined
     /// against the unpenalized equilibrium residual when that is not at round-off (see
-    /// [`Kernel::penalty_equilibrium`]).
-    fn regularized(&mut self, active: &[bool], w: &[f64], lambda_k: &[f64]) -> Step<Vec<f64>> {
+    /// [`Kernel::penalty_equilibrium`]). Without `refine` the iterate is only solved for and
+    /// kept ([`Unrefined`]); a later call with `refine` and the same operator and forces judges
+    /// and refines that iterate instead of solving again (the loop refines only the iterate of
+    /// a stable set, the one it may return).
+    fn regularized(
+        &mut self,
+        active: &[bool],
+        w: &[f64],
+        lambda_k: &[f64],
+        refine: bool,
+    ) -> Step<Vec<f64>> {
         if self.amg.is_some() {
             return self.regularized_iterative(active, w, lambda_k);
         }
         let f = self.factor_or_update(active, w)?;
-        let (x, best) = self.regularized_with(&f, active, w, lambda_k);
+        let pending = self.unrefined.take();
+        let (x, r, best) = match pending {
+            // this operator's iterate, left unrefined by the solve before: judge it now
+            Some(u) if refine && Rc::ptr_eq(&u.operator, &f) && u.lambda_k == lambda_k => {
+                let mut r = vec![0.0; self.sys.n];
+                let best = self.penalty_equilibrium(&u.x, active, w, lambda_k, &mut r);
+                (u.x, r, best)
+            }
+            _ if !refine => {
+                let x = self.solve_only(&f, active, w, lambda_k);
+                self.linear_solver = f.solver_name();
+                self.unrefined = Some(Unrefined {
+                    operator: f.clone(),
+                    lambda_k: lambda_k.to_vec(),
+                    x: x.clone(),
+                });
+                return Ok(x);
+            }
+            _ => self.solve_once(&f, active, w, lambda_k),
+        };
+        let (x, best) = self.refine_from(&f, x, r, best, active, w, lambda_k);
         if f.rank() == 0 || best <= EQUILIBRIUM_ROUND_OFF {
             self.linear_solver = f.solver_name();
             return Ok(x);
@@ -1380,7 +1431,8 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
         self.cache = None;
         let f = self.factor(active, w)?;
         self.linear_solver = "cholesky";
-        Ok(self.regularized_with(&f, active, w, lambda_k).0)
+        let (x, r, best) = self.solve_once(&f, active, w, lambda_k);
+        Ok(self.refine_from(&f, x, r, best, active, w, lambda_k).0)
     }
 
     /// The solve of [`Kernel::regularized`] by CG + AMG from the last iterate, to the case's
@@ -1423,15 +1475,24 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
         Ok(x)
     }
 
-    /// The solve of [`Kernel::regularized`] with the operator `f`, refined; returns the iterate
-    /// and its relative equilibrium residual.
-    fn regularized_with(
+    /// The solve of [`Kernel::regularized`] with the operator `f`; returns the iterate, its
+    /// equilibrium residual vector and that residual's relative size
+    /// ([`Kernel::penalty_equilibrium`]).
+    fn solve_once(
         &self,
         f: &Operator,
         active: &[bool],
         w: &[f64],
         lambda_k: &[f64],
-    ) -> (Vec<f64>, f64) {
+    ) -> (Vec<f64>, Vec<f64>, f64) {
+        let x = self.solve_only(f, active, w, lambda_k);
+        let mut r = vec![0.0; self.sys.n];
+        let best = self.penalty_equilibrium(&x, active, w, lambda_k, &mut r);
+        (x, r, best)
+    }
+
+    /// `M^-1 (f_f - K_fp u_p + sum_active b_i (lambda_k,i - w_i g0_i))` with the operator `f`.
+    fn solve_only(&self, f: &Operator, active: &[bool], w: &[f64], lambda_k: &[f64]) -> Vec<f64> {
         let mut x = self.rhs.clone();
         for (i, row) in self.rows.iter().enumerate() {
             if active[i] {
@@ -1439,13 +1500,25 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
             }
         }
         f.solve_in_place(&mut x);
-        // iterative refinement with the residual of equilibrium `f - K u + B^T lambda(u)`,
-        // `lambda_i = lambda_k,i - w_i (g0_i + b_i u)` (equal to `rhs - M u` in exact
-        // arithmetic, but computed from the forces the run reports, with an accurate `K u`):
-        // only when the first solve left it above round-off (a stiff penalty), and only while
-        // it at least halves; the best iterate is kept
-        let mut r = vec![0.0; self.sys.n];
-        let mut best = self.penalty_equilibrium(&x, active, w, lambda_k, &mut r);
+        x
+    }
+
+    /// Iterative refinement of the iterate `x` (residual `r`, relative size `best`) with the
+    /// residual of equilibrium `f - K u + B^T lambda(u)`, `lambda_i = lambda_k,i - w_i (g0_i +
+    /// b_i u)` (equal to `rhs - M u` in exact arithmetic, but computed from the forces the run
+    /// reports, with an accurate `K u`): only when it is above round-off (a stiff penalty), and
+    /// only while it at least halves; the best iterate is kept. Returns it and its residual.
+    #[allow(clippy::too_many_arguments)]
+    fn refine_from(
+        &self,
+        f: &Operator,
+        mut x: Vec<f64>,
+        mut r: Vec<f64>,
+        mut best: f64,
+        active: &[bool],
+        w: &[f64],
+        lambda_k: &[f64],
+    ) -> (Vec<f64>, f64) {
         if best.is_finite() && best > EQUILIBRIUM_ROUND_OFF {
             for _ in 0..MAX_REFINEMENT {
                 f.solve_in_place(&mut r);
@@ -2074,147 +2147,160 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
             let previous_forces = forces.clone();
             self.iteration = it;
             self.prepare(&active);
-            let step: Step<(Vec<f64>, Vec<f64>)> = match method {
-                Method::Lagrange => self.lagrange(&active),
-                Method::Elimination => self.eliminate(&active, &owners),
-                Method::Regularized { .. }
-                | Method::PerturbedLagrange { .. }
-                | Method::AugmentedLagrange { .. }
-                    if coupled =>
-                {
-                    self.perturbed(&active, &row_w, &lambda_k)
-                }
-                Method::Regularized { .. }
-                | Method::PerturbedLagrange { .. }
-                | Method::AugmentedLagrange { .. } => {
-                    let w = &row_w;
-                    self.regularized(&active, w, &lambda_k).map(|x| {
-                        let f = (0..nrows)
-                            .map(|i| {
-                                if active[i] {
-                                    lambda_k[i] - w[i] * (self.rows[i].g0 + self.rows[i].dot(&x))
-                                } else {
-                                    0.0
-                                }
-                            })
-                            .collect();
-                        (x, f)
-                    })
-                }
-                Method::PerturbedTangent { .. } => {
-                    // Newton on the Lagrange residual with the perturbed tangent
-                    let w = row_w.clone();
-                    let mut ku = vec![0.0; self.sys.n];
-                    self.sys.pattern.mul(&self.sys.k, &x, &mut ku);
-                    let mut b = vec![0.0; self.sys.n];
-                    for j in 0..self.sys.n {
-                        b[j] = self.rhs[j] - ku[j];
+            // the penalty family refines an iterate only when its set turns out stable (the
+            // others' sets decide the next iterate at any accuracy): a set that changes
+            // leaves its iterate unrefined, and a stable one solves the step again, refined
+            let mut refine = false;
+            let (gaps, force_tol, gaps_closed, mut new_active, stable) = loop {
+                let step: Step<(Vec<f64>, Vec<f64>)> = match method {
+                    Method::Lagrange => self.lagrange(&active),
+                    Method::Elimination => self.eliminate(&active, &owners),
+                    Method::Regularized { .. }
+                    | Method::PerturbedLagrange { .. }
+                    | Method::AugmentedLagrange { .. }
+                        if coupled =>
+                    {
+                        self.perturbed(&active, &row_w, &lambda_k)
                     }
-                    for (i, row) in self.rows.iter().enumerate() {
-                        if active[i] {
-                            row.add_to(forces[i], &mut b);
-                            let r_g = -(row.g0 + row.dot(&x));
-                            row.add_to(w[i] * r_g, &mut b);
-                        }
-                    }
-                    match self.factor(&active, &w) {
-                        Ok(f) => {
-                            f.solve_in_place(&mut b);
-                            let xn: Vec<f64> = x.iter().zip(&b).map(|(a, d)| a + d).collect();
+                    Method::Regularized { .. }
+                    | Method::PerturbedLagrange { .. }
+                    | Method::AugmentedLagrange { .. } => {
+                        let w = &row_w;
+                        self.regularized(&active, w, &lambda_k, refine).map(|x| {
                             let f = (0..nrows)
                                 .map(|i| {
                                     if active[i] {
-                                        let r_g = -(self.rows[i].g0 + self.rows[i].dot(&x));
-                                        forces[i] + w[i] * (r_g - self.rows[i].dot(&b))
+                                        lambda_k[i]
+                                            - w[i] * (self.rows[i].g0 + self.rows[i].dot(&x))
                                     } else {
                                         0.0
                                     }
                                 })
                                 .collect();
-                            Ok((xn, f))
-                        }
-                        Err(e) => Err(e.into()),
+                            (x, f)
+                        })
                     }
-                }
-            };
-            let (xn, fnew) = match step {
-                Ok(v) => v,
-                Err(StepError::Singular(msg)) => {
-                    return Ok((x, forces, active, Termination::Singular(msg), it))
-                }
-                Err(StepError::Fatal(e)) => return Err(e),
-            };
-            self.check_iterate(&xn, &fnew, it)?;
-            x = xn;
-            forces = fnew;
-            let closing = match self.push_to_contact(&mut x, &active) {
-                Ok(c) => c,
-                Err(msg) => return Ok((x, forces, active, Termination::Singular(msg), it)),
-            };
-            let gaps: Vec<f64> = self.rows.iter().map(|r| r.g0 + r.dot(&x)).collect();
-            let fmax = forces.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let force_tol = 1e-10 * fmax;
-            // the iterative methods stop when the multiplier update kappa A g of every active
-            // row is negligible against the contact forces (1e-12 of the largest), or the gap is
-            // at the round-off floor (1e-15 of the model size)
-            // (only the rows of iterative methods: a penalty row's gap stays open by design)
-            let gaps_closed = (0..nrows).filter(|&i| active[i] && iterative[i]).all(|i| {
-                let update = (row_w[i] * gaps[i]).abs();
-                update <= 1e-12 * fmax || gaps[i].abs() <= 1e-15 * size
-            });
-            // ties (bilateral rows) stay active whatever the sign of their force
-            let new_active: Vec<bool> = match method {
-                Method::Lagrange | Method::Elimination | Method::PerturbedTangent { .. } => (0
-                    ..nrows)
-                    .map(|i| {
-                        rows[i].bilateral
-                            || if active[i] {
-                                forces[i] >= -force_tol
-                            } else {
-                                gaps[i] < -gap_tol
+                    Method::PerturbedTangent { .. } => {
+                        // Newton on the Lagrange residual with the perturbed tangent
+                        let w = row_w.clone();
+                        let mut ku = vec![0.0; self.sys.n];
+                        self.sys.pattern.mul(&self.sys.k, &x, &mut ku);
+                        let mut b = vec![0.0; self.sys.n];
+                        for j in 0..self.sys.n {
+                            b[j] = self.rhs[j] - ku[j];
+                        }
+                        for (i, row) in self.rows.iter().enumerate() {
+                            if active[i] {
+                                row.add_to(forces[i], &mut b);
+                                let r_g = -(row.g0 + row.dot(&x));
+                                row.add_to(w[i] * r_g, &mut b);
                             }
-                    })
-                    .collect(),
-                // rows with multipliers (the consistent perturbed Lagrangian): complementarity of
-                // lambda >= 0 and g + C lambda >= 0; the others by their trial force
-                Method::Regularized { .. }
-                | Method::PerturbedLagrange { .. }
-                | Method::AugmentedLagrange { .. } => (0..nrows)
-                    .map(|i| {
-                        rows[i].bilateral
-                            || if !self.perturbation[i].is_empty() {
-                                if active[i] {
+                        }
+                        match self.factor(&active, &w) {
+                            Ok(f) => {
+                                f.solve_in_place(&mut b);
+                                let xn: Vec<f64> = x.iter().zip(&b).map(|(a, d)| a + d).collect();
+                                let f = (0..nrows)
+                                    .map(|i| {
+                                        if active[i] {
+                                            let r_g = -(self.rows[i].g0 + self.rows[i].dot(&x));
+                                            forces[i] + w[i] * (r_g - self.rows[i].dot(&b))
+                                        } else {
+                                            0.0
+                                        }
+                                    })
+                                    .collect();
+                                Ok((xn, f))
+                            }
+                            Err(e) => Err(e.into()),
+                        }
+                    }
+                };
+                let (xn, fnew) = match step {
+                    Ok(v) => v,
+                    Err(StepError::Singular(msg)) => {
+                        return Ok((x, forces, active, Termination::Singular(msg), it))
+                    }
+                    Err(StepError::Fatal(e)) => return Err(e),
+                };
+                self.check_iterate(&xn, &fnew, it)?;
+                x = xn;
+                forces = fnew;
+                let closing = match self.push_to_contact(&mut x, &active) {
+                    Ok(c) => c,
+                    Err(msg) => return Ok((x, forces, active, Termination::Singular(msg), it)),
+                };
+                let gaps: Vec<f64> = self.rows.iter().map(|r| r.g0 + r.dot(&x)).collect();
+                let fmax = forces.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let force_tol = 1e-10 * fmax;
+                // the iterative methods stop when the multiplier update kappa A g of every active
+                // row is negligible against the contact forces (1e-12 of the largest), or the gap is
+                // at the round-off floor (1e-15 of the model size)
+                // (only the rows of iterative methods: a penalty row's gap stays open by design)
+                let gaps_closed = (0..nrows).filter(|&i| active[i] && iterative[i]).all(|i| {
+                    let update = (row_w[i] * gaps[i]).abs();
+                    update <= 1e-12 * fmax || gaps[i].abs() <= 1e-15 * size
+                });
+                // ties (bilateral rows) stay active whatever the sign of their force
+                let new_active: Vec<bool> = match method {
+                    Method::Lagrange | Method::Elimination | Method::PerturbedTangent { .. } => (0
+                        ..nrows)
+                        .map(|i| {
+                            rows[i].bilateral
+                                || if active[i] {
                                     forces[i] >= -force_tol
                                 } else {
-                                    let c_lambda: f64 = self.perturbation[i]
-                                        .iter()
-                                        .map(|&(j, c)| c * forces[j])
-                                        .sum();
-                                    gaps[i] + c_lambda < -gap_tol
+                                    gaps[i] < -gap_tol
                                 }
-                            } else {
-                                lambda_k[i] - row_w[i] * gaps[i] > force_tol
-                            }
-                    })
-                    .collect(),
-            };
-            let mut new_active = new_active;
-            for i in closing {
-                new_active[i] = true;
-            }
-            // the cycling remedy: a held row stays closed while its force (the multiplier, or
-            // a penalty row's trial force) is not tensile beyond the tolerance
-            for &i in &held {
-                if active[i] && !new_active[i] && forces[i] >= -force_tol {
+                        })
+                        .collect(),
+                    // rows with multipliers (the consistent perturbed Lagrangian): complementarity of
+                    // lambda >= 0 and g + C lambda >= 0; the others by their trial force
+                    Method::Regularized { .. }
+                    | Method::PerturbedLagrange { .. }
+                    | Method::AugmentedLagrange { .. } => (0..nrows)
+                        .map(|i| {
+                            rows[i].bilateral
+                                || if !self.perturbation[i].is_empty() {
+                                    if active[i] {
+                                        forces[i] >= -force_tol
+                                    } else {
+                                        let c_lambda: f64 = self.perturbation[i]
+                                            .iter()
+                                            .map(|&(j, c)| c * forces[j])
+                                            .sum();
+                                        gaps[i] + c_lambda < -gap_tol
+                                    }
+                                } else {
+                                    lambda_k[i] - row_w[i] * gaps[i] > force_tol
+                                }
+                        })
+                        .collect(),
+                };
+                let mut new_active = new_active;
+                for i in closing {
                     new_active[i] = true;
                 }
-            }
+                // the cycling remedy: a held row stays closed while its force (the multiplier, or
+                // a penalty row's trial force) is not tensile beyond the tolerance
+                for &i in &held {
+                    if active[i] && !new_active[i] && forces[i] >= -force_tol {
+                        new_active[i] = true;
+                    }
+                }
+                let stable = new_active == active;
+                if stable && !refine && self.unrefined.is_some() {
+                    refine = true;
+                    continue;
+                }
+                self.unrefined = None;
+                break (gaps, force_tol, gaps_closed, new_active, stable);
+            };
             for i in 0..nrows {
                 if new_active[i] != active[i] {
                     flips[i] += 1;
                 }
             }
-            let stable = new_active == active;
             // the loops without a multiplier iteration of their own determine the iterate by
             // the set alone: a set chosen before repeats its iterate (the residual cannot have
             // decreased), a cycle
@@ -2407,7 +2493,7 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
                 used += 1;
                 let iteration_start = Instant::now();
                 self.prepare(&active);
-                let Ok(x) = self.regularized(&active, &w, &zero) else {
+                let Ok(x) = self.regularized(&active, &w, &zero, true) else {
                     return (active, used);
                 };
                 let gaps: Vec<f64> = self.rows.iter().map(|r| r.g0 + r.dot(&x)).collect();

@@ -61,6 +61,18 @@ impl Operator {
         }
     }
 
+    /// `B <- M^-1 B` for the `columns` columns of `b` (`b.len() / columns` values each, one
+    /// after the other): one pass over the factor for a factorization or a trailing-block
+    /// update, a solve per column for a Woodbury update.
+    pub fn solve_columns_in_place(&self, b: &mut [f64], columns: usize) {
+        let n = b.len() / columns.max(1);
+        match self {
+            Operator::Factored(f) => f.solve_columns_with_trailing(b, columns, |_| {}),
+            Operator::Updated(u) => b.chunks_mut(n.max(1)).for_each(|c| u.solve_in_place(c)),
+            Operator::Trailing(u) => u.solve_columns_in_place(b, columns),
+        }
+    }
+
     /// The rank of the update (0 for a factorization of `M` itself): the rows whose weight
     /// changed.
     pub fn rank(&self) -> usize {
@@ -183,13 +195,40 @@ pub struct TrailingUpdate {
 impl TrailingUpdate {
     /// `b <- M^-1 b`.
     pub fn solve_in_place(&self, b: &mut [f64]) {
+        self.solve_columns_in_place(b, 1)
+    }
+
+    /// `B <- M^-1 B` for the `columns` columns of `b`, one pass over the base factor.
+    pub fn solve_columns_in_place(&self, b: &mut [f64], columns: usize) {
         let l = &self.block.factor;
-        self.base.solve_in_place_with_trailing(b, |y| {
+        self.base.solve_columns_with_trailing(b, columns, |y| {
             let c = y.len();
-            let y_c = MatRef::from_column_major_slice(y, c, 1);
-            let z = self.llt.solve(l.as_ref() * y_c);
-            let x_c = l.transpose() * z;
-            y.iter_mut().enumerate().for_each(|(k, v)| *v = x_c[(k, 0)]);
+            let par = faer::get_global_parallelism();
+            // `L_CC y` and `L_CC^T z` read only the stored triangle
+            let mut t = Mat::<f64>::zeros(c, 1);
+            matmul(
+                t.as_mut(),
+                BlockStructure::Rectangular,
+                Accum::Replace,
+                l.as_ref(),
+                BlockStructure::TriangularLower,
+                MatRef::from_column_major_slice(y, c, 1),
+                BlockStructure::Rectangular,
+                1.0,
+                par,
+            );
+            let z = self.llt.solve(&t);
+            matmul(
+                faer::MatMut::from_column_major_slice_mut(y, c, 1),
+                BlockStructure::Rectangular,
+                Accum::Replace,
+                l.transpose(),
+                BlockStructure::TriangularUpper,
+                z.as_ref(),
+                BlockStructure::Rectangular,
+                1.0,
+                par,
+            );
         });
     }
 }

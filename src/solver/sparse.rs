@@ -486,7 +486,12 @@ impl Cholesky {
         let mut l = Vec::new();
         l.try_reserve_exact(sym.len_val())
             .map_err(|e| FactorError::Other(format!("{e}")))?;
-        l.resize(sym.len_val(), 0.0);
+        // the first write to each page of a large factor makes the kernel zero it; written
+        // by rayon's threads, that cost is shared by the cores instead of paid by one
+        {
+            use rayon::iter::ParallelExtend;
+            l.par_extend(rayon::iter::repeat_n(0.0, sym.len_val()));
+        }
         let par = faer::get_global_parallelism();
         let mut mem =
             MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()))
@@ -621,20 +626,38 @@ impl Factor {
     /// identity this is [`Factor::solve_in_place`]; a trailing-block update puts its dense
     /// correction there ([`crate::solver::low_rank::TrailingUpdate`]). `c` is 0 without
     /// trailing equations.
-    pub fn solve_in_place_with_trailing(&self, b: &mut [f64], middle: impl FnOnce(&mut [f64])) {
-        let n = b.len();
+    pub fn solve_in_place_with_trailing(&self, b: &mut [f64], middle: impl FnMut(&mut [f64])) {
+        self.solve_columns_with_trailing(b, 1, middle)
+    }
+
+    /// [`Factor::solve_in_place_with_trailing`] for the `columns` columns of `b` (`b.len() /
+    /// columns` values each, one after the other) in one pass over the factor; `middle` is
+    /// applied to each column's trailing entries.
+    pub fn solve_columns_with_trailing(
+        &self,
+        b: &mut [f64],
+        columns: usize,
+        mut middle: impl FnMut(&mut [f64]),
+    ) {
+        let columns = columns.max(1);
+        let n = b.len() / columns;
         let c = self.trailing.as_ref().map_or(0, |t| t.len());
         let par = faer::get_global_parallelism();
         let fwd = self.symbolic.perm().map(|p| p.arrays().0);
         let step_of = |k: usize| fwd.map_or(k, |f| f[k]);
-        let mut y = Mat::<f64>::from_fn(n, 1, |k, _| b[step_of(k)]);
-        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, par));
+        let mut y = Mat::<f64>::from_fn(n, columns, |k, j| b[j * n + step_of(k)]);
+        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(columns, par));
         let stack = MemStack::new(&mut mem);
+        let mut apply_middle = |y: &mut Mat<f64>| {
+            for j in 0..columns {
+                middle(&mut y.col_as_slice_mut(j)[n - c..]);
+            }
+        };
         match self.symbolic.raw() {
             SymbolicCholeskyRaw::Simplicial(s) => {
                 let l = SparseColMatRef::new(s.factor(), &self.values);
                 triangular_solve::solve_lower_triangular_in_place(l, Conj::No, y.as_mut(), par);
-                middle(&mut y.col_as_slice_mut(0)[n - c..]);
+                apply_middle(&mut y);
                 triangular_solve::solve_lower_triangular_transpose_in_place(
                     l,
                     Conj::No,
@@ -645,12 +668,14 @@ impl Factor {
             SymbolicCholeskyRaw::Supernodal(s) => {
                 let l = SupernodalLltRef::new(s, &self.values);
                 l.l_solve_with_conj(Conj::No, y.as_mut(), par, stack);
-                middle(&mut y.col_as_slice_mut(0)[n - c..]);
+                apply_middle(&mut y);
                 l.l_transpose_solve_with_conj(Conj::No, y.as_mut(), par, stack);
             }
         }
-        for k in 0..n {
-            b[step_of(k)] = y[(k, 0)];
+        for j in 0..columns {
+            for k in 0..n {
+                b[j * n + step_of(k)] = y[(k, j)];
+            }
         }
     }
 

@@ -1,5 +1,5 @@
-//! Segment-based mortar integration in 3D (Quad4, Tri3 and Quad9 facets), standard and dual
-//! multipliers: the mortar matrices `D`, `M` and the weighted-gap rows
+//! Segment-based mortar integration in 3D (Quad4, Tri3, Quad9 and Tri6 facets), standard and
+//! dual multipliers: the mortar matrices `D`, `M` and the weighted-gap rows
 //! [`crate::contact::Constraint<3>`].
 //!
 //! References: M. A. Puso and T. A. Laursen, "A mortar segment-to-segment contact method for
@@ -29,7 +29,7 @@
 //!    (negative signed area in the slave's counter-clockwise frame, beyond `1e-9` of its own
 //!    area); a facet seen edge-on or from its back does not.
 //! 3. **Clipping.** The projected slave polygon (convex, counter-clockwise; each of its pieces
-//!    for Quad9, see below) clips the projected master polygon (reversed to counter-clockwise)
+//!    for Quad9 and Tri6, see below) clips the projected master polygon (reversed to counter-clockwise)
 //!    by Sutherland-Hodgman
 //!    ([`clip_convex_polygons`]): a point is inside an edge when its signed distance is at least
 //!    `-tol` (`tol = 1e-12` of the slave facet's diameter), an intersection parameter is clamped
@@ -40,10 +40,13 @@
 //!    convex polygon). On each triangle a symmetric rule on the reference triangle: degree 2
 //!    (3 points) between Tri3 facets (the integrands `Phi_j N_k` are products of two linear
 //!    functions), degree 5 (Radon's 7 points) where a Quad4 takes part (products of two
-//!    bilinear functions, total degree 4 when the facet map is affine), degree 8 (the
-//!    collapsed 5 x 5 Gauss product, [`collapsed_triangle_rule`]) where a Quad9 takes part
-//!    (two biquadratic functions, total degree 8). A Quad4 facet that is not a parallelogram
-//!    (its projection onto the auxiliary plane) has a bilinear map that is not affine; the
+//!    bilinear functions, total degree 4 when the facet map is affine) or a Tri6 does and no
+//!    Quad9 (a quadratic multiplier times a quadratic, bilinear or linear shape function:
+//!    degree at most 4), degree 8 (the collapsed 5 x 5 Gauss product,
+//!    [`collapsed_triangle_rule`]) where a Quad9 takes part (two biquadratic functions, total
+//!    degree 8). A Quad4 facet that is not a parallelogram (its projection onto the
+//!    auxiliary plane) has a bilinear map that is not affine, and a Tri6 whose projected
+//!    mid-edge nodes are not the midpoints of its corners (curved) a quadratic one; the
 //!    natural coordinates of a plane point are then not polynomials in it, no triangle rule is
 //!    exact, and the pair is integrated with the collapsed 8 x 8 product (degree 14,
 //!    [`NON_AFFINE_POINTS`]): its integrals agree with a 20 x 20 product to round-off on
@@ -53,8 +56,8 @@
 //!    slave facets, Puso and Laursen's approximation otherwise).
 //! 5. **Back to the facets.** Each Gauss point `p` of the plane maps to the slave and master
 //!    natural coordinates by inverting the projected facet map `xi -> P(x(xi))`: in closed form
-//!    for Tri3 (affine), by Newton for Quad4 and Quad9 from the centre of the piece the point
-//!    lies in (converged to `1e-13` in `xi`, at most 50 steps, a failure is an error naming
+//!    for Tri3 (affine), by Newton for Quad4, Quad9 and Tri6 from the centre of the piece the
+//!    point lies in (converged to `1e-13` in `xi`, at most 50 steps, a failure is an error naming
 //!    the facets).
 //!
 //! **Quad9 facets** (Hex27) are segmented by their four sub-quadrilaterals through the mid-edge
@@ -62,17 +65,41 @@
 //! for quadratic elements and large deformations", CMAME 197 (2008)): each slave piece clips
 //! each master piece, and the cells are integrated with the full biquadratic shape functions.
 //! Exact for straight-edged facets (every facet of `mesh::block3`); on curved facets the
-//! pieces' chords stand for the curved edges.
+//! pieces' chords stand for the curved edges. **Tri6 facets** (Tet10) are segmented the same
+//! way, by their four sub-triangles through the mid-edge nodes (`0 3 5`, `3 1 4`, `5 4 2`,
+//! `3 4 5`), integrated with the full quadratic shape functions.
 //!
-//! **Multipliers.** Standard: `Phi_j = N_j`. Dual: `Phi_j = sum_k a_jk N_k` per slave facet,
-//! `A_e = D_e M_e^-1` with `D_e = diag(int_e N_k dA)` and `M_e = [int_e N_j N_k dA]` over the
-//! whole facet in the same (auxiliary-plane) measure (Gauss 3x3 for Quad4, 4x4 for Quad9,
-//! degree 2 for Tri3),
-//! so `int_e Psi_j N_k dA = delta_jk int_e N_k dA` and `D` is diagonal where the slave facet is
-//! covered. On affine facets this is `Psi_j = 4 N_j - 1` (Tri3) and
-//! `a = [[4, -2, 1, -2], ...]` (Quad4, the nodal pattern of `4 N_j - 2 N_{j+1} + N_{j+2} -
-//! 2 N_{j+3}`). On facets whose map is not affine the cell quadrature of `D` is not exact, so
-//! biorthogonality then holds to the quadrature error only.
+//! **Multipliers.** Each slave facet has a multiplier basis `B_k`: its shape functions `N_k`
+//! on Quad4, Tri3 and Quad9; on Tri6 the modified basis `N~_k` (below). Standard: `Phi_j =
+//! B_j`. Dual: `Phi_j = Psi_j = sum_k a_jk B_k` per slave facet, `A_e = D_e M_e^-1` with `D_e
+//! = diag(int_e B_k dA)` and `M_e = [int_e B_j B_k dA]` over the whole facet in the same
+//! (auxiliary-plane) measure (Gauss 3x3 for Quad4, 4x4 for Quad9, degree 2 for Tri3, the
+//! collapsed 4 x 4 product (degree 6) for Tri6), so `int_e Psi_j B_k dA = delta_jk int_e B_k
+//! dA`; where the basis is the shape basis `D` is then diagonal where the slave facet is
+//! covered. On affine facets this is
+//! `Psi_j = 4 N_j - 1` (Tri3) and `a = [[4, -2, 1, -2], ...]` (Quad4, the nodal pattern of
+//! `4 N_j - 2 N_{j+1} + N_{j+2} - 2 N_{j+3}`). On facets whose map is not affine the cell
+//! quadrature of `D` is not exact, so biorthogonality then holds to the quadrature error only.
+//!
+//! **Tri6: the modified basis.** A Tri6 corner function integrates to zero over a flat
+//! triangle (`int N_v dA = 0`, `int N_e dA = A/3`), so with `B = N` a corner's row would have
+//! `A_j = sum_k D_jk = int N_j dA = 0` (no weight, no normalization) and the dual basis
+//! `D_e M_e^-1` would have a zero corner function. Both spaces are therefore built on the
+//! modified basis of Puso, Laursen and Solberg (CMAME 197 (2008)) and Popp, Wohlmuth,
+//! Gee and Wall ("Dual quadratic mortar finite element methods for 3D finite deformation
+//! contact", SIAM J. Sci. Comput. 34 (2012); the same `alpha = 1/5` in the 4C mortar
+//! library's `quad2D_modified`): `N~_v = N_v + (1/5) (N_e + N_e')` over the corner's two
+//! edges, `N~_e = (3/5) N_e`, [`super::geometry::TRI6_MODIFIED_ALPHA`], the basis of the
+//! node-based Tri6 nodal weights too. It is a partition of unity with `int N~_v dA = 2A/15`
+//! and `int N~_e dA = A/5` (positive). The displacement keeps the standard `N_k` on both
+//! sides, so `D_jk = int Phi_j N_k dA`, `M_jl = int Phi_j N^m_l dA`. Standard rows carry the
+//! multiplier mass `int N~_j N~_k dA` (not `D`). The dual basis is biorthogonal to `N~`, not
+//! to `N`: with `N = T^-1 N~` (`N_v = N~_v - (1/3) (N~_e + N~_e')`, `N_e = (5/3) N~_e`), a
+//! corner row of `D` is diagonal, `D_vv = int N~_v dA`, and a mid-edge row has `D_ee = (5/3)
+//! int N~_e dA` and `-(1/3) int N~_e dA` at the edge's two corners (Popp et al.'s `D` in the
+//! transformed displacement basis, here in the nodal one). `A_j = int Phi_j dA = int B_j dA`
+//! stays positive; the dual basis reproduces constants (`sum_j Psi_j = 1`), so a uniform
+//! pressure is a multiplier of the space and the contact patch test is passed.
 //!
 //! **Rows.** For slave node `j` with the slave surface's outward unit nodal normal `n_j` (an
 //! input: the caller owns nodal normals), the gap direction is `nu_j = -n_j` (from master to
@@ -84,17 +111,17 @@
 //! ```
 //!
 //! with `area = A_j` and, for standard multipliers, the multiplier mass line
-//! `mass = [(k, D_jk)]` (the row's own node first); dual rows carry none (lumped). The
+//! `mass = [(k, int Phi_j Phi_k dA)]` (the row's own node first; `D_jk` except on Tri6); dual
+//! rows carry none (lumped). The
 //! coefficients are the small-strain linearization: `D`, `M` and `nu` frozen at the reference
 //! configuration. Linear momentum: `sum_k D_jk = sum_l M_jl` at every slave node (both sides'
 //! shape functions sum to one at every Gauss point of every cell); angular momentum:
 //! `sum_k D_jk x_k = sum_l M_jl x_l` on flat coplanar interfaces (both facets reproduce the
 //! plane point at every Gauss point).
 //!
-//! Tri6 facets (Tet10) are refused with a reason: their dual basis needs the modified basis
-//! (vertex functions plus 1/5 of the adjacent edge functions) first, which is not built here.
-//! Quad9 needs none (its corner integrals `int N_k` are positive).
+//! Quad9 needs no modified basis (its corner integrals `int N_k dA` are positive).
 
+use super::geometry::FacetShape;
 use super::node_based_rows::{dominant_component, gradient_coefficients};
 use super::search::BucketGrid;
 use crate::contact::Constraint;
@@ -117,7 +144,8 @@ pub(crate) const CLIP_TOLERANCE: f64 = 1e-12;
 /// One side of a 3D interface: facets of one kind, their node ids and coordinates.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FacetSet3 {
-    /// The facets' 2D reference element (`Q4` = Quad4, `T3` = Tri3, `Q9` = Quad9).
+    /// The facets' 2D reference element (`Q4` = Quad4, `T3` = Tri3, `Q9` = Quad9, `T6` =
+    /// Tri6).
     pub kind: ElementKind,
     /// Node ids of each facet, in the reference element's order (counter-clockwise seen from
     /// outside the body, so `x_xi x x_eta` is the outward normal).
@@ -187,7 +215,7 @@ impl FacetSet3 {
     }
 
     /// The facet set of `facets` of a 3D mesh (node ids are the mesh's), or why not (see
-    /// [`FacetSet3::new`]; Tet10 bodies have Tri6 facets, refused).
+    /// [`FacetSet3::new`]).
     pub fn from_mesh(mesh: &Mesh3, facets: &[Facet]) -> Result<Self, String> {
         let ids: Vec<Vec<usize>> = facets.iter().map(|&f| mesh.facet_nodes(f)).collect();
         let coords = ids
@@ -219,13 +247,11 @@ impl FacetSet3 {
     }
 }
 
-/// Whether the 3D mortar is built for facets of `kind`, the reason where not.
+/// Whether the 3D mortar is built for facets of `kind`, the reason where not: it is built for
+/// every facet of the 3D elements (Quad4, Tri3, Quad9 and Tri6).
 pub fn supported(kind: ElementKind) -> Result<(), String> {
     match kind {
-        ElementKind::Q4 | ElementKind::T3 | ElementKind::Q9 => Ok(()),
-        ElementKind::T6 => Err(
-            "segment-based 3D mortar is built for Quad4, Tri3 and Quad9 facets; Tri6 facets (Tet10) are not built: their dual basis needs the modified basis (vertex + 1/5 of the adjacent edge functions) first; use Tet4, Hex8 or Hex27 bodies on the interface, or node-to-surface".into(),
-        ),
+        ElementKind::Q4 | ElementKind::T3 | ElementKind::Q9 | ElementKind::T6 => Ok(()),
     }
 }
 
@@ -248,6 +274,10 @@ pub struct MortarIntegrals3 {
     pub d: MortarMatrix3,
     /// `M_jl` (slave-master), by slave node `j`.
     pub m: MortarMatrix3,
+    /// The multiplier mass `int Phi_j Phi_k dA` (slave-slave) over the same cells, by slave
+    /// node `j`: `D` itself where the multiplier basis is the shape basis (standard
+    /// multipliers on Quad4, Tri3, Quad9), `int N~_j N~_k` for standard multipliers on Tri6.
+    pub multiplier_mass: MortarMatrix3,
     /// Every non-empty clip polygon.
     pub cells: Vec<IntegrationCell>,
 }
@@ -299,6 +329,16 @@ fn shape(kind: ElementKind, xi: [f64; 2]) -> ([f64; MAX_NODES], [[f64; 2]; MAX_N
     (n, dn)
 }
 
+/// The basis the multipliers of a slave facet are built on, at `xi` (module notes,
+/// **Multipliers**): the facet's shape functions `N_k`, except on Tri6, where it is the
+/// modified basis `N~` of [`FacetShape::weight_basis`] (corners `N_v + (N_e + N_e') / 5`,
+/// mid-edge nodes `3/5 N_e`).
+fn multiplier_basis(kind: ElementKind, xi: [f64; 2]) -> [f64; MAX_NODES] {
+    let mut m = [0.0; MAX_NODES];
+    <ElementKind as FacetShape<3>>::weight_basis(kind, xi, &mut m[..kind.node_count()]);
+    m
+}
+
 /// The centre `x(xi_c)` of a facet and its outward unit normal there, or why it has none.
 fn centre_and_normal(kind: ElementKind, xs: &[[f64; 3]]) -> Result<([f64; 3], [f64; 3]), String> {
     let (n, dn) = shape(kind, kind.centre());
@@ -339,7 +379,7 @@ fn planar_map(kind: ElementKind, q: &[[f64; 2]], xi: [f64; 2]) -> ([f64; 2], [[f
 }
 
 /// The natural coordinates of in-plane point `p` on the projected facet with nodes `q`:
-/// closed form for Tri3, Newton from `start` for Quad4 and Quad9. `None` if the map is
+/// closed form for Tri3, Newton from `start` for Quad4, Quad9 and Tri6. `None` if the map is
 /// singular or Newton does not converge.
 pub(crate) fn inverse_map(
     kind: ElementKind,
@@ -464,8 +504,10 @@ pub fn clip_convex_polygons(subject: &[[f64; 2]], window: &[[f64; 2]], tol: f64)
     merged
 }
 
-/// The dual coefficients `a_jk` of a slave facet whose projected corners are `q` (see the
-/// module notes): `A_e = D_e M_e^-1` over the facet in the auxiliary-plane measure.
+/// The dual coefficients `a_jk` of a slave facet whose projected nodes are `q` (see the
+/// module notes): `A_e = D_e M_e^-1` over the facet in the auxiliary-plane measure, on the
+/// multiplier basis (the shape functions `N_k`; the modified basis `N~_k` on Tri6), so
+/// `Psi_j = sum_k a_jk N_k` (`sum_k a_jk N~_k` on Tri6).
 pub fn dual_coefficients(
     kind: ElementKind,
     q: &[[f64; 2]],
@@ -473,16 +515,18 @@ pub fn dual_coefficients(
     supported(kind)?;
     let n = kind.node_count();
     // exact for N_j N_k |J| on straight-sided facets: degree 2 (Tri3), (3, 3) (Quad4),
-    // (7, 7) (Quad9)
+    // (7, 7) (Quad9); for Tri6 degree 6, exact also where the facet is curved in its plane
+    // (N~_j N~_k of degree 4 times |J| of degree 2)
     let rule: Vec<QuadPoint> = match kind {
         ElementKind::T3 => triangle_rule(2),
+        ElementKind::T6 => collapsed_triangle_rule(4),
         ElementKind::Q9 => gauss_square(4),
-        _ => gauss_square(3),
+        ElementKind::Q4 => gauss_square(3),
     };
     let mut mass = DMatrix::<f64>::zeros(n, n);
     let mut lumped = vec![0.0; n];
     for qp in &rule {
-        let (values, _) = shape(kind, qp.xi);
+        let values = multiplier_basis(kind, qp.xi);
         let (_, j) = planar_map(kind, q, qp.xi);
         let w = qp.weight * (j[0][0] * j[1][1] - j[0][1] * j[1][0]).abs();
         for a in 0..n {
@@ -505,10 +549,10 @@ pub fn dual_coefficients(
 }
 
 /// The pieces a facet is segmented by, each with its local nodes (counter-clockwise) and the
-/// natural point the inverse map starts from: the facet itself (Quad4, Tri3), or the four
-/// sub-quadrilaterals of a Quad9 through its mid-edge and centre nodes (Puso, Laursen and
-/// Solberg's segmentation of quadratic facets; exact for straight-edged facets, chords of
-/// curved ones).
+/// natural point the inverse map starts from (the piece's centre): the facet itself (Quad4,
+/// Tri3), the four sub-quadrilaterals of a Quad9 through its mid-edge and centre nodes, or
+/// the four sub-triangles of a Tri6 through its mid-edge nodes (Puso, Laursen and Solberg's
+/// segmentation of quadratic facets; exact for straight-edged facets, chords of curved ones).
 pub(crate) fn pieces(kind: ElementKind) -> &'static [(&'static [usize], [f64; 2])] {
     const QUAD4: [(&[usize], [f64; 2]); 1] = [(&[0, 1, 2, 3], [0.0, 0.0])];
     const TRI3: [(&[usize], [f64; 2]); 1] = [(&[0, 1, 2], [1.0 / 3.0, 1.0 / 3.0])];
@@ -518,9 +562,17 @@ pub(crate) fn pieces(kind: ElementKind) -> &'static [(&'static [usize], [f64; 2]
         (&[8, 5, 2, 6], [0.5, 0.5]),
         (&[7, 8, 6, 3], [-0.5, 0.5]),
     ];
+    // corners 0, 1, 2 at (0, 0), (1, 0), (0, 1); mid-edge nodes 3 (0-1), 4 (1-2), 5 (2-0)
+    const TRI6: [(&[usize], [f64; 2]); 4] = [
+        (&[0, 3, 5], [1.0 / 6.0, 1.0 / 6.0]),
+        (&[3, 1, 4], [2.0 / 3.0, 1.0 / 6.0]),
+        (&[5, 4, 2], [1.0 / 6.0, 2.0 / 3.0]),
+        (&[3, 4, 5], [1.0 / 3.0, 1.0 / 3.0]),
+    ];
     match kind {
         ElementKind::Q9 => &QUAD9,
-        ElementKind::T3 | ElementKind::T6 => &TRI3,
+        ElementKind::T6 => &TRI6,
+        ElementKind::T3 => &TRI3,
         ElementKind::Q4 => &QUAD4,
     }
 }
@@ -567,9 +619,9 @@ fn fan(polygon: &[[f64; 2]]) -> Vec<CellTriangle> {
 }
 
 /// The rule on each cell triangle (weights summing to 1/2): degree 2 between Tri3 facets,
-/// degree 5 (Radon's 7 points) where a Quad4 takes part, degree 8 where a Quad9 does
-/// (biquadratic times biquadratic: the collapsed 5 x 5 Gauss product, see
-/// [`collapsed_triangle_rule`]).
+/// degree 5 (Radon's 7 points) where a Quad4 or a Tri6 takes part and no Quad9 (at most
+/// quadratic times quadratic, degree 4), degree 8 where a Quad9 does (biquadratic times
+/// biquadratic: the collapsed 5 x 5 Gauss product, see [`collapsed_triangle_rule`]).
 pub(crate) fn cell_rule(slave: ElementKind, master: ElementKind) -> Vec<QuadPoint> {
     if slave == ElementKind::Q9 || master == ElementKind::Q9 {
         collapsed_triangle_rule(5)
@@ -581,13 +633,25 @@ pub(crate) fn cell_rule(slave: ElementKind, master: ElementKind) -> Vec<QuadPoin
 }
 
 /// Points per direction of the collapsed Gauss product for cells where a Quad4 facet that is
-/// not a parallelogram takes part (module notes, step 4).
+/// not a parallelogram or a curved Tri6 takes part (module notes, step 4).
 pub const NON_AFFINE_POINTS: usize = 8;
 
-/// Whether a facet's projected map (corner positions `q` on the auxiliary plane) is affine: a
+/// Whether a facet's projected map (node positions `q` on the auxiliary plane) is affine: a
 /// Tri3 always, a Quad4 when it is a parallelogram (`q0 - q1 + q2 - q3 = 0` to `1e-12` of its
-/// diameter). Quad9 facets keep their degree-8 rule on sub-quadrilaterals either way.
+/// diameter), a Tri6 when its mid-edge nodes are the midpoints of its corners (to `1e-12` of
+/// its diameter). Quad9 facets keep their degree-8 rule on sub-quadrilaterals either way.
 pub(crate) fn affine_in_plane(kind: ElementKind, q: &[[f64; 2]]) -> bool {
+    if kind == ElementKind::T6 {
+        let size = (0..3)
+            .flat_map(|a| (0..3).map(move |b| (a, b)))
+            .map(|(a, b)| (q[a][0] - q[b][0]).hypot(q[a][1] - q[b][1]))
+            .fold(0.0, f64::max);
+        // mid-edge node 3 + e joins corners e and e + 1
+        return (0..3).all(|e| {
+            let (a, b, m) = (q[e], q[(e + 1) % 3], q[3 + e]);
+            (m[0] - 0.5 * (a[0] + b[0])).hypot(m[1] - 0.5 * (a[1] + b[1])) <= 1e-12 * size
+        });
+    }
     if kind != ElementKind::Q4 {
         return true;
     }
@@ -639,7 +703,8 @@ pub fn mortar_integrals3(
 }
 
 /// [`mortar_integrals3`] with `non_affine_points` points per direction of the collapsed Gauss
-/// product on the cells of non-affine Quad4 pairs (module notes, step 4), to study that rule.
+/// product on the cells of non-affine Quad4 and Tri6 pairs (module notes, step 4), to study
+/// that rule.
 pub fn mortar_integrals3_with_points(
     slave: &FacetSet3,
     master: &FacetSet3,
@@ -671,6 +736,7 @@ pub fn mortar_integrals3_with_points(
     );
     let mut d: MortarMatrix3 = BTreeMap::new();
     let mut m: MortarMatrix3 = BTreeMap::new();
+    let mut multiplier_mass: MortarMatrix3 = BTreeMap::new();
     let mut cells = Vec::new();
     for (f, xs) in slave.coords.iter().enumerate() {
         let (origin, normal) = centre_and_normal(ks, xs)
@@ -699,6 +765,7 @@ pub fn mortar_integrals3_with_points(
         };
         let [lo, hi] = bounding_box(xs);
         let mut d_local = [[0.0; MAX_NODES]; MAX_NODES];
+        let mut mass_local = [[0.0; MAX_NODES]; MAX_NODES];
         let mut m_local: Vec<(usize, [[f64; MAX_NODES]; MAX_NODES])> = Vec::new();
         // the cube about the slave box's centre holds the box; keep the boxes that meet it
         let centre: [f64; 3] = std::array::from_fn(|i| 0.5 * (lo[i] + hi[i]));
@@ -750,10 +817,12 @@ pub fn mortar_integrals3_with_points(
                             })?;
                             let (n_s, _) = shape(ks, xi_s);
                             let (n_m, _) = shape(km, xi_m);
-                            let phi = multiplier_values(ns, &n_s, phi_of.as_ref());
+                            let basis = multiplier_basis(ks, xi_s);
+                            let phi = multiplier_values(ns, &basis, phi_of.as_ref());
                             for j in 0..ns {
                                 for k in 0..ns {
                                     d_local[j][k] += w * phi[j] * n_s[k];
+                                    mass_local[j][k] += w * phi[j] * phi[k];
                                 }
                                 for l in 0..nm {
                                     m_facet[j][l] += w * phi[j] * n_m[l];
@@ -782,6 +851,10 @@ pub fn mortar_integrals3_with_points(
             for k in 0..ns {
                 *dj.entry(ids[k]).or_default() += d_local[j][k];
             }
+            let mass_j = multiplier_mass.entry(ids[j]).or_default();
+            for k in 0..ns {
+                *mass_j.entry(ids[k]).or_default() += mass_local[j][k];
+            }
             let mj = m.entry(ids[j]).or_default();
             for (c, m_facet) in &m_local {
                 for l in 0..nm {
@@ -790,11 +863,16 @@ pub fn mortar_integrals3_with_points(
             }
         }
     }
-    Ok(MortarIntegrals3 { d, m, cells })
+    Ok(MortarIntegrals3 {
+        d,
+        m,
+        multiplier_mass,
+        cells,
+    })
 }
 
-/// The multiplier functions at a point with slave shape values `n`: `N` itself (standard) or
-/// `sum_k a_jk N_k` (dual).
+/// The multiplier functions at a point with multiplier-basis values `n` (the shape functions,
+/// the modified basis on Tri6): `n` itself (standard) or `sum_k a_jk n_k` (dual).
 fn multiplier_values(
     ns: usize,
     n: &[f64; MAX_NODES],
@@ -896,6 +974,11 @@ pub fn mortar_rows3(
             .map(|mj| mj.iter().map(|(&l, &v)| (l, v / area)).collect())
             .unwrap_or_default();
         let mass: Vec<(usize, f64)> = match space {
+            // Tri6: the modified basis is not the shape basis, the mass is not D
+            MultiplierSpace::Standard if slave.kind == ElementKind::T6 => slave_terms
+                .iter()
+                .map(|&(k, _)| (k, integrals.multiplier_mass[&j][&k]))
+                .collect(),
             MultiplierSpace::Standard => slave_terms.iter().map(|&(k, w)| (k, w * area)).collect(),
             MultiplierSpace::Dual => Vec::new(),
         };

@@ -31,7 +31,8 @@
 //! of the frame of its nodal normal): a mortar row `g_j = nu_j . (sum_k D_jk u_k - sum_l M_jl
 //! u_l) / A_j` is a row with several slave terms, and its weights `D_jk / A_j`, `M_jl / A_j` are
 //! recovered from its coefficients on its dominant component as for a node-based row (the
-//! standard multipliers' `D_jk` couple several slave nodes; the dual ones' are diagonal). Its
+//! standard multipliers' `D_jk` couple several slave nodes; the dual ones' are diagonal, but
+//! for the mid-edge rows of Tri6 facets, see [`super::mortar3`]). Its
 //! tributary area is `A_j = sum_k D_jk`, the tangential penalty's `w_t = kappa_t A_j` as in 2D.
 //!
 //! Small strain: the geometry is taken once in the reference configuration. Finite kinematics
