@@ -403,7 +403,19 @@ fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
                         ));
                     }
                 }
-                DiscretizationSpec::Mortar { .. } => {}
+                DiscretizationSpec::Mortar { .. } => {
+                    if let Some(body) = finite_mortar_on_tri6(model, pair) {
+                        return Err(not_built(
+                            source,
+                            format!("{at}.discretization"),
+                            &format!(
+                                "mortar on the Tri6 facets of body '{}' (Tet10) under finite kinematics (the rows' second derivative covers Quad4, Tri3 and Quad9 facets)",
+                                model.bodies[body].name
+                            ),
+                            "use node-to-surface for this pair, or Hex8, Hex27 or Tet4 bodies",
+                        ));
+                    }
+                }
             }
         }
         if pair.interaction == Interaction::Tied {
@@ -443,6 +455,23 @@ fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// The body of a mortar pair whose contact facets are Tri6, if any (finite-strain mortar rows
+/// are not built on them: `mortar3_linearization` covers Quad4, Tri3 and Quad9).
+fn finite_mortar_on_tri6(model: &Model3, pair: &crate::model::ContactPair) -> Option<usize> {
+    use crate::contact::discretization::mortar3::FacetSet3;
+    let MasterSide::Body { body, facets } = &pair.master else {
+        return None;
+    };
+    let (slave_body, slave_facets) = &pair.slave;
+    [(*slave_body, slave_facets), (*body, facets)]
+        .into_iter()
+        .find(|(b, f)| {
+            FacetSet3::from_mesh(&model.bodies[*b].mesh, f)
+                .is_ok_and(|set| set.kind == crate::fe::ElementKind::T6)
+        })
+        .map(|(b, _)| b)
 }
 
 /// Whether the node-to-node pair `pair` between bodies matches node for node in the reference

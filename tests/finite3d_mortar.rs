@@ -398,8 +398,7 @@ fn mortar(multiplier: &str) -> Value {
 
 /// The mortar two-block patch test at finite strain (matching Hex8 grids, 20 % compression,
 /// Lagrange multipliers), standard and dual multipliers: the uniform uniaxial Cauchy stress at
-/// every quadrature point of both bodies to 1e-10 of `sigma_zz`. (The non-matching interface
-/// [`OFFSET`] did not finish within 14 minutes of one core, not diagnosed: not asserted.)
+/// every quadrature point of both bodies to 1e-10 of `sigma_zz`.
 #[test]
 fn mortar_passes_the_two_block_patch_test() {
     for multiplier in ["standard", "dual"] {
@@ -407,6 +406,44 @@ fn mortar_passes_the_two_block_patch_test() {
         let error = patch_test(mortar(multiplier), &MATCHING, &label);
         assert!(error < 1e-10, "{label}: {error:e}");
     }
+}
+
+/// The mortar two-block patch test on a non-matching interface (the punch's nodes on
+/// [`OFFSET`], off the base's nodes and edges), standard and dual multipliers: the uniform
+/// uniaxial Cauchy stress to 1e-10 of `sigma_zz`.
+#[test]
+fn mortar_passes_the_non_matching_two_block_patch_test() {
+    for multiplier in ["standard", "dual"] {
+        let label = format!("mortar {multiplier} non-matching");
+        let error = patch_test(mortar(multiplier), &OFFSET, &label);
+        assert!(error < 1e-10, "{label}: {error:e}");
+    }
+}
+
+/// Mortar on Tri6 facets (Tet10 bodies) under finite kinematics is refused before the solve,
+/// with the reason (the rows' second derivative covers Quad4, Tri3 and Quad9 facets).
+#[test]
+fn mortar_on_tri6_facets_is_refused() {
+    let mut case = stacked(
+        &MATCHING,
+        &MATCHING,
+        mortar("standard"),
+        json!({"kind": "lagrange"}),
+        -0.4,
+        4,
+    );
+    for b in 0..2 {
+        case["bodies"][b]["mesh"]["block3d"]["element"] = json!("Tet10");
+    }
+    let err = build3(&parse(&case), "finite3d_mortar")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("contact[0] 'interface'.discretization")
+            && err.contains("Tri6")
+            && err.contains("not built"),
+        "{err}"
+    );
 }
 
 /// The Newton tangent with mortar rows (the weighted gap's Hessian: auxiliary planes,
@@ -435,10 +472,8 @@ fn the_newton_tangent_with_mortar_rows_is_the_difference_of_the_residual() {
 }
 
 /// Mortar: the clamped, bulging pair (matching interface) turned by 60 degrees gives the
-/// turned answer (1e-8), standard multipliers. Not verified yet: the two solves did not
-/// finish within 12 minutes of one core (not diagnosed); run with `--ignored`.
+/// turned answer (1e-8), standard multipliers.
 #[test]
-#[ignore = "not verified: the two solves did not finish within 12 minutes of one core"]
 fn a_large_rotation_of_the_mortar_pair_rotates_the_answer() {
     let multiplier = "standard";
     let (u, s) = rotation_errors(
