@@ -30,8 +30,8 @@
 //! and dual, on Quad4, Tri3 and Quad9 facets (the weighted gap's exact gradient and Hessian
 //! through the auxiliary plane, the clipping and the projections,
 //! `contact::discretization::mortar3_linearization`), every enforcement method of the 2D
-//! Newton scheme. Refused with the reason: tied pairs under finite kinematics, contact
-//! without the Newton scheme, the current geometry or the geometric stiffness. The stress of the checks and the `.vtu` is
+//! Newton scheme. Refused with the reason: tied pairs under finite kinematics, mortar on
+//! Tri6 facets (Tet10 bodies) under finite kinematics, contact without the Newton scheme, the current geometry or the geometric stiffness. The stress of the checks and the `.vtu` is
 //! then the Cauchy stress `F S F^T / J`, at the reference positions of the points.
 //!
 //! Coulomb friction (issue 13, build item 4) runs through the 2D code path: the Newton scheme
