@@ -23,11 +23,15 @@
 //! bodies by node-to-surface with master normals, one or two passes, each row carrying the
 //! second derivative of its gap over the slave node and the master facet's nodes (closest
 //! points inside facets, on edges and at corners,
-//! [`crate::contact::discretization::facet_gap_hessian`]; Wriggers 2006, section 4.3), every
-//! enforcement method of the 2D Newton scheme. Refused with the reason: mortar and node-to-node
-//! between 3D bodies (their second-order terms are not built in 3D) and tied pairs under finite
-//! kinematics, contact without the Newton scheme, the current geometry or the geometric
-//! stiffness. The stress of the checks and the `.vtu` is
+//! [`crate::contact::discretization::facet_gap_hessian`]; Wriggers 2006, section 4.3), by
+//! node-to-node on interfaces that match in the reference configuration (the gap along the
+//! master's nodal normal, its variation included,
+//! [`crate::contact::discretization::nodal_normal3`]) and by segment-based mortar, standard
+//! and dual, on Quad4, Tri3 and Quad9 facets (the weighted gap's exact gradient and Hessian
+//! through the auxiliary plane, the clipping and the projections,
+//! `contact::discretization::mortar3_linearization`), every enforcement method of the 2D
+//! Newton scheme. Refused with the reason: tied pairs under finite kinematics, mortar on
+//! Tri6 facets (Tet10 bodies) under finite kinematics, contact without the Newton scheme, the current geometry or the geometric stiffness. The stress of the checks and the `.vtu` is
 //! then the Cauchy stress `F S F^T / J`, at the reference positions of the points.
 //!
 //! Coulomb friction (issue 13, build item 4) runs through the 2D code path: the Newton scheme
@@ -377,8 +381,9 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
 }
 
 /// What finite kinematics solves in 3D, refused otherwise with the reason: frictionless
-/// contact against rigid masters and node-to-surface contact between bodies (master normals,
-/// one or two passes), by the Newton scheme in the current geometry with the full tangent.
+/// contact against rigid masters and between bodies (node-to-surface with master normals, one
+/// or two passes; node-to-node on interfaces that match node for node in the reference
+/// configuration; mortar), by the Newton scheme in the current geometry with the full tangent.
 fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
     let source = &model.source;
     for (k, pair) in model.contact.iter().enumerate() {
@@ -387,20 +392,29 @@ fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
             match pair.discretization {
                 DiscretizationSpec::NodeToSurface { .. } => {}
                 DiscretizationSpec::NodeToNode => {
-                    return Err(not_built(
-                        source,
-                        format!("{at}.discretization"),
-                        "node-to-node contact between deformable bodies under finite kinematics (the variation of the master's nodal normal is not linearized)",
-                        "use {\"kind\": \"node_to_surface\"}, or small-strain kinematics",
-                    ))
+                    // the current configuration pairs the nodes by proximity: the reference
+                    // configuration must match node for node
+                    if let Err(reason) = reference_nodes_match(model, pair) {
+                        return Err(Error::invalid(
+                            source,
+                            format!("{at}.discretization"),
+                            format!("the discretization does not apply: {reason}"),
+                            "choose another discretization for this pair",
+                        ));
+                    }
                 }
                 DiscretizationSpec::Mortar { .. } => {
-                    return Err(not_built(
-                        source,
-                        format!("{at}.discretization"),
-                        "mortar contact between deformable bodies under finite kinematics (the second derivative of the 3D segments' weighted gap is not built)",
-                        "use {\"kind\": \"node_to_surface\"}, or small-strain kinematics",
-                    ))
+                    if let Some(body) = finite_mortar_on_tri6(model, pair) {
+                        return Err(not_built(
+                            source,
+                            format!("{at}.discretization"),
+                            &format!(
+                                "mortar on the Tri6 facets of body '{}' (Tet10) under finite kinematics (the rows' second derivative covers Quad4, Tri3 and Quad9 facets)",
+                                model.bodies[body].name
+                            ),
+                            "use node-to-surface for this pair, or Hex8, Hex27 or Tet4 bodies",
+                        ));
+                    }
                 }
             }
         }
@@ -441,6 +455,49 @@ fn check_finite3(model: &Model3, case: &Case) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// The body of a mortar pair whose contact facets are Tri6, if any (finite-strain mortar rows
+/// are not built on them: `mortar3_linearization` covers Quad4, Tri3 and Quad9).
+fn finite_mortar_on_tri6(model: &Model3, pair: &crate::model::ContactPair) -> Option<usize> {
+    use crate::contact::discretization::mortar3::FacetSet3;
+    let MasterSide::Body { body, facets } = &pair.master else {
+        return None;
+    };
+    let (slave_body, slave_facets) = &pair.slave;
+    [(*slave_body, slave_facets), (*body, facets)]
+        .into_iter()
+        .find(|(b, f)| {
+            FacetSet3::from_mesh(&model.bodies[*b].mesh, f)
+                .is_ok_and(|set| set.kind == crate::fe::ElementKind::T6)
+        })
+        .map(|(b, _)| b)
+}
+
+/// Whether the node-to-node pair `pair` between bodies matches node for node in the reference
+/// configuration (the small-strain pairing, to `1e-9` of the master surface's size), the reason
+/// where it does not.
+fn reference_nodes_match(
+    model: &Model3,
+    pair: &crate::model::ContactPair,
+) -> std::result::Result<(), String> {
+    use crate::contact::discretization::geometry::Surface3;
+    use crate::contact::discretization::node_based_rows::{node_to_node_rows, RowSettings};
+    let MasterSide::Body { body, facets } = &pair.master else {
+        return Ok(());
+    };
+    let (slave_body, slave_facets) = &pair.slave;
+    let slave =
+        Surface3::from_solid_mesh(*slave_body, &model.bodies[*slave_body].mesh, slave_facets);
+    let master = Surface3::from_solid_mesh(*body, &model.bodies[*body].mesh, facets);
+    let numbering = |b: usize, n: usize, c: usize| model.bodies[b].dof(n, c);
+    let settings = RowSettings {
+        dofs: &numbering,
+        pair: 0,
+        search_distance: pair.search_distance,
+        current_finite: false,
+    };
+    node_to_node_rows(&slave, &master, &settings).map(|_| ())
 }
 
 /// The material `name` of the case, validated: its small-strain elasticity, and its

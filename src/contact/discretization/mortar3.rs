@@ -139,7 +139,7 @@ const NEWTON_TOLERANCE: f64 = 1e-13;
 /// Largest number of Newton steps of the inverse Quad4 and Quad9 maps.
 const NEWTON_STEPS: usize = 50;
 /// Relative size (of the slave facet's diameter) below which polygon vertices coincide.
-const CLIP_TOLERANCE: f64 = 1e-12;
+pub(crate) const CLIP_TOLERANCE: f64 = 1e-12;
 
 /// One side of a 3D interface: facets of one kind, their node ids and coordinates.
 #[derive(Clone, Debug, PartialEq)]
@@ -381,7 +381,7 @@ fn planar_map(kind: ElementKind, q: &[[f64; 2]], xi: [f64; 2]) -> ([f64; 2], [[f
 /// The natural coordinates of in-plane point `p` on the projected facet with nodes `q`:
 /// closed form for Tri3, Newton from `start` for Quad4, Quad9 and Tri6. `None` if the map is
 /// singular or Newton does not converge.
-fn inverse_map(
+pub(crate) fn inverse_map(
     kind: ElementKind,
     q: &[[f64; 2]],
     p: [f64; 2],
@@ -424,7 +424,7 @@ fn inverse_map(
 }
 
 /// Twice the signed area of a planar polygon (positive counter-clockwise).
-fn twice_signed_area(polygon: &[[f64; 2]]) -> f64 {
+pub(crate) fn twice_signed_area(polygon: &[[f64; 2]]) -> f64 {
     let k = polygon.len();
     (0..k)
         .map(|i| {
@@ -436,7 +436,7 @@ fn twice_signed_area(polygon: &[[f64; 2]]) -> f64 {
 
 /// Whether a counter-clockwise polygon is strictly convex (every turn to the left, beyond
 /// `tol` times the edge lengths' product).
-fn is_convex(polygon: &[[f64; 2]], tol: f64) -> bool {
+pub(crate) fn is_convex(polygon: &[[f64; 2]], tol: f64) -> bool {
     let k = polygon.len();
     (0..k).all(|i| {
         let (a, b, c) = (polygon[i], polygon[(i + 1) % k], polygon[(i + 2) % k]);
@@ -553,7 +553,7 @@ pub fn dual_coefficients(
 /// Tri3), the four sub-quadrilaterals of a Quad9 through its mid-edge and centre nodes, or
 /// the four sub-triangles of a Tri6 through its mid-edge nodes (Puso, Laursen and Solberg's
 /// segmentation of quadratic facets; exact for straight-edged facets, chords of curved ones).
-fn pieces(kind: ElementKind) -> &'static [(&'static [usize], [f64; 2])] {
+pub(crate) fn pieces(kind: ElementKind) -> &'static [(&'static [usize], [f64; 2])] {
     const QUAD4: [(&[usize], [f64; 2]); 1] = [(&[0, 1, 2, 3], [0.0, 0.0])];
     const TRI3: [(&[usize], [f64; 2]); 1] = [(&[0, 1, 2], [1.0 / 3.0, 1.0 / 3.0])];
     const QUAD9: [(&[usize], [f64; 2]); 4] = [
@@ -622,7 +622,7 @@ fn fan(polygon: &[[f64; 2]]) -> Vec<CellTriangle> {
 /// degree 5 (Radon's 7 points) where a Quad4 or a Tri6 takes part and no Quad9 (at most
 /// quadratic times quadratic, degree 4), degree 8 where a Quad9 does (biquadratic times
 /// biquadratic: the collapsed 5 x 5 Gauss product, see [`collapsed_triangle_rule`]).
-fn cell_rule(slave: ElementKind, master: ElementKind) -> Vec<QuadPoint> {
+pub(crate) fn cell_rule(slave: ElementKind, master: ElementKind) -> Vec<QuadPoint> {
     if slave == ElementKind::Q9 || master == ElementKind::Q9 {
         collapsed_triangle_rule(5)
     } else if slave == ElementKind::T3 && master == ElementKind::T3 {
@@ -640,7 +640,7 @@ pub const NON_AFFINE_POINTS: usize = 8;
 /// Tri3 always, a Quad4 when it is a parallelogram (`q0 - q1 + q2 - q3 = 0` to `1e-12` of its
 /// diameter), a Tri6 when its mid-edge nodes are the midpoints of its corners (to `1e-12` of
 /// its diameter). Quad9 facets keep their degree-8 rule on sub-quadrilaterals either way.
-fn affine_in_plane(kind: ElementKind, q: &[[f64; 2]]) -> bool {
+pub(crate) fn affine_in_plane(kind: ElementKind, q: &[[f64; 2]]) -> bool {
     if kind == ElementKind::T6 {
         let size = (0..3)
             .flat_map(|a| (0..3).map(move |b| (a, b)))

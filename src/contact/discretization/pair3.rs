@@ -36,17 +36,23 @@
 //! tributary area is `A_j = sum_k D_jk`, the tangential penalty's `w_t = kappa_t A_j` as in 2D.
 //!
 //! Small strain: the geometry is taken once in the reference configuration. Finite kinematics
-//! builds the rows in the current configuration (the model's nodes moved), and node-to-surface
-//! rows then carry their gap's second derivative ([`super::facet_gap_hessian`]). Slave normals
-//! and mortar against rigid surfaces are not built in 3D and are refused with the reason.
+//! builds the rows in the current configuration (the model's nodes moved), and the rows
+//! between bodies then carry their gap's exact gradient and second derivative:
+//! node-to-surface ([`super::facet_gap_hessian`]), node-to-node (nodes paired by proximity,
+//! the master's nodal normal varied, [`super::nodal_normal3`]) and mortar (the weighted gap
+//! through the auxiliary plane, the clipping and the projections,
+//! `super::mortar3_linearization`). Slave normals and mortar against rigid surfaces are not
+//! built in 3D and are refused with the reason.
 
 use super::geometry::Surface3;
 use super::mortar3::{mortar_rows3, FacetSet3, RowNumbering};
+use super::mortar3_linearization::linearize_rows3;
+use super::nodal_normal3::node_to_node_current_rows;
 use super::node_based_rows::{
     dominant_component, gradient_coefficients, node_to_node_rows, node_to_surface_rows, rigid_rows,
     RigidMaster, RowSettings,
 };
-use crate::contact::{Constraint, TangentRow};
+use crate::contact::{Constraint, GapHessian, TangentRow};
 use crate::io::scene::{
     ContactGeometry, DiscretizationSpec, Interaction, Kinematics, NormalChoice, RigidSurface,
 };
@@ -91,6 +97,9 @@ pub fn pair_rows(model: &Model3, pair: &ContactPair) -> Result<Vec<Constraint<3>
                         return Err("slave normals in 3D are not built yet: use \"normal\": \"master\"".into());
                     }
                     node_to_surface_rows(&slave, &master, *passes, &settings)?
+                }
+                DiscretizationSpec::NodeToNode if settings.current_finite => {
+                    node_to_node_current_rows(&slave, &master, &settings)?
                 }
                 DiscretizationSpec::NodeToNode => node_to_node_rows(&slave, &master, &settings)?,
                 DiscretizationSpec::Mortar { multiplier } => {
@@ -224,7 +233,7 @@ fn mortar(
         master_dof: &master_dof,
         tied,
     };
-    let (rows, _) = mortar_rows3(
+    let (mut rows, integrals) = mortar_rows3(
         &slave_set,
         &master_set,
         multiplier,
@@ -232,6 +241,38 @@ fn mortar(
         &numbering,
         pair.search_distance,
     )?;
+    let finite = model.physics.kinematics == Kinematics::Finite
+        && model.physics.contact_geometry == ContactGeometry::Current;
+    if finite && !tied {
+        // finite kinematics: each row's exact gradient and the second derivative of its gap
+        // (segmentation, projections and nodal normal varied)
+        let nodes: Vec<usize> = rows.iter().map(|r| r.slave_node).collect();
+        let linearized = linearize_rows3(
+            &slave_set,
+            &master_set,
+            multiplier,
+            &integrals,
+            &nodes,
+            &slave_dof,
+            &master_dof,
+        )?;
+        for row in &mut rows {
+            let lin = &linearized[&row.slave_node];
+            row.g0 = lin.gap;
+            row.dofs.clear();
+            row.coeffs.clear();
+            for (&d, &c) in lin.dofs.iter().zip(&lin.gradient) {
+                if c != 0.0 {
+                    row.dofs.push(d);
+                    row.coeffs.push(c);
+                }
+            }
+            row.hessian = Some(GapHessian {
+                dofs: lin.dofs.clone(),
+                values: lin.hessian.clone(),
+            });
+        }
+    }
     Ok(rows)
 }
 
