@@ -151,6 +151,7 @@ use super::linear::{assemble, finish, max_abs, LinearSystem, Solution, Timings, 
 use super::newton::{self, Evaluation, System, Tangent};
 use super::sparse::{GeneralPattern, PatternBuilder, SymmetricPattern};
 use crate::contact::discretization::nodal_normal::RowCurvature;
+use crate::contact::discretization::OUT_OF_REACH;
 use crate::contact::discretization::{row_curvature, Discretize};
 use crate::contact::enforcement::{method, Method};
 use crate::contact::friction::{
@@ -1097,13 +1098,22 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
                 // rows at the step's start, so the reason is the diverging iterate, not
                 // surfaces that never meet: say so, with how far the iterate moved
                 Err(e) if self.model.physics.kinematics == Kinematics::Finite => {
-                    self.inverted = Some(diverged_off_master(
-                        &e,
-                        self.evaluations,
-                        &self.step_start,
-                        &u,
-                        self.model.size(),
-                    ));
+                    self.inverted = Some(match &e {
+                        crate::error::Error::Invalid { problem, .. }
+                            if problem.starts_with(OUT_OF_REACH) =>
+                        {
+                            diverged_off_master(
+                                &e,
+                                self.evaluations,
+                                &self.step_start,
+                                &u,
+                                self.model.size(),
+                            )
+                        }
+                        // another reason the rows cannot be built there (e.g. node-to-node
+                        // nodes that no longer match): that reason
+                        _ => format!("at a Newton iterate, {e}"),
+                    });
                     residual.iter_mut().for_each(|v| *v = f64::NAN);
                     return Ok(Evaluation {
                         force_scale: 1.0,
@@ -1758,8 +1768,8 @@ pub(crate) fn solve_step<const D: usize, K: NewtonDimension<D>>(
     Ok(solution)
 }
 
-/// Why a load step failed when the rows of a contact pair could not be built at Newton
-/// iterate `evaluation` (`error`, from [`rows_at`]): the pair had rows at the step's start
+/// Why a load step failed when a contact pair had no slave node within reach of its master at
+/// Newton iterate `evaluation` (`error`, from [`rows_at`], beginning [`OUT_OF_REACH`]): the pair had rows at the step's start
 /// (`start`), so the iterate `u` carried its slave nodes out of reach of the master: the
 /// iteration diverged. The message says so and how far the iterate moved (largest nodal
 /// displacement change, and as a fraction of the model size `size`), rather than the

@@ -49,6 +49,11 @@ pub mod node_to_segment;
 pub mod pair3;
 pub mod search;
 
+/// How the error of a pair with no slave node near its master begins (both dimensions): a
+/// Newton iterate that carries every slave node away gets it, which the Newton scheme reports
+/// as a diverging iterate (`solver::contact_newton`).
+pub(crate) const OUT_OF_REACH: &str = "no slave node lies within the search distance";
+
 use crate::contact::Constraint;
 use crate::io::scene::{
     DiscretizationSpec, Interaction, Kinematics, NormalChoice, RigidSurface, SlaveNormalVariation,
@@ -294,8 +299,10 @@ pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>,
     }
     if rows.out.is_empty() {
         return Err(format!(
-            "no slave node lies within the search distance ({}) of the master surface, so the pair could never act",
-            pair.search_distance.map(|d| d.to_string()).unwrap_or_else(|| "the largest master facet".into())
+            "{OUT_OF_REACH} ({}) of the master surface, so the pair could never act",
+            pair.search_distance
+                .map(|d| d.to_string())
+                .unwrap_or_else(|| "the largest master facet".into())
         ));
     }
     if let Some(bad) = rows.out.iter().find(|r| {

@@ -236,7 +236,8 @@ fn checked<const D: usize>(
 ) -> Result<Vec<Constraint<D>>, String> {
     if rows.is_empty() {
         return Err(format!(
-            "no slave node lies within the search distance ({}) of the master surface, so the pair could never act; check that the surfaces face each other or give a larger search_distance",
+            "{} ({}) of the master surface, so the pair could never act; check that the surfaces face each other or give a larger search_distance",
+            super::OUT_OF_REACH,
             search_distance
                 .map(|d| d.to_string())
                 .unwrap_or_else(|| "the largest master facet".into())
