@@ -542,18 +542,28 @@ mod tests {
         b.build()
     }
 
+    /// `order` holds each of the `n` equations once and each node's `dofs` equations together,
+    /// in turn.
+    fn assert_node_order(order: &[usize], n: usize, dofs: usize) {
+        let mut sorted = order.to_vec();
+        sorted.sort_unstable();
+        assert_eq!(
+            sorted,
+            (0..n).collect::<Vec<_>>(),
+            "not a permutation of {n}"
+        );
+        for chunk in order.chunks(dofs) {
+            assert_eq!(chunk[0] % dofs, 0);
+            assert!(chunk.windows(2).all(|w| w[1] == w[0] + 1));
+        }
+    }
+
     #[test]
     fn the_order_is_a_permutation_keeping_each_node_s_dofs_together() {
         for (n, dofs) in [(1, 1), (7, 1), (20, 2), (33, 3)] {
             let p = grid(n, dofs);
             let order = nested_dissection(&p.view());
-            let mut sorted = order.clone();
-            sorted.sort_unstable();
-            assert_eq!(sorted, (0..p.n).collect::<Vec<_>>(), "n {n}");
-            for chunk in order.chunks(dofs) {
-                assert_eq!(chunk[0] % dofs, 0);
-                assert!(chunk.windows(2).all(|w| w[1] == w[0] + 1));
-            }
+            assert_node_order(&order, p.n, dofs);
         }
     }
 
@@ -562,13 +572,7 @@ mod tests {
         for (n, dofs) in [(1, 1), (7, 1), (20, 2), (33, 3)] {
             let p = grid(n, dofs);
             let order = metis_nested_dissection(&p.view()).expect("METIS orders a grid");
-            let mut sorted = order.clone();
-            sorted.sort_unstable();
-            assert_eq!(sorted, (0..p.n).collect::<Vec<_>>(), "n {n}");
-            for chunk in order.chunks(dofs) {
-                assert_eq!(chunk[0] % dofs, 0);
-                assert!(chunk.windows(2).all(|w| w[1] == w[0] + 1));
-            }
+            assert_node_order(&order, p.n, dofs);
         }
         let empty = Owned {
             n: 0,
@@ -637,13 +641,7 @@ mod tests {
         for (n, dofs) in [(1, 1), (7, 1), (20, 2), (33, 3)] {
             let p = grid(n, dofs);
             let order = coordinate_dissection(&p.view(), &grid_points(n, dofs)).unwrap();
-            let mut sorted = order.clone();
-            sorted.sort_unstable();
-            assert_eq!(sorted, (0..p.n).collect::<Vec<_>>(), "n {n}");
-            for chunk in order.chunks(dofs) {
-                assert_eq!(chunk[0] % dofs, 0);
-                assert!(chunk.windows(2).all(|w| w[1] == w[0] + 1));
-            }
+            assert_node_order(&order, p.n, dofs);
         }
     }
 
