@@ -24,13 +24,12 @@ use contact_patch::run3d::{build3, run_case3, Outcome3};
 use contact_patch::solid_finite::{lame, Hyperelastic};
 use contact_patch::solid_finite3::displacement_gradient_at3;
 use contact_patch::solver::linear::Solution;
-use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
+use nalgebra::{Matrix3, Vector3};
 use serde_json::{json, Value};
 
 mod finite_common;
+use finite_common::{lateral_stretch, rotation, to_matrix, E, NU};
 
-const E: f64 = 1000.0;
-const NU: f64 = 0.3;
 const ELEMENTS: [&str; 4] = ["Hex8", "Hex27", "Tet4", "Tet10"];
 const MATERIALS: [&str; 2] = ["neo_hookean", "saint_venant_kirchhoff"];
 
@@ -70,14 +69,6 @@ fn parse(case: &Value) -> contact_patch::io::scene::Case {
 
 fn run(case: &Value) -> Outcome3 {
     run_case3(&parse(case), "finite3d").unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn rotation(axis: [f64; 3], angle: f64) -> Matrix3<f64> {
-    Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::from(axis)), angle).into_inner()
-}
-
-fn to_matrix(s: [f64; 6]) -> Matrix3<f64> {
-    Matrix3::new(s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2])
 }
 
 /// `F` and the Cauchy stress (Voigt) at every stiffness quadrature point of every cell.
@@ -230,22 +221,6 @@ fn a_homogeneous_deformation_is_exact_and_objective_on_distorted_meshes() {
             }
         }
     }
-}
-
-/// The lateral stretch `b` of a neo-Hookean bar stretched by `a` with free lateral faces:
-/// `sigma_xx = (mu (b^2 - 1) + lambda ln(a b^2)) / J = 0`, by bisection.
-fn lateral_stretch(a: f64) -> f64 {
-    let (lambda, mu) = lame(E, NU);
-    let (mut lo, mut hi) = (0.1, 3.0);
-    for _ in 0..200 {
-        let m = 0.5 * (lo + hi);
-        if mu * (m * m - 1.0) + lambda * (a * m * m).ln() > 0.0 {
-            hi = m;
-        } else {
-            lo = m;
-        }
-    }
-    0.5 * (lo + hi)
 }
 
 /// A neo-Hookean unit cube stretched by 50 % in z (top prescribed, rollers on the bottom,
@@ -1135,31 +1110,8 @@ fn clamped(enforcement: Value, r: &Matrix3<f64>) -> (Model3, Solution<3>) {
         {"body": "base", "set": "bottom", "x": 0.0, "y": 0.0, "z": 0.0},
         {"body": "punch", "set": "top", "x": 0.0, "y": 0.0, "z": 0.0}
     ]);
-    let mut model = build3(&parse(&case), "finite3d").unwrap();
-    for body in &mut model.bodies {
-        for p in &mut body.mesh.nodes {
-            let turned = r * Vector3::from(*p);
-            *p = [turned[0], turned[1], turned[2]];
-        }
-    }
-    let a = r * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 0.85)) * r.transpose();
-    for (b, set) in [(0, "bottom"), (1, "top")] {
-        let body = &model.bodies[b];
-        let moves: Vec<(usize, f64)> = body.mesh.node_sets[set]
-            .iter()
-            .flat_map(|&n| {
-                let x = Vector3::from(body.mesh.nodes[n]);
-                let u = a * x - x;
-                (0..3).map(move |i| (body.dof(n, i), u[i]))
-            })
-            .collect();
-        for (d, v) in moves {
-            model.prescribed[d] = Some(v);
-        }
-    }
-    let solution =
-        contact_patch::solver::finite::solve(&model, &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
-    (model, solution)
+    let model = build3(&parse(&case), "finite3d").unwrap();
+    finite_common::turned_and_squeezed(model, r)
 }
 
 /// The total contact force on the slave nodes of a solution.

@@ -1,6 +1,8 @@
-//! Helpers shared by the finite-strain contact tests (tests/finite_contact.rs,
-//! tests/finite_mortar.rs, tests/finite_slave_normals.rs): the two-block scene they slide, a
-//! scratch folder for its case file, and the check of the gaps measured afresh after a slide.
+//! Helpers shared by the finite-strain tests (tests/finite_contact.rs, tests/finite_mortar.rs,
+//! tests/finite_slave_normals.rs, tests/finite3d.rs, tests/finite3d_mortar.rs): the two-block
+//! scene they slide, a scratch folder for its case file, the check of the gaps measured afresh
+//! after a slide, and in 3D rotations, the neo-Hookean bar's lateral stretch and the turned,
+//! squeezed pair of the objectivity tests.
 
 #![allow(dead_code)] // not every test binary that includes this module uses every helper
 
@@ -126,4 +128,71 @@ where
         }
     }
     (worst, scale)
+}
+
+/// The rotation by `angle` about `axis`.
+pub fn rotation(axis: [f64; 3], angle: f64) -> nalgebra::Matrix3<f64> {
+    nalgebra::Rotation3::from_axis_angle(
+        &nalgebra::Unit::new_normalize(nalgebra::Vector3::from(axis)),
+        angle,
+    )
+    .into_inner()
+}
+
+/// The symmetric matrix of a Voigt vector `[xx, yy, zz, yz, xz, xy]`.
+pub fn to_matrix(s: [f64; 6]) -> nalgebra::Matrix3<f64> {
+    nalgebra::Matrix3::new(s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2])
+}
+
+/// The lateral stretch `b` of a neo-Hookean bar (`E`, `NU`) stretched by `a` with free lateral
+/// faces: `sigma_xx = (mu (b^2 - 1) + lambda ln(a b^2)) / J = 0`, by bisection.
+pub fn lateral_stretch(a: f64) -> f64 {
+    let (lambda, mu) = contact_patch::solid_finite::lame(E, NU);
+    let (mut lo, mut hi) = (0.1, 3.0);
+    for _ in 0..200 {
+        let m = 0.5 * (lo + hi);
+        if mu * (m * m - 1.0) + lambda * (a * m * m).ln() > 0.0 {
+            hi = m;
+        } else {
+            lo = m;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The pair of `model` (base, then punch) turned by `r` and squeezed: every node turned, and
+/// `A x - x` with `A = R diag(1, 1, 0.85) R^T` prescribed on the base's `bottom` and the
+/// punch's `top`; solved by the finite-strain Newton scheme.
+pub fn turned_and_squeezed(
+    mut model: contact_patch::model::Model3,
+    r: &nalgebra::Matrix3<f64>,
+) -> (
+    contact_patch::model::Model3,
+    contact_patch::solver::linear::Solution<3>,
+) {
+    use nalgebra::{Matrix3, Vector3};
+    for body in &mut model.bodies {
+        for p in &mut body.mesh.nodes {
+            let turned = r * Vector3::from(*p);
+            *p = [turned[0], turned[1], turned[2]];
+        }
+    }
+    let a = r * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 0.85)) * r.transpose();
+    for (b, set) in [(0, "bottom"), (1, "top")] {
+        let body = &model.bodies[b];
+        let moves: Vec<(usize, f64)> = body.mesh.node_sets[set]
+            .iter()
+            .flat_map(|&n| {
+                let x = Vector3::from(body.mesh.nodes[n]);
+                let u = a * x - x;
+                (0..3).map(move |i| (body.dof(n, i), u[i]))
+            })
+            .collect();
+        for (d, v) in moves {
+            model.prescribed[d] = Some(v);
+        }
+    }
+    let solution =
+        contact_patch::solver::finite::solve(&model, &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
+    (model, solution)
 }
