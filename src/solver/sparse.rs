@@ -1514,9 +1514,20 @@ mod tests {
         b.build()
     }
 
-    /// The work of the factor of `p` for AMD's and for the dissection order of the leading
-    /// block (the equations not in `trailing`), the trailing equations last.
-    fn candidate_work(p: &SymmetricPattern, trailing: &[usize]) -> (f64, f64) {
+    /// The factor work of `p` in each candidate order of its leading block (the equations
+    /// not in `trailing`), the trailing equations last: AMD's, METIS's nested dissection and,
+    /// given the equations' points, the coordinate bisection.
+    struct CandidateWork {
+        amd: f64,
+        metis: f64,
+        geometric: Option<f64>,
+    }
+
+    fn candidate_work(
+        p: &SymmetricPattern,
+        trailing: &[usize],
+        points: Option<&[[f64; 3]]>,
+    ) -> CandidateWork {
         let mut is_trailing = vec![false; p.n];
         trailing.iter().for_each(|&e| is_trailing[e] = true);
         let (leading, col_ptr, row_idx) = leading_block(p, &is_trailing);
@@ -1533,10 +1544,15 @@ mod tests {
                 .collect();
             FactorWork::of(&symbolic_in_order(p, &fwd).unwrap()).operations
         };
-        (
-            work(amd_order(&block).unwrap()),
-            work(crate::solver::ordering::dissection_order(&block)),
-        )
+        let geometric = points.map(|points| {
+            let leading_points: Vec<[f64; 3]> = leading.iter().map(|&e| points[e]).collect();
+            work(crate::solver::ordering::coordinate_dissection(&block, &leading_points).unwrap())
+        });
+        CandidateWork {
+            amd: work(amd_order(&block).unwrap()),
+            metis: work(crate::solver::ordering::dissection_order(&block)),
+            geometric,
+        }
     }
 
     /// The pattern of 3D Hex8 elasticity on an `m x m x m` grid of nodes (3 dofs per node,
@@ -1611,16 +1627,8 @@ mod tests {
         // below the size, the order is AMD's
         let (p, points) = q4_rectangle(400, 80);
         assert!(p.n >= COORDINATE_DISSECTION_FROM);
-        let block = crate::solver::ordering::Pattern {
-            n: p.n,
-            col_ptr: &p.col_ptr,
-            row_idx: &p.row_idx,
-        };
-        let work =
-            |order: &[usize]| FactorWork::of(&symbolic_in_order(&p, order).unwrap()).operations;
-        let amd = work(&amd_order(&block).unwrap());
-        let geometric =
-            work(&crate::solver::ordering::coordinate_dissection(&block, &points).unwrap());
+        let candidates = candidate_work(&p, &[], Some(&points));
+        let (amd, geometric) = (candidates.amd, candidates.geometric.unwrap());
         assert!(geometric < amd, "AMD {amd:e}, geometric {geometric:e}");
         let kept = Cholesky::analyse_at(&p, Some(&points), &UNLIMITED).unwrap();
         assert_eq!(kept.work().operations, geometric);
@@ -1667,22 +1675,17 @@ mod tests {
                 [(v % m) as f64, ((v / m) % m) as f64, (v / (m * m)) as f64]
             })
             .collect();
-        let block = crate::solver::ordering::Pattern {
-            n: p.n,
-            col_ptr: &p.col_ptr,
-            row_idx: &p.row_idx,
-        };
-        let work =
-            |order: &[usize]| FactorWork::of(&symbolic_in_order(&p, order).unwrap()).operations;
-        let geometric =
-            work(&crate::solver::ordering::coordinate_dissection(&block, &points).unwrap());
+        let CandidateWork {
+            amd,
+            metis,
+            geometric,
+        } = candidate_work(&p, &[], Some(&points));
+        let geometric = geometric.unwrap();
         assert!(
             geometric > NESTED_DISSECTION_ABOVE
                 && geometric > DISSECTION_WORK_PER_EQUATION * p.n as f64,
             "geometric {geometric:e}"
         );
-        let amd = work(&amd_order(&block).unwrap());
-        let metis = work(&crate::solver::ordering::dissection_order(&block));
         let kept = Cholesky::analyse_at(&p, Some(&points), &UNLIMITED)
             .unwrap()
             .work()
@@ -1703,7 +1706,7 @@ mod tests {
         let chol =
             Cholesky::analyse_with_trailing_at(&p, &trailing, Some(&points), &UNLIMITED).unwrap();
         assert_eq!(chol.trailing.as_deref(), Some(&trailing[..]));
-        let (amd, _) = candidate_work(&p, &trailing);
+        let amd = candidate_work(&p, &trailing, None).amd;
         assert!(
             chol.work().operations < amd,
             "kept {:e}, AMD {amd:e}",
@@ -1717,7 +1720,7 @@ mod tests {
         // analysis) and a 3D grid whose AMD factor is far above both thresholds (the cheaper
         // of the two kept)
         for (p, tried) in [(q4_grid_pattern(230), false), (hex8_grid_pattern(24), true)] {
-            let (amd, nd) = candidate_work(&p, &[]);
+            let CandidateWork { amd, metis: nd, .. } = candidate_work(&p, &[], None);
             let expensive =
                 amd > NESTED_DISSECTION_ABOVE && amd > DISSECTION_WORK_PER_EQUATION * p.n as f64;
             assert_eq!(expensive, tried, "n {}: amd {amd:e}", p.n);
@@ -1741,7 +1744,7 @@ mod tests {
         let trailing: Vec<usize> = (0..m * m).rev().map(|v| 3 * v + 2).collect();
         let chol = Cholesky::analyse_with_trailing(&p, &trailing, &UNLIMITED).unwrap();
         assert_eq!(chol.trailing.as_deref(), Some(&trailing[..]));
-        let (amd, nd) = candidate_work(&p, &trailing);
+        let CandidateWork { amd, metis: nd, .. } = candidate_work(&p, &trailing, None);
         assert!(nd < amd, "amd {amd:e}, nd {nd:e}");
         assert_eq!(chol.work().operations, nd, "amd {amd:e}, nd {nd:e}");
     }
