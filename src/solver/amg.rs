@@ -807,6 +807,38 @@ fn strong_neighbours(a: &CsrMatrix, blocks: &NodalBlocks, theta: f64) -> BlockSt
     }
 }
 
+/// A block not yet in an aggregate (in [`aggregate`]'s `of`).
+const FREE: usize = usize::MAX;
+
+/// Phase 1 of [`aggregate`] on `graph`: every block with neighbours, all of them still free,
+/// forms a new aggregate with them (numbered from `count`); returns the new count.
+fn whole_free_neighbourhoods(graph: &[Vec<usize>], of: &mut [usize], mut count: usize) -> usize {
+    for i in 0..graph.len() {
+        if of[i] == FREE && !graph[i].is_empty() && graph[i].iter().all(|&j| of[j] == FREE) {
+            of[i] = count;
+            for &j in &graph[i] {
+                of[j] = count;
+            }
+            count += 1;
+        }
+    }
+    count
+}
+
+/// Phase 2 of [`aggregate`] on `graph`: every free block with a neighbour aggregated before
+/// this phase joins that neighbour's aggregate (the first such neighbour's: the aggregate
+/// stays connected).
+fn join_an_aggregated_neighbour(graph: &[Vec<usize>], of: &mut [usize]) {
+    let before = of.to_vec();
+    for i in 0..graph.len() {
+        if of[i] == FREE {
+            if let Some(&j) = graph[i].iter().find(|&&j| before[j] != FREE) {
+                of[i] = before[j];
+            }
+        }
+    }
+}
+
 /// Vanek et al.'s aggregation (alg. 5.1), with the blocks that have no strong neighbour set
 /// aside as they set them aside; returns the aggregate of each block and their count.
 ///
@@ -823,31 +855,14 @@ fn strong_neighbours(a: &CsrMatrix, blocks: &NodalBlocks, theta: f64) -> BlockSt
 ///    its tangential dofs need the coarse correction; as a singleton aggregate it would stay
 ///    a block of its own on every level (the coarsening stalls).
 fn aggregate(strength: &BlockStrength) -> (Vec<usize>, usize) {
-    const FREE: usize = usize::MAX;
     let strong = &strength.strong;
     let n = strong.len();
     let mut of = vec![FREE; n];
-    let mut count = 0;
     // phase 1: whole free neighbourhoods
-    for i in 0..n {
-        if of[i] == FREE && !strong[i].is_empty() && strong[i].iter().all(|&j| of[j] == FREE) {
-            of[i] = count;
-            for &j in &strong[i] {
-                of[j] = count;
-            }
-            count += 1;
-        }
-    }
+    let mut count = whole_free_neighbourhoods(strong, &mut of, 0);
     // phase 2: join an aggregate of phase 1 (any strong neighbour's: the aggregate stays
     // connected)
-    let phase1 = of.clone();
-    for i in 0..n {
-        if of[i] == FREE {
-            if let Some(&j) = strong[i].iter().find(|&&j| phase1[j] != FREE) {
-                of[i] = phase1[j];
-            }
-        }
-    }
+    join_an_aggregated_neighbour(strong, &mut of);
     // phase 3: the free neighbourhoods of what is left
     for i in 0..n {
         if of[i] == FREE && !strong[i].is_empty() {
@@ -862,24 +877,8 @@ fn aggregate(strength: &BlockStrength) -> (Vec<usize>, usize) {
     }
     // phase 4: blocks without strong neighbours aggregate among themselves (phases 1 and 2
     // on the layer graph) ...
-    let layer = &strength.layer;
-    for i in 0..n {
-        if of[i] == FREE && !layer[i].is_empty() && layer[i].iter().all(|&j| of[j] == FREE) {
-            of[i] = count;
-            for &j in &layer[i] {
-                of[j] = count;
-            }
-            count += 1;
-        }
-    }
-    let phase4 = of.clone();
-    for i in 0..n {
-        if of[i] == FREE {
-            if let Some(&j) = layer[i].iter().find(|&&j| phase4[j] != FREE) {
-                of[i] = phase4[j];
-            }
-        }
-    }
+    count = whole_free_neighbourhoods(&strength.layer, &mut of, count);
+    join_an_aggregated_neighbour(&strength.layer, &mut of);
     // ... and what is left joins the aggregate of its most strongly coupled aggregated
     // neighbour
     loop {
