@@ -1255,3 +1255,72 @@ fn mortar_friction_on_triangular_facets_sticks_below_and_slips_at_mu_n_above() {
         }
     }
 }
+
+/// The dragged block under finite kinematics: neo-Hookean, the contact geometry of the current
+/// configuration (friction there is solved against a rigid plane or line, whose tangents do
+/// not turn).
+fn at_finite_strain(mut v: Value) -> Value {
+    v["materials"]["m"]["model"] = json!("neo_hookean");
+    v["physics"] = json!({"kinematics": "finite", "contact_geometry": "current"});
+    v
+}
+
+#[test]
+fn at_finite_strain_a_block_dragged_obliquely_over_a_rigid_plane_slides_at_mu_n() {
+    // a soft flat block (E = 100, height 0.2: the pressure 10 compresses it by a tenth)
+    // dragged by 0.5 along two directions: every bottom node slides with the force mu lambda_n,
+    // against its own slip; the forces sum to mu N nearly along the drag (the nodes slip along
+    // directions turned by the block's shear, so the sum is below mu N by second order)
+    for (name, enforcement) in [
+        ("penalty", json!({"kind": "penalty", "kappa": 1e3})),
+        ("Lagrange", json!({"kind": "lagrange"})),
+    ] {
+        for angle in [0.0f64, 0.7] {
+            let e = [angle.cos(), angle.sin()];
+            let d = 0.5;
+            let o = run(&at_finite_strain(dragged_block(
+                (100.0, 0.3, 0.2),
+                0.0,
+                [d * e[0], d * e[1]],
+                enforcement.clone(),
+            )));
+            assert_eq!(termination(&o), Termination::Converged, "{name} {angle}");
+            let state = o.solution.contact.as_ref().unwrap();
+            let (t, n, statuses) = totals(state);
+            assert!((n - P).abs() <= 1e-9 * P, "{name} {angle}: normal {n}");
+            assert_eq!(
+                statuses.len(),
+                9,
+                "{name} {angle}: every bottom node is closed"
+            );
+            assert!(
+                statuses.iter().all(|&s| s == Status::Slip),
+                "{name} {angle}: {statuses:?}"
+            );
+            for f in state.friction.iter().flatten() {
+                assert!(
+                    (f.force_length() - MU * f.normal_force).abs() <= 1e-12 * P,
+                    "{name} {angle}: {f:?}"
+                );
+            }
+            let along = -(t[0] * e[0] + t[1] * e[1]);
+            let across = t[0] * e[1] - t[1] * e[0];
+            assert!(t[2].abs() <= 1e-12 * P, "{name} {angle}: {t:?}");
+            assert!(
+                along <= MU * n * (1.0 + 1e-12) && along >= 0.99 * MU * n,
+                "{name} {angle}: along {along}, mu N {}",
+                MU * n
+            );
+            for step in &state.steps {
+                let f = step.friction.as_ref().unwrap();
+                assert!(f.dissipation >= 0.0, "{f:?}");
+                assert!(f.max_cone_ratio <= 1.0 + 1e-12, "{f:?}");
+            }
+            println!(
+                "finite strain, {name}, drag {d} along {angle}: along {along:.10}, across {across:.2e}, mu N {:.10}, iterations {:?}",
+                MU * n,
+                state.steps.iter().map(|s| s.iterations).collect::<Vec<_>>()
+            );
+        }
+    }
+}

@@ -108,6 +108,7 @@ pub(crate) fn obstacle(model: &Model, pair: &ContactPair) -> Option<String> {
         model.solver.scheme,
         model.physics.contact_geometry,
         &pair.enforcement,
+        matches!(&pair.master, crate::model::MasterSide::Rigid(r) if r.is_flat()),
     ) {
         return Some(o.why);
     }

@@ -356,6 +356,12 @@ impl RigidSurface {
         }
     }
 
+    /// Whether the surface is flat (a line or a plane): its tangents do not turn along it, so
+    /// the slip of a slave node over it is `t . u_s` in any configuration.
+    pub fn is_flat(&self) -> bool {
+        matches!(self, RigidSurface::Line { .. } | RigidSurface::Plane { .. })
+    }
+
     /// Whether the surface is degenerate: a zero normal, a radius that is not positive, or a
     /// value that is not finite.
     pub fn is_degenerate(&self) -> bool {

@@ -1079,11 +1079,12 @@ impl Model {
         }
         for (k, pair) in self.contact.iter().enumerate() {
             let at = format!("contact[{k}] '{}'", pair.name);
-            if matches!(pair.interaction, Interaction::Coulomb { .. }) {
+            let flat_rigid = matches!(&pair.master, MasterSide::Rigid(r) if r.is_flat());
+            if matches!(pair.interaction, Interaction::Coulomb { .. }) && !flat_rigid {
                 return invalid(
                     format!("{at}.interaction"),
-                    "finite kinematics with friction is not built yet".into(),
-                    "use a frictionless pair, or small-strain kinematics",
+                    "finite kinematics with friction is built against a rigid line or plane only, so far (against a deformable or curved master the slip is the motion relative to the master's material point in its convected coordinates, which is not built)".into(),
+                    "use a frictionless pair, let the master be a rigid line or plane, or use small-strain kinematics",
                 );
             }
             if let MasterSide::Body { .. } = pair.master {
@@ -1612,6 +1613,10 @@ fn validate_coulomb(
         case.solver.scheme,
         case.physics.contact_geometry,
         &spec.enforcement,
+        spec.master
+            .rigid
+            .as_ref()
+            .is_some_and(RigidSurface::is_flat),
     ) {
         let field = match o.field {
             "coulomb" => here,
@@ -1651,12 +1656,18 @@ pub struct CoulombObstacle {
 /// perturbed Lagrangian, augmented Lagrangian, perturbed tangent) or Lagrange multipliers, the
 /// reference geometry; every discretization (node-to-node, node-to-surface one- and two-pass
 /// with master or slave normals, rigid masters, standard and dual mortar with the weighted
-/// tangential slip). `None` when the combination is solved;
+/// tangential slip); in the current geometry (and so under finite kinematics) against a flat
+/// rigid master (`flat_rigid_master`: a line or a plane), whose tangents do not turn, so the
+/// slip `t . u_s` of a slave node is the distance it slid over the master in any
+/// configuration. Against a deformable or curved master the slip of the current geometry is
+/// the motion relative to the master's material point in its convected coordinates, which is
+/// not built. `None` when the combination is solved;
 /// used by [`Model::build`] and by the friction table (its `n/a` cells).
 pub fn coulomb_obstacle(
     scheme: crate::io::scene::Scheme,
     geometry: crate::io::scene::ContactGeometry,
     enforcement: &EnforcementSpec,
+    flat_rigid_master: bool,
 ) -> Option<CoulombObstacle> {
     let obstacle = |field, why: &str, fix: &str| {
         Some(CoulombObstacle {
@@ -1698,11 +1709,11 @@ pub fn coulomb_obstacle(
             "use the penalty, the perturbed Lagrangian, the augmented Lagrangian, the perturbed tangent or Lagrange multipliers for this pair",
         );
     }
-    if geometry != crate::io::scene::ContactGeometry::Reference {
+    if geometry != crate::io::scene::ContactGeometry::Reference && !flat_rigid_master {
         return obstacle(
             "coulomb",
-            "Coulomb friction is solved in the reference contact geometry only, so far",
-            "set \"physics\": {\"contact_geometry\": \"reference\"}",
+            "Coulomb friction in the current contact geometry (and so under finite kinematics) is solved against a rigid line or plane only, so far: against a deformable or curved master the slip is the motion relative to the master's material point in its convected coordinates, which is not built",
+            "set \"physics\": {\"contact_geometry\": \"reference\"} with small-strain kinematics, or let the pair's master be a rigid line or plane",
         );
     }
     None

@@ -22,11 +22,19 @@
 //! the nominal `1 / n`. Every attempt, converged or cut with its reason, is recorded in the
 //! history ([`FiniteHistory`], `summary.json`'s `finite`). When the cuts are spent the run
 //! stops with an error naming the step, the load factor and the last reason.
+//!
+//! **Friction history.** Coulomb friction is path dependent: each accepted step commits every
+//! frictional point's plastic slip and forces ([`crate::contact::friction::Committed`]), and
+//! the next step (or a cut retry of it) starts from them, as the small-strain load steps of
+//! [`crate::solver::active_set::solve`] do. (Under finite kinematics friction is solved against
+//! a flat rigid master only, whose tangents do not turn: see
+//! [`crate::model::coulomb_obstacle`].)
 
 use super::active_set::{active_keys, RowKey, StepRecord};
 use super::contact_newton::solve_step;
 pub use super::history::{FiniteHistory, FiniteStep};
 use super::linear::Solution;
+use crate::contact::friction::Committed;
 use crate::contact::state::{IterationRecord, Termination};
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -65,6 +73,9 @@ pub fn solve_observed<const D: usize, K: NewtonDimension<D>>(
     let mut record = FiniteHistory::default();
     let mut records: Vec<StepRecord> = Vec::new();
     let mut contact_history: Vec<IterationRecord> = Vec::new();
+    // the committed plastic slip of every frictional point at the last accepted step: a cut
+    // step starts again from it
+    let mut friction: HashMap<RowKey, Committed> = HashMap::new();
     let mut timings = crate::solver::linear::Timings::default();
     loop {
         let target = if done + increment >= n as f64 {
@@ -78,7 +89,7 @@ pub fn solve_observed<const D: usize, K: NewtonDimension<D>>(
             &at,
             previous.clone(),
             start.clone(),
-            HashMap::new(),
+            friction.clone(),
             progress,
         )?;
         timings.accumulate(&solution.timings);
@@ -132,7 +143,7 @@ pub fn solve_observed<const D: usize, K: NewtonDimension<D>>(
             iterations: state.iterations,
             geometry_updates: state.geometry_updates,
             geometry_changes: std::mem::take(&mut state.geometry_changes),
-            friction: None,
+            friction: crate::contact::friction::step_summary(state),
         });
         contact_history.append(&mut state.history);
         done = target;
@@ -147,6 +158,7 @@ pub fn solve_observed<const D: usize, K: NewtonDimension<D>>(
             return Ok(solution);
         }
         previous = Some(active_keys(state));
+        friction = state.friction_history();
         start = Some(solution.u);
         increment = (increment * 2.0).min(nominal);
     }
