@@ -905,9 +905,6 @@ fn a_move_off_the_top_face_keeps_the_automatic_top_set() {
 /// rows). The largest difference relative to the largest tangent entry is below 1e-7.
 #[test]
 fn the_newton_tangent_between_3d_bodies_is_the_difference_of_the_residual() {
-    use contact_patch::contact::discretization::pair3::pair_rows;
-    use contact_patch::contact::state::{ContactState, Termination};
-    use contact_patch::solver::contact_newton::Probe;
     for enforcement in [
         json!({"kind": "lagrange"}),
         json!({"kind": "augmented_lagrange", "kappa": 1e4}),
@@ -961,16 +958,7 @@ fn the_newton_tangent_between_3d_bodies_is_the_difference_of_the_residual() {
             }
         }
         // the rows at u, all active with compressive forces
-        let mut moved = model.clone();
-        for body in &mut moved.bodies {
-            let offset = body.dof_offset;
-            for (n, p) in body.mesh.nodes.iter_mut().enumerate() {
-                for i in 0..3 {
-                    p[i] += u[offset + 3 * n + i];
-                }
-            }
-        }
-        let rows = pair_rows(&moved, &moved.contact[0]).unwrap();
+        let rows = finite_common::rows_at3(&model, &u);
         // interior rows act on a facet's four nodes, edge rows on two, corner rows on one
         let master_nodes = |r: &contact_patch::contact::Constraint<3>| r.dofs.len() / 3 - 1;
         let count = |m: usize| rows.iter().filter(|r| master_nodes(r) == m).count();
@@ -980,33 +968,9 @@ fn the_newton_tangent_between_3d_bodies_is_the_difference_of_the_residual() {
             "{interior} {edge} {corner}"
         );
         assert!(rows.iter().all(|r| r.hessian.is_some()));
-        let n_rows = rows.len();
-        let state = ContactState {
-            rows,
-            active: vec![true; n_rows],
-            forces: (0..n_rows).map(|i| 2.0 + (i as f64).sin()).collect(),
-            gaps: vec![0.0; n_rows],
-            termination: Termination::Converged,
-            iterations: 0,
-            rank_deficiency: None,
-            linear_solver: "",
-            geometry_updates: 0,
-            configuration: None,
-            departures: Vec::new(),
-            steps: Vec::new(),
-            history: Vec::new(),
-            geometry_changes: Vec::new(),
-            friction: vec![None; n_rows],
-        };
-        let mut probe = Probe::new(&model, 0.0).unwrap();
-        let x = probe.unknowns_at(&u, &state);
-        // a first evaluation at x covers the rows found there; the tangent is the second's
-        probe.evaluate(&x).unwrap();
-        let at = probe.evaluate(&x).unwrap();
-        let n = probe.unknown_count();
-        let (worst, scale) = finite_common::tangent_difference(&mut probe, &x, &at);
+        let (worst, scale) = finite_common::tangent_difference_with_rows3(&model, &u, rows);
         println!(
-            "{}: {n} unknowns, rows: {interior} interior, {edge} edge, {corner} corner; tangent vs central difference {worst:.1e} of {scale:.3e}",
+            "{}: rows: {interior} interior, {edge} edge, {corner} corner; tangent vs central difference {worst:.1e} of {scale:.3e}",
             enforcement["kind"]
         );
         assert!(worst < 1e-7, "{}: {worst:e}", enforcement["kind"]);
@@ -1021,9 +985,6 @@ fn the_newton_tangent_between_3d_bodies_is_the_difference_of_the_residual() {
 /// largest difference relative to the largest tangent entry is below 1e-7.
 #[test]
 fn the_newton_tangent_past_the_free_boundary_is_the_difference_of_the_residual() {
-    use contact_patch::contact::discretization::pair3::pair_rows;
-    use contact_patch::contact::state::{ContactState, Termination};
-    use contact_patch::solver::contact_newton::Probe;
     let shifted = [0.05, 0.55, 1.05];
     for element in ["Hex8", "Tet4"] {
         for enforcement in [
@@ -1048,42 +1009,12 @@ fn the_newton_tangent_past_the_free_boundary_is_the_difference_of_the_residual()
                     }
                 }
             }
-            let mut moved = model.clone();
-            for body in &mut moved.bodies {
-                let offset = body.dof_offset;
-                for (n, p) in body.mesh.nodes.iter_mut().enumerate() {
-                    for i in 0..3 {
-                        p[i] += u[offset + 3 * n + i];
-                    }
-                }
-            }
-            let rows = pair_rows(&moved, &moved.contact[0]).unwrap();
+            let rows = finite_common::rows_at3(&model, &u);
             // the slave nodes past x = 1 have rows (held by the facets extended)
             let past = rows.iter().filter(|r| r.point[0] > 1.02).count();
             assert!(past >= 3, "{element}: {past} rows past the free boundary");
             let n_rows = rows.len();
-            let state = ContactState {
-                rows,
-                active: vec![true; n_rows],
-                forces: (0..n_rows).map(|i| 2.0 + (i as f64).sin()).collect(),
-                gaps: vec![0.0; n_rows],
-                termination: Termination::Converged,
-                iterations: 0,
-                rank_deficiency: None,
-                linear_solver: "",
-                geometry_updates: 0,
-                configuration: None,
-                departures: Vec::new(),
-                steps: Vec::new(),
-                history: Vec::new(),
-                geometry_changes: Vec::new(),
-                friction: vec![None; n_rows],
-            };
-            let mut probe = Probe::new(&model, 0.0).unwrap();
-            let x = probe.unknowns_at(&u, &state);
-            probe.evaluate(&x).unwrap();
-            let at = probe.evaluate(&x).unwrap();
-            let (worst, scale) = finite_common::tangent_difference(&mut probe, &x, &at);
+            let (worst, scale) = finite_common::tangent_difference_with_rows3(&model, &u, rows);
             println!(
                 "{element} {}: {n_rows} rows, {past} past the free boundary; tangent vs central difference {worst:.1e} of {scale:.3e}",
                 enforcement["kind"]

@@ -178,47 +178,12 @@ fn tangent_state(model: &Model3, press: f64) -> Vec<f64> {
 /// a compressive force (Lagrange multipliers, or Uzawa multipliers of the augmented
 /// Lagrangian), and the penalty: the largest difference relative to the largest entry.
 fn tangent_check(case: &Value, u: &[f64], label: &str) -> f64 {
-    use contact_patch::contact::discretization::pair3::pair_rows;
-    use contact_patch::contact::state::{ContactState, Termination};
-    use contact_patch::solver::contact_newton::Probe;
     let model = build3(&parse(case), "finite3d_mortar").unwrap_or_else(|e| panic!("{e}"));
-    let mut moved = model.clone();
-    for body in &mut moved.bodies {
-        let offset = body.dof_offset;
-        for (n, p) in body.mesh.nodes.iter_mut().enumerate() {
-            for i in 0..3 {
-                p[i] += u[offset + 3 * n + i];
-            }
-        }
-    }
-    let rows = pair_rows(&moved, &moved.contact[0]).unwrap_or_else(|e| panic!("{e}"));
+    let rows = finite_common::rows_at3(&model, u);
     assert!(rows.iter().all(|r| r.hessian.is_some()));
     let n_rows = rows.len();
-    let state = ContactState {
-        rows,
-        active: vec![true; n_rows],
-        forces: (0..n_rows).map(|i| 2.0 + (i as f64).sin()).collect(),
-        gaps: vec![0.0; n_rows],
-        termination: Termination::Converged,
-        iterations: 0,
-        rank_deficiency: None,
-        linear_solver: "",
-        geometry_updates: 0,
-        configuration: None,
-        departures: Vec::new(),
-        steps: Vec::new(),
-        history: Vec::new(),
-        geometry_changes: Vec::new(),
-        friction: vec![None; n_rows],
-    };
-    let mut probe = Probe::new(&model, 0.0).unwrap();
-    let x = probe.unknowns_at(u, &state);
-    // a first evaluation at x covers the rows found there; the tangent is the second's
-    probe.evaluate(&x).unwrap();
-    let at = probe.evaluate(&x).unwrap();
-    let n = probe.unknown_count();
-    let (worst, scale) = finite_common::tangent_difference(&mut probe, &x, &at);
-    println!("{label}: {n} unknowns, {n_rows} rows, tangent vs central difference {worst:.1e} of {scale:.3e}");
+    let (worst, scale) = finite_common::tangent_difference_with_rows3(&model, u, rows);
+    println!("{label}: {n_rows} rows, tangent vs central difference {worst:.1e} of {scale:.3e}");
     worst
 }
 

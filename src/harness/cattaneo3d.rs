@@ -185,32 +185,6 @@ impl Mindlin {
     }
 }
 
-/// Breaks from 0 to `length`: uniform of size `h` up to `fine` (whole elements), then each
-/// element `growth` times the previous, the last ending at `length` (merged with the one
-/// before when less than half the previous size), as
-/// [`crate::harness::hertz3d::graded_breaks`] with its growth given.
-pub fn graded_breaks_growing(h: f64, fine: f64, length: f64, growth: f64) -> Vec<f64> {
-    let mut breaks = vec![0.0];
-    let fine_elements = (fine / h).ceil() as usize;
-    for k in 1..=fine_elements {
-        breaks.push(k as f64 * h);
-    }
-    let mut size = h;
-    loop {
-        let last = *breaks.last().expect("starts at 0");
-        size *= growth;
-        if last + size >= length {
-            if length - last < 0.5 * size / growth && breaks.len() > 2 {
-                breaks.pop();
-            }
-            breaks.push(length);
-            break;
-        }
-        breaks.push(last + size);
-    }
-    breaks
-}
-
 /// The consistent nodal value of `f(r)` at a node `(x, y)` of a uniform grid of spacing `h`:
 /// `int N f dA / int N dA` with the node's bilinear hat `N` over its four cells (what a
 /// row's force over its area is in the limit), by 8 x 8 Gauss points on each of 4 x 4
@@ -253,7 +227,12 @@ pub fn gap_profile(r: f64) -> f64 {
 /// The case of the mesh with fine element size `h` and the shear step's drag `drag`.
 pub fn case(h: f64, scene: &Scene) -> Value {
     let size = scene.size;
-    let half = graded_breaks_growing(h, FINE_EXTENT * TARGET_RADIUS, size, scene.growth);
+    let half = crate::harness::hertz3d::graded_breaks_growing(
+        h,
+        FINE_EXTENT * TARGET_RADIUS,
+        size,
+        scene.growth,
+    );
     let xs: Vec<f64> = half
         .iter()
         .rev()

@@ -72,6 +72,11 @@ pub fn hertz(p: f64) -> (f64, f64, f64) {
 /// elements), then each element [`GROWTH`] times the previous; the last element ends at
 /// `length` (merged with the one before when it would be less than half the previous size).
 pub fn graded_breaks(h: f64, fine: f64, length: f64) -> Vec<f64> {
+    graded_breaks_growing(h, fine, length, GROWTH)
+}
+
+/// [`graded_breaks`] with each element `growth` times the previous one past `fine`.
+pub fn graded_breaks_growing(h: f64, fine: f64, length: f64, growth: f64) -> Vec<f64> {
     let mut breaks = vec![0.0];
     let fine_elements = (fine / h).ceil() as usize;
     for k in 1..=fine_elements {
@@ -80,9 +85,9 @@ pub fn graded_breaks(h: f64, fine: f64, length: f64) -> Vec<f64> {
     let mut size = h;
     loop {
         let last = *breaks.last().expect("starts at 0");
-        size *= GROWTH;
+        size *= growth;
         if last + size >= length {
-            if length - last < 0.5 * size / GROWTH && breaks.len() > 2 {
+            if length - last < 0.5 * size / growth && breaks.len() > 2 {
                 breaks.pop();
             }
             breaks.push(length);

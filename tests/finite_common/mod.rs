@@ -130,6 +130,61 @@ where
     (worst, scale)
 }
 
+/// The rows of `model`'s first contact pair (3D) found and built at the positions `X + u`.
+pub fn rows_at3(
+    model: &contact_patch::model::Model3,
+    u: &[f64],
+) -> Vec<contact_patch::contact::Constraint<3>> {
+    let mut moved = model.clone();
+    for body in &mut moved.bodies {
+        let offset = body.dof_offset;
+        for (n, p) in body.mesh.nodes.iter_mut().enumerate() {
+            for (i, x) in p.iter_mut().enumerate() {
+                *x += u[offset + 3 * n + i];
+            }
+        }
+    }
+    contact_patch::contact::discretization::pair3::pair_rows(&moved, &moved.contact[0])
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The whole Newton system of `model` (3D) at `u` with `rows` all active and the compressive
+/// forces `2 + sin i` (Lagrange multipliers, or Uzawa multipliers of the augmented
+/// Lagrangian; the penalty's rows act by their gaps): its tangent against central differences
+/// of its residual ([`tangent_difference`]), the largest difference relative to the largest
+/// entry, and that entry.
+pub fn tangent_difference_with_rows3(
+    model: &contact_patch::model::Model3,
+    u: &[f64],
+    rows: Vec<contact_patch::contact::Constraint<3>>,
+) -> (f64, f64) {
+    use contact_patch::contact::state::{ContactState, Termination};
+    let n_rows = rows.len();
+    let state = ContactState {
+        rows,
+        active: vec![true; n_rows],
+        forces: (0..n_rows).map(|i| 2.0 + (i as f64).sin()).collect(),
+        gaps: vec![0.0; n_rows],
+        termination: Termination::Converged,
+        iterations: 0,
+        rank_deficiency: None,
+        linear_solver: "",
+        geometry_updates: 0,
+        configuration: None,
+        departures: Vec::new(),
+        steps: Vec::new(),
+        history: Vec::new(),
+        geometry_changes: Vec::new(),
+        friction: vec![None; n_rows],
+    };
+    let mut probe = contact_patch::solver::contact_newton::Probe::new(model, 0.0).unwrap();
+    let x = probe.unknowns_at(u, &state);
+    // a first evaluation at x covers the rows found there; the tangent is the second's
+    probe.evaluate(&x).unwrap();
+    let at = probe.evaluate(&x).unwrap();
+    tangent_difference(&mut probe, &x, &at)
+}
+
 /// The rotation by `angle` about `axis`.
 pub fn rotation(axis: [f64; 3], angle: f64) -> nalgebra::Matrix3<f64> {
     nalgebra::Rotation3::from_axis_angle(
