@@ -1324,3 +1324,69 @@ fn at_finite_strain_a_block_dragged_obliquely_over_a_rigid_plane_slides_at_mu_n(
         }
     }
 }
+
+#[test]
+fn a_half_model_on_its_symmetry_plane_carries_half_the_frictional_force() {
+    // the slab dragged along x is symmetric about y = 0.5: its half y >= 0.5 with u_y = 0 on
+    // the plane y = 0.5 carries half of every force. The slave nodes on that plane have their
+    // tangent along y held (every dof of that row prescribed): with Lagrange multipliers its
+    // multiplier had an empty row and the factorization met a zero pivot; the tangent is
+    // dropped and the support carries that direction
+    // (stick: the penalty's springs take a drag of 1e-4; Lagrange multipliers hold the points,
+    // so only the slab's shear takes a drag, 1e-7)
+    for (name, enforcement, stick) in [
+        ("penalty", penalty(), 1e-4),
+        ("Lagrange", json!({"kind": "lagrange"}), 1e-7),
+    ] {
+        for d in [stick, 1.0] {
+            let full = run(&dragged_block(
+                STIFF_SLAB,
+                0.0,
+                [d, 0.0],
+                enforcement.clone(),
+            ));
+            let mut case = dragged_block(STIFF_SLAB, 0.0, [d, 0.0], enforcement.clone());
+            case["bodies"][0]["mesh"]["block3d"]["y"] = json!([0.5, 1.0]);
+            // (no rotation: the moves are the identity)
+            case["bodies"][0]["mesh"]["block3d"]
+                .as_object_mut()
+                .unwrap()
+                .remove("moves");
+            case["supports"]
+                .as_array_mut()
+                .unwrap()
+                .push(json!({"body": "block", "set": "front", "y": 0.0}));
+            let half = run(&case);
+            assert_eq!(termination(&full), Termination::Converged, "{name} {d}");
+            assert_eq!(termination(&half), Termination::Converged, "{name} {d}");
+            let (t_full, n_full, s_full) = totals(full.solution.contact.as_ref().unwrap());
+            let (t_half, n_half, s_half) = totals(half.solution.contact.as_ref().unwrap());
+            // (two solves, each to Newton's tolerance: the stiff slab's penalty leaves 7.5e-12 P)
+            assert!(
+                (2.0 * n_half - n_full).abs() <= 1e-10 * P,
+                "{name} {d}: normal {n_half} vs {n_full} / 2; tangential {t_half:?} vs {t_full:?}"
+            );
+            for k in 0..3 {
+                assert!(
+                    (2.0 * t_half[k] - t_full[k]).abs() <= 1e-10 * MU * P,
+                    "{name} {d}: {t_half:?} vs {t_full:?}"
+                );
+            }
+            let expect = if d == stick {
+                Status::Stick
+            } else {
+                Status::Slip
+            };
+            assert!(
+                s_full.iter().chain(&s_half).all(|&s| s == expect),
+                "{name} {d}: {s_full:?} {s_half:?}"
+            );
+            println!(
+                "{name}, drag {d}: half-model force x {:.12} (full / 2 {:.12}), {} closed points of the half",
+                t_half[0],
+                0.5 * t_full[0],
+                s_half.len()
+            );
+        }
+    }
+}
