@@ -108,7 +108,7 @@ pub(crate) fn obstacle(model: &Model, pair: &ContactPair) -> Option<String> {
         model.solver.scheme,
         model.physics.contact_geometry,
         &pair.enforcement,
-        matches!(&pair.master, crate::model::MasterSide::Rigid(r) if r.is_flat()),
+        pair.has_flat_rigid_master(),
     ) {
         return Some(o.why);
     }

@@ -137,6 +137,12 @@ impl ContactPair {
         }
     }
 
+    /// Whether the master is a rigid line or plane (its tangents do not turn: Coulomb friction
+    /// is solved against it in the current geometry too, see [`coulomb_obstacle`]).
+    pub fn has_flat_rigid_master(&self) -> bool {
+        matches!(&self.master, MasterSide::Rigid(r) if r.is_flat())
+    }
+
     /// The same pair with slave and master exchanged (a body master is required).
     pub fn swapped(&self) -> Option<ContactPair> {
         match &self.master {
@@ -1079,8 +1085,9 @@ impl Model {
         }
         for (k, pair) in self.contact.iter().enumerate() {
             let at = format!("contact[{k}] '{}'", pair.name);
-            let flat_rigid = matches!(&pair.master, MasterSide::Rigid(r) if r.is_flat());
-            if matches!(pair.interaction, Interaction::Coulomb { .. }) && !flat_rigid {
+            if matches!(pair.interaction, Interaction::Coulomb { .. })
+                && !pair.has_flat_rigid_master()
+            {
                 return invalid(
                     format!("{at}.interaction"),
                     "finite kinematics with friction is built against a rigid line or plane only, so far (against a deformable or curved master the slip is the motion relative to the master's material point in its convected coordinates, which is not built)".into(),
