@@ -926,40 +926,53 @@ fn lagrange_multipliers_pass_the_frictional_patch_test_in_stick_and_in_slip() {
     }
 }
 
+/// The checks of a converged incline solve at `F/G = f_over_g` (slope `tan_a`, weight 10): in
+/// every step Coulomb's inequality (to `cone`) and non-negative dissipation, and the forces on
+/// the block in balance with the load along and across the incline (to 1e-9 of the weight)
+/// inside the cone. Returns `|T| / (mu N)`.
+fn assert_incline_balance(o: &Outcome, f_over_g: f64, tan_a: f64, cone: f64, label: &str) -> f64 {
+    assert_eq!(termination(o), Termination::Converged, "{label}");
+    let state = o.solution.contact.as_ref().unwrap();
+    for step in &state.steps {
+        let f = step.friction.as_ref().unwrap();
+        assert!(f.max_cone_ratio <= 1.0 + cone, "{label}: {f:?}");
+        assert!(f.dissipation >= 0.0, "{label}: {f:?}");
+    }
+    let (s, c) = (
+        tan_a / (1.0 + tan_a * tan_a).sqrt(),
+        1.0 / (1.0 + tan_a * tan_a).sqrt(),
+    );
+    let (g, f) = (10.0, f_over_g * 10.0);
+    let tangential = tangential_x(o);
+    let normal: f64 = points(o).iter().map(|p| p.2).sum();
+    assert!(
+        (tangential + (f * c - g * s)).abs() <= 1e-9 * g,
+        "{label}: {tangential}"
+    );
+    assert!(
+        (normal - (g * c + f * s)).abs() <= 1e-9 * g,
+        "{label}: {normal}"
+    );
+    assert!(tangential.abs() <= MU * normal * (1.0 + cone), "{label}");
+    tangential.abs() / (MU * normal)
+}
+
 #[test]
 fn lagrange_multipliers_hold_a_block_on_an_incline_up_to_the_coulomb_limit() {
     let tan_a: f64 = 0.1;
     let limit = (tan_a + MU) / (1.0 - MU * tan_a);
     assert!((limit - 0.412371).abs() < 1e-6);
-    let (s, c) = (
-        tan_a / (1.0 + tan_a * tan_a).sqrt(),
-        1.0 / (1.0 + tan_a * tan_a).sqrt(),
-    );
     for ratio in [0.5, 0.98, 0.995] {
         let o = run(&lagrange(incline(ratio * limit, tan_a, 4)));
-        assert_eq!(
-            termination(&o),
-            Termination::Converged,
-            "F/G = {ratio} limit"
+        let share = assert_incline_balance(
+            &o,
+            ratio * limit,
+            tan_a,
+            1e-12,
+            &format!("F/G = {ratio} limit"),
         );
-        let state = o.solution.contact.as_ref().unwrap();
-        for step in &state.steps {
-            let f = step.friction.as_ref().unwrap();
-            assert!(f.max_cone_ratio <= 1.0 + 1e-12, "{f:?}");
-            assert!(f.dissipation >= 0.0, "{f:?}");
-        }
-        let (g, f) = (10.0, ratio * limit * 10.0);
-        let tangential = tangential_x(&o);
-        let normal: f64 = points(&o).iter().map(|p| p.2).sum();
-        assert!(
-            (tangential + (f * c - g * s)).abs() <= 1e-9 * g,
-            "{tangential}"
-        );
-        assert!((normal - (g * c + f * s)).abs() <= 1e-9 * g, "{normal}");
-        assert!(tangential.abs() <= MU * normal * (1.0 + 1e-12));
         println!(
-            "Lagrange, F/G = {ratio} x limit: |T|/(mu N) = {:.6}, Newton iterations per step {:?}",
-            tangential.abs() / (MU * normal),
+            "Lagrange, F/G = {ratio} x limit: |T|/(mu N) = {share:.6}, Newton iterations per step {:?}",
             iterations_per_step(&o)
         );
     }
@@ -1150,10 +1163,6 @@ fn augmented_lagrangian_holds_a_block_on_an_incline_up_to_the_coulomb_limit() {
     let tan_a: f64 = 0.1;
     let limit = (tan_a + MU) / (1.0 - MU * tan_a);
     assert!((limit - 0.412371).abs() < 1e-6);
-    let (s, c) = (
-        tan_a / (1.0 + tan_a * tan_a).sqrt(),
-        1.0 / (1.0 + tan_a * tan_a).sqrt(),
-    );
     type Law = fn(Value) -> Value;
     let variants: [(&str, Law); 3] = [
         ("per iteration", |v| augmented(v, "per_iteration")),
@@ -1163,12 +1172,6 @@ fn augmented_lagrangian_holds_a_block_on_an_incline_up_to_the_coulomb_limit() {
     for (label, law) in variants {
         for ratio in [0.5, 0.98, 0.995] {
             let o = run(&law(incline(ratio * limit, tan_a, 4)));
-            assert_eq!(
-                termination(&o),
-                Termination::Converged,
-                "{label}: F/G = {ratio} limit"
-            );
-            let state = o.solution.contact.as_ref().unwrap();
             // Laursen & Simo bound the slip force by the normal multiplier, which the Uzawa
             // loop brings to the normal force lambda_n = lambda_bar_n - w g until the gap g is
             // at its round-off floor (1e-15 of the model size): |lambda_t| / (mu lambda_n)
@@ -1179,26 +1182,15 @@ fn augmented_lagrangian_holds_a_block_on_an_incline_up_to_the_coulomb_limit() {
             } else {
                 1e-12
             };
-            for step in &state.steps {
-                let f = step.friction.as_ref().unwrap();
-                assert!(f.max_cone_ratio <= 1.0 + cone, "{label}: {f:?}");
-                assert!(f.dissipation >= 0.0, "{label}: {f:?}");
-            }
-            let (g, f) = (10.0, ratio * limit * 10.0);
-            let tangential = tangential_x(&o);
-            let normal: f64 = points(&o).iter().map(|p| p.2).sum();
-            assert!(
-                (tangential + (f * c - g * s)).abs() <= 1e-9 * g,
-                "{label}: {tangential}"
+            let share = assert_incline_balance(
+                &o,
+                ratio * limit,
+                tan_a,
+                cone,
+                &format!("{label}: F/G = {ratio} limit"),
             );
-            assert!(
-                (normal - (g * c + f * s)).abs() <= 1e-9 * g,
-                "{label}: {normal}"
-            );
-            assert!(tangential.abs() <= MU * normal * (1.0 + cone));
             println!(
-                "augmented Lagrangian {label}, F/G = {ratio} x limit: |T|/(mu N) = {:.6}, Newton iterations per step {:?}",
-                tangential.abs() / (MU * normal),
+                "augmented Lagrangian {label}, F/G = {ratio} x limit: |T|/(mu N) = {share:.6}, Newton iterations per step {:?}",
                 iterations_per_step(&o)
             );
         }
@@ -1281,10 +1273,6 @@ fn at_finite_strain_a_soft_block_holds_on_an_incline_up_to_the_coulomb_limit() {
     // block, whatever its deformation
     let tan_a: f64 = 0.1;
     let limit = (tan_a + MU) / (1.0 - MU * tan_a);
-    let (s, c) = (
-        tan_a / (1.0 + tan_a * tan_a).sqrt(),
-        1.0 / (1.0 + tan_a * tan_a).sqrt(),
-    );
     let soft = |ratio: f64, law: fn(Value) -> Value| {
         let mut v = at_finite_strain(incline(ratio * limit, tan_a, 4), 20.0);
         v["contact"][0]["enforcement"] = json!({"kind": "penalty", "kappa": 1e3});
@@ -1294,25 +1282,8 @@ fn at_finite_strain_a_soft_block_holds_on_an_incline_up_to_the_coulomb_limit() {
     for (name, law) in [("penalty", penalty), ("Lagrange", lagrange)] {
         for ratio in [0.5, 0.98] {
             let o = run(&soft(ratio, law));
-            assert_eq!(termination(&o), Termination::Converged, "{name} {ratio}");
-            let state = o.solution.contact.as_ref().unwrap();
-            for step in &state.steps {
-                let f = step.friction.as_ref().unwrap();
-                assert!(f.max_cone_ratio <= 1.0 + 1e-12, "{name} {f:?}");
-                assert!(f.dissipation >= 0.0, "{name} {f:?}");
-            }
-            let (g, f) = (10.0, ratio * limit * 10.0);
-            let tangential = tangential_x(&o);
-            let normal: f64 = points(&o).iter().map(|p| p.2).sum();
-            assert!(
-                (tangential + (f * c - g * s)).abs() <= 1e-9 * g,
-                "{name}: {tangential}"
-            );
-            assert!(
-                (normal - (g * c + f * s)).abs() <= 1e-9 * g,
-                "{name}: {normal}"
-            );
-            assert!(tangential.abs() <= MU * normal * (1.0 + 1e-12));
+            let label = format!("{name} {ratio}");
+            let share = assert_incline_balance(&o, ratio * limit, tan_a, 1e-12, &label);
             // the deformation is finite: the small-strain answer differs
             let mut small = soft(ratio, law);
             small["materials"]["m"] = json!({"E": 20.0, "nu": 0.3});
@@ -1320,8 +1291,7 @@ fn at_finite_strain_a_soft_block_holds_on_an_incline_up_to_the_coulomb_limit() {
             let linear = run(&small);
             let difference = largest_difference(&o, &linear);
             println!(
-                "finite strain, {name}, F/G = {ratio} x limit: |T|/(mu N) = {:.6}, iterations {:?}, largest difference from the small-strain displacements {difference:.3} of their largest",
-                tangential.abs() / (MU * normal),
+                "finite strain, {name}, F/G = {ratio} x limit: |T|/(mu N) = {share:.6}, iterations {:?}, largest difference from the small-strain displacements {difference:.3} of their largest",
                 iterations_per_step(&o)
             );
             assert!(difference > 0.05, "{difference}");
