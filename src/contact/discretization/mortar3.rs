@@ -32,7 +32,7 @@
 //!    for Quad9 and Tri6, see below) clips the projected master polygon (reversed to counter-clockwise)
 //!    by Sutherland-Hodgman
 //!    ([`clip_convex_polygons`]): a point is inside an edge when its signed distance is at least
-//!    `-tol` (`tol = 1e-12` of the slave facet's diameter), an intersection parameter is clamped
+//!    `-tol` (`tol = 1e-8` of the slave facet's diameter, [`CLIP_TOLERANCE`]), an intersection parameter is clamped
 //!    to `[0, 1]` (nearly parallel edges), consecutive vertices closer than `tol` merge, and a
 //!    polygon with fewer than 3 vertices or an area below `1e-12` of the slave facet's is no
 //!    overlap (disjoint facets and facets touching along an edge or a corner).
@@ -138,8 +138,23 @@ pub type MortarMatrix3 = BTreeMap<usize, BTreeMap<usize, f64>>;
 const NEWTON_TOLERANCE: f64 = 1e-13;
 /// Largest number of Newton steps of the inverse Quad4 and Quad9 maps.
 const NEWTON_STEPS: usize = 50;
-/// Relative size (of the slave facet's diameter) below which polygon vertices coincide.
-pub(crate) const CLIP_TOLERANCE: f64 = 1e-12;
+/// Relative size (of the slave facet's diameter) below which a polygon vertex lies on a window
+/// edge and two vertices coincide: about the square root of the machine epsilon.
+///
+/// Why not round-off size: where a slave edge and a master edge lie on one line (blocks whose
+/// outer faces are flush, the two-block patch test), an edge `epsilon h` off the other's line
+/// is cut at `t = d_p / (d_p - d_q)` with signed distances `d ~ epsilon h` computed to `1e-16
+/// h`, so `t`'s second derivative (about `1 / epsilon^2`) carries an absolute error of about
+/// `1e-16 / epsilon^2`: at `epsilon = 1e-8` the Newton tangent of the finite-strain rows
+/// (`mortar3_linearization`) is wrong by O(1) there. With a round-off tolerance (`1e-12`) the
+/// Newton iterates of the finite-strain patch test wandered at relative residuals `1e-9` to
+/// `1e-7` for 20 to 40 iterations a load step until one landed within it; with this one a
+/// vertex within `1e-8 h` of a window edge is on it, so the thin cuts whose derivatives
+/// round-off spoils are not made, and every step converges in 5 or 6 iterations
+/// (`tests/finite3d_mortar.rs`). The price: an overlap up to
+/// `1e-8 h` wider or narrower than the exact one, a relative change of the rows below `1e-8`
+/// (none where edges are flush or farther apart than that).
+pub(crate) const CLIP_TOLERANCE: f64 = 1e-8;
 
 /// One side of a 3D interface: facets of one kind, their node ids and coordinates.
 #[derive(Clone, Debug, PartialEq)]
