@@ -337,7 +337,8 @@ fn mortar_passes_the_non_matching_two_block_patch_test() {
 }
 
 /// Mortar on Tri6 facets (Tet10 bodies) under finite kinematics is refused before the solve,
-/// with the reason (the rows' second derivative covers Quad4, Tri3 and Quad9 facets).
+/// with the reason: the rows are built (`mortar3_linearization`'s unit tests), but Newton on
+/// the Tet10 two-block patch test leaves the uniform state.
 #[test]
 fn mortar_on_tri6_facets_is_refused() {
     let mut case = stacked(

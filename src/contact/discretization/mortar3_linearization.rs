@@ -30,9 +30,10 @@
 //! * the **cells**: triangles about the polygon's vertex average, whose points and weights
 //!   (twice the triangle's area times the rule's weight) move with the vertices;
 //! * the **natural coordinates** `xi_s`, `xi_m` of each cell point on the projected facets
-//!   (closed form on Tri3; Quad4 and Quad9: the root of `sum_a N_a(xi) q_a = p`);
+//!   (closed form on Tri3; Quad4, Quad9 and Tri6: the root of `sum_a N_a(xi) q_a = p`);
 //! * the **dual coefficients** `A_e = D_e M_e^-1` of each slave facet (dual multipliers), from
-//!   its projected corners;
+//!   its projected nodes; on Tri6 over the modified basis `N~` the multipliers are built on
+//!   (standard and dual, [`super::mortar3`]'s notes, **Multipliers**);
 //! * the nodal normal `n_j`.
 //!
 //! Which master facets overlap which slave facets, which window edges cut, which vertices
@@ -43,7 +44,7 @@
 //! **Derivatives by hyper-dual numbers.** Every step above is evaluated in second-order vector
 //! dual numbers (`num_dual`), which carry the exact gradient and Hessian through the
 //! arithmetic; the `f64` and the dual evaluation are one generic code path. The implicit roots
-//! (the natural coordinates of Quad4 and Quad9 points) are first found in `f64`
+//! (the natural coordinates of Quad4, Quad9 and Tri6 points) are first found in `f64`
 //! ([`super::mortar3`]'s inverse map) and then carried to second order by the implicit
 //! function theorem in dual numbers ([`natural_point`]).
 //!
@@ -57,7 +58,7 @@
 //! quadrature points' work, about 2.3 times cheaper per operation than over 24), (3) the
 //! second-order chain rule `H = J^T H_q J + sum_k (df/dq_k) H q_k` back to the coordinates
 //! ([`composed`]) and the products with `x`. Fixed-size dual numbers on the stack for Quad4 and
-//! Tri3 facets, dynamic ones where a Quad9 takes part. A row sums its cells' contributions
+//! Tri3 facets, dynamic ones where a Quad9 or a Tri6 takes part. A row sums its cells' contributions
 //! embedded into its own coordinates (the slave facets at `j` and the master facets they
 //! overlap) and divides in the row's coordinates.
 //!
@@ -68,9 +69,10 @@
 //! and its moment about any point is zero (linear and angular momentum of the contact
 //! forces); the two-block patch test passes to round-off. The unit tests check `b_j` against
 //! central differences of the gap of [`super::mortar3::mortar_rows3`] (another code path) and
-//! `H_j` against central differences of `b_j`, on distorted, curved, non-matching Quad4, Tri3
-//! and Quad9 interfaces; `tests/finite3d_mortar.rs` the Newton tangent and the patch test.
+//! `H_j` against central differences of `b_j`, on distorted, curved, non-matching Quad4, Tri3,
+//! Quad9 and Tri6 interfaces; `tests/finite3d_mortar.rs` the Newton tangent and the patch test.
 
+use super::geometry::TRI6_MODIFIED_ALPHA;
 use super::mortar3::{
     affine_in_plane, cell_rule, collapsed_triangle_rule, inverse_map, is_convex, pieces,
     twice_signed_area, FacetSet3, MortarIntegrals3, CLIP_TOLERANCE, NON_AFFINE_POINTS,
@@ -93,7 +95,8 @@ fn zero<T: DualNum<Primitive = f64>>() -> T {
 
 /// Shape functions of a facet at (dual) natural coordinates `xi`: the same functions as
 /// [`ElementKind::shape`] (Tri3; Quad4 and Quad9 as products of 1D Lagrange polynomials on the
-/// nodes of [`ElementKind::node_coordinates`]).
+/// nodes of [`ElementKind::node_coordinates`]; Tri6 in the area coordinates `l = (1 - s - t, s,
+/// t)`: corners `l_v (2 l_v - 1)`, mid-edge nodes `4 l_a l_b`).
 fn shape_values<T: DualNum<Primitive = f64>>(kind: ElementKind, xi: &Planar<T>) -> Vec<T> {
     let [s, t] = xi;
     match kind {
@@ -118,9 +121,37 @@ fn shape_values<T: DualNum<Primitive = f64>>(kind: ElementKind, xi: &Planar<T>) 
                 .map(|c| quadratic(c[0], s) * quadratic(c[1], t))
                 .collect()
         }
-        // Tri6 is refused by `mortar3::supported` before any row is built
-        ElementKind::T6 => vec![T::from(f64::NAN); 6],
+        ElementKind::T6 => {
+            let l = -s.clone() - t + 1.0;
+            vec![
+                l.clone() * (l.clone() * 2.0 - 1.0),
+                s.clone() * (s.clone() * 2.0 - 1.0),
+                t.clone() * (t.clone() * 2.0 - 1.0),
+                l.clone() * s * 4.0,
+                s.clone() * t * 4.0,
+                t.clone() * l * 4.0,
+            ]
+        }
     }
+}
+
+/// The multiplier basis of a facet from its shape functions' values `n` (dual numbers): `n`
+/// itself, but on Tri6 the modified basis of
+/// [`super::geometry::FacetShape::weight_basis`] (corners
+/// `N_v + alpha (N_e + N_e')`, mid-edge nodes `(1 - 2 alpha) N_e`,
+/// [`super::geometry::TRI6_MODIFIED_ALPHA`]), as [`super::mortar3`] builds its multipliers.
+fn multiplier_values<T: DualNum<Primitive = f64>>(kind: ElementKind, mut n: Vec<T>) -> Vec<T> {
+    if kind == ElementKind::T6 {
+        let a = TRI6_MODIFIED_ALPHA;
+        let (m3, m4, m5) = (n[3].clone(), n[4].clone(), n[5].clone());
+        n[0] += (m3.clone() + &m5) * a;
+        n[1] += (m3 + &m4) * a;
+        n[2] += (m4 + m5) * a;
+        for v in &mut n[3..6] {
+            *v = v.clone() * (1.0 - 2.0 * a);
+        }
+    }
+    n
 }
 
 /// The projected facet map `xi -> sum_a N_a(xi) q_a` at (dual) `xi` and its Jacobian
@@ -188,7 +219,20 @@ fn shape_derivatives<T: DualNum<Primitive = f64>>(
                 })
                 .collect()
         }
-        ElementKind::T6 => vec![[T::from(f64::NAN), T::from(f64::NAN)]; 6],
+        ElementKind::T6 => {
+            let l = -s.clone() - t + 1.0;
+            let corner = |v: &T| v.clone() * 4.0 - 1.0;
+            [
+                [-corner(&l), -corner(&l)],
+                [corner(s), zero()],
+                [zero(), corner(t)],
+                [(l.clone() - s) * 4.0, s.clone() * -4.0],
+                [t.clone() * 4.0, s.clone() * 4.0],
+                [t.clone() * -4.0, (l - t) * 4.0],
+            ]
+            .into_iter()
+            .collect()
+        }
     }
 }
 
@@ -230,12 +274,20 @@ fn shape_second_derivatives(kind: ElementKind, xi: [f64; 2]) -> Vec<[f64; 3]> {
                 })
                 .collect()
         }
-        ElementKind::T6 => vec![[f64::NAN; 3]; 6],
+        // corners l (2 l - 1), mid-edge nodes 4 l_a l_b, in l = (1 - s - t, s, t)
+        ElementKind::T6 => vec![
+            [4.0, 4.0, 4.0],
+            [4.0, 0.0, 0.0],
+            [0.0, 0.0, 4.0],
+            [-8.0, -4.0, 0.0],
+            [0.0, 4.0, 0.0],
+            [0.0, -4.0, -8.0],
+        ],
     }
 }
 
 /// The natural coordinates of the (dual) in-plane point `p` on the projected facet `q`:
-/// closed form on Tri3; on Quad4 and Quad9 the `f64` root `xi_0` of [`inverse_map`] from
+/// closed form on Tri3; on Quad4, Quad9 and Tri6 the `f64` root `xi_0` of [`inverse_map`] from
 /// `start`, carried to second order (module notes): with `x_0`, `J_0` the map and its
 /// Jacobian at `xi_0` (linear in `q`, the shape functions' values there `f64`) and `B` its
 /// second derivative, `xi = xi_0 + d` solves `x_0 + J_0 d + B(d, d) / 2 = p` (exact to second
@@ -380,16 +432,18 @@ fn dual_coefficients<T: DualNum<Primitive = f64>>(
     q: &[Planar<T>],
 ) -> Option<Vec<Vec<T>>> {
     let n = kind.node_count();
+    // the rules of `mortar3::dual_coefficients`
     let rule: Vec<QuadPoint> = match kind {
         ElementKind::T3 => crate::fe::triangle_rule(2),
+        ElementKind::T6 => collapsed_triangle_rule(4),
         ElementKind::Q9 => crate::fe::gauss_square(4),
-        _ => crate::fe::gauss_square(3),
+        ElementKind::Q4 => crate::fe::gauss_square(3),
     };
     let mut mass: Vec<Vec<T>> = vec![vec![zero(); n]; n];
     let mut lumped: Vec<T> = vec![zero(); n];
     for qp in &rule {
         let xi = [T::from(qp.xi[0]), T::from(qp.xi[1])];
-        let values = shape_values(kind, &xi);
+        let values = multiplier_values(kind, shape_values(kind, &xi));
         let (_, j) = planar_map(kind, q, &xi);
         let det = j[0][0].clone() * &j[1][1] - j[0][1].clone() * &j[1][0];
         let w = det.abs() * qp.weight;
@@ -571,11 +625,12 @@ fn planar_share<T: DualNum<Primitive = f64>>(
                     )?;
                     let n_s = shape_values(ks, &xi_s);
                     let n_m = shape_values(km, &xi_m);
+                    let basis = multiplier_values(ks, n_s.clone());
                     for j in 0..ns {
                         let phi = match &dual {
-                            None => n_s[j].clone(),
+                            None => basis[j].clone(),
                             Some(a) => {
-                                (0..ns).fold(zero::<T>(), |s, k| s + a[j][k].clone() * &n_s[k])
+                                (0..ns).fold(zero::<T>(), |s, k| s + a[j][k].clone() * &basis[k])
                             }
                         };
                         let wj = w.clone() * phi;
@@ -793,7 +848,7 @@ fn add_times_variable(total: &mut Parts, f: &Parts, sign: f64, x: f64, v: usize,
 /// quadrature points' work is), joined by the chain rule ([`composed`]), then
 /// `A_j = sum_a D_ja`, `S_j = sum_a D_ja x_a - sum_l M_jl x_l`. Dual numbers of a fixed size
 /// on the stack where the pair of kinds has one here (Tri3 and Quad4 facets), of a dynamic
-/// size otherwise (Quad9).
+/// size otherwise (Quad9, Tri6).
 fn cell_parts(
     ks: ElementKind,
     km: ElementKind,
@@ -976,13 +1031,13 @@ pub(crate) fn linearize_rows3(
 
 #[cfg(test)]
 mod tests {
-    use super::super::geometry::Surface3;
+    use super::super::geometry::{FacetShape, Surface3};
     use super::super::mortar3::{mortar_rows3, RowNumbering};
     use super::*;
     use crate::fe::MAX_NODES;
 
-    /// A grid surface of `kind` facets on `cells x cells` quadrilaterals (Tri3: each split in
-    /// two; Quad9: `2 cells + 1` nodes a side) with node positions `at(u, v)` for grid
+    /// A grid surface of `kind` facets on `cells x cells` quadrilaterals (Tri3 and Tri6: each
+    /// split in two; Quad9 and Tri6: `2 cells + 1` nodes a side) with node positions `at(u, v)` for grid
     /// parameters in `[0, 1]`; outward normal along `+z` (`up`) or `-z`.
     fn grid(
         kind: ElementKind,
@@ -990,7 +1045,8 @@ mod tests {
         up: bool,
         at: &dyn Fn(f64, f64) -> [f64; 3],
     ) -> FacetSet3 {
-        let per = if kind == ElementKind::Q9 { 2 } else { 1 };
+        let quadratic = matches!(kind, ElementKind::Q9 | ElementKind::T6);
+        let per = if quadratic { 2 } else { 1 };
         let n = per * cells + 1;
         let id = |i: usize, j: usize| j * n + i;
         let mut facets = Vec::new();
@@ -1003,8 +1059,9 @@ mod tests {
                     id(i0 + per, j0 + per),
                     id(i0, j0 + per),
                 ];
-                let mut f: Vec<usize> = match kind {
-                    ElementKind::Q9 => vec![
+                // a Quad9's nodes on the quadratic grids
+                let mut f: Vec<usize> = match quadratic {
+                    true => vec![
                         quad[0],
                         quad[1],
                         quad[2],
@@ -1015,21 +1072,25 @@ mod tests {
                         id(i0, j0 + 1),
                         id(i0 + 1, j0 + 1),
                     ],
-                    _ => quad.to_vec(),
+                    false => quad.to_vec(),
                 };
                 if !up {
                     // the same facet seen from below: corners reversed, mid-edges with them
-                    f = match kind {
-                        ElementKind::Q9 => {
-                            vec![f[0], f[3], f[2], f[1], f[7], f[6], f[5], f[4], f[8]]
-                        }
-                        _ => vec![f[0], f[3], f[2], f[1]],
+                    f = match quadratic {
+                        true => vec![f[0], f[3], f[2], f[1], f[7], f[6], f[5], f[4], f[8]],
+                        false => vec![f[0], f[3], f[2], f[1]],
                     };
                 }
                 match kind {
                     ElementKind::T3 => {
                         facets.push(vec![f[0], f[1], f[2]]);
                         facets.push(vec![f[0], f[2], f[3]]);
+                    }
+                    // corners, then the mid-edge nodes 0-1, 1-2, 2-0 (the Quad9's centre on
+                    // the diagonal)
+                    ElementKind::T6 => {
+                        facets.push(vec![f[0], f[1], f[2], f[4], f[5], f[8]]);
+                        facets.push(vec![f[0], f[2], f[3], f[8], f[6], f[7]]);
                     }
                     _ => facets.push(f),
                 }
@@ -1049,13 +1110,13 @@ mod tests {
 
     /// A curved master (`z` up) and a smaller, turned, curved slave above it (penetrating by
     /// up to about 0.03), neither matching the other, every node moved off the grid.
-    fn curved_pair(kind: ElementKind) -> (FacetSet3, FacetSet3) {
-        let master = grid(kind, 2, true, &|u, v| {
+    fn curved_pair(kind: ElementKind, cells: usize) -> (FacetSet3, FacetSet3) {
+        let master = grid(kind, cells, true, &|u, v| {
             let (x, y) = (u + 0.04 * (7.0 * v).sin(), v + 0.03 * (5.0 * u).cos());
             [x, y, 0.08 * (x - 0.5) * (y - 0.3) + 0.03 * x * x]
         });
         let (c, s) = (0.3f64.cos(), 0.3f64.sin());
-        let slave = grid(kind, 2, false, &|u, v| {
+        let slave = grid(kind, cells, false, &|u, v| {
             let (a, b) = (0.15 + 0.7 * u + 0.02 * (9.0 * v).sin(), 0.2 + 0.6 * v);
             let (x, y) = (
                 0.5 + c * (a - 0.5) - s * (b - 0.5),
@@ -1143,11 +1204,11 @@ mod tests {
         .unwrap()
     }
 
-    /// On a curved, distorted, non-matching, penetrating interface (Quad4, Tri3, Quad9;
+    /// On a curved, distorted, non-matching, penetrating interface (Quad4, Tri3, Quad9, Tri6;
     /// standard and dual multipliers): every row's gap is the `f64` mortar row's (1e-13), its
     /// gradient the central difference of the `f64` rows' gaps (1e-7 of the largest entry),
-    /// its Hessian times three directions the central difference of the gradient along them
-    /// (1e-6 of the largest entry); the gradient's translations sum to zero and its moment
+    /// its Hessian times three directions (Tri6: one) the central difference of the gradient
+    /// along them (1e-6 of the largest entry); the gradient's translations sum to zero and its moment
     /// about the origin vanishes (1e-10: linear and angular momentum of the row's forces).
     #[test]
     fn rows_gradients_and_hessians_are_the_differences_of_the_f64_gaps() {
@@ -1157,9 +1218,14 @@ mod tests {
             (ElementKind::T3, MultiplierSpace::Standard),
             (ElementKind::T3, MultiplierSpace::Dual),
             (ElementKind::Q9, MultiplierSpace::Standard),
+            (ElementKind::T6, MultiplierSpace::Standard),
+            (ElementKind::T6, MultiplierSpace::Dual),
         ];
         for (kind, space) in cases {
-            let (slave, master) = curved_pair(kind);
+            // Tri6 on one cell a side (two facets: 16 pieces and 64 points a fan triangle per
+            // facet pair make the dynamic dual numbers' cells the slowest), the rest on two
+            let cells = if kind == ElementKind::T6 { 1 } else { 2 };
+            let (slave, master) = curved_pair(kind, cells);
             let gaps = f64_gaps(&slave, &master, space);
             let nodes: Vec<usize> = gaps.keys().copied().collect();
             let start = std::time::Instant::now();
@@ -1228,7 +1294,9 @@ mod tests {
             let v = row.dofs.len();
             let scale_h = row.hessian.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             let mut worst_h = 0.0f64;
-            for k in 0..3 {
+            // (Tri6: one direction; each is two linearizations of about 2 s)
+            let directions = if kind == ElementKind::T6 { 1 } else { 3 };
+            for k in 0..directions {
                 let direction: Vec<f64> = (0..v).map(|a| ((a * 7 + k * 3) as f64).sin()).collect();
                 let shifted = |sign: f64| {
                     let (mut s, mut m) = (slave.clone(), master.clone());
@@ -1251,7 +1319,8 @@ mod tests {
                 }
             }
             println!(
-                "{kind:?} {space:?}: {} rows in {seconds:.2} s; gap vs f64 {worst_gap:.1e}, gradient vs difference {worst_b:.1e}, Hessian vs difference {worst_h:.1e} (of {scale_h:.2e}), momentum {worst_momentum:.1e}",
+                "{kind:?} {space:?} ({:.1} s in all): {} rows in {seconds:.2} s; gap vs f64 {worst_gap:.1e}, gradient vs difference {worst_b:.1e}, Hessian vs difference {worst_h:.1e} (of {scale_h:.2e}), momentum {worst_momentum:.1e}",
+                start.elapsed().as_secs_f64(),
                 rows.len()
             );
             assert!(rows.len() >= 4, "{kind:?}: {} rows", rows.len());
@@ -1265,10 +1334,16 @@ mod tests {
         }
     }
 
-    /// The dual-number shape functions are [`ElementKind::shape`]'s, values and derivatives.
+    /// The dual-number shape functions are [`ElementKind::shape`]'s, values and derivatives; their
+    /// second derivatives the differences of the first; the multiplier basis the `f64` rows'.
     #[test]
     fn shape_functions_are_the_elements() {
-        for kind in [ElementKind::Q4, ElementKind::T3, ElementKind::Q9] {
+        for kind in [
+            ElementKind::Q4,
+            ElementKind::T3,
+            ElementKind::Q9,
+            ElementKind::T6,
+        ] {
             let xi = [0.23, -0.41];
             let k = kind.node_count();
             let (mut n, mut dn) = ([0.0; MAX_NODES], [[0.0; 2]; MAX_NODES]);
@@ -1279,6 +1354,30 @@ mod tests {
                 assert!((values[a] - n[a]).abs() < 1e-15, "{kind:?} {a}");
                 assert!((derivatives[a][0] - dn[a][0]).abs() < 1e-15, "{kind:?} {a}");
                 assert!((derivatives[a][1] - dn[a][1]).abs() < 1e-15, "{kind:?} {a}");
+            }
+            // the second derivatives: central differences of the first (quadratic at most in
+            // each coordinate, so only round-off remains)
+            let second = shape_second_derivatives(kind, xi);
+            let h = 1e-4;
+            let along =
+                |ds: f64, dt: f64| shape_derivatives::<f64>(kind, &[xi[0] + ds, xi[1] + dt]);
+            let (ps, ms, pt, mt) = (along(h, 0.0), along(-h, 0.0), along(0.0, h), along(0.0, -h));
+            for a in 0..k {
+                let differences = [
+                    (ps[a][0] - ms[a][0]) / (2.0 * h),
+                    (pt[a][0] - mt[a][0]) / (2.0 * h),
+                    (pt[a][1] - mt[a][1]) / (2.0 * h),
+                ];
+                for (d, s) in differences.iter().zip(&second[a]) {
+                    assert!((d - s).abs() < 1e-9, "{kind:?} {a}: {d} vs {s}");
+                }
+            }
+            // the multiplier basis is the one the f64 rows are built on
+            let mut basis = [0.0; MAX_NODES];
+            FacetShape::<3>::weight_basis(kind, xi, &mut basis[..k]);
+            let dual_basis = multiplier_values(kind, values);
+            for a in 0..k {
+                assert!((dual_basis[a] - basis[a]).abs() < 1e-15, "{kind:?} {a}");
             }
         }
     }
