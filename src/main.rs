@@ -529,6 +529,9 @@ fn run3(
             ExitCode::from(2)
         }
         Ok((o, folder)) => {
+            for w in &o.warnings {
+                eprintln!("warning: {w}");
+            }
             let cells: Vec<String> = o
                 .model
                 .bodies

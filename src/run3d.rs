@@ -92,6 +92,9 @@ pub struct Outcome3 {
     pub model: Model3,
     pub solution: Solution<3>,
     pub checks: Vec<CheckResult>,
+    /// What the run should say although no check failed (an unstable equilibrium,
+    /// [`crate::harness::stability::unstable_equilibrium`]).
+    pub warnings: Vec<String>,
 }
 
 impl Outcome3 {
@@ -134,11 +137,15 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
             _ => unreachable!("build3 refuses every other check"),
         })
         .collect();
+    let warnings = crate::harness::stability::unstable_equilibrium(&solution)
+        .into_iter()
+        .collect();
     Ok(Outcome3 {
         name: case.name.clone(),
         model,
         solution,
         checks,
+        warnings,
     })
 }
 
@@ -784,6 +791,7 @@ pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
         "timings": outcome.solution.timings,
         "contact": contact_summary(outcome),
         "passed": outcome.passed(),
+        "warnings": outcome.warnings,
         "checks": outcome.checks.iter().map(|c| serde_json::json!({
             "check": c.check, "error": c.error, "tol": c.tol, "passed": c.passed,
         })).collect::<Vec<_>>(),

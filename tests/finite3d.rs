@@ -857,10 +857,27 @@ fn the_two_block_contact_patch_test_transmits_a_uniform_pressure() {
 /// `[[A, B^T], [B, D]]` has one negative eigenvalue per multiplier plus one per direction of
 /// negative stiffness of `A` on the kernel of the active rows `B` (Sylvester's law of inertia
 /// on its block elimination), so 0 means a stable equilibrium and more an unstable one. Also
-/// the eigenvalue nearest zero of those counted.
-fn unstable_directions(case: &Value) -> (usize, f64) {
+/// the eigenvalue nearest zero of those counted, and the solver's own verdict (the last
+/// Newton iteration's `stability`) with its warnings.
+fn unstable_directions(
+    case: &Value,
+) -> (
+    usize,
+    f64,
+    Option<contact_patch::solver::newton::Stability>,
+    Vec<String>,
+) {
     let o = run(case);
     assert!(o.converged());
+    let verdict = o
+        .solution
+        .finite
+        .as_ref()
+        .unwrap()
+        .history
+        .last()
+        .unwrap()
+        .stability;
     let state = o.solution.contact.as_ref().unwrap();
     // the tangent at the last load step's prescribed values: the model of one step
     let mut one_step = case.clone();
@@ -882,7 +899,12 @@ fn unstable_directions(case: &Value) -> (usize, f64) {
         .collect();
     eigenvalues.sort_by(|a, b| a.total_cmp(b));
     let negative = eigenvalues.iter().filter(|v| **v < 0.0).count();
-    (negative - multipliers, eigenvalues[multipliers])
+    (
+        negative - multipliers,
+        eigenvalues[multipliers],
+        verdict,
+        o.warnings.clone(),
+    )
 }
 
 /// Why the stacked pair held at two corner nodes (the base's bottom and the punch's top each
@@ -894,7 +916,12 @@ fn unstable_directions(case: &Value) -> (usize, f64) {
 /// 2.5 % (smallest eigenvalue of the stiffness on the active rows' kernel 0.16, then 0.10),
 /// unstable at 5 % (-0.080) and 7 % (-0.30); the Hex8 pair, stiffer in bending, at 10 %
 /// (-0.67). On symmetry planes ([`stacked_on_symmetry_planes`]) the sway is held and the
-/// uniform state of the Hex27 pair at 20 % is stable (smallest eigenvalue 8.6).
+/// uniform state of the Hex27 pair at 20 % is stable (smallest eigenvalue 8.6). The solver
+/// says the same of each (`stability` on the last Newton iteration, from the inertia of its
+/// factorizations and the test of `LinearSolver::stability_at`) and warns of the unstable
+/// ones; `contact-patch run` on the corner-held Hex8 pair at 20 % (which converges, its
+/// iterates kept on the uniform state by the symmetry of mesh and load) prints the warning
+/// and exits 0 (the answer balances the loads), the pair on symmetry planes does not warn.
 #[test]
 fn the_corner_held_pair_buckles_and_the_pair_on_symmetry_planes_does_not() {
     let lagrange = json!({"kind": "lagrange"});
@@ -926,10 +953,36 @@ fn the_corner_held_pair_buckles_and_the_pair_on_symmetry_planes_does_not() {
         ),
     ];
     for (what, case, expected) in measured {
-        let (unstable, nearest) = unstable_directions(&case);
-        println!("{what}: {unstable} unstable direction(s), the lowest stiffness {nearest:.3e}");
+        let (unstable, nearest, verdict, warnings) = unstable_directions(&case);
+        println!("{what}: {unstable} unstable direction(s), the lowest stiffness {nearest:.3e}; the solver: {verdict:?}");
         assert_eq!(unstable, expected, "{what}: lowest stiffness {nearest:e}");
+        let stable = contact_patch::solver::newton::Stability::Stable;
+        let said_unstable = verdict != Some(stable);
+        assert_eq!(said_unstable, expected > 0, "{what}: {verdict:?}");
+        assert_eq!(
+            warnings
+                .iter()
+                .any(|w| w.contains("not a stable equilibrium")),
+            expected > 0,
+            "{what}: {warnings:?}"
+        );
     }
+    let (code, stderr) = run_binary(&corner_held("Hex8", -0.4, 4));
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(
+        stderr.contains("warning: the state the solve converged to is not a stable equilibrium"),
+        "{stderr}"
+    );
+    let (code, stderr) = run_binary(&stacked_on_symmetry_planes(
+        "Hex8",
+        &MATCHING3,
+        &MATCHING3,
+        lagrange.clone(),
+        -0.4,
+        1,
+    ));
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(!stderr.contains("stable equilibrium"), "{stderr}");
 }
 
 /// `contact-patch run` on `case`: the exit code and stderr; a panic fails the test.

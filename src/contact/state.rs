@@ -157,4 +157,9 @@ pub struct IterationRecord {
     /// The cycling remedy (`solver.cycling_remedy`) was in force in this iteration.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub cycling_remedy: bool,
+    /// On the last iteration of a converged Newton solve with a symmetric tangent: whether the
+    /// state it converged to is a stable equilibrium ([`crate::solver::newton::Stability`]);
+    /// absent elsewhere.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stability: Option<crate::solver::newton::Stability>,
 }

@@ -30,6 +30,7 @@ use crate::contact::state::{ContactState, Termination};
 use crate::model::Model;
 use crate::solver::conditioning::{lost_digits, EQUILIBRIUM_ROUND_OFF};
 use crate::solver::linear::Solution;
+use crate::solver::newton::Stability;
 use serde::Serialize;
 
 /// What `summary.json` says of the conditioning and the equilibrium of an answer.
@@ -284,14 +285,56 @@ fn iterative_stall(model: &Model, state: &ContactState) -> Option<String> {
     ))
 }
 
-/// The stability warnings of a run: equilibrium not at round-off, a stalled iteration.
+/// The stability warnings of a run: equilibrium not at round-off, a stalled iteration, an
+/// unstable equilibrium.
 pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
     let stall = stall_diagnosis(model, solution);
     equilibrium_warning(model, solution)
         .into_iter()
         .chain(stall)
         .chain(energy_growth(solution))
+        .chain(unstable_equilibrium(solution))
         .collect()
+}
+
+/// A warning when a finite-kinematics solve converged to a state that is not a stable
+/// equilibrium: the last Newton iteration of the last load step records
+/// [`Stability::Unstable`] (the tangent is not positive definite on the kernel of the active
+/// contact rows, [`crate::solver::newton::LinearSolver::stability_at`]). Such a state balances
+/// the loads but the slightest disturbance leaves it (a structure that buckles, a contact that
+/// slides away): a real body would not stay there, and Newton reaches it only when nothing
+/// disturbs the iterates (a symmetric mesh and load). The earlier load steps whose state was
+/// already unstable are named with the load factor where it was first seen.
+pub fn unstable_equilibrium<const D: usize>(solution: &Solution<D>) -> Option<String> {
+    let finite = solution.finite.as_deref()?;
+    let last = finite.history.last()?;
+    if last.stability != Some(Stability::Unstable) {
+        return None;
+    }
+    let load_factor = |attempt: usize| {
+        finite
+            .steps
+            .iter()
+            .find(|s| s.attempt == attempt)
+            .map_or(f64::NAN, |s| s.to)
+    };
+    let first = finite
+        .history
+        .iter()
+        .filter(|r| r.stability == Some(Stability::Unstable))
+        .map(|r| r.step)
+        .find(|&attempt| {
+            // from the first unstable accepted step on
+            finite
+                .steps
+                .iter()
+                .any(|s| s.attempt == attempt && s.accepted)
+        })
+        .unwrap_or(last.step);
+    Some(format!(
+        "the state the solve converged to is not a stable equilibrium: the Newton tangent there is not positive definite on the kernel of the active contact rows (first seen at load factor {:.4}, the end of load step {first}): the loads are balanced, but the slightest disturbance leaves this state (the structure buckles, or a body slides away on its contact), and a real body would not stay in it; hold the modes the supports leave free (symmetry planes, more supports), or apply less load",
+        load_factor(first)
+    ))
 }
 
 /// Share of the largest energy of a time integration by which the total energy may grow

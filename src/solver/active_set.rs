@@ -2376,6 +2376,7 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
                 seconds: iteration_start.elapsed().as_secs_f64(),
                 repeated_set: repeated,
                 cycling_remedy: !held.is_empty(),
+                stability: None,
             });
             let converged = match method {
                 Method::Lagrange | Method::Elimination => stable,
@@ -2566,6 +2567,7 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
                     seconds: iteration_start.elapsed().as_secs_f64(),
                     repeated_set: false,
                     cycling_remedy: false,
+                    stability: None,
                 });
                 previous_forces = forces;
                 seen.push(std::mem::replace(&mut active, next));

@@ -269,7 +269,10 @@ pub fn solve_with(
             // a new pattern carries the iterate to new unknowns: the step is taken as it is
             trial = None;
             earlier_seconds += linear.seconds - base_seconds;
+            // the last factorization's inertia stays the verdict of the iterates it solved for
+            let inertia = linear.last_inertia;
             *linear = LinearSolver::new(system.pattern(), settings.factor_limit);
+            linear.last_inertia = inertia;
             base_seconds = 0.0;
             version = system.pattern_version();
             *x = system.carry(x);
@@ -329,6 +332,7 @@ pub fn solve_with(
                 seconds: start.elapsed().as_secs_f64(),
                 repeated_set: false,
                 cycling_remedy: false,
+                stability: None,
             });
             start = Instant::now();
         }
@@ -380,6 +384,9 @@ pub fn solve_with(
         }
         augmented = false;
         if converged {
+            if let Some(last) = history.last_mut() {
+                last.stability = linear.stability_at(&tangent);
+            }
             break Termination::Converged;
         }
         if !relative.is_finite() {
@@ -441,6 +448,26 @@ pub fn solve_with(
     })
 }
 
+/// Whether a converged state is a stable equilibrium: its tangent positive definite on the
+/// kernel of its active contact rows (for the Lagrangian of the Lagrange multipliers, the
+/// second-order condition of a minimum of the energy subject to the active rows), or not: a
+/// direction along which the energy does not rise, where the slightest disturbance leaves the
+/// state (a structure that buckles, a contact that slides away). See
+/// [`LinearSolver::stability_at`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stability {
+    Stable,
+    Unstable,
+}
+
+/// The weight `t` of the active rows' `rho B_A^T B_A` added to the displacement block to test
+/// it on their kernel ([`LinearSolver::stability_at`]): a direction outside the kernel with a
+/// negative stiffness above `t rho |B_A v|^2` would be counted as unstable (the displacement
+/// block's negative parts, the geometric terms of stress and contact forces, are small against
+/// `rho`, the largest diagonal of the stiffness).
+pub const FINSLER_WEIGHT: f64 = 1e4;
+
 enum Factorization {
     Cholesky(Factor),
     Ldlt(LdltFactor),
@@ -478,6 +505,11 @@ pub struct LinearSolver {
     /// Estimated 1-norm condition number of the last factorization (Cholesky, LDL^T, and LU
     /// with its transpose solves), see [`crate::solver::conditioning`].
     pub last_condition: Option<f64>,
+    /// Whether the last factored tangent, symmetric, had the inertia of a stable equilibrium
+    /// (Cholesky, or `L D L^T` with one negative pivot per multiplier: `Some(true)`) or not
+    /// (`Some(false)`: it went to LU); `None` for an unsymmetric tangent, constraint
+    /// elimination, or an LU taken for another reason.
+    last_inertia: Option<bool>,
 }
 
 impl LinearSolver {
@@ -495,6 +527,7 @@ impl LinearSolver {
             seconds: 0.0,
             last_solver: "none",
             last_condition: None,
+            last_inertia: None,
         }
     }
 
@@ -527,6 +560,67 @@ impl LinearSolver {
         self.factorizations += 1;
         self.last = Some((tangent.values.clone(), factor));
         Ok(())
+    }
+
+    /// Whether the state whose symmetric `tangent` this is (Newton has converged there) is a
+    /// stable equilibrium. A tangent like the last one factored by Cholesky or by `L D L^T`
+    /// with the saddle-point inertia is stable (the last factorization is of the previous
+    /// iterate, whose tangent differs from this one by the last Newton step). Otherwise this
+    /// tangent is tested: without multipliers it is stable when it is positive definite
+    /// (Cholesky); with multipliers `[[A, C], [C^T, D]]` (the active rows' columns `C = -rho
+    /// B_A^T` with a zero diagonal, the inactive ones `D = -rho`), when `A` is positive
+    /// definite on the kernel of the active rows, which by Finsler's lemma is when `A + t rho
+    /// B_A^T B_A` is positive definite for some `t`, tried at [`FINSLER_WEIGHT`]: a direction
+    /// of non-positive stiffness inside the kernel makes it fail at every `t`, one outside is
+    /// lifted by `t`. `None` for an unsymmetric tangent, constraint elimination, or a test that
+    /// cannot be made (a tangent too large to factor).
+    pub fn stability_at(&mut self, tangent: &Tangent) -> Option<Stability> {
+        if !tangent.symmetric || tangent.elimination.is_some() {
+            return None;
+        }
+        if self.last_inertia? {
+            return Some(Stability::Stable);
+        }
+        let p = &self.symmetric;
+        let mut upper = self.general.upper_values(&tangent.values, p.nnz());
+        let leading = self.general.n - tangent.multipliers;
+        let block = if tangent.multipliers == 0 {
+            p.clone()
+        } else {
+            let weight = FINSLER_WEIGHT / tangent.scale;
+            for j in leading..self.general.n {
+                let column = p.col_ptr[j]..p.col_ptr[j + 1];
+                let diagonal = p.position(j, j).map_or(0.0, |k| upper[k]);
+                if diagonal != 0.0 {
+                    continue;
+                }
+                let coupling: Vec<(usize, f64)> = column
+                    .filter(|&k| p.row_idx[k] < leading && upper[k] != 0.0)
+                    .map(|k| (p.row_idx[k], upper[k]))
+                    .collect();
+                for (a, &(ea, ca)) in coupling.iter().enumerate() {
+                    for &(eb, cb) in &coupling[a..] {
+                        let k = p.position(ea, eb)?;
+                        upper[k] += weight * ca * cb;
+                    }
+                }
+            }
+            let end = p.col_ptr[leading];
+            upper.truncate(end);
+            SymmetricPattern {
+                n: leading,
+                col_ptr: p.col_ptr[..=leading].to_vec(),
+                row_idx: p.row_idx[..end].to_vec(),
+            }
+        };
+        let cholesky = Cholesky::analyse(&block, &self.limit).ok()?;
+        match cholesky.factor(&block, &upper) {
+            Ok(_) => Some(Stability::Stable),
+            Err(FactorError::NotPositiveDefinite { .. } | FactorError::ZeroPivot { .. }) => {
+                Some(Stability::Unstable)
+            }
+            Err(_) => None,
+        }
     }
 
     /// Constraint elimination of the saddle-point system `[[A, C], [C^T, D]] [dx; dmu] = [b_u;
@@ -621,6 +715,7 @@ impl LinearSolver {
     }
 
     fn factor(&mut self, tangent: &Tangent) -> std::result::Result<Factorization, FactorError> {
+        self.last_inertia = None;
         if tangent.symmetric && tangent.multipliers > 0 {
             let n = self.general.n;
             let leading = n - tangent.multipliers;
@@ -639,6 +734,7 @@ impl LinearSolver {
             match ldlt.factor(&self.symmetric, &upper, &signs, 1e-13 * scale, scale) {
                 Ok(f) => {
                     self.last_solver = "ldlt";
+                    self.last_inertia = Some(true);
                     self.last_condition =
                         Some(condition_estimate_symmetric(&self.symmetric, &upper, |b| {
                             f.solve_in_place(b)
@@ -649,7 +745,9 @@ impl LinearSolver {
                 // derivative times a contact force) gives pivots of the wrong sign, and
                 // regularizing them may overflow the factor; LU below, which has no expected
                 // inertia
-                Err(FactorError::ZeroPivot { .. }) if tangent.indefinite_block => {}
+                Err(FactorError::ZeroPivot { .. }) if tangent.indefinite_block => {
+                    self.last_inertia = Some(false);
+                }
                 // singular: dependent rows (two passes), a body the active rows leave free
                 Err(e @ FactorError::ZeroPivot { .. }) => return Err(e),
                 // LU below
@@ -666,6 +764,7 @@ impl LinearSolver {
             match chol.factor(&self.symmetric, &upper) {
                 Ok(f) => {
                     self.last_solver = "cholesky";
+                    self.last_inertia = Some(true);
                     self.last_condition =
                         Some(condition_estimate_symmetric(&self.symmetric, &upper, |b| {
                             f.solve_in_place(b)
@@ -673,7 +772,9 @@ impl LinearSolver {
                     return Ok(Factorization::Cholesky(f));
                 }
                 // indefinite (a geometric term): LU below; a zero pivot is singular either way
-                Err(FactorError::NotPositiveDefinite { .. }) => {}
+                Err(FactorError::NotPositiveDefinite { .. }) => {
+                    self.last_inertia = Some(false);
+                }
                 Err(e) => return Err(e),
             }
         }
@@ -978,6 +1079,82 @@ mod tests {
         linear.solve(&t, &mut b).unwrap();
         linear.solve(&t, &mut b).unwrap();
         assert_eq!((linear.factorizations, linear.reused), (1, 1));
+    }
+
+    /// The dense symmetric `values` (row-major, `n x n`) as a tangent on a full pattern, solved
+    /// once (which records the factorization's inertia), and the stability verdict on it.
+    fn verdict(n: usize, values: &[f64], multipliers: usize) -> (Option<Stability>, &'static str) {
+        let pattern = SymmetricPattern {
+            n,
+            col_ptr: (0..=n).map(|j| j * (j + 1) / 2).collect(),
+            row_idx: (0..n).flat_map(|j| 0..=j).collect(),
+        };
+        let mut linear = LinearSolver::new(&pattern, UNLIMITED);
+        let general = linear.general.clone();
+        let mut upper = vec![0.0; pattern.nnz()];
+        for j in 0..n {
+            for i in 0..=j {
+                upper[pattern.position(i, j).unwrap()] = values[i * n + j];
+            }
+        }
+        let tangent = Tangent {
+            values: general.symmetric_values(&upper),
+            symmetric: true,
+            multipliers,
+            scale: 1.0,
+            elimination: None,
+            indefinite_block: true,
+        };
+        let mut b = vec![1.0; n];
+        linear.solve(&tangent, &mut b).unwrap();
+        (linear.stability_at(&tangent), linear.last_solver)
+    }
+
+    /// The stability verdict on small tangents whose answer is known: without multipliers,
+    /// stable exactly when positive definite; with a Lagrange multiplier row `b` (the saddle
+    /// point `[[A + rho b b^T, -rho b], [-rho b^T, 0]]`, `rho = 1`), when `A` is positive on
+    /// the kernel of `b`. `A = diag(1, -1)` is stable when the row holds the second unknown
+    /// (its negative direction is not in the kernel; the augmented block `diag(1, 0)` fails
+    /// the `L D L^T` inertia, so the verdict comes from the test at the Finsler weight) and
+    /// unstable when the row holds the first.
+    #[test]
+    fn the_stability_verdict_is_the_sign_of_the_stiffness_on_the_rows_kernel() {
+        // no multipliers
+        assert_eq!(
+            verdict(2, &[2.0, 1.0, 1.0, 2.0], 0),
+            (Some(Stability::Stable), "cholesky")
+        );
+        assert_eq!(
+            verdict(2, &[1.0, 0.0, 0.0, -1.0], 0),
+            (Some(Stability::Unstable), "lu")
+        );
+        // a row on the second unknown: A + b b^T = diag(1, 0)
+        #[rustfmt::skip]
+        let held_second = [
+            1.0, 0.0, 0.0,
+            0.0, 0.0, -1.0,
+            0.0, -1.0, 0.0,
+        ];
+        assert_eq!(verdict(3, &held_second, 1), (Some(Stability::Stable), "lu"));
+        // a row on the first unknown: A + b b^T = diag(2, -1)
+        #[rustfmt::skip]
+        let held_first = [
+            2.0, 0.0, -1.0,
+            0.0, -1.0, 0.0,
+            -1.0, 0.0, 0.0,
+        ];
+        assert_eq!(
+            verdict(3, &held_first, 1),
+            (Some(Stability::Unstable), "lu")
+        );
+        // positive definite with its row: L D L^T with the saddle-point inertia
+        #[rustfmt::skip]
+        let stable = [
+            2.0, 0.0, -1.0,
+            0.0, 1.0, 0.0,
+            -1.0, 0.0, 0.0,
+        ];
+        assert_eq!(verdict(3, &stable, 1), (Some(Stability::Stable), "ldlt"));
     }
 
     #[test]
