@@ -125,6 +125,19 @@ pub struct Departure {
     pub update: usize,
 }
 
+/// Whether a converged state is a stable equilibrium: its tangent positive definite on the
+/// kernel of its active contact rows (for the Lagrangian of the Lagrange multipliers, the
+/// second-order condition of a minimum of the energy subject to the active rows), or not: a
+/// direction along which the energy does not rise, where the slightest disturbance leaves the
+/// state (a structure that buckles, a contact that slides away). See
+/// [`crate::solver::newton::LinearSolver::stability_at`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stability {
+    Stable,
+    Unstable,
+}
+
 /// What one iteration of the active-set loop did (the solve's history, in `summary.json`).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct IterationRecord {
@@ -161,5 +174,5 @@ pub struct IterationRecord {
     /// state it converged to is a stable equilibrium ([`crate::solver::newton::Stability`]);
     /// absent elsewhere.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub stability: Option<crate::solver::newton::Stability>,
+    pub stability: Option<Stability>,
 }

@@ -448,18 +448,7 @@ pub fn solve_with(
     })
 }
 
-/// Whether a converged state is a stable equilibrium: its tangent positive definite on the
-/// kernel of its active contact rows (for the Lagrangian of the Lagrange multipliers, the
-/// second-order condition of a minimum of the energy subject to the active rows), or not: a
-/// direction along which the energy does not rise, where the slightest disturbance leaves the
-/// state (a structure that buckles, a contact that slides away). See
-/// [`LinearSolver::stability_at`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Stability {
-    Stable,
-    Unstable,
-}
+pub use crate::contact::state::Stability;
 
 /// The weight `t` of the active rows' `rho B_A^T B_A` added to the displacement block to test
 /// it on their kernel ([`LinearSolver::stability_at`]): a direction outside the kernel with a
