@@ -32,6 +32,11 @@
 //! the edge point (zero on the facet's other nodes). **Corners**: `g = |x_s - x_v|` and the
 //! second derivative is `(I - nu nu^T) / g` on `x_s` and `-` that between `x_s` and `x_v`.
 //!
+//! A node behind the facet's plane whose closest point is on an edge or a corner (inside the
+//! master body under a concave edge, where neither facet's normal through the node meets it)
+//! has the gap `-|r|`, so `-1` times the above ([`side_of_facet`]): a penetration, not a
+//! separation.
+//!
 //! Edge and corner points are points outside the facet's natural domain (a point on its
 //! boundary is interior, to [`super::facet_projection::INSIDE`]), so their distance is positive
 //! unless the node sits on the edge or the vertex itself, where the direction `nu` and so the
@@ -75,16 +80,20 @@ pub fn node_to_facet_gap_hessian_at(
             if q.distance == 0.0 {
                 return None;
             }
-            return Some(edge_gap_hessian(kind, coords, x_s, &q, k));
+            let side = side_of_facet(&q, x_s);
+            let mut h = edge_gap_hessian(kind, coords, x_s, &q, k);
+            h.iter_mut().for_each(|v| *v *= side);
+            return Some(h);
         }
         FacetFeature::Corner(k) => {
             if q.distance == 0.0 {
                 return None;
             }
+            let side = side_of_facet(&q, x_s);
             let nu = std::array::from_fn::<f64, 3, _>(|i| (x_s[i] - q.point[i]) / q.distance);
             for i in 0..3 {
                 for j in 0..3 {
-                    let v = (f64::from(u8::from(i == j)) - nu[i] * nu[j]) / q.distance;
+                    let v = side * (f64::from(u8::from(i == j)) - nu[i] * nu[j]) / q.distance;
                     for (a, b, sign) in [(0, 0, 1.0), (0, k + 1, -1.0), (k + 1, 0, -1.0)] {
                         h[(3 * a + i) * len + 3 * b + j] += sign * v;
                     }
@@ -194,6 +203,19 @@ pub fn node_to_facet_gap_hessian_at(
     Some(h)
 }
 
+/// The sign of the gap of `x_s` whose closest point `q` on a facet is on an edge or a corner:
+/// `+1` on the side the facet's normal points to at `q` (outside a convex edge or corner),
+/// `-1` behind it (inside the master body under a concave edge or corner, where the closest
+/// points of both facets are their common edge): the gap is `side |x_s - x(q)|`.
+pub fn side_of_facet(q: &FacetProjection, x_s: [f64; 3]) -> f64 {
+    let d: [f64; 3] = std::array::from_fn(|i| x_s[i] - q.point[i]);
+    if dot(d, q.normal) < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
 /// The second derivative of the gap of `x_s` against the edge `k` of the facet that holds its
 /// closest point `q` at a positive distance (module notes, **Edges**).
 fn edge_gap_hessian(
@@ -279,7 +301,8 @@ mod tests {
 
     /// The gap's gradient over `q = [x_s, x_1, .., x_n]` at these positions (re-projected):
     /// `n` on the slave, `-N_a n` on node `a` inside; `nu`, `-N_a nu` on an edge, `nu`, `-nu`
-    /// at a corner (`nu` the unit direction from the closest point to the slave).
+    /// at a corner (`nu` the unit direction from the closest point to the slave, turned round
+    /// behind the facet, where the gap is `-|x_s - x|`).
     fn gradient(kind: ElementKind, coords: &[[f64; 3]], x_s: [f64; 3]) -> Vec<f64> {
         let q = project_onto_facet(kind, coords, x_s);
         let mut out = vec![0.0; 3 * (coords.len() + 1)];
@@ -292,7 +315,9 @@ mod tests {
                 (q.normal, shape[..k].to_vec())
             }
             FacetFeature::Corner(c) => (
-                std::array::from_fn(|i| (x_s[i] - q.point[i]) / q.distance),
+                std::array::from_fn(|i| {
+                    side_of_facet(&q, x_s) * (x_s[i] - q.point[i]) / q.distance
+                }),
                 (0..coords.len())
                     .map(|a| f64::from(u8::from(a == c)))
                     .collect(),
@@ -303,7 +328,9 @@ mod tests {
                 let k = coords.len();
                 FacetShape::<3>::shape(kind, q.natural, &mut shape[..k], &mut dshape[..k]);
                 (
-                    std::array::from_fn(|i| (x_s[i] - q.point[i]) / q.distance),
+                    std::array::from_fn(|i| {
+                        side_of_facet(&q, x_s) * (x_s[i] - q.point[i]) / q.distance
+                    }),
                     shape[..k].to_vec(),
                 )
             }
@@ -315,6 +342,37 @@ mod tests {
             }
         }
         out
+    }
+
+    /// The warped Quad4 of the test below.
+    fn warped_quad4_behind() -> Vec<[f64; 3]> {
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.2],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.2],
+        ]
+    }
+
+    /// A node behind a facet whose closest point is on an edge or a corner has a negative gap,
+    /// minus its distance, and a row and second derivative of that sign: the unit direction
+    /// from the closest point to the node points into the facet's back side.
+    #[test]
+    fn behind_the_facet_an_edge_or_corner_gap_is_minus_the_distance() {
+        for (x_s, corner) in [([1.4, 0.4, -0.3], false), ([1.3, 1.2, -0.3], true)] {
+            let coords = warped_quad4_behind();
+            let q = project_onto_facet(ElementKind::Q4, &coords, x_s);
+            assert_eq!(matches!(q.feature, FacetFeature::Corner(_)), corner);
+            assert!(matches!(
+                q.feature,
+                FacetFeature::Edge(_) | FacetFeature::Corner(_)
+            ));
+            assert_eq!(side_of_facet(&q, x_s), -1.0);
+            // in front of the facet, mirrored through its edge's plane: +1
+            let front = [x_s[0], x_s[1], 0.5];
+            let p = project_onto_facet(ElementKind::Q4, &coords, front);
+            assert_eq!(side_of_facet(&p, front), 1.0);
+        }
     }
 
     #[test]
@@ -349,6 +407,15 @@ mod tests {
                 ElementKind::T6,
                 super::super::facet_projection::tests::curved_tri6(),
                 [1.0, 1.0, 0.2],
+            ),
+            // behind the facet (inside the master body under a concave edge or corner): the
+            // gap -|x_s - x| and its second derivative turned round
+            (ElementKind::Q4, warped_quad4_behind(), [1.4, 0.4, -0.3]),
+            (ElementKind::Q4, warped_quad4_behind(), [1.3, 1.2, -0.3]),
+            (
+                ElementKind::T6,
+                super::super::facet_projection::tests::curved_tri6(),
+                [1.3, 1.2, -0.3],
             ),
         ];
         let h = 1e-6;
@@ -388,7 +455,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!((corners, edges), (1, 3), "one corner and three edge cases");
+        assert_eq!((corners, edges), (2, 5), "two corner and five edge cases");
     }
 
     /// A slave node on a facet's edge or corner itself (distance zero, where an edge or corner

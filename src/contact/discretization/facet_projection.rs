@@ -66,7 +66,7 @@ pub struct FacetProjection {
 /// The bounds of the natural domain, one per edge (edge `k` from corner `k` to corner
 /// `k + 1` of [`natural_corners`]): how far `s` lies past edge `k`'s line (negative inside).
 /// Quadrilaterals: `-1 - t`, `s - 1`, `t - 1`, `-1 - s`; triangles: `-t`, `s + t - 1`, `-s`.
-fn edge_violations(kind: ElementKind, s: [f64; 2]) -> [f64; 4] {
+pub fn edge_violations(kind: ElementKind, s: [f64; 2]) -> [f64; 4] {
     if is_quadrilateral(kind) {
         [-1.0 - s[1], s[0] - 1.0, s[1] - 1.0, -1.0 - s[0]]
     } else {

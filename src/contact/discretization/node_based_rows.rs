@@ -20,7 +20,13 @@
 //!   a convex edge or corner) is held at the distance `g = |x_s - x_c|` along
 //!   `nu = (x_s - x_c) / |x_s - x_c|` (or the facet normal when the node sits on it), the row
 //!   `nu` on the slave and `-N_a(xi) nu` on the edge's nodes (`-nu` on the vertex): the 3D
-//!   corner condition. A slave node whose closest point is on the free boundary of the master
+//!   corner condition. Behind the facet's plane (a node inside the master body under a concave
+//!   edge, which neither facet's normal through the node meets) the gap is `-|x_s - x_c|` and
+//!   `nu` turns round ([`super::facet_gap_hessian::side_of_facet`]): a penetration, not a
+//!   separation. **Kinks under finite kinematics**: within [`SHARED_EDGE_HOLD`] of an edge two
+//!   facets share, the facet of lower index holds the node, extended past the edge
+//!   ([`held_across_shared_edge`]): on a concave kink neither facet's row has an equilibrium
+//!   near the edge and Newton alternated between them. A slave node whose closest point is on the free boundary of the master
 //!   surface (an edge of one facet only, or a vertex on such an edge) lies beyond it and gets
 //!   no row under small strain; under finite kinematics (rows built in the current
 //!   configuration) a node within a quarter facet ([`FREE_BOUNDARY_EXTENSION`]) beyond it is
@@ -47,9 +53,10 @@
 //! corner) and are dropped. The global dof of `(body, node, component)` comes from a
 //! [`DofNumbering`] (any closure `Fn(usize, usize, usize) -> usize`).
 
-use super::facet_gap_hessian::node_to_facet_gap_hessian_at;
+use super::facet_gap_hessian::{node_to_facet_gap_hessian_at, side_of_facet};
 use super::facet_projection::{
-    project_onto_extended_facet, project_onto_facet, violated_edges, FacetFeature, FacetProjection,
+    edge_violations, project_onto_extended_facet, project_onto_facet, violated_edges, FacetFeature,
+    FacetProjection,
 };
 use super::geometry::{dot, FacetShape, Surface, Surface3, MAX_FACET_NODES};
 use super::search::BucketGrid;
@@ -409,6 +416,12 @@ fn node_to_surface_pass(
         } else {
             q
         };
+        let (f, q) = if settings.current_finite && q.feature == FacetFeature::Interior {
+            held_across_shared_edge(master, &candidates, p, (f, q), &edge_facets, tol)
+        } else {
+            (f, q)
+        };
+        let facet = &master.facets[f];
         let mut n = [0.0; MAX_FACET_NODES];
         let mut dn = [[0.0; 2]; MAX_FACET_NODES];
         kind.shape(q.natural, &mut n[..nodes], &mut dn[..nodes]);
@@ -416,8 +429,14 @@ fn node_to_surface_pass(
         let d: [f64; 3] = std::array::from_fn(|i| p[i] - q.point[i]);
         let (nu, terms) = match q.feature {
             FacetFeature::Interior => (q.normal, terms),
-            FacetFeature::Edge(_) => (away(d, q.distance, q.normal, tol), terms),
-            FacetFeature::Corner(k) => (away(d, q.distance, q.normal, tol), vec![(facet[k], 1.0)]),
+            FacetFeature::Edge(_) => (
+                away(d, q.distance, q.normal, tol, side_of_facet(&q, p)),
+                terms,
+            ),
+            FacetFeature::Corner(k) => (
+                away(d, q.distance, q.normal, tol, side_of_facet(&q, p)),
+                vec![(facet[k], 1.0)],
+            ),
         };
         let g0 = dot(nu, d);
         let mut row = node_row(
@@ -448,6 +467,86 @@ fn node_to_surface_pass(
     rows
 }
 
+/// How far past an edge it shares with another facet (natural units, per unit of the facet's
+/// natural span) a facet still holds a slave node under finite kinematics
+/// ([`held_across_shared_edge`]).
+pub const SHARED_EDGE_HOLD: f64 = 1e-2;
+
+/// Under finite kinematics, the facet that holds a slave node at `p` whose closest point
+/// `best` lies inside a facet: of the candidates whose interpolation, extended by at most
+/// [`SHARED_EDGE_HOLD`] past edges they share with other facets (never past the free
+/// boundary), holds the node at the distance of `best` (to the height the extension can add,
+/// twice the distance past the edge, and `tol`), the one of lowest index, as an interior
+/// point of the facet extended.
+///
+/// Why: a slave node on or next to a kink of the master surface is held by the single facet of
+/// its closest point, whose normal changes at the edge. Where the kink is concave (a valley
+/// under the node, which the discrete solution of a non-matching or quadratic interface makes
+/// even on a flat patch) neither facet's row has an equilibrium near the edge: the force
+/// `lambda n_A` pushes the node across the edge onto `B`, and `lambda n_B` pushes it back.
+/// Newton then alternates between the two facets forever with a fixed residual (found on the
+/// finite two-block patch test: Tet4 with the punch's nodes at 0.25 and 0.8 over the base's
+/// 0.5 grid, period-2 cycle at a relative residual of 3e-10 to 2e-7; Tet10 with the penalty,
+/// whose vertex and mid-edge nodes penetrate differently). Choosing the facet by index inside
+/// a band around the edge makes the choice a function of the position that does not change
+/// across the edge, so the rows are smooth there and the node finds its equilibrium against
+/// the facet extended a short way past the edge; outside the band the closest facet holds it
+/// as before. The price: on a kinked surface the held node's gap is that of the extended
+/// facet, off the closest-point gap by at most the distance past the edge times the change of
+/// the normal (`SHARED_EDGE_HOLD` facet sizes times the kink's angle), and zero on a flat one.
+fn held_across_shared_edge(
+    master: &Surface3,
+    candidates: &[usize],
+    p: [f64; 3],
+    best: (usize, FacetProjection),
+    edge_facets: &HashMap<(usize, usize), usize>,
+    tol: f64,
+) -> (usize, FacetProjection) {
+    let kind = master.kind;
+    let corners = FacetShape::<3>::corner_count(kind);
+    let span = natural_span(kind);
+    let band = SHARED_EDGE_HOLD * span;
+    let size = |f: usize| facet_diameter(&master.coords[f][..corners]);
+    // the height an extension past the edges can add to the distance
+    let height = |f: usize, q: &FacetProjection| 2.0 * q.excess / span * size(f);
+    for &f in candidates {
+        if f >= best.0 {
+            break;
+        }
+        let facet = &master.facets[f];
+        let shared = |k: usize| {
+            let (a, b) = (facet[k], facet[(k + 1) % corners]);
+            edge_facets[&(a.min(b), a.max(b))] > 1
+        };
+        let margin = FREE_BOUNDARY_EXTENSION * span;
+        let Some(e) = project_onto_extended_facet(kind, &master.coords[f], p, margin) else {
+            continue;
+        };
+        // past shared edges by at most the band; past the free boundary as far as its
+        // extension reaches
+        let violations = edge_violations(kind, e.natural);
+        if (0..corners).any(|k| violations[k] > band && shared(k)) {
+            continue;
+        }
+        if (e.distance - best.1.distance).abs() <= height(f, &e) + height(best.0, &best.1) + tol {
+            return (f, e);
+        }
+    }
+    best
+}
+
+/// The largest distance between two of `corners`.
+fn facet_diameter(corners: &[[f64; 3]]) -> f64 {
+    let mut d = 0.0f64;
+    for (a, x) in corners.iter().enumerate() {
+        for y in &corners[a + 1..] {
+            let r: [f64; 3] = std::array::from_fn(|i| x[i] - y[i]);
+            d = d.max(dot(r, r));
+        }
+    }
+    d.sqrt()
+}
+
 /// Whether the natural point `s` of a facet (of kind `kind`, `free_edge(k)` telling which of
 /// its edges lie on the free boundary of the master surface) lies past a free edge and past no
 /// other edge by more than [`TIE_EXCESS`] (round-off at a vertex the free edge shares with an
@@ -476,10 +575,11 @@ fn natural_span(kind: crate::fe::ElementKind) -> f64 {
     }
 }
 
-/// The unit direction of `d` (of length `length`), or `fallback` when it is shorter than `tol`.
-fn away(d: [f64; 3], length: f64, fallback: [f64; 3], tol: f64) -> [f64; 3] {
+/// The unit direction of `d` (of length `length`) times `side` (`-1` for a node behind the
+/// facet, whose gap `nu . d` is then `-length`), or `fallback` when it is shorter than `tol`.
+fn away(d: [f64; 3], length: f64, fallback: [f64; 3], tol: f64, side: f64) -> [f64; 3] {
     if length > tol {
-        d.map(|c| c / length)
+        d.map(|c| side * c / length)
     } else {
         fallback
     }
@@ -968,6 +1068,83 @@ mod tests {
         let (f, feature, excess) = held(1e-15);
         assert_eq!((f, feature), (0, FacetFeature::Interior));
         assert!(excess <= TIE_EXCESS, "{excess:e}");
+    }
+
+    /// Two Tri3 master facets meeting at the diagonal `x = y` of the unit square in a shallow
+    /// valley (the far corners raised by 1e-3), a slave node on the surface beside the
+    /// diagonal at `offset` (natural units of the facets) on either side. Under finite
+    /// kinematics a node within [`SHARED_EDGE_HOLD`] of the edge is held by the facet of lower
+    /// index on both sides (its row weight on that facet's far corner, `N = -offset` past the
+    /// edge, goes through zero continuously) and its gap is continuous; farther out, and under
+    /// small strain at any offset, the facet it is over holds it.
+    #[test]
+    fn a_node_beside_a_valley_keeps_one_facet_across_the_shared_edge() {
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 1e-3],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 1e-3],
+        ];
+        // facet 0 over x > y, facet 1 over x < y
+        let master = surface(
+            1,
+            ElementKind::T3,
+            &positions,
+            &[vec![0, 1, 2], vec![0, 2, 3]],
+        );
+        // the row of a slave node at (0.4 + offset, 0.4 - offset), on the surface: its gap and
+        // its coefficients on u_z of master nodes 1 and 3 (the far corners)
+        let row_at = |offset: f64, current_finite: bool| {
+            let height = 2e-3 * offset.abs();
+            let slave_positions = [
+                [0.4 + offset, 0.4 - offset, height],
+                [0.9, 0.1, 0.5],
+                [0.1, 0.9, 0.5],
+            ];
+            let slave = surface(0, ElementKind::T3, &slave_positions, &[vec![0, 1, 2]]);
+            let settings = RowSettings {
+                current_finite,
+                ..settings(&dof)
+            };
+            let rows = node_to_surface_rows(&slave, &master, 1, &settings).unwrap();
+            let row = rows.iter().find(|r| r.slave_node == 0).unwrap();
+            let on = |node: usize| {
+                let d = dof(1, node, 2);
+                row.dofs.iter().position(|&x| x == d).map(|k| row.coeffs[k])
+            };
+            (row.g0, on(1), on(3))
+        };
+        for offset in [1e-6, -1e-6, 1e-4, -1e-4] {
+            let (g, w1, w3) = row_at(offset, true);
+            // facet 0 holds it on both sides: weight on node 1, none on node 3
+            assert!(w1.is_some() && w3.is_none(), "{offset}: {w1:?} {w3:?}");
+            // zero over facet 0; over facet 1 the height of the surface above facet 0's
+            // extension, the distance past the edge times the change of slope (4e-3 |offset|)
+            let expected = if offset > 0.0 {
+                0.0
+            } else {
+                4e-3 * offset.abs()
+            };
+            assert!(
+                (g - expected).abs() < 1e-5 * offset.abs(),
+                "{offset}: gap {g:e}, not {expected:e}"
+            );
+        }
+        // facet 0 extended past the edge: the far corner's weight -N_1 nu_z follows the node
+        // through zero (N_1 = x - y = 2 offset on facet 0's plane)
+        let (_, w_plus, _) = row_at(1e-4, true);
+        let (_, w_minus, _) = row_at(-1e-4, true);
+        let (w_plus, w_minus) = (w_plus.unwrap(), w_minus.unwrap());
+        assert!(
+            (w_plus + w_minus).abs() < 1e-9 && w_plus < 0.0,
+            "{w_plus} {w_minus}"
+        );
+        // beyond the band: the facet the node is over
+        let (_, w1, w3) = row_at(-0.05, true);
+        assert!(w1.is_none() && w3.is_some(), "{w1:?} {w3:?}");
+        // small strain: the facet the node is over, however close to the edge
+        let (_, w1, w3) = row_at(-1e-6, false);
+        assert!(w1.is_none() && w3.is_some(), "{w1:?} {w3:?}");
     }
 
     /// A slave node just past the free edge `y = 0` of two flat Quad4 master facets (by
