@@ -469,7 +469,14 @@ fn node_to_surface_pass(
 
 /// How far past an edge it shares with another facet (natural units, per unit of the facet's
 /// natural span) a facet still holds a slave node under finite kinematics
-/// ([`held_across_shared_edge`]).
+/// ([`held_across_shared_edge`]). The band must hold the node's equilibrium against the
+/// extended facet, which lies past the edge by about the row's force times the kink's angle
+/// over the slave surface's tangential stiffness: 1e-3 was too narrow for the Tet4 punch on
+/// the 0.25/0.8 grid at 20 % compression (Lagrange; its last load step alternated again at a
+/// relative residual of 1e-4, `tests/finite3d.rs`,
+/// `the_interfaces_that_fail_the_patch_test_converge_to_a_kinked_surface`). On a faceted
+/// curved master (kink angle `h / R` between facets of size `h`) the gap error it allows,
+/// `1e-2 h^2 / R`, is a twelfth of the facets' own distance from the curve, `h^2 / (8 R)`.
 pub const SHARED_EDGE_HOLD: f64 = 1e-2;
 
 /// Under finite kinematics, the facet that holds a slave node at `p` whose closest point
@@ -1145,6 +1152,49 @@ mod tests {
         // small strain: the facet the node is over, however close to the edge
         let (_, w1, w3) = row_at(-1e-6, false);
         assert!(w1.is_none() && w3.is_some(), "{w1:?} {w3:?}");
+    }
+
+    /// A slave node inside the master body under a steep valley (two Tri3 facets meeting at
+    /// the diagonal `x = y` with their far corners raised by 0.5), 0.2 below the edge: the
+    /// normals of both facets through it miss their facets, its closest point is on the
+    /// shared edge, and its row is a penetration: `g0` is minus its distance to the edge and
+    /// the row's slave direction points from the node up to the edge (a positive gap, before,
+    /// opened the row of a node pressed in by a penalty and sent Newton off).
+    #[test]
+    fn a_node_under_a_concave_edge_is_a_penetration() {
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.5],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.5],
+        ];
+        let master = surface(
+            1,
+            ElementKind::T3,
+            &positions,
+            &[vec![0, 1, 2], vec![0, 2, 3]],
+        );
+        let slave_positions = [[0.5, 0.5, -0.2], [0.9, 0.1, 0.8], [0.1, 0.9, 0.8]];
+        let slave = surface(0, ElementKind::T3, &slave_positions, &[vec![0, 1, 2]]);
+        for current_finite in [false, true] {
+            let settings = RowSettings {
+                current_finite,
+                search_distance: Some(1.0),
+                ..settings(&dof)
+            };
+            let rows = node_to_surface_rows(&slave, &master, 1, &settings).unwrap();
+            let row = rows.iter().find(|r| r.slave_node == 0).unwrap();
+            assert!(
+                (row.g0 + 0.2).abs() < 1e-12,
+                "{current_finite}: g0 {}",
+                row.g0
+            );
+            assert!(
+                (row.normal[2] - 1.0).abs() < 1e-12,
+                "{current_finite}: {:?}",
+                row.normal
+            );
+        }
     }
 
     /// A slave node just past the free edge `y = 0` of two flat Quad4 master facets (by
