@@ -437,3 +437,62 @@ fn corner_rows_are_gap_gradients() {
         }
     }
 }
+
+/// The corner condition behind a concave kink: the lower surface has a valley at (4.4, 4.93)
+/// (its neighbours at 5.06 and 5.05); a slave node 0.13 below it, inside the lower block,
+/// projects past the ends of both facets and is held against the vertex, as a penetration:
+/// its gap is minus its distance to the vertex (it read plus, an open row for a node pressed
+/// in), and the row is that signed distance's gradient.
+#[test]
+fn a_node_under_a_concave_corner_is_a_penetration() {
+    let mut m = two_blocks("Q4", 0.03, 0.0);
+    let upper = m.body_index("upper").unwrap();
+    let lower = m.body_index("lower").unwrap();
+    let below = m.bodies[upper]
+        .mesh
+        .nodes
+        .iter()
+        .position(|p| (p[0] - 4.3).abs() < 1e-12 && p[1] < 5.3)
+        .unwrap();
+    m.bodies[upper].mesh.nodes[below] = [4.4, 4.8];
+    let row_of = |m: &Model| {
+        constraints(m, &m.contact[0])
+            .unwrap()
+            .into_iter()
+            .find(|r| r.slave_node == below)
+            .expect("a row for the node under the valley")
+    };
+    let corner = row_of(&m);
+    let on_lower: Vec<usize> = corner
+        .dofs
+        .iter()
+        .filter(|&&d| {
+            d >= m.bodies[lower].dof_offset
+                && d < m.bodies[lower].dof_offset + m.bodies[lower].dof_count()
+        })
+        .map(|d| (d - m.bodies[lower].dof_offset) / 2)
+        .collect();
+    let v = on_lower[0];
+    assert!(on_lower.iter().all(|&n| n == v), "{corner:?}");
+    assert_eq!(m.bodies[lower].mesh.nodes[v], [4.4, 4.93]);
+    assert!((corner.g0 + 0.13).abs() < 1e-12, "gap {}", corner.g0);
+    let h = 1e-6;
+    for (b, n) in [(upper, below), (lower, v)] {
+        for i in 0..2 {
+            let gap_at = |delta: f64| {
+                let mut mm = m.clone();
+                mm.bodies[b].mesh.nodes[n][i] += delta;
+                row_of(&mm).g0
+            };
+            let fd = (gap_at(h) - gap_at(-h)) / (2.0 * h);
+            let dof = m.bodies[b].dof(n, i);
+            let c = corner
+                .dofs
+                .iter()
+                .position(|&d| d == dof)
+                .map(|k| corner.coeffs[k])
+                .unwrap_or(0.0);
+            assert!((fd - c).abs() < 1e-7, "dof {dof}: fd {fd} vs {c}");
+        }
+    }
+}

@@ -34,8 +34,8 @@
 //!
 //! A node behind the facet's plane whose closest point is on an edge or a corner (inside the
 //! master body under a concave edge, where neither facet's normal through the node meets it)
-//! has the gap `-|r|`, so `-1` times the above ([`side_of_facet`]): a penetration, not a
-//! separation.
+//! has the gap `-|r|`, so `-1` times the above (the caller's `side`; [`side_of_facet`] for a
+//! facet alone): a penetration, not a separation.
 //!
 //! Edge and corner points are points outside the facet's natural domain (a point on its
 //! boundary is interior, to [`super::facet_projection::INSIDE`]), so their distance is positive
@@ -58,17 +58,21 @@ pub fn node_to_facet_gap_hessian(
     coords: &[[f64; 3]],
     x_s: [f64; 3],
 ) -> Option<Vec<f64>> {
-    node_to_facet_gap_hessian_at(kind, coords, x_s, &project_onto_facet(kind, coords, x_s))
+    let q = project_onto_facet(kind, coords, x_s);
+    node_to_facet_gap_hessian_at(kind, coords, x_s, &q, side_of_facet(&q, x_s))
 }
 
 /// [`node_to_facet_gap_hessian`] at the closest point `q` of `x_s` on the facet, found by the
 /// caller (an interior point may lie on the facet's extension beyond a free boundary,
-/// [`super::facet_projection::project_onto_extended_facet`]: the same formulas hold there).
+/// [`super::facet_projection::project_onto_extended_facet`]: the same formulas hold there);
+/// on an edge or a corner the gap is `side |x_s - x(q)|` (`side` `1` outside the master body,
+/// `-1` inside it, as the caller decides: [`side_of_facet`] for a facet alone).
 pub fn node_to_facet_gap_hessian_at(
     kind: ElementKind,
     coords: &[[f64; 3]],
     x_s: [f64; 3],
     q: &FacetProjection,
+    side: f64,
 ) -> Option<Vec<f64>> {
     let n_nodes = coords.len();
     let len = 3 * (n_nodes + 1);
@@ -80,7 +84,6 @@ pub fn node_to_facet_gap_hessian_at(
             if q.distance == 0.0 {
                 return None;
             }
-            let side = side_of_facet(&q, x_s);
             let mut h = edge_gap_hessian(kind, coords, x_s, &q, k);
             h.iter_mut().for_each(|v| *v *= side);
             return Some(h);
@@ -89,7 +92,6 @@ pub fn node_to_facet_gap_hessian_at(
             if q.distance == 0.0 {
                 return None;
             }
-            let side = side_of_facet(&q, x_s);
             let nu = std::array::from_fn::<f64, 3, _>(|i| (x_s[i] - q.point[i]) / q.distance);
             for i in 0..3 {
                 for j in 0..3 {
@@ -203,10 +205,12 @@ pub fn node_to_facet_gap_hessian_at(
     Some(h)
 }
 
-/// The sign of the gap of `x_s` whose closest point `q` on a facet is on an edge or a corner:
-/// `+1` on the side the facet's normal points to at `q` (outside a convex edge or corner),
-/// `-1` behind it (inside the master body under a concave edge or corner, where the closest
-/// points of both facets are their common edge): the gap is `side |x_s - x(q)|`.
+/// The sign of the gap of `x_s` whose closest point `q` on a facet alone is on an edge or a
+/// corner: `+1` on the side the facet's normal points to at `q`, `-1` behind it: the gap is
+/// `side |x_s - x(q)|`. On a surface of several facets the side is that of the surface's
+/// normal there, averaged over the facets at the edge or corner
+/// ([`super::node_based_rows`]): outside a convex edge whose facets turn by more than a right
+/// angle a node can lie behind one facet's plane.
 pub fn side_of_facet(q: &FacetProjection, x_s: [f64; 3]) -> f64 {
     let d: [f64; 3] = std::array::from_fn(|i| x_s[i] - q.point[i]);
     if dot(d, q.normal) < 0.0 {

@@ -14,7 +14,9 @@
 //!   **Corner condition**: a slave node that projects inside no facet but lies in the wedge
 //!   outside a convex master corner (a vertex shared by two facets) is held against the corner
 //!   vertex, along the direction from the vertex to the node (or the vertex's averaged normal
-//!   when it sits on it). A free end of the master surface is extended by a quarter facet
+//!   when it sits on it); one behind the vertex's averaged normal whose closest points on both
+//!   facets at the vertex lie past it (inside the master body under a concave corner) has the
+//!   gap minus that distance, a penetration. A free end of the master surface is extended by a quarter facet
 //!   along its own curve ([`END_EXTENSION`]); a slave node beyond that gets no row.
 //! * **Two-pass**: the rows of the pass with the roles swapped are appended (pass 2).
 //! * **Rigid masters**: a line `g = n . (x_s - p)` or a circle `g = |x_s - c| - R` with
@@ -538,9 +540,12 @@ fn node_to_surface(
     let linearize = model.physics.kinematics == Kinematics::Finite && !rows.tied;
     // how many master facets end at each vertex (a corner needs two)
     let mut facets_at: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
-    for f in &master.facets {
+    let mut facets_of_vertex: std::collections::HashMap<usize, Vec<usize>> =
+        std::collections::HashMap::new();
+    for (k, f) in master.facets.iter().enumerate() {
         for v in [f[0], f[1]] {
             *facets_at.entry(v).or_default() += 1;
+            facets_of_vertex.entry(v).or_default().push(k);
         }
     }
     for (&s, data) in &slave.nodes {
@@ -657,15 +662,31 @@ fn node_to_surface(
             let x = mb.mesh.nodes[v];
             let d = [p[0] - x[0], p[1] - x[1]];
             let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+            // behind the vertex's normal and past the end at `v` of both facets that share it
+            // (inside the master body under a concave vertex): a penetration, the gap minus
+            // the distance; elsewhere (outside a convex corner, or a node past the master's
+            // free end held against the nearest shared vertex) plus
+            let n_v = master.nodes[&v].normal;
+            let past_v = |f: &Vec<usize>, coords: &[[f64; 2]]| {
+                let xi = closest_point(kind, coords, p);
+                (f[1] == v && xi >= 1.0) || (f[0] == v && xi <= -1.0)
+            };
+            let at_v = &facets_of_vertex[&v];
+            let under_concave_vertex = n_v[0] * d[0] + n_v[1] * d[1] < 0.0
+                && at_v.len() == 2
+                && at_v
+                    .iter()
+                    .all(|&f| past_v(&master.facets[f], &master.coords[f]));
+            let side = if under_concave_vertex { -1.0 } else { 1.0 };
             let nu = if l > tol {
-                [d[0] / l, d[1] / l]
+                [side * d[0] / l, side * d[1] / l]
             } else {
-                master.nodes[&v].normal
+                n_v
             };
             let g0 = nu[0] * d[0] + nu[1] * d[1];
             rows.node(slave, s, nu, g0, Some((master, &[v], &[1.0])), pass);
             if linearize {
-                attach_segment(rows, slave, s, master, &[v], MasterPoint::Vertex);
+                attach_segment(rows, slave, s, master, &[v], MasterPoint::Vertex { side });
             }
         }
     }

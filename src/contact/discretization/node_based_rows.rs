@@ -22,8 +22,8 @@
 //!   `nu` on the slave and `-N_a(xi) nu` on the edge's nodes (`-nu` on the vertex): the 3D
 //!   corner condition. Behind the facet's plane (a node inside the master body under a concave
 //!   edge, which neither facet's normal through the node meets) the gap is `-|x_s - x_c|` and
-//!   `nu` turns round ([`super::facet_gap_hessian::side_of_facet`]): a penetration, not a
-//!   separation. **Kinks under finite kinematics**: within [`SHARED_EDGE_HOLD`] of an edge two
+//!   `nu` turns round (the side of the surface's averaged normal there: the nodal normals
+//!   interpolated on the edge, the vertex's at a corner): a penetration, not a separation. **Kinks under finite kinematics**: within [`SHARED_EDGE_HOLD`] of an edge two
 //!   facets share, the facet of lower index holds the node, extended past the edge
 //!   ([`held_across_shared_edge`]): on a concave kink neither facet's row has an equilibrium
 //!   near the edge and Newton alternated between them. A slave node whose closest point is on the free boundary of the master
@@ -53,7 +53,7 @@
 //! corner) and are dropped. The global dof of `(body, node, component)` comes from a
 //! [`DofNumbering`] (any closure `Fn(usize, usize, usize) -> usize`).
 
-use super::facet_gap_hessian::{node_to_facet_gap_hessian_at, side_of_facet};
+use super::facet_gap_hessian::node_to_facet_gap_hessian_at;
 use super::facet_projection::{
     edge_violations, project_onto_extended_facet, project_onto_facet, violated_edges, FacetFeature,
     FacetProjection,
@@ -427,14 +427,27 @@ fn node_to_surface_pass(
         kind.shape(q.natural, &mut n[..nodes], &mut dn[..nodes]);
         let terms: Vec<(usize, f64)> = facet.iter().copied().zip(n).collect();
         let d: [f64; 3] = std::array::from_fn(|i| p[i] - q.point[i]);
+        // on an edge or a corner: outside the master body (`1`) or inside it (`-1`, under a
+        // concave edge or corner), by the surface's averaged normal there (the facet's nodal
+        // normals interpolated on the edge, the vertex's at a corner)
+        let surface_normal: [f64; 3] = match q.feature {
+            FacetFeature::Corner(k) => master.nodes[&facet[k]].normal,
+            _ => std::array::from_fn(|i| {
+                (0..nodes)
+                    .map(|a| n[a] * master.nodes[&facet[a]].normal[i])
+                    .sum()
+            }),
+        };
+        let side = if dot(d, surface_normal) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
         let (nu, terms) = match q.feature {
             FacetFeature::Interior => (q.normal, terms),
-            FacetFeature::Edge(_) => (
-                away(d, q.distance, q.normal, tol, side_of_facet(&q, p)),
-                terms,
-            ),
+            FacetFeature::Edge(_) => (away(d, q.distance, q.normal, tol, side), terms),
             FacetFeature::Corner(k) => (
-                away(d, q.distance, q.normal, tol, side_of_facet(&q, p)),
+                away(d, q.distance, q.normal, tol, side),
                 vec![(facet[k], 1.0)],
             ),
         };
@@ -452,7 +465,7 @@ fn node_to_surface_pass(
             // over the slave node and every node of the facet (zero rows for the nodes off
             // the edge or the corner); none where the node sits on the edge or vertex itself
             row.hessian =
-                node_to_facet_gap_hessian_at(kind, &master.coords[f], p, &q).map(|values| {
+                node_to_facet_gap_hessian_at(kind, &master.coords[f], p, &q, side).map(|values| {
                     let dofs_of = settings.dofs;
                     let mut dofs: Vec<usize> =
                         (0..3).map(|i| dofs_of.dof(slave.body, s, i)).collect();
@@ -1193,6 +1206,45 @@ mod tests {
                 (row.normal[2] - 1.0).abs() < 1e-12,
                 "{current_finite}: {:?}",
                 row.normal
+            );
+        }
+    }
+
+    /// A slave node outside a sharp convex edge: two Tri3 master facets meeting along the y
+    /// axis, one in the plane `z = 0` (normal `+z`), the other turned down by 135 degrees
+    /// (normal `(1, 0, -1) / sqrt 2`, a knife edge pointing along `+x`); a node at
+    /// `(0.6, 0.5, -0.2)` in the wedge outside the edge, whose closest point is the edge point
+    /// `(0, 0.5, 0)`, lies behind the first facet's plane but outside the body: its gap is plus
+    /// its distance (the side is the surface's averaged normal's, not one facet's).
+    #[test]
+    fn a_node_outside_a_sharp_convex_edge_is_a_separation() {
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [-1.0, 0.5, 0.0],
+            [-0.7, 0.5, -0.7],
+        ];
+        let master = surface(
+            1,
+            ElementKind::T3,
+            &positions,
+            &[vec![0, 1, 2], vec![1, 0, 3]],
+        );
+        let slave_positions = [[0.6, 0.5, -0.2], [1.5, 0.1, 0.8], [1.5, 0.9, 0.8]];
+        let slave = surface(0, ElementKind::T3, &slave_positions, &[vec![0, 1, 2]]);
+        let distance = (0.6f64 * 0.6 + 0.2 * 0.2).sqrt();
+        for current_finite in [false, true] {
+            let settings = RowSettings {
+                current_finite,
+                search_distance: Some(2.0),
+                ..settings(&dof)
+            };
+            let rows = node_to_surface_rows(&slave, &master, 1, &settings).unwrap();
+            let row = rows.iter().find(|r| r.slave_node == 0).unwrap();
+            assert!(
+                (row.g0 - distance).abs() < 1e-12,
+                "{current_finite}: g0 {}, not {distance}",
+                row.g0
             );
         }
     }

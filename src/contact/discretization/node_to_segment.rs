@@ -38,7 +38,9 @@
 //!
 //! **The corner condition** (a slave node in the wedge outside a convex master vertex `x_v`):
 //! `g = |x_s - x_v|`, `b = (nu, -nu)`, `nu = (x_s - x_v) / g`, and
-//! `H = [[P, -P], [-P, P]] / g` with `P = I - nu nu^T`.
+//! `H = [[P, -P], [-P, P]] / g` with `P = I - nu nu^T`. A node inside the master body under a
+//! concave vertex (behind the vertex's normal, past both facets' ends) is a penetration:
+//! `g = -|x_s - x_v|`, and `b`, `H` change sign (`side = -1`).
 //!
 //! The unit tests check `b` and `H` against central differences of the gap computed afresh
 //! by the closest-point projection of the `geometry` module, on a straight and a curved facet.
@@ -51,8 +53,9 @@ use crate::fe::EdgeKind;
 pub enum MasterPoint {
     /// The closest point `xi` of a facet of `kind`.
     Facet { kind: EdgeKind, xi: f64 },
-    /// A convex corner vertex (the corner condition).
-    Vertex,
+    /// A master vertex (the corner condition): `side` is `1` for a node outside a convex
+    /// corner, `-1` for a node behind a concave one (its gap `side |x_s - x_v|`).
+    Vertex { side: f64 },
 }
 
 /// What the second derivative of a node-to-segment gap needs: the row's nodes (the slave node
@@ -77,7 +80,7 @@ impl SegmentLinearization {
         let mut h = vec![0.0; n_dofs * n_dofs];
         let x_s = self.positions[0];
         match self.point {
-            MasterPoint::Vertex => {
+            MasterPoint::Vertex { side } => {
                 let x_v = self.positions[1];
                 let d = [x_s[0] - x_v[0], x_s[1] - x_v[1]];
                 let g = dot(d, d).sqrt();
@@ -87,14 +90,14 @@ impl SegmentLinearization {
                 let nu = [d[0] / g, d[1] / g];
                 for i in 0..2 {
                     for j in 0..2 {
-                        let p = (if i == j { 1.0 } else { 0.0 } - nu[i] * nu[j]) / g;
+                        let p = side * (if i == j { 1.0 } else { 0.0 } - nu[i] * nu[j]) / g;
                         h[i * n_dofs + j] = p;
                         h[(2 + i) * n_dofs + 2 + j] = p;
                         h[i * n_dofs + 2 + j] = -p;
                         h[(2 + i) * n_dofs + j] = -p;
                     }
                 }
-                (g, h)
+                (side * g, h)
             }
             MasterPoint::Facet { kind, xi } => {
                 let facet = &self.positions[1..];
@@ -233,33 +236,39 @@ mod tests {
         }
     }
 
+    /// The corner condition's gap and second derivative against the second difference of the
+    /// signed distance `side |x_s - x_v|`, outside a convex vertex (`side = 1`) and behind a
+    /// concave one (`side = -1`).
     #[test]
     fn the_corner_condition_has_the_distance_s_second_derivative() {
         let positions = vec![[0.4, 0.3], [0.1, -0.2]];
-        let lin = SegmentLinearization {
-            dofs: vec![0, 1, 2, 3],
-            positions: positions.clone(),
-            point: MasterPoint::Vertex,
-        };
-        let (g, hess) = lin.gap_and_hessian();
-        let distance =
-            |p: &[[f64; 2]]| ((p[0][0] - p[1][0]).powi(2) + (p[0][1] - p[1][1]).powi(2)).sqrt();
-        assert!((g - distance(&positions)).abs() < 1e-15);
-        let h = 1e-5;
-        for a in 0..4 {
-            for k in 0..4 {
-                // the second difference of the distance
-                let pp = perturbed(&perturbed(&positions, a, h), k, h);
-                let pm = perturbed(&perturbed(&positions, a, h), k, -h);
-                let mp = perturbed(&perturbed(&positions, a, -h), k, h);
-                let mm = perturbed(&perturbed(&positions, a, -h), k, -h);
-                let fd =
-                    (distance(&pp) - distance(&pm) - distance(&mp) + distance(&mm)) / (4.0 * h * h);
-                assert!(
-                    (fd - hess[a * 4 + k]).abs() < 1e-5,
-                    "{a} {k}: {fd} {}",
-                    hess[a * 4 + k]
-                );
+        for side in [1.0, -1.0] {
+            let lin = SegmentLinearization {
+                dofs: vec![0, 1, 2, 3],
+                positions: positions.clone(),
+                point: MasterPoint::Vertex { side },
+            };
+            let (g, hess) = lin.gap_and_hessian();
+            let distance = |p: &[[f64; 2]]| {
+                side * ((p[0][0] - p[1][0]).powi(2) + (p[0][1] - p[1][1]).powi(2)).sqrt()
+            };
+            assert!((g - distance(&positions)).abs() < 1e-15);
+            let h = 1e-5;
+            for a in 0..4 {
+                for k in 0..4 {
+                    // the second difference of the signed distance
+                    let pp = perturbed(&perturbed(&positions, a, h), k, h);
+                    let pm = perturbed(&perturbed(&positions, a, h), k, -h);
+                    let mp = perturbed(&perturbed(&positions, a, -h), k, h);
+                    let mm = perturbed(&perturbed(&positions, a, -h), k, -h);
+                    let fd = (distance(&pp) - distance(&pm) - distance(&mp) + distance(&mm))
+                        / (4.0 * h * h);
+                    assert!(
+                        (fd - hess[a * 4 + k]).abs() < 1e-5,
+                        "side {side}, {a} {k}: {fd} {}",
+                        hess[a * 4 + k]
+                    );
+                }
             }
         }
     }
