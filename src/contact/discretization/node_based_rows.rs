@@ -490,14 +490,20 @@ fn node_to_surface_pass(
 /// `the_interfaces_that_fail_the_patch_test_converge_to_a_kinked_surface`). On a faceted
 /// curved master (kink angle `h / R` between facets of size `h`) the gap error it allows,
 /// `1e-2 h^2 / R`, is a twelfth of the facets' own distance from the curve, `h^2 / (8 R)`.
+/// The price for a node that slides across a concave edge: where it leaves the band the facet
+/// changes and its gap jumps by up to that error (at the edge itself, without the band, the
+/// gap is continuous and only its gradient jumps). The same band in 2D (a trial on
+/// 2026-11-28, not kept) made the finite contact patch test's foundation-slave Lagrange cell on
+/// mesh A pass but took the finite sliding study's master-normal run from one load cut to
+/// five, so the 2D rows keep the closest facet.
 pub const SHARED_EDGE_HOLD: f64 = 1e-2;
 
 /// Under finite kinematics, the facet that holds a slave node at `p` whose closest point
 /// `best` lies inside a facet: of the candidates whose interpolation, extended by at most
 /// [`SHARED_EDGE_HOLD`] past edges they share with other facets (never past the free
 /// boundary), holds the node at the distance of `best` (to the height the extension can add,
-/// twice the distance past the edge, and `tol`), the one of lowest index, as an interior
-/// point of the facet extended.
+/// twice the distance past the edge, and `tol`) and at a gap no smaller than `best`'s (a
+/// concave kink), the one of lowest index, as an interior point of the facet extended.
 ///
 /// Why: a slave node on or next to a kink of the master surface is held by the single facet of
 /// its closest point, whose normal changes at the edge. Where the kink is concave (a valley
@@ -548,7 +554,13 @@ fn held_across_shared_edge(
         if (0..corners).any(|k| violations[k] > band && shared(k)) {
             continue;
         }
-        if (e.distance - best.1.distance).abs() <= height(f, &e) + height(best.0, &best.1) + tol {
+        // a concave kink only (a valley: the facet extended lies below the surface beside
+        // it, so the node is no closer to it than to `best`); at a convex one the edge rows
+        // are continuous and the extension would hold the node above the surface
+        let gap = |q: &FacetProjection| dot(q.normal, std::array::from_fn(|i| p[i] - q.point[i]));
+        if gap(&e) >= gap(&best.1) - tol
+            && (e.distance - best.1.distance).abs() <= height(f, &e) + height(best.0, &best.1) + tol
+        {
             return (f, e);
         }
     }
