@@ -1179,6 +1179,31 @@ mod tests {
         assert!(w1.is_none() && w3.is_some(), "{w1:?} {w3:?}");
     }
 
+    /// The row of slave node 0 of the Tri3 triangle `slave_positions` against the Tri3 master
+    /// `facets` on `positions` (search distance 2), under small strain and under finite
+    /// kinematics.
+    fn first_slave_rows(
+        positions: &[[f64; 3]],
+        facets: &[Vec<usize>],
+        slave_positions: [[f64; 3]; 3],
+    ) -> Vec<(bool, Constraint<3>)> {
+        let master = surface(1, ElementKind::T3, positions, facets);
+        let slave = surface(0, ElementKind::T3, &slave_positions, &[vec![0, 1, 2]]);
+        [false, true]
+            .into_iter()
+            .map(|current_finite| {
+                let settings = RowSettings {
+                    current_finite,
+                    search_distance: Some(2.0),
+                    ..settings(&dof)
+                };
+                let rows = node_to_surface_rows(&slave, &master, 1, &settings).unwrap();
+                let row = rows.into_iter().find(|r| r.slave_node == 0).unwrap();
+                (current_finite, row)
+            })
+            .collect()
+    }
+
     /// A slave node inside the master body under a steep valley (two Tri3 facets meeting at
     /// the diagonal `x = y` with their far corners raised by 0.5), 0.2 below the edge: the
     /// normals of both facets through it miss their facets, its closest point is on the
@@ -1193,22 +1218,11 @@ mod tests {
             [1.0, 1.0, 0.0],
             [0.0, 1.0, 0.5],
         ];
-        let master = surface(
-            1,
-            ElementKind::T3,
+        for (current_finite, row) in first_slave_rows(
             &positions,
             &[vec![0, 1, 2], vec![0, 2, 3]],
-        );
-        let slave_positions = [[0.5, 0.5, -0.2], [0.9, 0.1, 0.8], [0.1, 0.9, 0.8]];
-        let slave = surface(0, ElementKind::T3, &slave_positions, &[vec![0, 1, 2]]);
-        for current_finite in [false, true] {
-            let settings = RowSettings {
-                current_finite,
-                search_distance: Some(1.0),
-                ..settings(&dof)
-            };
-            let rows = node_to_surface_rows(&slave, &master, 1, &settings).unwrap();
-            let row = rows.iter().find(|r| r.slave_node == 0).unwrap();
+            [[0.5, 0.5, -0.2], [0.9, 0.1, 0.8], [0.1, 0.9, 0.8]],
+        ) {
             assert!(
                 (row.g0 + 0.2).abs() < 1e-12,
                 "{current_finite}: g0 {}",
@@ -1236,23 +1250,12 @@ mod tests {
             [-1.0, 0.5, 0.0],
             [-0.7, 0.5, -0.7],
         ];
-        let master = surface(
-            1,
-            ElementKind::T3,
+        let distance = (0.6f64 * 0.6 + 0.2 * 0.2).sqrt();
+        for (current_finite, row) in first_slave_rows(
             &positions,
             &[vec![0, 1, 2], vec![1, 0, 3]],
-        );
-        let slave_positions = [[0.6, 0.5, -0.2], [1.5, 0.1, 0.8], [1.5, 0.9, 0.8]];
-        let slave = surface(0, ElementKind::T3, &slave_positions, &[vec![0, 1, 2]]);
-        let distance = (0.6f64 * 0.6 + 0.2 * 0.2).sqrt();
-        for current_finite in [false, true] {
-            let settings = RowSettings {
-                current_finite,
-                search_distance: Some(2.0),
-                ..settings(&dof)
-            };
-            let rows = node_to_surface_rows(&slave, &master, 1, &settings).unwrap();
-            let row = rows.iter().find(|r| r.slave_node == 0).unwrap();
+            [[0.6, 0.5, -0.2], [1.5, 0.1, 0.8], [1.5, 0.9, 0.8]],
+        ) {
             assert!(
                 (row.g0 - distance).abs() < 1e-12,
                 "{current_finite}: g0 {}, not {distance}",
