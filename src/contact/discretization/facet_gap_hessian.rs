@@ -348,8 +348,8 @@ mod tests {
         out
     }
 
-    /// The warped Quad4 of the test below.
-    fn warped_quad4_behind() -> Vec<[f64; 3]> {
+    /// A Quad4 facet with two opposite corners raised by 0.2 (warped).
+    fn warped_quad4() -> Vec<[f64; 3]> {
         vec![
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.2],
@@ -364,7 +364,7 @@ mod tests {
     #[test]
     fn behind_the_facet_an_edge_or_corner_gap_is_minus_the_distance() {
         for (x_s, corner) in [([1.4, 0.4, -0.3], false), ([1.3, 1.2, -0.3], true)] {
-            let coords = warped_quad4_behind();
+            let coords = warped_quad4();
             let q = project_onto_facet(ElementKind::Q4, &coords, x_s);
             assert_eq!(matches!(q.feature, FacetFeature::Corner(_)), corner);
             assert!(matches!(
@@ -390,22 +390,16 @@ mod tests {
             quad9[k][2] = z;
         }
         let tri6 = super::super::facet_projection::tests::curved_tri6();
-        let warped_quad4 = vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.2],
-            [1.0, 1.0, 0.0],
-            [0.0, 1.0, 0.2],
-        ];
         let cases = [
             (ElementKind::Q9, quad9, [0.2, 0.1, 0.4]),
             (ElementKind::Q9, quad9_below(), [-0.3, 0.2, -0.2]),
             (ElementKind::T6, tri6.clone(), [0.5, 0.4, 0.35]),
             (ElementKind::T6, tri6, [0.4, 0.3, -0.1]),
-            (ElementKind::Q4, warped_quad4.clone(), [0.6, 0.3, 0.5]),
-            (ElementKind::Q4, warped_quad4.clone(), [1.3, 1.2, 0.3]),
+            (ElementKind::Q4, warped_quad4(), [0.6, 0.3, 0.5]),
+            (ElementKind::Q4, warped_quad4(), [1.3, 1.2, 0.3]),
             // edges: beyond a straight edge of a warped Quad4, a curved edge of a Quad9 and of
             // a Tri6 (the hypotenuse)
-            (ElementKind::Q4, warped_quad4, [1.4, 0.4, 0.3]),
+            (ElementKind::Q4, warped_quad4(), [1.4, 0.4, 0.3]),
             (ElementKind::Q9, quad9_below(), [0.3, 1.35, 0.25]),
             (
                 ElementKind::T6,
@@ -414,8 +408,8 @@ mod tests {
             ),
             // behind the facet (inside the master body under a concave edge or corner): the
             // gap -|x_s - x| and its second derivative turned round
-            (ElementKind::Q4, warped_quad4_behind(), [1.4, 0.4, -0.3]),
-            (ElementKind::Q4, warped_quad4_behind(), [1.3, 1.2, -0.3]),
+            (ElementKind::Q4, warped_quad4(), [1.4, 0.4, -0.3]),
+            (ElementKind::Q4, warped_quad4(), [1.3, 1.2, -0.3]),
             (
                 ElementKind::T6,
                 super::super::facet_projection::tests::curved_tri6(),

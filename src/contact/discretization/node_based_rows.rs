@@ -23,16 +23,18 @@
 //!   corner condition. Behind the facet's plane (a node inside the master body under a concave
 //!   edge, which neither facet's normal through the node meets) the gap is `-|x_s - x_c|` and
 //!   `nu` turns round (the side of the surface's averaged normal there: the nodal normals
-//!   interpolated on the edge, the vertex's at a corner): a penetration, not a separation. **Kinks under finite kinematics**: within [`SHARED_EDGE_HOLD`] of an edge two
-//!   facets share, the facet of lower index holds the node, extended past the edge
-//!   ([`held_across_shared_edge`]): on a concave kink neither facet's row has an equilibrium
-//!   near the edge and Newton alternated between them. A slave node whose closest point is on the free boundary of the master
-//!   surface (an edge of one facet only, or a vertex on such an edge) lies beyond it and gets
-//!   no row under small strain; under finite kinematics (rows built in the current
-//!   configuration) a node within a quarter facet ([`FREE_BOUNDARY_EXTENSION`]) beyond it is
-//!   held against the facet's interpolation extrapolated, as an interior point (the 2D rows'
-//!   free-end extension, [`super::END_EXTENSION`]): a slave node of a patch test whose surface
-//!   ends where the master's does leaves it by round-off of the iterates otherwise.
+//!   interpolated on the edge, the vertex's at a corner): a penetration, not a separation.
+//!   **Kinks under finite kinematics**: within [`SHARED_EDGE_HOLD`] of an edge two facets
+//!   share in a concave kink, the facet of lower index holds the node, extended past the edge
+//!   ([`held_across_shared_edge`]): there neither facet's row has an equilibrium near the edge
+//!   and Newton alternated between them. A slave node whose closest point is on the free
+//!   boundary of the master surface (an edge of one facet only, or a vertex on such an edge)
+//!   lies beyond it and gets no row under small strain; under finite kinematics (rows built
+//!   in the current configuration) a node within a quarter facet ([`FREE_BOUNDARY_EXTENSION`])
+//!   beyond it is held against the facet's interpolation extrapolated, as an interior point
+//!   (the 2D rows' free-end extension, [`super::END_EXTENSION`]): a slave node of a patch test
+//!   whose surface ends where the master's does leaves it by round-off of the iterates
+//!   otherwise.
 //!   **Finite kinematics**: every node-to-surface row also carries the second derivative of its
 //!   gap over the slave node and the facet's nodes ([`super::facet_gap_hessian`], interior,
 //!   edge and corner points; `Constraint::hessian`), which the Newton tangent consumes.
