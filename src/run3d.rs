@@ -118,13 +118,7 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
     let model = build3(case, source)?;
     let meshed = start.elapsed().as_secs_f64();
     crate::model::admit::check_rigid_modes(&model)?;
-    let mut solution = if model.physics.kinematics == Kinematics::Finite {
-        crate::solver::finite::solve(&model, &mut |_| {})?
-    } else if model.contact.is_empty() {
-        crate::solver::linear::solve_elastic(&model, &mut |_| {})?
-    } else {
-        crate::solver::active_set::solve(&model, &mut |_| {})?
-    };
+    let mut solution = crate::solver::solve_quasi_static(&model, &mut |_| {})?;
     solution.timings.mesh = meshed;
     solution.timings.total = start.elapsed().as_secs_f64();
     let checks = case

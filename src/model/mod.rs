@@ -333,9 +333,14 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
     }
 
     /// The model at load step `k` of `n`: the proportional loads and supports at the factor
-    /// `k / n`, those on a load path at their own factor for step `k`.
-    pub fn at_step(&self, k: usize, n: usize) -> Self {
-        self.at_load(k as f64, n)
+    /// `k / n`, those on a load path at their own factor for step `k`. The model itself (no
+    /// copy) where that is the whole load: the last step of a model without a load path.
+    pub fn at_step(&self, k: usize, n: usize) -> std::borrow::Cow<'_, Self> {
+        if k == n && self.load_path.is_empty() {
+            std::borrow::Cow::Borrowed(self)
+        } else {
+            std::borrow::Cow::Owned(self.at_load(k as f64, n))
+        }
     }
 
     /// The model at the (possibly fractional) load step `s` of `n`, `0 < s <= n`: the
@@ -385,6 +390,8 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
                 *v *= path_dof[d].unwrap_or(t);
             }
         }
+        // the loads are applied: a loaded model is loaded once (its own last step is itself)
+        m.load_path.clear();
         m
     }
 
@@ -1828,7 +1835,21 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str, notes: &mut Vec<String>) 
                     "add cells",
                 ));
             }
-            Ok(Mesh::new(e.element, e.nodes.clone(), conn))
+            let mesh = Mesh::new(e.element, e.nodes.clone(), conn);
+            if let Some(n) = mesh.used_nodes().iter().position(|&u| !u) {
+                let p = e.nodes[n];
+                return Err(Error::invalid(
+                    source,
+                    format!("{at}.mesh.explicit.nodes[{n}]"),
+                    format!(
+                        "node {n} at ({}, {}) is used by no cell: it has no stiffness, and no \
+                         set chosen by position (top, bottom, a box) can hold it",
+                        p[0], p[1]
+                    ),
+                    "remove the node (and renumber the cells) or add the cell that uses it",
+                ));
+            }
+            Ok(mesh)
         }
     }
 }

@@ -147,15 +147,9 @@ pub fn solve<const D: usize, K: ContactStep<D>>(
     let mut step = 1;
     loop {
         let t = step as f64 / n as f64;
-        let scaled;
-        let at = if n == 1 {
-            model
-        } else {
-            scaled = model.at_step(step, n);
-            &scaled
-        };
+        let at = model.at_step(step, n);
         let mut solution = K::solve_step(
-            at,
+            &at,
             previous.take(),
             start.take(),
             std::mem::take(&mut friction),

@@ -29,13 +29,28 @@ use crate::solver::linear::Solution;
 
 /// Solve `model`; `progress` is told the name of each stage as it starts.
 pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Solution> {
+    if model.dynamics.is_some() {
+        crate::solver::iterative::refuse_unless_admitted(model)?;
+        return crate::solver::dynamics::solve(model, progress);
+    }
+    solve_quasi_static(model, progress)
+}
+
+/// Solve the static (load-stepped) `model` of any dimension: finite strain by Newton in load
+/// steps with cuts, elasticity alone at the last load step (a linear answer depends on the
+/// final load only, so the load path's last factors apply), contact in load steps. Every branch
+/// applies the load path through [`Model::at_load`], so `path` is the load history in every
+/// run (one step or many, with or without contact).
+pub fn solve_quasi_static<const D: usize, K: crate::solver::contact_newton::NewtonDimension<D>>(
+    model: &crate::model::Model<D, K>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<crate::solver::linear::Solution<D>> {
     crate::solver::iterative::refuse_unless_admitted(model)?;
     if model.physics.kinematics == crate::io::scene::Kinematics::Finite {
         crate::solver::finite::solve(model, progress)
-    } else if model.dynamics.is_some() {
-        crate::solver::dynamics::solve(model, progress)
     } else if model.contact.is_empty() {
-        crate::solver::linear::solve_elastic(model, progress)
+        let n = model.solver.load_steps;
+        crate::solver::linear::solve_elastic(&model.at_step(n, n), progress)
     } else {
         crate::solver::active_set::solve(model, progress)
     }

@@ -2,12 +2,14 @@
 
 use std::path::{Path, PathBuf};
 
-/// The reproducer `tests/defects/NAME-*.json` (NAME as `D12` or `D24a`).
+/// The reproducer `tests/defects/NAME-*` or `tests/defects/s4/NAME-*` (NAME as `D12`, `D24a`
+/// or `W01a`; the second report's reproducers keep their own folder).
 #[allow(dead_code)] // not every test binary that includes this module replays defects
 pub fn defect(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/defects");
-    std::fs::read_dir(&dir)
-        .unwrap()
+    let top = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/defects");
+    [top.clone(), top.join("s4")]
+        .iter()
+        .flat_map(|dir| std::fs::read_dir(dir).unwrap())
         .map(|e| e.unwrap().path())
         .find(|p| {
             p.file_name()
@@ -15,7 +17,7 @@ pub fn defect(name: &str) -> PathBuf {
                 .to_string_lossy()
                 .starts_with(&format!("{name}-"))
         })
-        .unwrap_or_else(|| panic!("no reproducer {name} in {}", dir.display()))
+        .unwrap_or_else(|| panic!("no reproducer {name} in {}", top.display()))
 }
 
 /// `contact-patch run CASE --out OUT`, its output captured.
