@@ -94,7 +94,14 @@ impl<const D: usize, K: ReferenceCell<D>> Mesh<D, K> {
     pub fn bounding_box(&self) -> [[f64; D]; 2] {
         let mut lo = [f64::INFINITY; D];
         let mut hi = [f64::NEG_INFINITY; D];
-        for p in &self.nodes {
+        let used = self.used_nodes();
+        for p in self
+            .nodes
+            .iter()
+            .zip(&used)
+            .filter(|(_, &u)| u)
+            .map(|(p, _)| p)
+        {
             for i in 0..D {
                 lo[i] = lo[i].min(p[i]);
                 hi[i] = hi[i].max(p[i]);
@@ -173,9 +180,23 @@ impl<const D: usize, K: ReferenceCell<D>> Mesh<D, K> {
 
     /// Nodes inside the closed box `[lo, hi]` (with tolerance `tol`).
     pub fn nodes_in_box(&self, lo: [f64; D], hi: [f64; D], tol: f64) -> Vec<usize> {
+        let used = self.used_nodes();
         (0..self.nodes.len())
-            .filter(|&n| inside(self.nodes[n], lo, hi, tol))
+            .filter(|&n| used[n] && inside(self.nodes[n], lo, hi, tol))
             .collect()
+    }
+
+    /// Whether each node is a node of some cell. The bounding box and every set chosen by
+    /// position ignore the others: a stray node far away (a point of a Gmsh geometry, a typo
+    /// in an explicit list) neither moves `top` onto itself nor lands in a box.
+    pub fn used_nodes(&self) -> Vec<bool> {
+        let mut used = vec![false; self.nodes.len()];
+        for &n in &self.connectivity {
+            if let Some(u) = used.get_mut(n) {
+                *u = true;
+            }
+        }
+        used
     }
 
     /// Boundary facets whose nodes all lie in the closed box `[lo, hi]`.
@@ -751,6 +772,27 @@ mod tests {
         assert_eq!(t6.cell_count(), 4);
         let t3 = block(ElementKind::T3, &[0.0, 1.0, 3.0], &[0.0, 2.0], &[]).unwrap();
         assert_eq!((t3.nodes.len(), t3.cell_count()), (6, 4));
+    }
+
+    /// Defect W04 (second report): a node of no cell at (1000, 1000) made itself the whole
+    /// `top` set (and every set of the bounding box's upper and right sides).
+    #[test]
+    fn a_node_of_no_cell_is_in_no_set_chosen_by_position() {
+        let nodes = vec![
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.0, 1.0],
+            [0.0, 1.0],
+            [1000.0, 1000.0],
+        ];
+        let m = Mesh::new(ElementKind::Q4, nodes, vec![0, 1, 2, 3]);
+        assert_eq!(m.used_nodes(), vec![true, true, true, true, false]);
+        assert_eq!(m.bounding_box(), [[0.0, 0.0], [1.0, 1.0]]);
+        assert_eq!(m.node_sets["top"], vec![2, 3]);
+        assert_eq!(m.node_sets["right"], vec![1, 2]);
+        assert_eq!(m.node_sets["top_right"], vec![2]);
+        assert_eq!(m.facet_sets["top"].len(), 1);
+        assert!(m.nodes_in_box([-1.0; 2], [2000.0; 2], 0.0).len() == 4);
     }
 
     #[test]
