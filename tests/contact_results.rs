@@ -404,3 +404,52 @@ fn profile_command_writes_the_plot_and_refuses_an_unknown_pair() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("'nope'") && err.contains("cylinder"), "{err}");
 }
+
+/// Defect W02 (second report): tied node-to-surface with the slave face [0, 4] longer than the
+/// master's [1, 3]. The corner condition's fallback glued the slave nodes beyond the master's
+/// ends to the interior master vertex at x = 2 (two bilateral rows with zero gap), a stress
+/// error of 0.65 on a case that is exact with mortar (W02b, the control). Now a slave node
+/// with no master facet under it gets no row, and the run names it.
+#[test]
+fn a_tie_glues_only_slave_nodes_with_a_master_facet_under_them() {
+    for name in ["W02a", "W02b"] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        let o = run_case(&common::defect(name), &out);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{name}: the uniform stress check fails\n{}",
+            String::from_utf8_lossy(&o.stdout)
+        );
+        let s = summary(&out);
+        let error = s["checks"][0]["error"].as_f64().unwrap();
+        assert!(error < 1e-12, "{name}: stress error {error}");
+        // the four slave nodes outside [1, 3] are named, and no other
+        let warnings: Vec<&str> = s["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|w| w.as_str())
+            .filter(|w| w.contains("not tied"))
+            .collect();
+        assert_eq!(warnings.len(), 1, "{name}: {warnings:?}");
+        for x in [
+            "(0.000000, 1.000000)",
+            "(0.500000, 1.000000)",
+            "(3.500000, 1.000000)",
+        ] {
+            assert!(
+                warnings[0].contains(x),
+                "{name}: {x} not named in {}",
+                warnings[0]
+            );
+        }
+        assert!(warnings[0].contains("4 slave node(s)"), "{}", warnings[0]);
+        assert!(
+            !warnings[0].contains("(1.000000, 1.000000)"),
+            "{}",
+            warnings[0]
+        );
+    }
+}

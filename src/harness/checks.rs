@@ -169,11 +169,24 @@ pub fn force_balance(model: &Model, solution: &Solution, forces: &[PairForces]) 
     force_balance_of(model, solution, forces)
 }
 
+/// The force [`force_balance`] divides by: the applied load `F` of [`Magnitudes`], or, where
+/// `F` is below `sqrt(eps)` of the stiffness terms' magnitude [`Solution::force_scale`] (a
+/// motion without load, such as a rigid lift, whose reactions are round-off of those terms),
+/// that magnitude, the scale of the solve's round-off.
+pub fn balance_scale(model: &Model, solution: &Solution) -> f64 {
+    let load = Magnitudes::of(model, solution).force;
+    if load < f64::EPSILON.sqrt() * solution.force_scale {
+        solution.force_scale
+    } else {
+        load
+    }
+}
+
 /// [`force_balance`] of the given nodal forces; `solution.reactions` must already hold
 /// `K u - f - f_contact` (the out-of-balance force at the free dofs).
 pub fn force_balance_of(model: &Model, solution: &Solution, forces: &[PairForces]) -> f64 {
     let size = model.size();
-    let load = Magnitudes::of(model, solution).force.max(f64::MIN_POSITIVE);
+    let load = balance_scale(model, solution).max(f64::MIN_POSITIVE);
     let out_of_balance: f64 = model
         .prescribed
         .iter()
@@ -256,9 +269,57 @@ pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
             )
         });
     departures
+        .chain(untied_slave_nodes(model, state))
         .chain(penetrations)
         .chain(crate::harness::stability::warnings(model, solution))
         .collect()
+}
+
+/// One warning per tied pair whose slave surface has nodes with no tie row: no master facet
+/// under them (a slave surface longer than the master's), so they are not glued and carry no
+/// interface force. Named so that a tie that covers less than the user's set is never silent.
+fn untied_slave_nodes(model: &Model, state: &crate::contact::state::ContactState) -> Vec<String> {
+    let mut out = Vec::new();
+    for (k, pair) in model.contact.iter().enumerate() {
+        if pair.interaction != Interaction::Tied {
+            continue;
+        }
+        let (body, facets) = &pair.slave;
+        let mesh = &model.bodies[*body].mesh;
+        let tied: std::collections::HashSet<usize> = state
+            .rows
+            .iter()
+            .filter(|r| r.pair == k && r.pass == 1 && r.slave_body == *body)
+            .map(|r| r.slave_node)
+            .collect();
+        let mut loose: Vec<usize> = facets
+            .iter()
+            .flat_map(|&f| mesh.facet_nodes(f))
+            .filter(|n| !tied.contains(n))
+            .collect();
+        loose.sort_unstable();
+        loose.dedup();
+        if loose.is_empty() {
+            continue;
+        }
+        let named: Vec<String> = loose
+            .iter()
+            .map(|&n| {
+                let x = mesh.nodes[n];
+                format!("{n} ({:.6}, {:.6})", x[0], x[1])
+            })
+            .collect();
+        out.push(format!(
+            "tied pair '{}': {} slave node(s) of body '{}' have no master facet under them and \
+             are not tied (they carry no interface force): {}; shorten the slave set to the \
+             master's extent if they should not be on the interface",
+            pair.name,
+            loose.len(),
+            model.bodies[*body].name,
+            named.join(", ")
+        ));
+    }
+    out
 }
 
 fn pair_of<'a>(forces: &'a [PairForces], model: &Model, name: &str) -> Option<&'a PairForces> {
@@ -416,9 +477,13 @@ pub fn evaluate_with(
                 }
                 Check::ForceBalance { tol } => (
                     format!(
-                        "force balance: net force and net moment / L (L = {:.3e}) of each pair between bodies and the out-of-balance force, relative to the applied load {:.3e}",
+                        "force balance: net force and net moment / L (L = {:.3e}) of each pair between bodies and the out-of-balance force, relative to {}",
                         model.size(),
-                        magnitudes.force
+                        if balance_scale(model, solution) != magnitudes.force {
+                            format!("the magnitude of the stiffness terms {:.3e} (the applied load {:.3e} is round-off of it)", solution.force_scale, magnitudes.force)
+                        } else {
+                            format!("the applied load {:.3e}", magnitudes.force)
+                        }
                     ),
                     if has_forces { force_balance_of(model, solution, forces) } else { f64::INFINITY },
                     *tol,

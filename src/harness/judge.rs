@@ -487,6 +487,7 @@ fn solution_of(model: &Model, u: Vec<f64>, contact_force: Option<&[f64]>) -> Sol
         equations: 0,
         matrix_nonzeros: 0,
         relative_residual: largest_free / scale,
+        force_scale: scale,
         timings: Timings::default(),
         contact: None,
         dynamics: None,

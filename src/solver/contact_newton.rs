@@ -1732,6 +1732,7 @@ pub(crate) fn solve_step<const D: usize, K: NewtonDimension<D>>(
             equations: system.sys.n,
             matrix_nonzeros: system.sys.pattern.nnz(),
             relative_residual: f64::NAN,
+            force_scale: f64::NAN,
             timings,
             contact: None,
             dynamics: None,

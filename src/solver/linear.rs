@@ -64,8 +64,13 @@ pub struct Solution<const D: usize = 2> {
     pub reactions: Vec<f64>,
     pub equations: usize,
     pub matrix_nonzeros: usize,
-    /// Largest |K u - f| at a free dof relative to the largest external or reaction force.
+    /// Largest |K u - f| at a free dof relative to [`Solution::force_scale`].
     pub relative_residual: f64,
+    /// The force the residual is measured against: the largest external, contact or support
+    /// force, or the largest sum of magnitudes `sum_j |K_ij| |u_j|` that makes up a row of
+    /// `K u` (its round-off is the residual's floor), whichever is larger. A body moved
+    /// without load (a rigid lift) has no load to divide by, but has those terms.
+    pub force_scale: f64,
     pub timings: Timings,
     /// What the contact solve found, when the model has contact pairs.
     pub contact: Option<crate::contact::state::ContactState<D>>,
@@ -492,12 +497,25 @@ pub fn finish<const D: usize, K: SolidCell<D>>(
     }
     // the support reactions are the forces of the Dirichlet constraints
     let supports = sys.constraints.forces(&reactions);
+    // sum_j |K_ij| |u_j| over the free equations (the prescribed values' terms |K_fp| |u_p|
+    // are in the right-hand side's magnitude)
+    let mut terms = vec![0.0; sys.n];
+    let abs_k: Vec<f64> = sys.k.iter().map(|v| v.abs()).collect();
+    let abs_u: Vec<f64> = sys
+        .constraints
+        .free_dofs()
+        .iter()
+        .map(|&d| u[d].abs())
+        .collect();
+    sys.pattern.mul(&abs_k, &abs_u, &mut terms);
     let scale = max_abs(
         model
             .external_force
             .iter()
             .chain(contact_force)
-            .chain(&supports),
+            .chain(&supports)
+            .chain(&terms)
+            .chain(&sys.rhs),
     );
     let worst = max_abs(sys.constraints.free_dofs().iter().map(|&d| &reactions[d]));
     Ok(Solution {
@@ -506,6 +524,7 @@ pub fn finish<const D: usize, K: SolidCell<D>>(
         equations: sys.n,
         matrix_nonzeros: sys.pattern.nnz(),
         relative_residual: if scale > 0.0 { worst / scale } else { worst },
+        force_scale: scale,
         timings,
         contact: None,
         dynamics: None,
