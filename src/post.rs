@@ -6,7 +6,9 @@
 //!   at the point's reference position (the `.vtu` holds the reference mesh and the
 //!   displacement: warped by the displacement it is the deformed mesh the stress lives on).
 //!   Every check that compares stresses (`uniform_stress`, `contact_pressure`, the exact
-//!   fields) then compares the Cauchy stress.
+//!   fields) then compares the Cauchy stress. The out-of-plane `sigma_zz` is the law's too:
+//!   `S_33 / J` under finite kinematics, `nu (sigma_xx + sigma_yy)` in small-strain plane
+//!   strain, zero in plane stress ([`out_of_plane_stress_at`]).
 //! * Cell stress: at the cell centre. Nodal stress: the average over the cells sharing a node of
 //!   each cell's stress evaluated at that node (no smoothing beyond averaging).
 //! * Relative L2 displacement error: `sqrt(int |u_h - u|^2 dA / int |u|^2 dA)`, with a Gauss rule
@@ -69,25 +71,60 @@ pub fn cell_stresses(body: &Body, u: &[f64]) -> Vec<[f64; 3]> {
 
 /// Nodal stresses averaged over the cells that share each node.
 pub fn nodal_stresses(body: &Body, u: &[f64]) -> Vec<[f64; 3]> {
+    nodal_average(body, |c, xi| stress_at(body, u, c, xi).0)
+}
+
+/// The out-of-plane stress `sigma_zz` at natural point `xi` of cell `c`, by the law the body
+/// is solved with: zero in plane stress; in plane strain `nu (sigma_xx + sigma_yy)` under
+/// small strain, and under finite kinematics the Cauchy stress `S_33 / J` of the hyperelastic
+/// law (`lambda ln J / J` for the neo-Hookean solid), which is not the small-strain relation.
+pub fn out_of_plane_stress_at(body: &Body, u: &[f64], c: usize, xi: [f64; 2]) -> f64 {
+    if let Some(law) = &body.hyperelastic {
+        let mut ue = Vec::with_capacity(MAX_DOFS);
+        cell_displacements(body, u, c, &mut ue);
+        let coords = body.mesh.cell_coords(c);
+        let (h, _) = displacement_gradient_at(body.mesh.kind, &coords, &ue, xi);
+        if jacobian(&h) <= 0.0 {
+            return f64::NAN;
+        }
+        return law.cauchy(&h).1;
+    }
+    body.material.sigma_zz(stress_at(body, u, c, xi).0)
+}
+
+/// Nodal out-of-plane stresses ([`out_of_plane_stress_at`]) averaged as [`nodal_stresses`].
+pub fn nodal_out_of_plane_stresses(body: &Body, u: &[f64]) -> Vec<f64> {
+    nodal_average(body, |c, xi| [out_of_plane_stress_at(body, u, c, xi)])
+        .into_iter()
+        .map(|[v]| v)
+        .collect()
+}
+
+/// The average at each node of `value(cell, xi)` evaluated at the node's natural coordinates
+/// in every cell that shares it (zero at a node of no cell).
+fn nodal_average<const N: usize>(
+    body: &Body,
+    value: impl Fn(usize, [f64; 2]) -> [f64; N] + Sync,
+) -> Vec<[f64; N]> {
     let mesh = &body.mesh;
-    let mut sum = vec![[0.0; 3]; mesh.nodes.len()];
+    let mut sum = vec![[0.0; N]; mesh.nodes.len()];
     let mut count = vec![0u32; mesh.nodes.len()];
     let natural = mesh.kind.node_coordinates();
     // the corner values cell by cell on every core, summed in cell order (the same sums,
     // to the bit, as one loop)
     use rayon::prelude::*;
-    let corners: Vec<Vec<[f64; 3]>> = (0..mesh.cell_count())
+    let corners: Vec<Vec<[f64; N]>> = (0..mesh.cell_count())
         .into_par_iter()
         .with_min_len(4096)
         .map(|c| {
             (0..mesh.cell(c).len())
-                .map(|a| stress_at(body, u, c, natural[a]).0)
+                .map(|a| value(c, natural[a]))
                 .collect()
         })
         .collect();
     for (c, values) in corners.iter().enumerate() {
         for (&n, s) in mesh.cell(c).iter().zip(values) {
-            for i in 0..3 {
+            for i in 0..N {
                 sum[n][i] += s[i];
             }
             count[n] += 1;
@@ -97,7 +134,7 @@ pub fn nodal_stresses(body: &Body, u: &[f64]) -> Vec<[f64; 3]> {
         .zip(&count)
         .map(|(s, &k)| {
             if k == 0 {
-                [0.0; 3]
+                [0.0; N]
             } else {
                 s.map(|v| v / k as f64)
             }

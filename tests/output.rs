@@ -231,3 +231,74 @@ fn two_outputs_with_one_name_are_refused_not_written_over_each_other() {
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
+
+/// Defect W03 (second report): under finite kinematics the `.vtu` field `stress_zz` was the
+/// small-strain relation `nu (sigma_xx + sigma_yy)` (-28.912 where the neo-Hookean law gives
+/// -31.028). One neo-Hookean Q4 cell under a dead top traction (0, -100) on rollers: the
+/// homogeneous stretch `F = diag(l1, l2)` is exact, and every stress field written is checked
+/// against the law at that stretch: `sigma = (mu (b - I) + lambda ln J I) / J` with
+/// `b = diag(l1^2, l2^2)`, `J = l1 l2`, so `sigma_zz = lambda ln J / J`; equilibrium gives
+/// `sigma_yy = -100 / l1` (the dead load over the current width).
+#[test]
+fn every_stress_field_at_finite_strain_is_the_hyperelastic_law_s() {
+    let case = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/defects/s4/W03-finite-stress-zz-small-strain-formula.json");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .args([
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let xml = std::fs::read_to_string(out.join("b.vtu")).unwrap();
+    let points = data_array(&xml, "Points", None);
+    let u = data_array(&xml, "PointData", Some("displacement"));
+    // the stretches from the node at (1, 1)
+    let corner = (0..points.len() / 3)
+        .find(|&n| points[3 * n] == 1.0 && points[3 * n + 1] == 1.0)
+        .unwrap();
+    let (l1, l2) = (1.0 + u[3 * corner], 1.0 + u[3 * corner + 1]);
+    let (e, nu) = (1000.0f64, 0.3f64);
+    let mu = e / (2.0 * (1.0 + nu));
+    let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let j = l1 * l2;
+    let expected = [
+        (mu * (l1 * l1 - 1.0) + lambda * j.ln()) / j,
+        (mu * (l2 * l2 - 1.0) + lambda * j.ln()) / j,
+        0.0,
+        lambda * j.ln() / j,
+    ];
+    assert!(
+        (expected[1] + 100.0 / l1).abs() < 1e-9,
+        "the stretch is not the law's equilibrium: {expected:?}, l1 {l1}"
+    );
+    assert!((expected[3] + 31.028).abs() < 1e-3, "{expected:?}");
+    let nodal = data_array(&xml, "PointData", Some("stress"));
+    let zz = data_array(&xml, "PointData", Some("stress_zz"));
+    let cells = data_array(&xml, "CellData", Some("stress"));
+    for (n, s) in nodal.chunks(3).enumerate() {
+        for i in 0..3 {
+            assert!(
+                (s[i] - expected[i]).abs() < 1e-9,
+                "node {n}: stress {s:?}, law {expected:?}"
+            );
+        }
+        assert!(
+            (zz[n] - expected[3]).abs() < 1e-9,
+            "node {n}: stress_zz {}, law {}",
+            zz[n],
+            expected[3]
+        );
+    }
+    for i in 0..3 {
+        assert!(
+            (cells[i] - expected[i]).abs() < 1e-9,
+            "cell: {cells:?}, law {expected:?}"
+        );
+    }
+}

@@ -538,8 +538,9 @@ pub fn write_vtu_with(
         text,
         "<DataArray type=\"Float64\" Name=\"stress_zz\" format=\"ascii\">"
     );
-    text += &lines_in_parallel(nodal_stress.len(), |n, t| {
-        let _ = writeln!(t, "{}", body.material.sigma_zz(nodal_stress[n]));
+    let stress_zz = crate::post::nodal_out_of_plane_stresses(body, u);
+    text += &lines_in_parallel(stress_zz.len(), |n, t| {
+        let _ = writeln!(t, "{}", stress_zz[n]);
     });
     if extra.is_empty() {
         let _ = writeln!(text, "</DataArray></PointData>");
