@@ -1132,7 +1132,9 @@ pub enum ImpactTreatment {
     /// The contact-stabilized Newmark method of Deuflhard, Krause & Ertel (2008): the predictor
     /// `d_n + dt v_n` is projected onto the admissible set in the mass norm before the
     /// trapezoidal step; energy is conserved away from contact and never gained at impact or
-    /// release (average acceleration only).
+    /// release where the constraints hold exactly (Lagrange multipliers; a penalty's
+    /// penetration can return energy, and the run warns when it does) (average acceleration
+    /// only).
     ContactStabilized,
 }
 

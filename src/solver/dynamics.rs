@@ -53,9 +53,15 @@
 //!   `(K + c0 M) d_{n+1} = c0 M d^ + 2 f - K d_n + B^T lambda` (`c0 = 4 / dt^2`; `lambda / 2` is
 //!   the step's mean contact force) and `v_{n+1} = v_n + (2 / dt)(d_{n+1} - d^)`. Without
 //!   contact it is the trapezoidal rule (energy conserved); with contact the projection removes
-//!   the velocity into the obstacle, so the discrete energy never grows (their theorem; the
-//!   history shows the drift) and the contact nodes do not chatter. The recorded acceleration
-//!   is the step's mean `(v_{n+1} - v_n) / dt`.
+//!   the velocity into the obstacle, so the discrete energy does not grow where the
+//!   constraints hold exactly (their theorem, for Lagrange multipliers: the history shows the
+//!   drift, about 1e-14) and the contact nodes do not chatter. A penalty's penetration stores
+//!   energy the projection does not see and can give it back: the bar on a rigid wall with
+//!   `kappa = E / h` gains 8.6 % (`tests/stable_step.rs`), and such a run warns
+//!   ([`crate::harness::stability::energy_growth`]). The method's equilibrium holds at the
+//!   step's mean displacement, `K (d_n + d_{n+1}) / 2 + M a = f + B^T lambda / 2`; the recorded
+//!   acceleration is the step's mean `(v_{n+1} - v_n) / dt` and the recorded contact force the
+//!   step's mean `lambda / 2`, and the residual of the solution is that equation's.
 
 use super::contact_newton::ContactSystem;
 use super::history::{DynamicHistory, StepRecord};
@@ -273,6 +279,9 @@ struct Integrator<'a> {
     /// Impedance `rho c_p` of each global dof's body.
     impedance: Vec<f64>,
     d: Vec<f64>,
+    /// `d_n`, the displacement at the start of the last step (the contact-stabilized
+    /// method's equilibrium holds at the step's mean displacement, see [`Integrator::finish`]).
+    d_before: Vec<f64>,
     v: Vec<f64>,
     a: Vec<f64>,
     /// Unknowns of the system (free displacements, then multipliers).
@@ -365,6 +374,7 @@ impl<'a> Integrator<'a> {
             c0,
             impedance,
             a: vec![0.0; model.dof_count],
+            d_before: d.clone(),
             d,
             v,
             x: vec![0.0; n_unknowns],
@@ -515,7 +525,8 @@ impl<'a> Integrator<'a> {
                 &mut self.timings,
                 &at,
             )?;
-            self.d = self.system.linear_system().expand(&self.x[..n]);
+            let d_new = self.system.linear_system().expand(&self.x[..n]);
+            self.d_before = std::mem::replace(&mut self.d, d_new);
             for k in 0..self.v.len() {
                 let v_new = self.v[k] + 2.0 / dt * (self.d[k] - projected[k]);
                 self.a[k] = (v_new - self.v[k]) / dt;
@@ -824,13 +835,30 @@ impl<'a> Integrator<'a> {
                 }
             }
         }
-        // dynamic equilibrium: K d - f - B^T lambda + M a = 0 at the free dofs
+        // dynamic equilibrium: K d - f - B^T lambda + M a = 0 at the free dofs; the
+        // contact-stabilized method satisfies it at the step's mean displacement
+        // (K (d_n + d_{n+1}) / 2 + M a - f - B^T lambda = 0 with the mean acceleration
+        // a = (v_{n+1} - v_n) / dt and the mean contact force, from its update
+        // (K + c0 M) d_{n+1} = c0 M d^ + 2 f - K d_n + B^T lambda), so K (d_{n+1} - d_n) / 2
+        // is added to the applied side
         let inertia = self.mass.mul(&self.a);
-        let applied: Vec<f64> = contact_force
+        let mut applied: Vec<f64> = contact_force
             .iter()
             .zip(&inertia)
             .map(|(c, i)| c - i)
             .collect();
+        if self.dynamics.impact == ImpactTreatment::ContactStabilized {
+            let increment: Vec<f64> = self
+                .d
+                .iter()
+                .zip(&self.d_before)
+                .map(|(a, b)| a - b)
+                .collect();
+            let k_increment = super::linear::internal_force(model, &increment);
+            for (a, k) in applied.iter_mut().zip(&k_increment) {
+                *a += 0.5 * k;
+            }
+        }
         let mut solution = finish(
             model,
             self.system.linear_system(),
