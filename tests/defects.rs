@@ -449,3 +449,129 @@ fn duplicated_names_and_pairs_are_errors() {
         &["contact[1] 'swapped'", "repeats the surfaces"],
     );
 }
+
+/// A reproducer of `tests/defects/s4/` (copied from the defect report of cb6f864, see its
+/// README), by its path under that folder.
+fn s4(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/defects/s4")
+        .join(path)
+}
+
+/// C01: a `.vtu` whose `NumberOfPoints` or `NumberOfComponents` is far beyond what the file
+/// holds made `judge` and `table --results` panic (capacity overflow, exit 101) or abort
+/// (allocating 24 TB). The sizes are checked against the file's length before allocating.
+#[test]
+fn c01_hostile_vtu_sizes_are_refused_before_allocation() {
+    let s = Scratch::new();
+    std::fs::copy(
+        s4("C01-judge-hostile-vtu/case.json"),
+        s.work.join("case.json"),
+    )
+    .unwrap();
+    for (file, needles) in [
+        (
+            "res-numberofpoints-2e62.vtu",
+            [
+                "NumberOfPoints=\"4611686018427387904\"",
+                "NumberOfComponents=\"3\"",
+            ],
+        ),
+        (
+            "res-numberofpoints-1e12.vtu",
+            [
+                "NumberOfPoints=\"1000000000000\"",
+                "NumberOfComponents=\"3\"",
+            ],
+        ),
+        (
+            "res-numberofcomponents-1e12.vtu",
+            [
+                "NumberOfPoints=\"16\"",
+                "NumberOfComponents=\"1000000000000\"",
+            ],
+        ),
+    ] {
+        std::fs::copy(
+            s4(&format!("C01-judge-hostile-vtu/{file}")),
+            s.work.join(file),
+        )
+        .unwrap();
+        let limit = [
+            "more than a file of",
+            "bytes can hold (at most",
+            "read up to 1073741824 bytes",
+        ];
+        let all: Vec<&str> = needles.iter().chain(&limit).copied().collect();
+        assert_refused(s.run(&["judge", "case.json", file], &[]), &all);
+        // `table --results`: the same reader, the same refusal for the case's cell
+        std::fs::create_dir_all(s.work.join("res")).unwrap();
+        std::fs::copy(s.work.join(file), s.work.join("res/patch-A-nu0.3.vtu")).unwrap();
+        let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/patch/patch-A-nu0.3.json");
+        let (code, _, stderr) = s.run(
+            &[
+                "table",
+                case.to_str().unwrap(),
+                "--results",
+                "res",
+                "--code",
+                "X",
+                "--out",
+                "t",
+            ],
+            &["t"],
+        );
+        assert_eq!(code, 2, "{stderr}");
+        for n in &all {
+            assert!(stderr.contains(n), "table --results: no {n:?}:\n{stderr}");
+        }
+    }
+}
+
+/// C02: `merge` trusted the shard numbers and the study's `total` read from a partial file:
+/// index 0 (index out of bounds), 5 of 2, a count of 1e18 (capacity overflow) and a total of
+/// 1e15 cells (an abort allocating 8 PB). Each is refused naming the file and the field, with
+/// the check `--shard K/N` gets on the command line.
+#[test]
+fn c02_hostile_shard_files_are_refused_naming_the_field() {
+    let s = Scratch::new();
+    let dir = s4("C02-merge-hostile-shards");
+    for f in std::fs::read_dir(&dir).unwrap() {
+        let f = f.unwrap().path();
+        std::fs::copy(&f, s.work.join(f.file_name().unwrap())).unwrap();
+    }
+    for (file, shard) in [
+        ("table-shard-index-0.json", "index 0 of count 2"),
+        ("table-shard-index-5-of-2.json", "index 5 of count 2"),
+        (
+            "table-shard-count-1e18.json",
+            "index 1 of count 1000000000000000000",
+        ),
+    ] {
+        assert_refused(
+            s.run(&["merge", file, "--out", "D"], &["D"]),
+            &[
+                &format!("{file}: shard: {shard}"),
+                "K must be from 1 to N and N at most 10000",
+            ],
+        );
+    }
+    let parts = ["study-total-1e15-part1.json", "study-total-1e15-part2.json"];
+    assert_refused(
+        s.run(&["merge", parts[0], parts[1], "--out", "D"], &["D"]),
+        &[
+            "study-total-1e15-part1.json: total: 1000000000000000 cells",
+            "the study's axes make a grid of 2",
+        ],
+    );
+    // the same parts with the total their study makes merge
+    for p in parts {
+        let text = std::fs::read_to_string(s.work.join(p)).unwrap();
+        let fixed = text.replace("\"total\": 1000000000000000", "\"total\": 2");
+        assert_ne!(text, fixed);
+        std::fs::write(s.work.join(p), fixed).unwrap();
+    }
+    let (code, stdout, stderr) = s.run(&["merge", parts[0], parts[1], "--out", "D"], &["D"]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+}
+
