@@ -250,6 +250,12 @@ pub fn load_study(path: &Path) -> Result<Study> {
     let source = path.display().to_string();
     let text =
         std::fs::read_to_string(path).map_err(|e| Error::io(&source, "reading the study", e))?;
+    crate::model::refuse_non_object(
+        &text,
+        &source,
+        "study file",
+        "the studies under cases/studies/",
+    )?;
     let spec: StudySpec = serde_json::from_str(&text).map_err(|e| {
         refused(
             &source,
