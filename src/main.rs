@@ -113,7 +113,7 @@ enum Command {
     /// Run a study: a base case over the cartesian grid of the study's axes; writes
     /// <study>.md, <study>.json and one error-versus-time SVG per metric.
     #[command(
-        after_help = "Example:\n  contact-patch study cases/studies/hertz-cylinder.study.json\n  contact-patch study cases/studies/penalty-window.study.json --shard 1/4 --out parts\n  contact-patch merge parts/penalty-window.shard-*-of-4.json --out reports\n\nThe study format's JSON Schema: contact-patch schema --study. Exit 2 on a bad study file."
+        after_help = "Example:\n  contact-patch study cases/studies/hertz-cylinder.study.json\n  contact-patch study cases/studies/penalty-window.study.json --shard 1/4 --out parts\n  contact-patch merge parts/penalty-window.shard-*-of-4.json --out reports\n\nThe study format's JSON Schema: contact-patch schema --study. Exit 2 on a bad study file, or when no cell could run."
     )]
     Study {
         /// The study file (JSON).
@@ -495,6 +495,10 @@ fn run(case: &Path, out: Option<PathBuf>) -> ExitCode {
         Ok((outcome, folder)) => {
             print_outcome(&outcome);
             println!("output: {}", folder.path().display());
+            if let Some(why) = outcome.failed_solve() {
+                eprintln!("error: {why}");
+                return ExitCode::from(2);
+            }
             if outcome.passed() {
                 ExitCode::SUCCESS
             } else {
@@ -1819,6 +1823,18 @@ fn run_study(
             b.finish_and_clear();
         }
         let failed = cells.iter().filter(|c| c.error.is_some()).count();
+        // the reports are written either way; a run in which no cell could run failed
+        let none_ran = || {
+            contact_patch::error::Error::invalid(
+                path.display(),
+                "cells",
+                format!(
+                    "none of the {} cells could run (each says why above)",
+                    todo.len()
+                ),
+                "fix the base case or the axis values named above",
+            )
+        };
         match shard {
             Some(k) => {
                 let part = shards::Part::Study {
@@ -1836,6 +1852,9 @@ fn run_study(
                     todo.len(),
                     folder.shown(&file).display()
                 );
+                if failed > 0 && failed == todo.len() {
+                    return Err(none_ran());
+                }
             }
             None => {
                 let command = format!("contact-patch study {}", path.display());
@@ -1843,6 +1862,9 @@ fn run_study(
                 println!("{total} cells ({failed} could not run)");
                 for f in files {
                     println!("wrote {}", folder.shown(&f).display());
+                }
+                if failed > 0 && failed == todo.len() {
+                    return Err(none_ran());
                 }
             }
         }

@@ -1,4 +1,5 @@
-//! One run of one case: load and validate, solve, judge the checks, time every stage.
+//! One run of one case: load and validate, solve, judge the checks, time every stage; a
+//! contact solve that ended singular is a failed solve ([`Outcome::failed_solve`]).
 
 use crate::error::Result;
 use crate::harness::checks::{evaluate, warnings, CheckResult};
@@ -22,6 +23,21 @@ pub struct Outcome {
 impl Outcome {
     pub fn passed(&self) -> bool {
         self.checks.iter().all(|c| c.passed)
+    }
+
+    /// Why the contact solve could not be solved (its system was singular: the message names
+    /// the place and the remedy), unless the case expects that ending (a `terminates_with`
+    /// check). The command line reports it as a failed solve, exit 2, not as a failed check.
+    pub fn failed_solve(&self) -> Option<&str> {
+        let expected = self
+            .model
+            .checks
+            .iter()
+            .any(|c| matches!(c, crate::io::scene::Check::TerminatesWith { .. }));
+        match &self.solution.contact.as_ref()?.termination {
+            crate::contact::state::Termination::Singular(why) if !expected => Some(why),
+            _ => None,
+        }
     }
 }
 

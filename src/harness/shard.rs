@@ -11,7 +11,10 @@
 //! what it must be merged with (the study itself, or the list of case files). `merge` refuses
 //! parts of different studies or catalogues, different `N`, a shard given twice (overlap) and
 //! a shard missing, naming them; otherwise it orders the units by index, which is the order of
-//! one unsharded run, and writes the same Markdown and JSON.
+//! one unsharded run, and writes the same Markdown and JSON. The shard numbers read from a
+//! file get the check `--shard K/N` gets ([`Shard::new`]), and a study part's `total` must be
+//! the grid of the study it carries (within that study's cell limit), before anything is sized
+//! from them: a hostile or edited file is refused naming the file and the field.
 
 use crate::error::{Error, Result};
 use crate::harness::study::{StudyCell, StudySpec};
@@ -31,6 +34,15 @@ pub struct Shard {
 pub const MAX_SHARDS: usize = 10_000;
 
 impl Shard {
+    /// Shard `index` of `count`, when `1 <= index <= count <= MAX_SHARDS`: the one check of a
+    /// shard, whether it comes from `--shard K/N` or from a partial file.
+    pub fn new(index: usize, count: usize) -> std::result::Result<Shard, String> {
+        if index == 0 || count == 0 || index > count || count > MAX_SHARDS {
+            return Err(format!("K must be from 1 to N and N at most {MAX_SHARDS}"));
+        }
+        Ok(Shard { index, count })
+    }
+
     /// Whether unit `i` (from 0) belongs to this shard.
     pub fn owns(&self, i: usize) -> bool {
         i % self.count == self.index - 1
@@ -53,12 +65,7 @@ impl std::str::FromStr for Shard {
             (Ok(k), Ok(n)) => (k, n),
             _ => return Err(format!("'{s}' is not two whole numbers K/N; {hint}")),
         };
-        if k == 0 || n == 0 || k > n || n > MAX_SHARDS {
-            return Err(format!(
-                "'{s}': K must be from 1 to N and N at most {MAX_SHARDS}; {hint}"
-            ));
-        }
-        Ok(Shard { index: k, count: n })
+        Shard::new(k, n).map_err(|why| format!("'{s}': {why}; {hint}"))
     }
 }
 
@@ -93,7 +100,9 @@ fn refuse(what: &str, problem: String, hint: &str) -> Error {
     Error::invalid("merge", what, problem, hint)
 }
 
-/// Read partial files.
+/// Read partial files. The shard each file states gets the check `--shard K/N` gets
+/// ([`Shard::new`]) and a study part's `total` must be its study's grid (within the study's
+/// cell limit), before anything is sized from them.
 pub fn read_parts(paths: &[std::path::PathBuf]) -> Result<Vec<(String, Part)>> {
     if paths.is_empty() {
         return Err(refuse(
@@ -116,6 +125,26 @@ pub fn read_parts(paths: &[std::path::PathBuf]) -> Result<Vec<(String, Part)>> {
                     "give the *.shard-K-of-N.json files the shards wrote",
                 )
             })?;
+            let (Part::Study { shard, .. } | Part::Table { shard, .. }) = &part;
+            Shard::new(shard.index, shard.count).map_err(|why| {
+                Error::invalid(
+                    &shown,
+                    "shard",
+                    format!("index {} of count {}: {why}", shard.index, shard.count),
+                    "give the files the shards wrote (`--shard K/N`), unedited",
+                )
+            })?;
+            if let Part::Study { study, total, .. } = &part {
+                let grid = study.checked_cells(&shown)?;
+                if *total != grid {
+                    return Err(Error::invalid(
+                        &shown,
+                        "total",
+                        format!("{total} cells, but the study's axes make a grid of {grid}"),
+                        "give the files the shards wrote (`study --shard K/N`), unedited",
+                    ));
+                }
+            }
             Ok((shown, part))
         })
         .collect()

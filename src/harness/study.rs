@@ -90,6 +90,40 @@ pub struct StudySpec {
     pub max_cells: Option<usize>,
 }
 
+impl StudySpec {
+    /// The number of cells of the grid (saturating).
+    pub fn cell_count(&self) -> usize {
+        self.axes
+            .iter()
+            .map(|a| a.values.len().max(a.refine.len()))
+            .fold(1usize, |n, m| n.saturating_mul(m))
+    }
+
+    /// The number of cells of the grid, when it is within the study's `max_cells` (and that
+    /// within [`MAX_CELLS_CEILING`]); `source` names the study in the refusal.
+    pub fn checked_cells(&self, source: &str) -> Result<usize> {
+        let cells = self.cell_count();
+        let limit = self.max_cells.unwrap_or(DEFAULT_MAX_CELLS);
+        if limit > MAX_CELLS_CEILING {
+            return Err(refused(
+                source,
+                "max_cells",
+                format!("{limit} is above the ceiling {MAX_CELLS_CEILING}"),
+                "split the study into several files",
+            ));
+        }
+        if cells > limit {
+            return Err(refused(
+                source,
+                "axes",
+                format!("the grid has {cells} cells, more than the limit {limit}"),
+                "remove values, or raise `max_cells` in the study file (at most 100,000)",
+            ));
+        }
+        Ok(cells)
+    }
+}
+
 /// One axis: either `paths` with `values`, or `refine`.
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -216,6 +250,12 @@ pub fn load_study(path: &Path) -> Result<Study> {
     let source = path.display().to_string();
     let text =
         std::fs::read_to_string(path).map_err(|e| Error::io(&source, "reading the study", e))?;
+    crate::model::refuse_non_object(
+        &text,
+        &source,
+        "study file",
+        "the studies under cases/studies/",
+    )?;
     let spec: StudySpec = serde_json::from_str(&text).map_err(|e| {
         refused(
             &source,
@@ -330,24 +370,7 @@ impl Study {
                 }
             }
         }
-        let cells = self.cell_count();
-        let limit = s.max_cells.unwrap_or(DEFAULT_MAX_CELLS);
-        if limit > MAX_CELLS_CEILING {
-            return Err(refused(
-                &src,
-                "max_cells",
-                format!("{limit} is above the ceiling {MAX_CELLS_CEILING}"),
-                "split the study into several files",
-            ));
-        }
-        if cells > limit {
-            return Err(refused(
-                &src,
-                "axes",
-                format!("the grid has {cells} cells, more than the limit {limit}"),
-                "remove values, or raise `max_cells` in the study file (at most 100,000)",
-            ));
-        }
+        s.checked_cells(&src)?;
         for name in s.along.iter().chain(s.window.as_ref().map(|w| &w.axis)) {
             if !names.contains(name) {
                 return Err(refused(
@@ -429,11 +452,7 @@ impl Study {
 
     /// The number of cells of the grid.
     pub fn cell_count(&self) -> usize {
-        self.spec
-            .axes
-            .iter()
-            .map(|a| a.values.len().max(a.refine.len()))
-            .fold(1usize, |n, m| n.saturating_mul(m))
+        self.spec.cell_count()
     }
 
     /// The value index of each axis of cell `index`.

@@ -7,7 +7,9 @@
 //!   `$Elements`); an element's physical groups are those of its entity. `mshio` skips
 //!   `$PhysicalNames`, which is plain text in both encodings, so that section is read here.
 //!   Where the node tags of the file are contiguous `mshio` keeps no tags and the nodes are
-//!   numbered in file order from the smallest tag, as Gmsh writes them.
+//!   numbered in file order from the smallest tag, as Gmsh writes them. When `mshio` fails,
+//!   a section that opens without its `$End` line is named (`mshio` says only "Unknown error
+//!   occurred").
 //! * MSH 2.2 ASCII, read here line by line: `$Nodes` (`tag x y z`), `$Elements`
 //!   (`tag type ntags physical elementary ... nodes`), `$PhysicalNames` (`dim tag "name"`).
 //!
@@ -230,9 +232,50 @@ fn physical_names(bytes: &[u8]) -> Read<BTreeMap<(i32, i32), String>> {
     }
 }
 
+/// The sections of an MSH 4.1 file, by the name between `$` and `$End`.
+const V41_SECTIONS: [&str; 13] = [
+    "MeshFormat",
+    "PhysicalNames",
+    "Entities",
+    "PartitionedEntities",
+    "Nodes",
+    "Elements",
+    "Periodic",
+    "GhostElements",
+    "Parametrizations",
+    "NodeData",
+    "ElementData",
+    "ElementNodeData",
+    "InterpolationScheme",
+];
+
+/// The first section of an MSH 4.1 file that opens without its `$End` line (a truncated or
+/// cut file), as [`section`] names it; `None` when every section that opens is closed.
+fn unclosed_v41_section(bytes: &[u8]) -> Option<MshError> {
+    let text = String::from_utf8_lossy(bytes);
+    let lines: Vec<(usize, &str)> = text
+        .split('\n')
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .collect();
+    V41_SECTIONS
+        .iter()
+        .filter_map(|name| section(&lines, name).err())
+        .min_by(|a, b| {
+            a.place
+                .len()
+                .cmp(&b.place.len())
+                .then(a.place.cmp(&b.place))
+        })
+}
+
 fn read_v41(bytes: &[u8]) -> Read<MshContent> {
     let names = physical_names(bytes)?;
     let file = mshio::parse_msh_bytes(bytes).map_err(|e| {
+        // mshio says "Unknown error occurred" for a section cut short: name it when that is so
+        if let Some(unclosed) = unclosed_v41_section(bytes) {
+            return unclosed;
+        }
         MshError::new(
             "MSH 4.1 sections",
             format!(

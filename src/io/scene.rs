@@ -362,30 +362,41 @@ impl RigidSurface {
         matches!(self, RigidSurface::Line { .. } | RigidSurface::Plane { .. })
     }
 
-    /// Whether the surface is degenerate: a zero normal, a radius that is not positive, or a
-    /// value that is not finite.
-    pub fn is_degenerate(&self) -> bool {
-        fn finite(v: &[f64]) -> bool {
-            v.iter().all(|x| x.is_finite())
-        }
-        fn nonzero(v: &[f64]) -> bool {
-            v.iter().any(|&x| x != 0.0)
-        }
-        let ok = match self {
-            RigidSurface::Line { point, normal } => {
-                finite(point) && finite(normal) && nonzero(normal)
-            }
-            RigidSurface::Plane { point, normal } => {
-                finite(point) && finite(normal) && nonzero(normal)
-            }
-            RigidSurface::Circle { centre, radius } => {
-                finite(centre) && radius.is_finite() && *radius > 0.0
-            }
-            RigidSurface::Sphere { centre, radius } => {
-                finite(centre) && radius.is_finite() && *radius > 0.0
-            }
+    /// The largest coordinate or radius of a rigid surface: gaps square differences of
+    /// positions, and `1e150` keeps a sum of three squared differences of such values finite.
+    pub const LARGEST: f64 = 1e150;
+
+    /// Why the surface cannot be used, if it cannot: a zero normal, a radius that is not
+    /// positive, a value that is not finite, or one beyond [`Self::LARGEST`] (its gap would
+    /// overflow); `None` for a usable surface.
+    pub fn problem(&self) -> Option<String> {
+        let (values, normal, radius): (&[f64], Option<&[f64]>, Option<f64>) = match self {
+            RigidSurface::Line { point, normal } => (point, Some(normal), None),
+            RigidSurface::Plane { point, normal } => (point, Some(normal), None),
+            RigidSurface::Circle { centre, radius } => (centre, None, Some(*radius)),
+            RigidSurface::Sphere { centre, radius } => (centre, None, Some(*radius)),
         };
-        !ok
+        let all = values
+            .iter()
+            .chain(normal.into_iter().flatten())
+            .chain(&radius);
+        if let Some(v) = all.clone().find(|v| !v.is_finite()) {
+            return Some(format!("a value is not finite ({v})"));
+        }
+        if let Some(n) = normal.filter(|n| n.iter().all(|&c| c == 0.0)) {
+            return Some(format!("the normal {n:?} is zero"));
+        }
+        if let Some(r) = radius.filter(|&r| r <= 0.0) {
+            return Some(format!("the radius {r} is not positive"));
+        }
+        if let Some(v) = all.map(|v| v.abs()).find(|&v| v > Self::LARGEST) {
+            return Some(format!(
+                "{v} is too large to compute a gap with (coordinates and radii at most {:e}: \
+                 the gap squares differences of positions, which would overflow)",
+                Self::LARGEST
+            ));
+        }
+        None
     }
 }
 
@@ -933,6 +944,7 @@ pub enum NodeSetSpec {
     /// Nodes in a closed axis-aligned box.
     Box(BoxSpec),
     /// The node at a point (within a small tolerance).
+    #[serde(deserialize_with = "point2")]
     Point([f64; 2]),
     /// Node ids.
     Nodes(Vec<usize>),
@@ -954,7 +966,9 @@ pub enum FacetSetSpec {
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BoxSpec {
+    #[serde(deserialize_with = "point2")]
     pub min: [f64; 2],
+    #[serde(deserialize_with = "point2")]
     pub max: [f64; 2],
 }
 
@@ -966,11 +980,45 @@ pub enum FromExact {
 }
 
 /// A prescribed displacement component: a number, or `"exact"`.
-#[derive(Copy, Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[derive(Copy, Clone, Debug, Serialize, JsonSchema)]
 #[serde(untagged)]
 pub enum Prescribed {
     Value(f64),
     Exact(FromExact),
+}
+
+/// A number becomes [`Prescribed::Value`], the string `"exact"` [`Prescribed::Exact`]; anything
+/// else is refused naming the field and both forms (not serde's "did not match any variant of
+/// untagged enum").
+impl<'de> Deserialize<'de> for Prescribed {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct PrescribedVisitor;
+        impl serde::de::Visitor<'_> for PrescribedVisitor {
+            type Value = Prescribed;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(
+                    "a support's displacement component (`x`, `y` or `z`): a number, or \
+                     \"exact\" for the case's exact solution",
+                )
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Prescribed, E> {
+                Ok(Prescribed::Value(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Prescribed, E> {
+                Ok(Prescribed::Value(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Prescribed, E> {
+                Ok(Prescribed::Value(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Prescribed, E> {
+                match v {
+                    "exact" => Ok(Prescribed::Exact(FromExact::Exact)),
+                    _ => Err(E::invalid_value(serde::de::Unexpected::Str(v), &self)),
+                }
+            }
+        }
+        d.deserialize_any(PrescribedVisitor)
+    }
 }
 
 /// Prescribed displacement components on a node set (`x`, `y` or both).
@@ -994,11 +1042,81 @@ pub struct Support {
 }
 
 /// A traction vector, or `"exact"` (sigma_exact . n).
-#[derive(Copy, Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[derive(Copy, Clone, Debug, Serialize, JsonSchema)]
 #[serde(untagged)]
 pub enum TractionSpec {
     Vector([f64; 2]),
     Exact(FromExact),
+}
+
+/// A list of two numbers becomes [`TractionSpec::Vector`], the string `"exact"`
+/// [`TractionSpec::Exact`]; anything else is refused naming the field and both forms.
+impl<'de> Deserialize<'de> for TractionSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct TractionVisitor;
+        impl<'de> serde::de::Visitor<'de> for TractionVisitor {
+            type Value = TractionSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(
+                    "a load's `traction`: a vector [t_x, t_y] (force per area), or \"exact\" \
+                     for sigma_exact . n of the case's exact solution",
+                )
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                seq: A,
+            ) -> Result<TractionSpec, A::Error> {
+                coordinates(seq, &self).map(TractionSpec::Vector)
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<TractionSpec, E> {
+                match v {
+                    "exact" => Ok(TractionSpec::Exact(FromExact::Exact)),
+                    _ => Err(E::invalid_value(serde::de::Unexpected::Str(v), &self)),
+                }
+            }
+        }
+        d.deserialize_any(TractionVisitor)
+    }
+}
+
+/// `N` numbers from `seq`, or an error naming what `expected` describes and how many numbers
+/// were given (not serde_json's "trailing characters" for one too many).
+fn coordinates<'de, A: serde::de::SeqAccess<'de>, const N: usize>(
+    mut seq: A,
+    expected: &dyn serde::de::Expected,
+) -> Result<[f64; N], A::Error> {
+    let mut out = [0.0; N];
+    let mut given = 0;
+    while let Some(v) = seq.next_element::<f64>()? {
+        if given < N {
+            out[given] = v;
+        }
+        given += 1;
+    }
+    if given != N {
+        return Err(serde::de::Error::invalid_length(given, expected));
+    }
+    Ok(out)
+}
+
+/// A 2D point `[x, y]` of a node or facet set; three numbers (a 3D point) are refused saying
+/// that these sets are 2D.
+fn point2<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    struct Point2;
+    impl<'de> serde::de::Visitor<'de> for Point2 {
+        type Value = [f64; 2];
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str(
+                "a 2D point [x, y] (user-defined node and facet sets are 2D; a 3D body uses its \
+                 automatic sets: left/right (x), front/back (y), bottom/top (z), the corners \
+                 such as bottom_front_left, and all)",
+            )
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<[f64; 2], A::Error> {
+            coordinates(seq, &self)
+        }
+    }
+    d.deserialize_seq(Point2)
 }
 
 /// One load: `pressure` or `traction` on a facet set, a concentrated `force` at every node of a

@@ -8,6 +8,11 @@
 //! concatenated. Only `format="ascii"` arrays are read (what this tool, DOLFINx's `VTKFile` and
 //! meshio with `binary=False` write); binary and appended arrays are refused with that hint.
 //! Cells are not read: results are matched to our nodes by position.
+//!
+//! The sizes a file states (`NumberOfPoints`, `NumberOfComponents`) are checked against the
+//! file's length before anything is allocated: each value takes at least one character and a
+//! separator, so a text of `n` bytes holds at most `n / 2 + 1` values (and a file is read up to
+//! [`MAX_VTU_BYTES`]). A hostile or corrupt header is refused, naming the attribute.
 
 use crate::error::{Error, Result};
 use std::collections::BTreeMap;
@@ -102,6 +107,10 @@ pub fn parse_vtu(text: &str, source: &str) -> Result<PointGrid> {
             "the file holds no points",
         ));
     }
+    let room = Room {
+        bytes: text.len(),
+        values: text.len() / 2 + 1,
+    };
     let mut piece_fields: Vec<BTreeMap<String, PointField>> = Vec::new();
     for (k, piece) in pieces.iter().enumerate() {
         let at = format!("<Piece> {}", k + 1);
@@ -126,7 +135,7 @@ pub fn parse_vtu(text: &str, source: &str) -> Result<PointGrid> {
                     "a .vtu piece lists its points' coordinates under <Points>",
                 )
             })?;
-        let coords = data_array(&coords, count, source, &format!("{at} <Points>"))?;
+        let coords = data_array(&coords, count, room, source, &format!("{at} <Points>"))?;
         if coords.components != 3 {
             return Err(bad(
                 format!("{at} <Points>"),
@@ -140,8 +149,13 @@ pub fn parse_vtu(text: &str, source: &str) -> Result<PointGrid> {
         if let Some(data) = piece.children().find(|n| n.has_tag_name("PointData")) {
             for array in data.children().filter(|n| n.has_tag_name("DataArray")) {
                 let name = array.attribute("Name").unwrap_or("").to_string();
-                let field =
-                    data_array(&array, count, source, &format!("{at} <PointData> '{name}'"))?;
+                let field = data_array(
+                    &array,
+                    count,
+                    room,
+                    source,
+                    &format!("{at} <PointData> '{name}'"),
+                )?;
                 fields.insert(name, field);
             }
         }
@@ -171,10 +185,19 @@ pub fn parse_vtu(text: &str, source: &str) -> Result<PointGrid> {
     Ok(out)
 }
 
-/// One ASCII `<DataArray>` with `count` tuples.
+/// How many values a text can hold: `bytes` long, at most `values` (module notes).
+#[derive(Clone, Copy)]
+struct Room {
+    bytes: usize,
+    values: usize,
+}
+
+/// One ASCII `<DataArray>` with `count` tuples (`NumberOfPoints` of its piece), the sizes
+/// checked against the `room` of the file before anything is allocated.
 fn data_array(
     node: &roxmltree::Node,
     count: usize,
+    room: Room,
     source: &str,
     location: &str,
 ) -> Result<PointField> {
@@ -196,7 +219,23 @@ fn data_array(
             )
         })?,
     };
-    let mut values = Vec::with_capacity(count * components);
+    let expected = count
+        .checked_mul(components)
+        .filter(|&n| n <= room.values)
+        .ok_or_else(|| {
+            bad(
+                format!(
+                    "NumberOfPoints=\"{count}\" x NumberOfComponents=\"{components}\" values are \
+                     more than a file of {} bytes can hold (at most {}: each value takes a \
+                     character and a separator; results files are read up to {MAX_VTU_BYTES} \
+                     bytes)",
+                    room.bytes, room.values
+                ),
+                "correct the NumberOfPoints of the <Piece> or the NumberOfComponents of the \
+                 array: the file is corrupt or was not written by a VTK writer",
+            )
+        })?;
+    let mut values = Vec::with_capacity(expected);
     for text in node.descendants().filter(|n| n.is_text()) {
         for word in text.text().unwrap_or("").split_ascii_whitespace() {
             let v: f64 = word.parse().map_err(|_| {
@@ -208,12 +247,12 @@ fn data_array(
             values.push(v);
         }
     }
-    if values.len() != count * components {
+    if values.len() != expected {
         return Err(bad(
             format!(
-                "{} values where {count} points x {components} components = {} were expected",
+                "{} values where {count} points x {components} components = {expected} were \
+                 expected",
                 values.len(),
-                count * components
             ),
             "the array must hold NumberOfComponents values for each of the piece's points",
         ));
@@ -278,6 +317,22 @@ mod tests {
         let word = TWO_POINTS.replace("7 8", "7 x");
         let e = parse_vtu(&word, "t.vtu").unwrap_err().to_string();
         assert!(e.contains("'x' (value 2) is not a number"), "{e}");
+        // sizes beyond what the text holds are refused before anything is allocated
+        for (attribute, hostile) in [
+            (
+                "NumberOfPoints=\"2\"",
+                "NumberOfPoints=\"4611686018427387904\"",
+            ),
+            (
+                "Name=\"p\"",
+                "Name=\"p\" NumberOfComponents=\"1000000000000\"",
+            ),
+        ] {
+            let e = parse_vtu(&TWO_POINTS.replace(attribute, hostile), "t.vtu")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("more than a file of"), "{e}");
+        }
         let e = parse_vtu("<VTKFile type=\"PolyData\"/>", "t.vtu")
             .unwrap_err()
             .to_string();

@@ -201,42 +201,44 @@ pub struct Model<const D: usize = 2, K: SolidCell<D> = ElementKind> {
     pub iteration_dofs: u64,
 }
 
-/// Parse case JSON; errors carry line, column and a hint.
-pub fn parse(text: &str, source: &str) -> Result<Case> {
-    let at_start = |message: &str, hint: &str| Error::Parse {
+/// Refuse, at line 1 column 1, a JSON file that does not start as one object: a byte-order
+/// mark, an array, nothing, or other text. `kind` names the file (`"case file"`) and
+/// `examples` where complete ones are (`"the cases under cases/"`). Every JSON file the tool
+/// reads as one object (cases, studies) goes through this check.
+pub fn refuse_non_object(text: &str, source: &str, kind: &str, examples: &str) -> Result<()> {
+    let at_start = |message: String, hint: String| Error::Parse {
         path: source.to_string(),
         line: 1,
         column: 1,
-        message: message.to_string(),
-        hint: hint.to_string(),
+        message,
+        hint,
     };
     if text.starts_with('\u{feff}') {
         return Err(at_start(
-            "the file starts with a byte-order mark (U+FEFF), which JSON does not allow",
-            "save the file as UTF-8 without a byte-order mark",
+            "the file starts with a byte-order mark (U+FEFF), which JSON does not allow".into(),
+            "save the file as UTF-8 without a byte-order mark".into(),
         ));
     }
     match text.trim_start().chars().next() {
-        Some('{') => {}
-        Some('[') => {
-            return Err(at_start(
-                "the file holds an array; a case file holds one JSON object",
-                "write one case per file, as an object {\"name\": .., \"materials\": .., ..}",
-            ))
-        }
-        None => {
-            return Err(at_start(
-                "the file is empty",
-                "a case file holds one JSON object; see the cases under cases/",
-            ))
-        }
-        Some(_) => {
-            return Err(at_start(
-                "the file does not start with '{': a case file holds one JSON object",
-                "see the cases under cases/ for complete examples",
-            ))
-        }
+        Some('{') => Ok(()),
+        Some('[') => Err(at_start(
+            format!("the file holds an array; a {kind} holds one JSON object"),
+            format!("write one per file, as an object {{..}}; see {examples}"),
+        )),
+        None => Err(at_start(
+            "the file is empty".into(),
+            format!("a {kind} holds one JSON object; see {examples}"),
+        )),
+        Some(_) => Err(at_start(
+            format!("the file does not start with '{{': a {kind} holds one JSON object"),
+            format!("see {examples} for complete examples"),
+        )),
     }
+}
+
+/// Parse case JSON; errors carry line, column and a hint.
+pub fn parse(text: &str, source: &str) -> Result<Case> {
+    refuse_non_object(text, source, "case file", "the cases under cases/")?;
     serde_json::from_str::<Case>(text).map_err(|e| {
         let message = e.to_string();
         // serde_json appends " at line L column C"; the location is reported separately.
@@ -576,8 +578,8 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
                         let hint = if D == 2 { "a 2D body meets a \"line\" or a \"circle\"" } else { "a 3D body meets a \"plane\" or a \"sphere\"" };
                         return Err(Error::invalid(&self.source, format!("{at}.master.rigid"), format!("the rigid surface is {}D and the bodies are {D}D", rigid.dimension()), hint));
                     }
-                    if rigid.is_degenerate() {
-                        return Err(Error::invalid(&self.source, format!("{at}.master.rigid"), "the rigid surface is degenerate (zero normal, non-positive radius or non-finite values)", "give a non-zero normal or a positive radius"));
+                    if let Some(why) = rigid.problem() {
+                        return Err(Error::invalid(&self.source, format!("{at}.master.rigid"), format!("the rigid surface cannot be used: {why}"), "give a finite, non-zero normal, or a positive radius; a sphere or circle far larger than the bodies is a plane or a line to them: give one"));
                     }
                     MasterSide::Rigid(rigid.clone())
                 }
