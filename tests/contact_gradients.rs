@@ -11,7 +11,8 @@
 use contact_patch::contact::discretization::constraints;
 use contact_patch::contact::Constraint;
 use contact_patch::io::scene::{DiscretizationSpec, NormalChoice};
-use contact_patch::model::{parse, Model};
+use contact_patch::mesh::Facet;
+use contact_patch::model::{parse, MasterSide, Model};
 
 fn two_blocks(element: &str, gap: f64, tilt: f64) -> Model {
     let lift = |x: f64| 5.0 + gap + tilt * (x - 4.0);
@@ -44,8 +45,10 @@ fn find(rows: &[Constraint], r: &Constraint) -> Constraint {
 }
 
 /// Central differences of every row's gap against every dof of the model. Rows of slave nodes
-/// at the ends of the interface (the lowest and highest x of their pass) are skipped: there
-/// the gap has a kink where the projection leaves the master surface.
+/// at the ends of their pass's slave surface (its lowest and highest x) are skipped: there the
+/// gap has a kink where the projection leaves the master surface. (Slave nodes beyond the
+/// master's ends have no row: until defect W02 of the second report they were held against
+/// an interior master vertex, spurious rows this test counted.)
 fn check(model: &Model, disc: DiscretizationSpec, h: f64, tol: f64, only_closed: bool) -> usize {
     check_dofs(model, disc, h, tol, only_closed, false)
 }
@@ -64,11 +67,27 @@ fn check_dofs(
     let rows = constraints(&model, &model.contact[0]).unwrap();
     assert!(!rows.is_empty());
     let mut checked = 0;
+    let pair = &model.contact[0];
+    let surface_ends = |body: usize, facets: &[Facet]| {
+        let mesh = &model.bodies[body].mesh;
+        facets
+            .iter()
+            .flat_map(|&f| mesh.facet_nodes(f))
+            .map(|n| mesh.nodes[n][0])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x), b.max(x))
+            })
+    };
+    // a rigid master has no second pass
+    let ends = [
+        surface_ends(pair.slave.0, &pair.slave.1),
+        match &pair.master {
+            MasterSide::Body { body, facets } => surface_ends(*body, facets),
+            MasterSide::Rigid(_) => (f64::NAN, f64::NAN),
+        },
+    ];
     let end = |r: &Constraint| {
-        let xs = rows.iter().filter(|q| q.pass == r.pass).map(|q| q.point[0]);
-        let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-            (a.min(x), b.max(x))
-        });
+        let (lo, hi) = ends[usize::from(r.pass == 2)];
         r.point[0] <= lo + 1e-9 || r.point[0] >= hi - 1e-9
     };
     for r in rows
