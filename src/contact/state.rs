@@ -86,6 +86,7 @@ pub(crate) fn committed_history<const D: usize>(
                         slip: f.plastic_slip,
                         normal_force: f.normal_force,
                         tangential_force: f.force,
+                        start_slip: f.slip,
                     },
                 )
             })
