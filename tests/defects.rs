@@ -669,6 +669,17 @@ fn s4_messages_name_the_field_and_the_accepted_forms() {
             "at most 1e150",
         ],
     );
+    // a density of 1e308: the density named, not a pivot ratio of NaN in the factorization
+    let r = run(&s4("messages/M-density-1e308-ratio-nan.json"));
+    never(&r.2, &["ratio NaN", "0000000000"]);
+    assert_refused(
+        r,
+        &[
+            "materials.m.density",
+            "beyond double precision",
+            "rescale the units",
+        ],
+    );
 }
 
 /// A contact solve whose system is singular is a failed solve: exit 2 with the message, as

@@ -191,6 +191,23 @@ pub fn resolve(case: &Case, model: &Model) -> Result<Option<Dynamics>> {
                 "give density > 0",
             ));
         }
+        // the inertia of a time step, 4 rho A t / dt^2 over the body's bounding box, bounds
+        // every entry the mass adds to the step's matrix: beyond double precision it is
+        // infinite (and the factorization meets NaN pivots far from the cause)
+        let side = b.mesh.size();
+        let inertia = 4.0 * rho * side * side * model.thickness / (dt * dt);
+        if !inertia.is_finite() {
+            return Err(invalid(
+                &at,
+                format!(
+                    "the density {rho:e} gives body '{}' an inertia per time step 4 rho A t / dt^2 \
+                     of {inertia:e} (side {side:e}, dt {dt:e}), beyond double precision",
+                    b.name
+                ),
+                "rescale the units (e.g. t/mm^3 with N and mm, or kg/m^3 with N and m) so that \
+                 density, size and time step stay far from 1e308",
+            ));
+        }
         density.push(rho);
     }
     let mut velocity = vec![0.0; model.dof_count];
