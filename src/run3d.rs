@@ -125,6 +125,9 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
     } else {
         crate::solver::active_set::solve(&model, &mut |_| {})?
     };
+    // what the output writes must be finite (the stresses of a displacement that is finite
+    // can overflow), as in 2D
+    crate::post::check_finite_nodal_stresses(&model, &solution.u, nodal_stress)?;
     solution.timings.mesh = meshed;
     solution.timings.total = start.elapsed().as_secs_f64();
     let checks = case
@@ -267,6 +270,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
         ));
     }
     crate::model::check_size(case, source)?;
+    crate::model::check_solver_settings(case, source)?;
     let mut bodies: Vec<Body3> = Vec::new();
     for (bi, spec) in case.bodies.iter().enumerate() {
         let at = format!("bodies[{bi}] '{}'", spec.name);

@@ -449,3 +449,80 @@ fn duplicated_names_and_pairs_are_errors() {
         &["contact[1] 'swapped'", "repeats the surfaces"],
     );
 }
+
+/// The reproducer `tests/defects/s4/NAME-*.json` (issue 38's set, NAME as `T01` or `T03a`).
+fn s4(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/defects/s4");
+    std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| {
+            p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with(&format!("{name}-"))
+        })
+        .unwrap_or_else(|| panic!("no reproducer {name} in {}", dir.display()))
+}
+
+/// `summary.json` of the output folder `out` of the scratch's working folder.
+fn summary(s: &Scratch, out: &str) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(s.work.join(out).join("summary.json")).unwrap())
+        .unwrap()
+}
+
+/// T01: a 3D patch under a pressure of 1e308 ended with exit 0, `passed: true` and NaN and
+/// infinity in `block.vtu` (the displacement finite, its stress overflowing). As in 2D (D08)
+/// it is an error naming the body, the node and the stage, and nothing is written.
+#[test]
+fn t01_3d_non_finite_stresses_are_an_error_naming_where() {
+    let s = Scratch::new();
+    let case = s.case(&s4("T01"), "case.json", |_| {});
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &[
+            "the nodal stress is not finite",
+            "body 'block', node",
+            "when the stresses were computed from the displacement",
+            "rescale the units",
+        ],
+    );
+    assert!(!s.work.join("o").exists(), "an output folder was written");
+    // the control: the patch's own pressure runs and passes
+    let case = s.case(&s4("T01"), "case.json", |v| {
+        v["loads"][0]["pressure"] = 2.0.into()
+    });
+    let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(summary(&s, "o")["passed"], true);
+}
+
+/// T03a/b: `load_steps: 0` in 3D gave "the external force is not finite (NaN)" at finite
+/// strain and was ignored at small strain; `1e9` ran without bound. As in 2D, both are
+/// refused with the range.
+#[test]
+fn t03_3d_load_steps_are_bounded_as_in_2d() {
+    let s = Scratch::new();
+    for (name, got) in [("T03a", "got 0"), ("T03b", "got 1000000000")] {
+        let case = s.case(&s4(name), "case.json", |_| {});
+        assert_refused(
+            s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+            &["solver.load_steps", "must be from 1 to 100000", got],
+        );
+    }
+    // small strain too, and the other counts and tolerances of the solver
+    for (field, value) in [
+        ("load_steps", serde_json::json!(0)),
+        ("max_iterations", serde_json::json!(0)),
+        ("linear_tolerance", serde_json::json!(2.0)),
+    ] {
+        let case = s.case(&s4("T01"), "case.json", |v| {
+            v["loads"][0]["pressure"] = 2.0.into();
+            v["solver"] = serde_json::json!({ field: value })
+        });
+        assert_refused(
+            s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+            &[&format!("solver.{field}")],
+        );
+    }
+}

@@ -876,47 +876,7 @@ impl Model {
         }
 
         check_size(case, source)?;
-        let counts = [
-            ("solver.load_steps", case.solver.load_steps),
-            ("solver.max_iterations", case.solver.max_iterations),
-            (
-                "solver.max_geometry_updates",
-                case.solver.max_geometry_updates,
-            ),
-        ];
-        for (field, n) in counts {
-            if !(1..=MAX_SOLVER_COUNT).contains(&n) {
-                return Err(invalid(
-                    field.into(),
-                    format!("must be from 1 to {MAX_SOLVER_COUNT}, got {n}"),
-                    "the defaults (1 load step, 200 iterations, 50 geometry updates) suit most cases",
-                ));
-            }
-        }
-        let tol = case.solver.linear_tolerance;
-        if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
-            return Err(invalid(
-                "solver.linear_tolerance".into(),
-                format!("must lie in (0, 1), got {tol}"),
-                "the default is 1e-10 (the relative residual of the CG solve)",
-            ));
-        }
-        let n = case.solver.linear_max_iterations;
-        if !(1..=MAX_SOLVER_COUNT).contains(&n) {
-            return Err(invalid(
-                "solver.linear_max_iterations".into(),
-                format!("must be from 1 to {MAX_SOLVER_COUNT}, got {n}"),
-                "the default is 500",
-            ));
-        }
-        let tol = case.solver.geometry_tolerance;
-        if !(tol.is_finite() && tol > 0.0) {
-            return Err(invalid(
-                "solver.geometry_tolerance".into(),
-                format!("must be a positive number, got {tol}"),
-                "the default is 1e-12",
-            ));
-        }
+        check_solver_settings(case, source)?;
         let mut bodies: Vec<Body> = Vec::new();
         let mut set_warnings = Vec::new();
         let mut offset = 0;
@@ -1859,6 +1819,58 @@ fn read_gmsh_mesh(g: &GmshMeshSpec, source: &str, at: &str) -> Result<(Mesh, usi
                 e.hint,
             )
         })
+}
+
+/// The solver's counts and tolerances of `case` (`solver.load_steps`, `max_iterations`,
+/// `max_geometry_updates`, `linear_tolerance`, `linear_max_iterations`,
+/// `geometry_tolerance`), each within its range, for 2D and 3D cases alike.
+pub(crate) fn check_solver_settings(case: &Case, source: &str) -> Result<()> {
+    let counts = [
+        ("solver.load_steps", case.solver.load_steps),
+        ("solver.max_iterations", case.solver.max_iterations),
+        (
+            "solver.max_geometry_updates",
+            case.solver.max_geometry_updates,
+        ),
+    ];
+    for (field, n) in counts {
+        if !(1..=MAX_SOLVER_COUNT).contains(&n) {
+            return Err(Error::invalid(
+                source,
+                field,
+                format!("must be from 1 to {MAX_SOLVER_COUNT}, got {n}"),
+                "the defaults (1 load step, 200 iterations, 50 geometry updates) suit most cases",
+            ));
+        }
+    }
+    let tol = case.solver.linear_tolerance;
+    if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
+        return Err(Error::invalid(
+            source,
+            "solver.linear_tolerance",
+            format!("must lie in (0, 1), got {tol}"),
+            "the default is 1e-10 (the relative residual of the CG solve)",
+        ));
+    }
+    let n = case.solver.linear_max_iterations;
+    if !(1..=MAX_SOLVER_COUNT).contains(&n) {
+        return Err(Error::invalid(
+            source,
+            "solver.linear_max_iterations",
+            format!("must be from 1 to {MAX_SOLVER_COUNT}, got {n}"),
+            "the default is 500",
+        ));
+    }
+    let tol = case.solver.geometry_tolerance;
+    if !(tol.is_finite() && tol > 0.0) {
+        return Err(Error::invalid(
+            source,
+            "solver.geometry_tolerance",
+            format!("must be a positive number, got {tol}"),
+            "the default is 1e-12",
+        ));
+    }
+    Ok(())
 }
 
 /// The nodes read from Gmsh files count against `limits.nodes` once read (a block's or an
