@@ -497,6 +497,93 @@ fn t01_3d_non_finite_stresses_are_an_error_naming_where() {
     assert_eq!(summary(&s, "o")["passed"], true);
 }
 
+/// T02: a Hex8 block on a rigid plane with a penalty of 0.01 sank 200 (about 283 times its
+/// facets' diagonal) with exit 0, no warning and no penetration in `summary.json`. As in 2D
+/// (D14): a warning above 5 % of the contact element size, `max_penetration` and
+/// `max_penetration_share` in `summary.json`, and the check `max_penetration`.
+#[test]
+fn t02_3d_deep_penetration_warns_is_reported_and_is_a_check() {
+    let s = Scratch::new();
+    let case = s.case(&s4("T02"), "case.json", |_| {});
+    let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    assert_eq!(code, 0, "{stderr}");
+    for needle in [
+        "contact 'ground': penetration",
+        "of body 'block'",
+        "times the contact element size (warning above 0.05)",
+        "raise the penalty kappa",
+    ] {
+        assert!(stderr.contains(needle), "{needle:?} missing from {stderr}");
+    }
+    let v = summary(&s, "o");
+    assert!(v["warnings"].as_array().unwrap().iter().any(|w| w
+        .as_str()
+        .unwrap()
+        .contains("times the contact element size")));
+    let contact = &v["contact"];
+    // the pressure 2 on the unit top against kappa 0.01 on the unit bottom: 2 / 0.01 = 200
+    let depth = contact["max_penetration"].as_f64().unwrap();
+    assert!((depth - 200.0).abs() < 1.0, "{contact}");
+    // the facets are 0.5 squares: their longest chord is the diagonal
+    let share = contact["max_penetration_share"].as_f64().unwrap();
+    assert!(
+        (share - depth / 0.5f64.hypot(0.5)).abs() < 1e-9 * share,
+        "{contact}"
+    );
+    let pair = &contact["pairs"][0];
+    assert_eq!(pair["name"], "ground");
+    assert_eq!(pair["max_penetration"], contact["max_penetration"]);
+    assert_eq!(pair["max_penetration_at"]["body"], "block");
+    // the check fails the run
+    let case = s.case(
+        &s4("T02"),
+        "case.json",
+        |v| {
+            v["checks"] =
+                serde_json::json!([{"check": "max_penetration", "pair": "ground", "share": 0.05}])
+        },
+    );
+    let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    assert_eq!(code, 1, "{stderr}");
+    let v = summary(&s, "o");
+    let check = &v["checks"][0];
+    assert_eq!(check["passed"], false, "{check}");
+    assert_eq!(check["error"], v["contact"]["max_penetration_share"]);
+    assert_eq!(check["tol"], 0.05);
+    // a stiff penalty: no warning, the check passes
+    let case = s.case(&s4("T02"), "case.json", |v| {
+        v["contact"][0]["enforcement"]["kappa"] = 1e6.into();
+        v["checks"] = serde_json::json!([{"check": "max_penetration", "share": 0.05}])
+    });
+    let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!stderr.contains("penetration"), "{stderr}");
+    let v = summary(&s, "o");
+    assert_eq!(v["checks"][0]["passed"], true);
+    assert!(v["contact"]["max_penetration_share"].as_f64().unwrap() < 0.05);
+    // the check names a pair that exists, and needs contact
+    let case = s.case(
+        &s4("T02"),
+        "case.json",
+        |v| {
+            v["checks"] =
+                serde_json::json!([{"check": "max_penetration", "pair": "floor", "share": 0.05}])
+        },
+    );
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &["checks[0]", "contact pair 'floor' does not exist", "ground"],
+    );
+    let case = s.case(&s4("T01"), "case.json", |v| {
+        v["loads"][0]["pressure"] = 2.0.into();
+        v["checks"] = serde_json::json!([{"check": "max_penetration", "share": 0.05}])
+    });
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &["checks[0]", "max_penetration needs contact pairs"],
+    );
+}
+
 /// T03a/b: `load_steps: 0` in 3D gave "the external force is not finite (NaN)" at finite
 /// strain and was ignored at small strain; `1e9` ran without bound. As in 2D, both are
 /// refused with the range.

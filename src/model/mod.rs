@@ -512,6 +512,22 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
         ))
     }
 
+    /// The pair of a `max_penetration` check at `location` (2D and 3D): `pair` must exist, and
+    /// without one the case must have pairs.
+    pub(crate) fn resolve_max_penetration(&self, pair: Option<&str>, location: &str) -> Result<()> {
+        if let Some(pair) = pair {
+            self.find_pair(pair, location)?;
+        } else if self.contact.is_empty() {
+            return Err(Error::invalid(
+                &self.source,
+                location,
+                "max_penetration needs contact pairs, and the case has none",
+                "remove the check or add a pair",
+            ));
+        }
+        Ok(())
+    }
+
     fn find_pair(&self, name: &str, location: &str) -> Result<usize> {
         self.contact
             .iter()
@@ -1422,16 +1438,7 @@ impl Model {
                     *tol
                 }
                 Check::MaxPenetration { pair, share } => {
-                    if let Some(pair) = pair {
-                        self.find_pair(pair, &at)?;
-                    } else if self.contact.is_empty() {
-                        return Err(Error::invalid(
-                            &self.source,
-                            &at,
-                            "max_penetration needs contact pairs, and the case has none",
-                            "remove the check or add a pair",
-                        ));
-                    }
+                    self.resolve_max_penetration(pair.as_deref(), &at)?;
                     *share
                 }
                 Check::ContactForce { pair, tol, .. }
