@@ -39,7 +39,9 @@
 //! the run's index alone, so the same seed gives the same sequence of runs whatever the timing.
 //! The fuzzing stops at a time budget (`CONTACT_PATCH_FUZZ_SECONDS`, default 60 s; a run started
 //! before the end may add up to the per-run limit) or a run count (`CONTACT_PATCH_FUZZ_RUNS`); the
-//! seed can be changed with `CONTACT_PATCH_FUZZ_SEED`. At the end the test prints (straight to
+//! seed can be changed with `CONTACT_PATCH_FUZZ_SEED`, and `CONTACT_PATCH_FUZZ_FAMILY` (a family
+//! named in the per-family count, e.g. `3d`, `finite strain`, `gmsh`) mutates the cases of that
+//! family only. At the end the test prints (straight to
 //! stderr, so it shows in CI even when the test passes) the number of runs, the runs per family
 //! of the mutated cases (2D or 3D, contact, friction, finite strain, dynamics, Gmsh, explicit
 //! mesh, sweep), the count of each exit code, of each command and of each mutation kind. All failures are collected, grouped into
@@ -1597,7 +1599,7 @@ fn draw_trial(
             },
         }
     } else {
-        let table = roll < 20;
+        let table = roll < 20 && !sweeps.is_empty();
         let base = if table {
             *rng.pick(sweeps)
         } else {
@@ -1649,12 +1651,21 @@ fn mutated_cases_keep_the_invariants() {
     let budget =
         Duration::from_secs_f64(env_or("CONTACT_PATCH_FUZZ_SECONDS", DEFAULT_BUDGET_SECONDS));
     let max_runs: usize = env_or("CONTACT_PATCH_FUZZ_RUNS", DEFAULT_MAX_RUNS);
-    let bases = bases();
+    let mut bases = bases();
+    assert!(
+        bases.len() > 20 && bases.iter().any(|b| b.value.get("sweep").is_some()),
+        "the catalogue"
+    );
+    // one family only (`CONTACT_PATCH_FUZZ_FAMILY`, a name of the per-family count)
+    let family: String = env_or("CONTACT_PATCH_FUZZ_FAMILY", String::new());
+    if !family.is_empty() {
+        bases.retain(|b| b.families.contains(&family.as_str()));
+        assert!(!bases.is_empty(), "no case of the family {family:?}");
+    }
     let sweeps: Vec<&Base> = bases
         .iter()
         .filter(|b| b.value.get("sweep").is_some())
         .collect();
-    assert!(bases.len() > 20 && !sweeps.is_empty(), "the catalogue");
     let root = tempfile::Builder::new()
         .prefix("contact-patch-fuzz-")
         .tempdir()
