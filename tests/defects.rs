@@ -651,3 +651,32 @@ fn t04_3d_work_beyond_the_limits_is_refused_before_allocation() {
         &["stiffness matrix of about", "1.0e1 multiply-adds"],
     );
 }
+
+/// Found by the fuzz (issue 38 item 8, seed 0xb, family `dynamics`, run 1385):
+/// `cases/dynamics/block-drop-rigid.json` with 8000 divisions along x drops a strip whose 8001
+/// bottom nodes touch the rigid line; the seed's post-impact correction projects the active
+/// rows densely (7997 columns of 144 k equations, 10 GB) and aborted on allocation
+/// under the fuzz's 4 GiB address space (11.6 GB resident without it). It is refused before
+/// the allocation, naming the limits; with 80 divisions it runs.
+#[test]
+fn a_dense_post_impact_projection_beyond_the_limits_is_refused() {
+    let s = Scratch::new();
+    let drop = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/dynamics/block-drop-rigid.json");
+    let case = s.case(&drop, "case.json", |v| {
+        v["bodies"][0]["mesh"]["block"]["x"]["divisions"] = 8000.into()
+    });
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &[
+            "post-impact correction would project",
+            "active contact rows densely",
+            "limits.factor_gigabytes",
+            "contact_stabilized",
+        ],
+    );
+    let case = s.case(&drop, "case.json", |v| {
+        v["bodies"][0]["mesh"]["block"]["x"]["divisions"] = 80.into()
+    });
+    let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    assert!(code == 0 || code == 1, "exit {code}:\n{stderr}");
+}
