@@ -16,6 +16,7 @@
 
 use crate::fe::point_values;
 use crate::harness::exact::ExactField;
+use crate::model::space::SolidCell;
 use crate::model::{Body, Model};
 use crate::solid::{strain_at, MAX_DOFS};
 use crate::solid_finite::{displacement_gradient_at, jacobian};
@@ -145,8 +146,19 @@ fn nodal_average<const N: usize>(
 /// `Ok` when every nodal stress of every body (what the output writes) is finite, else the
 /// error naming the first node where one is not.
 pub fn check_finite_stresses(model: &Model, u: &[f64]) -> crate::Result<()> {
+    check_finite_nodal_stresses(model, u, nodal_stresses)
+}
+
+/// [`check_finite_stresses`] in any dimension: `nodal(body, u)` gives the nodal stresses the
+/// output writes for `body` (any number of components); the error names the body, the node,
+/// its position and the stage.
+pub fn check_finite_nodal_stresses<const D: usize, K: SolidCell<D>, const S: usize>(
+    model: &Model<D, K>,
+    u: &[f64],
+    nodal: impl Fn(&Body<D, K>, &[f64]) -> Vec<[f64; S]>,
+) -> crate::Result<()> {
     for body in &model.bodies {
-        let stresses = nodal_stresses(body, u);
+        let stresses = nodal(body, u);
         if let Some((n, s)) = stresses
             .iter()
             .enumerate()
@@ -158,11 +170,12 @@ pub fn check_finite_stresses(model: &Model, u: &[f64]) -> crate::Result<()> {
                 .find(|v| !v.is_finite())
                 .unwrap_or(f64::NAN);
             let p = body.mesh.nodes[n];
+            let point: Vec<String> = p.iter().map(|x| x.to_string()).collect();
             return Err(crate::solver::linear::non_finite_at(
                 model,
                 "the nodal stress",
                 value,
-                &format!("body '{}', node {n} at ({}, {})", body.name, p[0], p[1]),
+                &format!("body '{}', node {n} at ({})", body.name, point.join(", ")),
                 "when the stresses were computed from the displacement",
             ));
         }

@@ -11,7 +11,8 @@
 //! not built in 3D yet is refused here with the reason (an invalid-case error, exit 2), never
 //! computed wrongly: dynamics, the current contact geometry under small strain, sweeps, exact
 //! solutions, user-defined sets, loads other
-//! than pressure, checks other than `uniform_stress_3d`; the 3D discretizations refuse what
+//! than pressure, checks other than `uniform_stress_3d` and `max_penetration`; the 3D
+//! discretizations refuse what
 //! they do not treat ([`crate::contact::discretization::Discretize`]).
 //!
 //! **Finite strain** (`physics.kinematics: "finite"`, hyperelastic materials
@@ -45,6 +46,14 @@
 //! and pressures, steps with committed slip) are the 2D model's
 //! ([`crate::model::Model::at_load`]).
 //!
+//! The guards of a 2D run hold here, through the same functions: the solver's counts and
+//! tolerances ([`crate::model::check_solver_settings`]), finite nodal stresses
+//! ([`crate::post::check_finite_nodal_stresses`]), and the largest penetration of each pair
+//! relative to the contact element size ([`crate::contact::forces::pair_penetration`]): a
+//! warning above [`crate::harness::checks::PENETRATION_WARNING_SHARE`], the fields
+//! `max_penetration` and `max_penetration_share` of `summary.json` (`contact`, and per pair
+//! under `contact.pairs`), and the check `max_penetration`.
+//!
 //! The check `uniform_stress_3d` is the 3D uniform-stress check: the largest difference over
 //! the quadrature points of the stiffness rule and the six components, relative to the
 //! largest component of the expected stress. The `.vtu` holds the displacement (3
@@ -52,10 +61,13 @@
 //! kinematics), the mean over the cells
 //! around each node of the stress at the cell's natural centre.
 
+use crate::contact::discretization::geometry::Surface3;
+use crate::contact::forces::{element_sizes, pair_penetration, Penetration};
+use crate::contact::state::ContactState;
 use crate::error::{Error, Result};
 use crate::fe::ReferenceCell;
 use crate::fe3d::SolidKind;
-use crate::harness::checks::CheckResult;
+use crate::harness::checks::{max_penetration_check, penetration_warnings, CheckResult};
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
 use crate::io::scene::{
     Case, Check, ContactGeometry, DiscretizationSpec, Interaction, Kinematics, MaterialModel,
@@ -92,9 +104,13 @@ pub struct Outcome3 {
     pub model: Model3,
     pub solution: Solution<3>,
     pub checks: Vec<CheckResult>,
-    /// What the run should say although no check failed (an unstable equilibrium,
-    /// [`crate::harness::stability::unstable_equilibrium`]).
+    /// What the run should say although no check failed: penetration above
+    /// [`crate::harness::checks::PENETRATION_WARNING_SHARE`] of the contact element size
+    /// ([`crate::harness::checks::penetration_warnings`]), an unstable equilibrium
+    /// ([`crate::harness::stability::unstable_equilibrium`]).
     pub warnings: Vec<String>,
+    /// The largest penetration of each contact pair (empty without contact).
+    pub penetrations: Vec<Penetration<3>>,
 }
 
 impl Outcome3 {
@@ -119,8 +135,15 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
     let meshed = start.elapsed().as_secs_f64();
     crate::model::admit::check_rigid_modes(&model)?;
     let mut solution = crate::solver::solve_quasi_static(&model, &mut |_| {})?;
+    // what the output writes must be finite (the stresses of a displacement that is finite
+    // can overflow), as in 2D
+    crate::post::check_finite_nodal_stresses(&model, &solution.u, nodal_stress)?;
     solution.timings.mesh = meshed;
     solution.timings.total = start.elapsed().as_secs_f64();
+    let penetrations = solution
+        .contact
+        .as_ref()
+        .map(|state| penetrations3(&model, state));
     let checks = case
         .checks
         .iter()
@@ -128,18 +151,39 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
             Check::UniformStress3d { stress, tol } => {
                 uniform_stress_check3(&model, &solution.u, stress, *tol)
             }
+            Check::MaxPenetration { pair, share } => {
+                let shares = penetrations.as_ref().map(|p| {
+                    p.iter()
+                        .enumerate()
+                        .map(|(k, p)| (model.contact[k].name.as_str(), p.share_of_element))
+                });
+                let (check, error) = max_penetration_check(pair.as_deref(), shares);
+                CheckResult {
+                    check,
+                    error,
+                    tol: *share,
+                    passed: error <= *share,
+                }
+            }
             _ => unreachable!("build3 refuses every other check"),
         })
         .collect();
-    let warnings = crate::harness::stability::unstable_equilibrium(&solution)
-        .into_iter()
-        .collect();
+    let mut warnings: Vec<String> = Vec::new();
+    if let (Some(state), Some(p)) = (&solution.contact, &penetrations) {
+        warnings.extend(penetration_warnings(
+            &model,
+            state,
+            p.iter().cloned().enumerate(),
+        ));
+    }
+    warnings.extend(crate::harness::stability::unstable_equilibrium(&solution));
     Ok(Outcome3 {
         name: case.name.clone(),
         model,
         solution,
         checks,
         warnings,
+        penetrations: penetrations.unwrap_or_default(),
     })
 }
 
@@ -261,6 +305,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
         ));
     }
     crate::model::check_size(case, source)?;
+    crate::model::check_solver_settings(case, source)?;
     let mut bodies: Vec<Body3> = Vec::new();
     for (bi, spec) in case.bodies.iter().enumerate() {
         let at = format!("bodies[{bi}] '{}'", spec.name);
@@ -367,12 +412,23 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
                     ));
                 }
             }
+            Check::MaxPenetration { pair, share } => {
+                model.resolve_max_penetration(pair.as_deref(), &at)?;
+                if !(share.is_finite() && *share >= 0.0) {
+                    return Err(Error::invalid(
+                        source,
+                        &at,
+                        format!("tolerance must be a non-negative number, got {share}"),
+                        "give the largest penetration relative to the element size, e.g. 0.01",
+                    ));
+                }
+            }
             _ => {
                 return Err(not_built(
                     source,
                     &at,
                     "this check",
-                    "use \"uniform_stress_3d\"",
+                    "use \"uniform_stress_3d\" or \"max_penetration\"",
                 ))
             }
         }
@@ -730,6 +786,46 @@ fn nodal_stress(body: &Body3, u: &[f64]) -> Vec<[f64; 6]> {
         .collect()
 }
 
+/// The largest penetration of every contact pair of `model` in the contact solution `state`
+/// ([`crate::contact::forces::pair_penetration`], as in 2D): relative to the longest facet at
+/// the slave node, the facets and positions taken where the rows were linearized (the
+/// reference configuration, or `X + u` in the current geometry).
+fn penetrations3(model: &Model3, state: &ContactState<3>) -> Vec<Penetration<3>> {
+    let config = state.configuration.as_deref();
+    let position = |b: usize, n: usize| {
+        let body = &model.bodies[b];
+        let p = body.mesh.nodes[n];
+        match config {
+            Some(u) => std::array::from_fn(|i| p[i] + u[body.dof(n, i)]),
+            None => p,
+        }
+    };
+    (0..model.contact.len())
+        .map(|k| {
+            let pair = &model.contact[k];
+            let mut sides = vec![(pair.slave.0, &pair.slave.1)];
+            if let MasterSide::Body { body, facets } = &pair.master {
+                sides.push((*body, facets));
+            }
+            let surfaces: Vec<Surface3> = sides
+                .iter()
+                .map(|&(b, facets)| {
+                    let mesh = &model.bodies[b].mesh;
+                    let nodes: Vec<Vec<usize>> =
+                        facets.iter().map(|&f| mesh.facet_nodes(f)).collect();
+                    let coords = nodes
+                        .iter()
+                        .map(|f| f.iter().map(|&n| position(b, n)).collect())
+                        .collect();
+                    Surface3::from_facets(b, mesh.kind.facet_kind(), nodes, coords, 1.0)
+                })
+                .collect();
+            let sizes: Vec<_> = surfaces.iter().map(element_sizes).collect();
+            pair_penetration(state, k, &surfaces, &sizes, position)
+        })
+        .collect()
+}
+
 /// The contact part of the summary: how the solve ended and the rows' totals.
 fn contact_summary(outcome: &Outcome3) -> Option<serde_json::Value> {
     let state = outcome.solution.contact.as_ref()?;
@@ -740,12 +836,37 @@ fn contact_summary(outcome: &Outcome3) -> Option<serde_json::Value> {
             force[i] += f * r.normal[i];
         }
     }
+    let pairs: Vec<serde_json::Value> = outcome
+        .penetrations
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let mut pair = serde_json::json!({
+                "name": outcome.model.contact[k].name,
+                "max_penetration": p.depth,
+                "max_penetration_share": p.share_of_element,
+            });
+            if let Some((b, node, point)) = p.at {
+                pair["max_penetration_at"] = serde_json::json!({
+                    "body": outcome.model.bodies[b].name,
+                    "node": node,
+                    "point": point,
+                });
+            }
+            pair
+        })
+        .collect();
+    let most =
+        |get: fn(&Penetration<3>) -> f64| outcome.penetrations.iter().map(get).fold(0.0, f64::max);
     let mut summary = serde_json::json!({
         "termination": format!("{:?}", state.termination),
         "iterations": state.iterations,
         "rows": state.rows.len(),
         "active": active,
         "force_on_slaves": force,
+        "max_penetration": most(|p| p.depth),
+        "max_penetration_share": most(|p| p.share_of_element),
+        "pairs": pairs,
     });
     if let Some(friction) = crate::contact::friction::step_summary(state) {
         // Coulomb pairs: the tangential force, the open/stick/slip counts and the dissipation

@@ -732,3 +732,220 @@ fn a_study_in_which_no_cell_ran_exits_2() {
     assert_eq!(code, 0, "{stdout}\n{stderr}");
     assert!(stdout.contains("2 cells (1 could not run)"), "{stdout}");
 }
+
+
+/// `summary.json` of the output folder `out` of the scratch's working folder.
+fn summary(s: &Scratch, out: &str) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(s.work.join(out).join("summary.json")).unwrap())
+        .unwrap()
+}
+
+/// T01: a 3D patch under a pressure of 1e308 ended with exit 0, `passed: true` and NaN and
+/// infinity in `block.vtu` (the displacement finite, its stress overflowing). As in 2D (D08)
+/// it is an error naming the body, the node and the stage, and nothing is written.
+#[test]
+fn t01_3d_non_finite_stresses_are_an_error_naming_where() {
+    let s = Scratch::new();
+    let case = s.case(&defect("T01"), "case.json", |_| {});
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &[
+            "the nodal stress is not finite",
+            "body 'block', node",
+            "when the stresses were computed from the displacement",
+            "rescale the units",
+        ],
+    );
+    assert!(!s.work.join("o").exists(), "an output folder was written");
+    // the control: the patch's own pressure runs and passes
+    let case = s.case(&defect("T01"), "case.json", |v| {
+        v["loads"][0]["pressure"] = 2.0.into()
+    });
+    let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(summary(&s, "o")["passed"], true);
+}
+
+/// T02: a Hex8 block on a rigid plane with a penalty of 0.01 sank 200 (about 283 times its
+/// facets' diagonal) with exit 0, no warning and no penetration in `summary.json`. As in 2D
+/// (D14): a warning above 5 % of the contact element size, `max_penetration` and
+/// `max_penetration_share` in `summary.json`, and the check `max_penetration`.
+#[test]
+fn t02_3d_deep_penetration_warns_is_reported_and_is_a_check() {
+    let s = Scratch::new();
+    let case = s.case(&defect("T02"), "case.json", |_| {});
+    let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    assert_eq!(code, 0, "{stderr}");
+    for needle in [
+        "contact 'ground': penetration",
+        "of body 'block'",
+        "times the contact element size (warning above 0.05)",
+        "raise the penalty kappa",
+    ] {
+        assert!(stderr.contains(needle), "{needle:?} missing from {stderr}");
+    }
+    let v = summary(&s, "o");
+    assert!(v["warnings"].as_array().unwrap().iter().any(|w| w
+        .as_str()
+        .unwrap()
+        .contains("times the contact element size")));
+    let contact = &v["contact"];
+    // the pressure 2 on the unit top against kappa 0.01 on the unit bottom: 2 / 0.01 = 200
+    let depth = contact["max_penetration"].as_f64().unwrap();
+    assert!((depth - 200.0).abs() < 1.0, "{contact}");
+    // the facets are 0.5 squares: their longest chord is the diagonal
+    let share = contact["max_penetration_share"].as_f64().unwrap();
+    assert!(
+        (share - depth / 0.5f64.hypot(0.5)).abs() < 1e-9 * share,
+        "{contact}"
+    );
+    let pair = &contact["pairs"][0];
+    assert_eq!(pair["name"], "ground");
+    assert_eq!(pair["max_penetration"], contact["max_penetration"]);
+    assert_eq!(pair["max_penetration_at"]["body"], "block");
+    // the check fails the run
+    let case = s.case(
+        &defect("T02"),
+        "case.json",
+        |v| {
+            v["checks"] =
+                serde_json::json!([{"check": "max_penetration", "pair": "ground", "share": 0.05}])
+        },
+    );
+    let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    assert_eq!(code, 1, "{stderr}");
+    let v = summary(&s, "o");
+    let check = &v["checks"][0];
+    assert_eq!(check["passed"], false, "{check}");
+    assert_eq!(check["error"], v["contact"]["max_penetration_share"]);
+    assert_eq!(check["tol"], 0.05);
+    // a stiff penalty: no warning, the check passes
+    let case = s.case(&defect("T02"), "case.json", |v| {
+        v["contact"][0]["enforcement"]["kappa"] = 1e6.into();
+        v["checks"] = serde_json::json!([{"check": "max_penetration", "share": 0.05}])
+    });
+    let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!stderr.contains("penetration"), "{stderr}");
+    let v = summary(&s, "o");
+    assert_eq!(v["checks"][0]["passed"], true);
+    assert!(v["contact"]["max_penetration_share"].as_f64().unwrap() < 0.05);
+    // the check names a pair that exists, and needs contact
+    let case = s.case(
+        &defect("T02"),
+        "case.json",
+        |v| {
+            v["checks"] =
+                serde_json::json!([{"check": "max_penetration", "pair": "floor", "share": 0.05}])
+        },
+    );
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &["checks[0]", "contact pair 'floor' does not exist", "ground"],
+    );
+    let case = s.case(&defect("T01"), "case.json", |v| {
+        v["loads"][0]["pressure"] = 2.0.into();
+        v["checks"] = serde_json::json!([{"check": "max_penetration", "share": 0.05}])
+    });
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &["checks[0]", "max_penetration needs contact pairs"],
+    );
+}
+
+/// T03a/b: `load_steps: 0` in 3D gave "the external force is not finite (NaN)" at finite
+/// strain and was ignored at small strain; `1e9` ran without bound. As in 2D, both are
+/// refused with the range.
+#[test]
+fn t03_3d_load_steps_are_bounded_as_in_2d() {
+    let s = Scratch::new();
+    for (name, got) in [("T03a", "got 0"), ("T03b", "got 1000000000")] {
+        let case = s.case(&s4(name), "case.json", |_| {});
+        assert_refused(
+            s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+            &["solver.load_steps", "must be from 1 to 100000", got],
+        );
+    }
+    // small strain too, and the other counts and tolerances of the solver
+    for (field, value) in [
+        ("load_steps", serde_json::json!(0)),
+        ("max_iterations", serde_json::json!(0)),
+        ("linear_tolerance", serde_json::json!(2.0)),
+    ] {
+        let case = s.case(&defect("T01"), "case.json", |v| {
+            v["loads"][0]["pressure"] = 2.0.into();
+            v["solver"] = serde_json::json!({ field: value })
+        });
+        assert_refused(
+            s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+            &[&format!("solver.{field}")],
+        );
+    }
+}
+
+/// T04: a Hex27 block of 60 divisions a side (1.77 M nodes, under the node limit) aborted on
+/// allocation (after 13-19 s under a 4 GiB address-space limit, no `error:` line). Its matrix
+/// and factor are estimated from the spec and refused before anything is allocated, naming
+/// the limits; the limits are the case's to set.
+#[test]
+fn t04_3d_work_beyond_the_limits_is_refused_before_allocation() {
+    let s = Scratch::new();
+    let case = s.case(&defect("T04"), "case.json", |_| {});
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &[
+            "bodies[0] 'block'.mesh",
+            "stiffness matrix of about",
+            "multiply-adds",
+            "limits.factor_gigabytes",
+            "limits.factor_operations",
+            "fewer divisions",
+        ],
+    );
+    // with the iterative solver no factor is made, and the matrix alone is too large
+    let case = s.case(&defect("T04"), "case.json", |v| {
+        v["solver"] = serde_json::json!({"linear_solver": "cg_amg"})
+    });
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &["stiffness matrix of about", "GB with their row indices"],
+    );
+    // a small limit refuses a small 3D mesh before its matrix is assembled
+    let case = s.case(&defect("T01"), "case.json", |v| {
+        v["loads"][0]["pressure"] = 2.0.into();
+        v["limits"] = serde_json::json!({"factor_operations": 10.0})
+    });
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &["stiffness matrix of about", "1.0e1 multiply-adds"],
+    );
+}
+
+/// Found by the fuzz (issue 38 item 8, seed 0xb, family `dynamics`, run 1385):
+/// `cases/dynamics/block-drop-rigid.json` with 8000 divisions along x drops a strip whose 8001
+/// bottom nodes touch the rigid line; the seed's post-impact correction projects the active
+/// rows densely (7997 columns of 144 k equations, 10 GB) and aborted on allocation
+/// under the fuzz's 4 GiB address space (11.6 GB resident without it). It is refused before
+/// the allocation, naming the limits; with 80 divisions it runs.
+#[test]
+fn a_dense_post_impact_projection_beyond_the_limits_is_refused() {
+    let s = Scratch::new();
+    let drop = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/dynamics/block-drop-rigid.json");
+    let case = s.case(&drop, "case.json", |v| {
+        v["bodies"][0]["mesh"]["block"]["x"]["divisions"] = 8000.into()
+    });
+    assert_refused(
+        s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
+        &[
+            "post-impact correction would project",
+            "active contact rows densely",
+            "limits.factor_gigabytes",
+            "contact_stabilized",
+        ],
+    );
+    let case = s.case(&drop, "case.json", |v| {
+        v["bodies"][0]["mesh"]["block"]["x"]["divisions"] = 80.into()
+    });
+    let (code, _, stderr) = s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]);
+    assert!(code == 0 || code == 1, "exit {code}:\n{stderr}");
+}

@@ -2,11 +2,15 @@
 //! defect reproducers in `tests/defects/`.
 //!
 //! `mutated_cases_keep_the_invariants` takes every case under `cases/` (except `cases/large/`
-//! and the refinement study `cases/friction-bench/`, too slow) and two reproducers with explicit meshes (which `cases/` lacks) and mutates them
+//! and the refinement study `cases/friction-bench/`, too slow), two reproducers with explicit
+//! meshes and four 3D cases with contact, friction and finite strain (which `cases/` lacks,
+//! [`EXTRA_BASES`]) and mutates them
 //! with a fixed seed: keys deleted, values replaced by a wrong type, huge, tiny and shifted
 //! numbers, NaN and infinity tokens, names replaced by path-like, empty or odd strings (renamed
 //! everywhere they are referenced), keys inserted or duplicated, the text truncated or damaged,
-//! a byte-order mark put in front, the object wrapped in an array. Each mutant is run through
+//! a byte-order mark put in front, the object wrapped in an array; a Gmsh mesh file the case
+//! reads is put beside the mutant, one time in ten cut short and one in ten with bytes
+//! overwritten. Each mutant is run through
 //! the release binary, mostly as `run CASE [--out DIR]`, sometimes as `check FOLDER` over a
 //! folder of several mutants, and as `table CASE --out DIR` on mutants of the sweep cases
 //! (`cases/patch`, `cases/tied`).
@@ -35,9 +39,12 @@
 //! the run's index alone, so the same seed gives the same sequence of runs whatever the timing.
 //! The fuzzing stops at a time budget (`CONTACT_PATCH_FUZZ_SECONDS`, default 60 s; a run started
 //! before the end may add up to the per-run limit) or a run count (`CONTACT_PATCH_FUZZ_RUNS`); the
-//! seed can be changed with `CONTACT_PATCH_FUZZ_SEED`. At the end the test prints (straight to
-//! stderr, so it shows in CI even when the test passes) the number of runs, the count of each exit
-//! code, of each command and of each mutation kind. All failures are collected, grouped into
+//! seed can be changed with `CONTACT_PATCH_FUZZ_SEED`, and `CONTACT_PATCH_FUZZ_FAMILY` (a family
+//! named in the per-family count, e.g. `3d`, `finite strain`, `gmsh`) mutates the cases of that
+//! family only. At the end the test prints (straight to
+//! stderr, so it shows in CI even when the test passes) the number of runs, the runs per family
+//! of the mutated cases (2D or 3D, contact, friction, finite strain, dynamics, Gmsh, explicit
+//! mesh, sweep), the count of each exit code, of each command and of each mutation kind. All failures are collected, grouped into
 //! classes and reported at once; the inputs of the first few failures of each class are saved
 //! under `target/fuzz-failures/` with the command, stdout and stderr, to be replayed by hand, and
 //! `report.txt` there lists every failure.
@@ -750,11 +757,19 @@ fn stays_in_scratch(bytes: &[u8], allowed_absolute: &[String]) -> bool {
 // ---------------------------------------------------------------------------------------------
 // The scratch folder, the command, the run.
 
-/// Cases with explicit meshes (node and cell lists; `cases/` has none), fuzzed besides
-/// `cases/`: a stray node (D09) and a block on a cylinder (D11a).
-const EXPLICIT_MESH_BASES: &[&str] = &[
+/// Cases fuzzed besides `cases/`, for what `cases/` lacks: explicit meshes (node and cell
+/// lists: a stray node, D09, and a block on a cylinder, D11a), and 3D contact, friction and
+/// finite strain (`cases/3d/` holds the small-strain patch tests only): a block dragged on a
+/// rigid plane with Coulomb friction, a punch on a foundation (mortar, Lagrange), a sphere
+/// pressed into a neo-Hookean block and two neo-Hookean blocks pressed together
+/// (`tests/data/fuzz/`).
+const EXTRA_BASES: &[&str] = &[
     "tests/defects/D09-singular-message-names-wrong-node.json",
     "tests/defects/D11a-arbitrary-rigid-rotation-numbering-1.json",
+    "tests/data/fuzz/3d-friction-block-dragged.json",
+    "tests/data/fuzz/3d-punch-mortar.json",
+    "tests/data/fuzz/3d-finite-sphere-on-block.json",
+    "tests/data/fuzz/3d-finite-two-blocks.json",
 ];
 
 /// One case of the catalogue.
@@ -763,6 +778,71 @@ struct Base {
     rel: String,
     text: String,
     value: Value,
+    /// The families the case belongs to ([`families`]), for the count of runs per family.
+    families: Vec<&'static str>,
+    /// The files the case reads besides itself (Gmsh meshes): the name it gives and the bytes,
+    /// put beside the mutant.
+    attachments: Vec<(String, Vec<u8>)>,
+}
+
+/// The families of the case `v`: its dimension (`2d` or `3d`), and each of `contact`,
+/// `friction`, `finite strain`, `dynamics`, `gmsh`, `explicit mesh` and `sweep` it uses.
+fn families(v: &Value) -> Vec<&'static str> {
+    let bodies = v["bodies"].as_array().cloned().unwrap_or_default();
+    let mesh = |key: &str| bodies.iter().any(|b| b["mesh"].get(key).is_some());
+    let contact = v["contact"].as_array().cloned().unwrap_or_default();
+    let mut out = vec![if mesh("block3d") { "3d" } else { "2d" }];
+    let flags = [
+        ("contact", !contact.is_empty()),
+        (
+            "friction",
+            contact
+                .iter()
+                .any(|c| c["interaction"].get("coulomb").is_some()),
+        ),
+        ("finite strain", v["physics"]["kinematics"] == "finite"),
+        ("dynamics", v["physics"].get("dynamics").is_some()),
+        ("gmsh", mesh("gmsh")),
+        ("explicit mesh", mesh("explicit")),
+        ("sweep", v.get("sweep").is_some()),
+    ];
+    out.extend(flags.iter().filter(|(_, on)| *on).map(|(name, _)| *name));
+    out
+}
+
+/// The Gmsh files the case `v` at `path` names, read from beside it.
+fn attachments(v: &Value, path: &Path) -> Vec<(String, Vec<u8>)> {
+    let bodies = v["bodies"].as_array().cloned().unwrap_or_default();
+    bodies
+        .iter()
+        .filter_map(|b| b["mesh"]["gmsh"]["file"].as_str())
+        .map(|file| {
+            let bytes = fs::read(path.parent().unwrap().join(file)).unwrap();
+            (file.to_string(), bytes)
+        })
+        .collect()
+}
+
+/// An attachment as a mutant sees it: mostly unchanged, sometimes cut short at a random byte
+/// or with a stretch of bytes overwritten (the mesh file's own damage), with what was done.
+fn damaged(rng: &mut Rng, bytes: &[u8]) -> (Vec<u8>, Option<String>) {
+    let mut out = bytes.to_vec();
+    match rng.below(10) {
+        0 if !out.is_empty() => {
+            let at = rng.below(out.len());
+            out.truncate(at);
+            (out, Some(format!("cut at byte {at} of {}", bytes.len())))
+        }
+        1 if !out.is_empty() => {
+            let at = rng.below(out.len());
+            let n = 1 + rng.below(8);
+            for b in out.iter_mut().skip(at).take(n) {
+                *b = rng.below(256) as u8;
+            }
+            (out, Some(format!("{n} bytes overwritten at byte {at}")))
+        }
+        _ => (out, None),
+    }
 }
 
 fn bases() -> Vec<Base> {
@@ -787,14 +867,17 @@ fn bases() -> Vec<Base> {
     let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files = Vec::new();
     walk(&manifest.join("cases"), &mut files);
-    files.extend(EXPLICIT_MESH_BASES.iter().map(|p| manifest.join(p)));
+    files.extend(EXTRA_BASES.iter().map(|p| manifest.join(p)));
     files
         .into_iter()
         .map(|p| {
             let text = fs::read_to_string(&p).unwrap();
+            let value: Value = serde_json::from_str(&text).unwrap();
             Base {
                 rel: p.strip_prefix(manifest).unwrap().display().to_string(),
-                value: serde_json::from_str(&text).unwrap(),
+                families: families(&value),
+                attachments: attachments(&value, &p),
+                value,
                 text,
             }
         })
@@ -855,6 +938,8 @@ type Inputs = Vec<(String, Vec<u8>)>;
 struct Trial {
     /// Mutation kind(s), for the statistics and the report.
     kinds: Vec<&'static str>,
+    /// The families of the case(s) mutated (each once), for the statistics.
+    families: Vec<&'static str>,
     /// What the failure classes name as the mutation.
     cause: String,
     description: String,
@@ -1402,6 +1487,8 @@ fn say(text: &str) {
 #[derive(Default)]
 struct Stats {
     runs: usize,
+    /// Runs per family of the mutated case(s) ([`families`]).
+    families: BTreeMap<&'static str, usize>,
     exits: BTreeMap<String, usize>,
     commands: BTreeMap<&'static str, usize>,
     kinds: BTreeMap<&'static str, usize>,
@@ -1464,6 +1551,7 @@ fn draw_trial(
         let good_at = rng.chance(0.5).then(|| rng.below(count));
         let (mut inputs, mut kinds, mut causes, mut names, mut descs) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut families: Vec<&'static str> = Vec::new();
         for j in 0..count {
             let base = rng.pick(bases);
             let name = format!("case-{j}.json");
@@ -1482,14 +1570,26 @@ fn draw_trial(
             } else {
                 safe_mutant(rng, base)
             };
+            let mut desc = desc;
+            for (file, original) in &base.attachments {
+                let (bytes, damage) = damaged(rng, original);
+                if let Some(damage) = damage {
+                    desc.push_str(&format!("; {file} {damage}"));
+                }
+                inputs.push((format!("cases/{file}"), bytes));
+            }
+            families.extend(&base.families);
             descs.push(format!("{name} = {} {kind}: {desc}", base.rel));
             inputs.push((format!("cases/{name}"), bytes));
             kinds.push(kind);
             causes.push(cause);
             names.push(name);
         }
+        families.sort_unstable();
+        families.dedup();
         Trial {
             kinds,
+            families,
             cause: causes.join("+"),
             description: descs.join(" | "),
             inputs,
@@ -1499,7 +1599,7 @@ fn draw_trial(
             },
         }
     } else {
-        let table = roll < 20;
+        let table = roll < 20 && !sweeps.is_empty();
         let base = if table {
             *rng.pick(sweeps)
         } else {
@@ -1525,11 +1625,21 @@ fn draw_trial(
                 out,
             }
         };
+        let mut description = format!("{} {}: {}", base.rel, m.kind, m.description);
+        let mut inputs = vec![("case.json".to_string(), m.bytes)];
+        for (file, original) in &base.attachments {
+            let (bytes, damage) = damaged(rng, original);
+            if let Some(damage) = damage {
+                description.push_str(&format!("; {file} {damage}"));
+            }
+            inputs.push((file.clone(), bytes));
+        }
         Trial {
             kinds: vec![m.kind],
+            families: base.families.clone(),
             cause: m.cause,
-            description: format!("{} {}: {}", base.rel, m.kind, m.description),
-            inputs: vec![("case.json".into(), m.bytes)],
+            description,
+            inputs,
             cmd,
         }
     }
@@ -1541,12 +1651,21 @@ fn mutated_cases_keep_the_invariants() {
     let budget =
         Duration::from_secs_f64(env_or("CONTACT_PATCH_FUZZ_SECONDS", DEFAULT_BUDGET_SECONDS));
     let max_runs: usize = env_or("CONTACT_PATCH_FUZZ_RUNS", DEFAULT_MAX_RUNS);
-    let bases = bases();
+    let mut bases = bases();
+    assert!(
+        bases.len() > 20 && bases.iter().any(|b| b.value.get("sweep").is_some()),
+        "the catalogue"
+    );
+    // one family only (`CONTACT_PATCH_FUZZ_FAMILY`, a name of the per-family count)
+    let family: String = env_or("CONTACT_PATCH_FUZZ_FAMILY", String::new());
+    if !family.is_empty() {
+        bases.retain(|b| b.families.contains(&family.as_str()));
+        assert!(!bases.is_empty(), "no case of the family {family:?}");
+    }
     let sweeps: Vec<&Base> = bases
         .iter()
         .filter(|b| b.value.get("sweep").is_some())
         .collect();
-    assert!(bases.len() > 20 && !sweeps.is_empty(), "the catalogue");
     let root = tempfile::Builder::new()
         .prefix("contact-patch-fuzz-")
         .tempdir()
@@ -1582,6 +1701,9 @@ fn mutated_cases_keep_the_invariants() {
                     for k in &trial.kinds {
                         *st.kinds.entry(k).or_default() += 1;
                     }
+                    for f in &trial.families {
+                        *st.families.entry(f).or_default() += 1;
+                    }
                     st.unsafe_redrawn += redrawn;
                 }
                 let title = format!("run {index}");
@@ -1615,12 +1737,13 @@ fn mutated_cases_keep_the_invariants() {
     };
     say(&format!(
         "\nfuzz: seed {seed:#x}, {} runs in {elapsed:.1} s (budget {:.0} s, {WORKERS} workers, \
-         limit {:.0} s a run), {} failing\n  exit codes: {}\n  commands: {}\n  mutations: {}\n  \
-         mutants drawn again because a name could leave the scratch folder: {}\n",
+         limit {:.0} s a run), {} failing\n  runs per family: {}\n  exit codes: {}\n  commands: {}\n  \
+         mutations: {}\n  mutants drawn again because a name could leave the scratch folder: {}\n",
         st.runs,
         budget.as_secs_f64(),
         run_limit().as_secs_f64(),
         failures.len(),
+        counts_static(&st.families),
         counts(&st.exits),
         counts_static(&st.commands),
         counts_static(&st.kinds),
@@ -1732,6 +1855,7 @@ fn defect_reproducers_keep_the_invariants() {
         }
         let trial = Trial {
             kinds: vec!["defect"],
+            families: Vec::new(),
             cause: "defect".into(),
             description: "replay".into(),
             inputs,

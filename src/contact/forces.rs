@@ -25,7 +25,8 @@
 //! `d = u_s - u_m` one component at a time; the normal overlap at the slave node is
 //! `max(0, d . n_s)` with `n_s` the slave surface's outward normal (pointing into the other
 //! body), the same whichever body is the slave. Penetration is also given relative to the
-//! contact element size `h`: the longest slave facet at the node.
+//! contact element size `h`: the longest slave facet at the node (its chord in 2D, the largest
+//! distance between two of its nodes in 3D; [`pair_penetration`] in either dimension).
 //!
 //! **Configuration.** Normals, areas and the positions of moments are taken where the rows were
 //! linearized: the reference configuration, or `X + u_k` with contact geometry in the current
@@ -55,15 +56,15 @@ pub struct NodalTraction {
     pub carries_rows: bool,
 }
 
-/// The largest penetration of a pair and where it is.
+/// The largest penetration of a pair and where it is (`D`: the dimension of the position).
 #[derive(Clone, Debug, Default)]
-pub struct Penetration {
+pub struct Penetration<const D: usize = 2> {
     /// Largest overlap (0 when nothing penetrates).
     pub depth: f64,
     /// The same relative to the contact element size at the node (the longest slave facet).
     pub share_of_element: f64,
     /// Body, node and position of the slave node with the largest share.
-    pub at: Option<(usize, usize, [f64; 2])>,
+    pub at: Option<(usize, usize, [f64; D])>,
 }
 
 /// What one pair transmits.
@@ -111,12 +112,18 @@ fn placed<'a>(body: &'a Body, u: Option<&[f64]>) -> std::borrow::Cow<'a, Body> {
     std::borrow::Cow::Owned(b)
 }
 
-/// Longest facet (chord) at each node of `surface`.
-pub(crate) fn element_sizes(surface: &Surface) -> BTreeMap<usize, f64> {
+/// Longest facet at each node of `surface`: the largest distance between two nodes of a
+/// facet that holds the node (in 2D the chord of the edge).
+pub(crate) fn element_sizes<const D: usize, K>(surface: &Surface<D, K>) -> BTreeMap<usize, f64> {
     let mut h = BTreeMap::new();
     for (nodes, coords) in surface.facets.iter().zip(&surface.coords) {
-        let len =
-            ((coords[1][0] - coords[0][0]).powi(2) + (coords[1][1] - coords[0][1]).powi(2)).sqrt();
+        let mut len = 0.0f64;
+        for (a, p) in coords.iter().enumerate() {
+            for q in &coords[a + 1..] {
+                let d2: f64 = (0..D).map(|i| (q[i] - p[i]).powi(2)).sum();
+                len = len.max(d2.sqrt());
+            }
+        }
         for &n in nodes {
             let e = h.entry(n).or_insert(0.0f64);
             *e = e.max(len);
@@ -214,18 +221,42 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
         }
     }
 
-    // Penetration: frictionless rows one by one; the rows of a tie together per slave node.
     let sizes: Vec<BTreeMap<usize, f64>> = surfaces.iter().map(element_sizes).collect();
+    let penetration = pair_penetration(state, k, &surfaces, &sizes, position);
+
+    PairForces {
+        pair: k,
+        on_slave,
+        on_master,
+        net_moment,
+        force_scale,
+        nodes,
+        penetration,
+    }
+}
+
+/// The largest penetration of pair `k` in `state`, in any dimension: frictionless rows one by
+/// one (`max(0, -g)`), the rows of a tie together per slave node (the jump along the slave
+/// surface's outward normal); relative to the contact element size at the node, the longest
+/// facet there of `surfaces` (`sizes[i]`: [`element_sizes`] of `surfaces[i]`); `position`
+/// places a node of a body (in the configuration of the rows).
+pub fn pair_penetration<const D: usize, K>(
+    state: &ContactState<D>,
+    k: usize,
+    surfaces: &[Surface<D, K>],
+    sizes: &[BTreeMap<usize, f64>],
+    position: impl Fn(usize, usize) -> [f64; D],
+) -> Penetration<D> {
     let size_at = |b: usize, n: usize| {
         surfaces
             .iter()
-            .zip(&sizes)
+            .zip(sizes)
             .find(|(s, _)| s.body == b)
             .and_then(|(_, h)| h.get(&n).copied())
             .unwrap_or(0.0)
     };
     let mut depth_at: BTreeMap<(usize, usize), f64> = BTreeMap::new();
-    let mut jumps: BTreeMap<(usize, usize), ([f64; 2], [f64; 2])> = BTreeMap::new();
+    let mut jumps: BTreeMap<(usize, usize), ([f64; D], [f64; D])> = BTreeMap::new();
     for (r, &g) in state.rows.iter().zip(&state.gaps) {
         if r.pair != k {
             continue;
@@ -234,9 +265,10 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
         if r.bilateral {
             // the row's gradient on the slave node is the unit direction of the component it
             // ties; its gap is that component of the jump
-            let e = jumps.entry(key).or_insert(([0.0; 2], r.slave_normal));
-            e.0[0] += g * r.normal[0];
-            e.0[1] += g * r.normal[1];
+            let e = jumps.entry(key).or_insert(([0.0; D], r.slave_normal));
+            for i in 0..D {
+                e.0[i] += g * r.normal[i];
+            }
         } else {
             let d = depth_at.entry(key).or_insert(0.0f64);
             *d = d.max(-g);
@@ -244,7 +276,7 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
     }
     for (key, (d, ns)) in jumps {
         let e = depth_at.entry(key).or_insert(0.0f64);
-        *e = e.max(d[0] * ns[0] + d[1] * ns[1]);
+        *e = e.max((0..D).map(|i| d[i] * ns[i]).sum());
     }
     let mut penetration = Penetration::default();
     for (&(b, n), &depth) in &depth_at {
@@ -257,14 +289,5 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
             penetration.at = Some((b, n, position(b, n)));
         }
     }
-
-    PairForces {
-        pair: k,
-        on_slave,
-        on_master,
-        net_moment,
-        force_scale,
-        nodes,
-        penetration,
-    }
+    penetration
 }

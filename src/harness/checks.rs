@@ -18,9 +18,10 @@
 //! not change with the units (defect D19: a reaction expected to be 0 failed at 7.6e-6 once E
 //! and the loads were scaled by 1e9, while the stress was exact to 1.5e-15).
 
-use crate::contact::forces::{pair_forces, PairForces};
-use crate::contact::state::Termination;
+use crate::contact::forces::{pair_forces, PairForces, Penetration};
+use crate::contact::state::{ContactState, Termination};
 use crate::io::scene::{Check, Interaction, TerminationReason};
+use crate::model::space::SolidCell;
 use crate::model::{MasterSide, Model};
 use crate::post::{for_each_quadrature_stress, relative_l2_displacement_error};
 use crate::solver::linear::Solution;
@@ -238,17 +239,39 @@ pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
             d.update
         )
     });
-    let penetrations = pair_forces(model, state)
+    let penetrations = penetration_warnings(
+        model,
+        state,
+        pair_forces(model, state)
+            .into_iter()
+            .map(|f| (f.pair, f.penetration)),
+    );
+    departures
+        .chain(untied_slave_nodes(model, state))
+        .chain(penetrations)
+        .chain(crate::harness::stability::warnings(model, solution))
+        .collect()
+}
+
+/// The warnings of the pairs whose penetration is above [`PENETRATION_WARNING_SHARE`] of the
+/// contact element size, in any dimension: `penetrations` holds each pair's index and its
+/// largest penetration ([`crate::contact::forces::pair_penetration`]).
+pub fn penetration_warnings<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    state: &ContactState<D>,
+    penetrations: impl IntoIterator<Item = (usize, Penetration<D>)>,
+) -> Vec<String> {
+    penetrations
         .into_iter()
-        .filter(|f| f.penetration.share_of_element > PENETRATION_WARNING_SHARE)
-        .map(|f| {
-            let at = f
-                .penetration
-                .at
-                .map(|(b, n, p)| {
+        .filter(|(_, p)| p.share_of_element > PENETRATION_WARNING_SHARE)
+        .map(|(pair, p)| {
+            let at =
+                p.at.map(|(b, n, x)| {
+                    let x: Vec<String> = x.iter().map(|v| format!("{v:.6}")).collect();
                     format!(
-                        " at node {n} of body '{}' ({:.6}, {:.6})",
-                        model.bodies[b].name, p[0], p[1]
+                        " at node {n} of body '{}' ({})",
+                        model.bodies[b].name,
+                        x.join(", ")
                     )
                 })
                 .unwrap_or_default();
@@ -265,13 +288,9 @@ pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
                 "contact '{}': penetration {:.3e}{at} is {:.3} times the contact element size \
                  (warning above {PENETRATION_WARNING_SHARE}); {cause}; a `max_penetration` \
                  check makes this a failure",
-                model.contact[f.pair].name, f.penetration.depth, f.penetration.share_of_element
+                model.contact[pair].name, p.depth, p.share_of_element
             )
-        });
-    departures
-        .chain(untied_slave_nodes(model, state))
-        .chain(penetrations)
-        .chain(crate::harness::stability::warnings(model, solution))
+        })
         .collect()
 }
 
@@ -320,6 +339,27 @@ fn untied_slave_nodes(model: &Model, state: &crate::contact::state::ContactState
         ));
     }
     out
+
+}
+
+/// The check `max_penetration` in any dimension: its words and the largest penetration
+/// relative to the contact element size over the pair `pair` (every pair without), from each
+/// pair's name and share; NaN (a failure) without contact forces (`shares` is `None`).
+pub fn max_penetration_check<'a>(
+    pair: Option<&str>,
+    shares: Option<impl Iterator<Item = (&'a str, f64)>>,
+) -> (String, f64) {
+    let got = match shares {
+        Some(shares) => shares
+            .filter(|(name, _)| pair.is_none_or(|p| *name == p))
+            .fold(0.0, |m, (_, share)| worst(m, share)),
+        None => f64::NAN,
+    };
+    let of = pair.map(|p| format!(" of '{p}'")).unwrap_or_default();
+    (
+        format!("largest penetration{of} relative to the contact element size"),
+        got,
+    )
 }
 
 fn pair_of<'a>(forces: &'a [PairForces], model: &Model, name: &str) -> Option<&'a PairForces> {
@@ -430,12 +470,9 @@ pub fn evaluate_with(
                     (format!("max contact pressure of '{pair}' = {got:.6e} ({expected})"), error, *tol)
                 }
                 Check::MaxPenetration { pair, share } => {
-                    let got = forces
-                        .iter()
-                        .filter(|f| pair.as_ref().is_none_or(|p| model.contact[f.pair].name == *p))
-                        .fold(if has_forces { 0.0 } else { f64::NAN }, |m, f| worst(m, f.penetration.share_of_element));
-                    let of = pair.as_ref().map(|p| format!(" of '{p}'")).unwrap_or_default();
-                    (format!("largest penetration{of} relative to the contact element size"), got, *share)
+                    let shares = forces.iter().map(|f| (model.contact[f.pair].name.as_str(), f.penetration.share_of_element));
+                    let (words, got) = max_penetration_check(pair.as_deref(), has_forces.then_some(shares));
+                    (words, got, *share)
                 }
                 Check::TerminatesWith { reason, contains } => {
                     let (got, text) = match solution.contact.as_ref().map(|c| &c.termination) {

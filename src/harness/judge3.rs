@@ -7,7 +7,8 @@
 //! point within `delta = share * L` of it in space (`L` the model size); a node with no point
 //! that close, or with two points that close carrying different displacements, is an error
 //! that names the node. The matched `displacement` (3 components) gives the global vector `u`,
-//! and the case's checks, all `uniform_stress_3d` (the only check 3D cases take), are judged:
+//! and the case's `uniform_stress_3d` checks are judged (a `max_penetration` check, which needs
+//! our contact rows, is listed as not judged):
 //!
 //! * from `u` with our element kinematics, exactly as the run judges them
 //!   ([`crate::run3d::uniform_stress_check3`]: the largest difference over the quadrature
@@ -219,13 +220,21 @@ pub fn judge3(model: &Model3, results: &Results, match_share: f64) -> Result<Jud
     }
 
     let mut checks = Vec::new();
-    let not_judged = Vec::new();
+    let mut not_judged = Vec::new();
     for check in &model.checks {
         match check {
             Check::UniformStress3d { stress, tol } => {
                 checks.push(uniform_stress_check3(model, &u, stress, *tol))
             }
-            _ => unreachable!("build3 refuses every check but uniform_stress_3d"),
+            Check::MaxPenetration { .. } => not_judged.push(NotJudged {
+                check: serde_json::to_string(check).expect("checks serialize"),
+                why: "the penetration of a 3D pair is judged from our contact rows only (a \
+                      run of the case), not from another code's results"
+                    .to_string(),
+            }),
+            _ => {
+                unreachable!("build3 refuses every check but uniform_stress_3d and max_penetration")
+            }
         }
     }
     // the results' own stress field

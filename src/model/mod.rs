@@ -521,6 +521,22 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
         ))
     }
 
+    /// The pair of a `max_penetration` check at `location` (2D and 3D): `pair` must exist, and
+    /// without one the case must have pairs.
+    pub(crate) fn resolve_max_penetration(&self, pair: Option<&str>, location: &str) -> Result<()> {
+        if let Some(pair) = pair {
+            self.find_pair(pair, location)?;
+        } else if self.contact.is_empty() {
+            return Err(Error::invalid(
+                &self.source,
+                location,
+                "max_penetration needs contact pairs, and the case has none",
+                "remove the check or add a pair",
+            ));
+        }
+        Ok(())
+    }
+
     fn find_pair(&self, name: &str, location: &str) -> Result<usize> {
         self.contact
             .iter()
@@ -885,47 +901,7 @@ impl Model {
         }
 
         check_size(case, source)?;
-        let counts = [
-            ("solver.load_steps", case.solver.load_steps),
-            ("solver.max_iterations", case.solver.max_iterations),
-            (
-                "solver.max_geometry_updates",
-                case.solver.max_geometry_updates,
-            ),
-        ];
-        for (field, n) in counts {
-            if !(1..=MAX_SOLVER_COUNT).contains(&n) {
-                return Err(invalid(
-                    field.into(),
-                    format!("must be from 1 to {MAX_SOLVER_COUNT}, got {n}"),
-                    "the defaults (1 load step, 200 iterations, 50 geometry updates) suit most cases",
-                ));
-            }
-        }
-        let tol = case.solver.linear_tolerance;
-        if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
-            return Err(invalid(
-                "solver.linear_tolerance".into(),
-                format!("must lie in (0, 1), got {tol}"),
-                "the default is 1e-10 (the relative residual of the CG solve)",
-            ));
-        }
-        let n = case.solver.linear_max_iterations;
-        if !(1..=MAX_SOLVER_COUNT).contains(&n) {
-            return Err(invalid(
-                "solver.linear_max_iterations".into(),
-                format!("must be from 1 to {MAX_SOLVER_COUNT}, got {n}"),
-                "the default is 500",
-            ));
-        }
-        let tol = case.solver.geometry_tolerance;
-        if !(tol.is_finite() && tol > 0.0) {
-            return Err(invalid(
-                "solver.geometry_tolerance".into(),
-                format!("must be a positive number, got {tol}"),
-                "the default is 1e-12",
-            ));
-        }
+        check_solver_settings(case, source)?;
         let mut bodies: Vec<Body> = Vec::new();
         let mut set_warnings = Vec::new();
         let mut offset = 0;
@@ -1471,16 +1447,7 @@ impl Model {
                     *tol
                 }
                 Check::MaxPenetration { pair, share } => {
-                    if let Some(pair) = pair {
-                        self.find_pair(pair, &at)?;
-                    } else if self.contact.is_empty() {
-                        return Err(Error::invalid(
-                            &self.source,
-                            &at,
-                            "max_penetration needs contact pairs, and the case has none",
-                            "remove the check or add a pair",
-                        ));
-                    }
+                    self.resolve_max_penetration(pair.as_deref(), &at)?;
                     *share
                 }
                 Check::ContactForce { pair, tol, .. }
@@ -1884,6 +1851,58 @@ fn read_gmsh_mesh(g: &GmshMeshSpec, source: &str, at: &str) -> Result<(Mesh, usi
         })
 }
 
+/// The solver's counts and tolerances of `case` (`solver.load_steps`, `max_iterations`,
+/// `max_geometry_updates`, `linear_tolerance`, `linear_max_iterations`,
+/// `geometry_tolerance`), each within its range, for 2D and 3D cases alike.
+pub(crate) fn check_solver_settings(case: &Case, source: &str) -> Result<()> {
+    let counts = [
+        ("solver.load_steps", case.solver.load_steps),
+        ("solver.max_iterations", case.solver.max_iterations),
+        (
+            "solver.max_geometry_updates",
+            case.solver.max_geometry_updates,
+        ),
+    ];
+    for (field, n) in counts {
+        if !(1..=MAX_SOLVER_COUNT).contains(&n) {
+            return Err(Error::invalid(
+                source,
+                field,
+                format!("must be from 1 to {MAX_SOLVER_COUNT}, got {n}"),
+                "the defaults (1 load step, 200 iterations, 50 geometry updates) suit most cases",
+            ));
+        }
+    }
+    let tol = case.solver.linear_tolerance;
+    if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
+        return Err(Error::invalid(
+            source,
+            "solver.linear_tolerance",
+            format!("must lie in (0, 1), got {tol}"),
+            "the default is 1e-10 (the relative residual of the CG solve)",
+        ));
+    }
+    let n = case.solver.linear_max_iterations;
+    if !(1..=MAX_SOLVER_COUNT).contains(&n) {
+        return Err(Error::invalid(
+            source,
+            "solver.linear_max_iterations",
+            format!("must be from 1 to {MAX_SOLVER_COUNT}, got {n}"),
+            "the default is 500",
+        ));
+    }
+    let tol = case.solver.geometry_tolerance;
+    if !(tol.is_finite() && tol > 0.0) {
+        return Err(Error::invalid(
+            source,
+            "solver.geometry_tolerance",
+            format!("must be a positive number, got {tol}"),
+            "the default is 1e-12",
+        ));
+    }
+    Ok(())
+}
+
 /// The nodes read from Gmsh files count against `limits.nodes` once read (a block's or an
 /// explicit mesh's count is checked from the spec by [`check_size`]).
 fn check_read_size(case: &Case, built: &[Body], mesh: &Mesh, source: &str, at: &str) -> Result<()> {
@@ -1903,7 +1922,8 @@ fn check_read_size(case: &Case, built: &[Body], mesh: &Mesh, source: &str, at: &
 }
 
 /// The node count of every mesh, from the spec alone (nothing is allocated), against
-/// `limits.nodes`.
+/// `limits.nodes`, and the work of the block meshes' sparse solve ([`block_work`]) against
+/// `limits.factor_gigabytes` and `limits.factor_operations` ([`check_work`]), in 2D and 3D.
 pub(crate) fn check_size(case: &Case, source: &str) -> Result<()> {
     for (field, value) in [
         ("factor_gigabytes", case.limits.factor_gigabytes),
@@ -1920,12 +1940,17 @@ pub(crate) fn check_size(case: &Case, source: &str) -> Result<()> {
     }
     let limit = case.limits.nodes as u128;
     let mut total: u128 = 0;
+    let mut work = SolveWork::default();
     for (bi, spec) in case.bodies.iter().enumerate() {
-        let nodes = match &spec.mesh {
+        let (nodes, body_work) = match &spec.mesh {
             MeshSpec::Block(b) => {
                 let order = if b.element.is_quadratic() { 2 } else { 1 };
                 let along = |n: usize| order * n as u128 + 1;
-                along(b.x.intervals()) * along(b.y.intervals())
+                let nodes = along(b.x.intervals()) * along(b.y.intervals());
+                (
+                    nodes,
+                    Some(block_work(b.element, [b.x.intervals(), b.y.intervals()])),
+                )
             }
             MeshSpec::Block3d(b) => {
                 let order = if crate::fe::ReferenceCell::is_quadratic(b.element) {
@@ -1934,25 +1959,144 @@ pub(crate) fn check_size(case: &Case, source: &str) -> Result<()> {
                     1
                 };
                 let along = |n: usize| order * n as u128 + 1;
-                along(b.x.intervals())
+                let nodes = along(b.x.intervals())
                     .saturating_mul(along(b.y.intervals()))
-                    .saturating_mul(along(b.z.intervals()))
+                    .saturating_mul(along(b.z.intervals()));
+                let intervals = [b.x.intervals(), b.y.intervals(), b.z.intervals()];
+                (nodes, Some(block_work(b.element, intervals)))
             }
-            MeshSpec::Explicit(e) => e.nodes.len() as u128,
+            MeshSpec::Explicit(e) => (e.nodes.len() as u128, None),
             // counted once read (check_read_size)
-            MeshSpec::Gmsh(_) => 0,
+            MeshSpec::Gmsh(_) => (0, None),
         };
         total = total.saturating_add(nodes);
+        let at = format!("bodies[{bi}] '{}'.mesh", spec.name);
         if total > limit {
             return Err(Error::invalid(
                 source,
-                format!("bodies[{bi}] '{}'.mesh", spec.name),
+                at,
                 format!(
                     "the meshes would have {total} nodes or more, above the limit of {limit}"
                 ),
                 "use fewer divisions, or raise \"limits\": {\"nodes\": N} if the machine has the memory",
             ));
         }
+        if let Some(body_work) = body_work {
+            work.add(&body_work);
+            check_work(case, source, &at, &work)?;
+        }
+    }
+    Ok(())
+}
+
+/// What the meshes of a case ask of the sparse solve, estimated from the block specs before
+/// anything is allocated ([`block_work`]), summed over the bodies (each body's factor apart:
+/// bodies meet through contact rows only).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct SolveWork {
+    /// Stored entries (upper triangle) of the stiffness matrix.
+    pub matrix_entries: f64,
+    /// Entries of the factor: at least the matrix's, and the dense block of the separator.
+    pub factor_entries: f64,
+    /// Multiply-adds of the factorization (`sum_j c_j^2`, the measure of
+    /// [`crate::solver::sparse::FactorWork`]).
+    pub factor_operations: f64,
+}
+
+impl SolveWork {
+    fn add(&mut self, other: &SolveWork) {
+        self.matrix_entries += other.matrix_entries;
+        self.factor_entries += other.factor_entries;
+        self.factor_operations += other.factor_operations;
+    }
+}
+
+/// The work of the sparse solve of a block mesh of `kind` cells with `intervals` elements
+/// along each axis, in any dimension (`D` dofs a node), from the spec alone. Estimates kept
+/// below what the assembly and the symbolic analysis find (`tests` of this module compare
+/// them on block meshes of every element), so that a case refused here would have been refused
+/// there, after the allocation of its matrix:
+///
+/// * the stiffness's stored entries: quadrilaterals and hexahedra couple every pair of nodes of
+///   a cell, and the coupled pairs of a tensor-product lattice are the product over the axes
+///   of the pairs along one axis, `n (p + 1)^2 - (n - 1)` for `n` elements of order `p` (exact
+///   without supports); triangles and tetrahedra count their vertices and the neighbours along
+///   the axes only (a lower bound);
+/// * the factor: the smallest plane across the lattice (all nodes but those along the longest
+///   axis) separates the mesh, and whatever the ordering the factor holds a dense block about
+///   that size (a grid's treewidth); half its dofs, `s`, are counted as a dense block: `s^2 / 2`
+///   entries (at least the matrix's) and `s^3 / 3` multiply-adds.
+pub(crate) fn block_work<const D: usize, C: crate::fe::ReferenceCell<D>>(
+    kind: C,
+    intervals: [usize; D],
+) -> SolveWork {
+    let tensor = kind.corner_count() == 1 << D;
+    let dofs = D as f64;
+    // the lattice of the nodes counted: every node of a tensor-product cell, the vertices of
+    // a simplex mesh
+    let order = if tensor && kind.is_quadratic() {
+        2.0
+    } else {
+        1.0
+    };
+    let along: [f64; D] = std::array::from_fn(|i| order * intervals[i] as f64 + 1.0);
+    let nodes: f64 = along.iter().product();
+    let pairs = if tensor {
+        intervals
+            .iter()
+            .map(|&n| {
+                let n = n as f64;
+                n * (order + 1.0).powi(2) - (n - 1.0)
+            })
+            .product::<f64>()
+    } else {
+        // each vertex with itself, and both ends of each lattice edge along an axis
+        let edges: f64 = (0..D).map(|i| nodes / along[i] * (along[i] - 1.0)).sum();
+        nodes + 2.0 * edges
+    };
+    let matrix_entries = (dofs * dofs * pairs + dofs * nodes) / 2.0;
+    let longest = along.iter().copied().fold(0.0, f64::max);
+    let separator = dofs * (nodes / longest) / 2.0;
+    SolveWork {
+        matrix_entries,
+        factor_entries: matrix_entries.max(separator * separator / 2.0),
+        factor_operations: separator.powi(3) / 3.0,
+    }
+}
+
+/// `work` against the case's limits (`limits.factor_gigabytes`, 8 bytes a factor entry, and
+/// `limits.factor_operations`); with `solver.linear_solver: "cg_amg"` no factor is made, and
+/// the matrix's values and row indices (16 bytes an entry) count against the gigabytes.
+fn check_work(case: &Case, source: &str, at: &str, work: &SolveWork) -> Result<()> {
+    let gigabytes = case.limits.factor_gigabytes;
+    let operations = case.limits.factor_operations;
+    let matrix = format!(
+        "the meshes would give a stiffness matrix of about {:.3e} stored entries",
+        work.matrix_entries
+    );
+    if case.solver.linear_solver == crate::io::scene::LinearSolver::CgAmg {
+        let needed = work.matrix_entries * 16.0 / 1e9;
+        if needed > gigabytes {
+            return Err(Error::invalid(
+                source,
+                at,
+                format!("{matrix} ({needed:.2} GB with their row indices), above the limit of {gigabytes} GB (limits.factor_gigabytes)"),
+                "use fewer divisions or a linear element, or raise \"limits\": {\"factor_gigabytes\": G} if the machine has the memory",
+            ));
+        }
+        return Ok(());
+    }
+    let needed = work.factor_entries * 8.0 / 1e9;
+    if needed > gigabytes || work.factor_operations > operations {
+        return Err(Error::invalid(
+            source,
+            at,
+            format!(
+                "{matrix}, and its sparse factorization at least {:.3e} factor entries ({needed:.2} GB) and {:.2e} multiply-adds, above the limits of {gigabytes} GB (limits.factor_gigabytes) and {operations:.1e} multiply-adds (limits.factor_operations)",
+                work.factor_entries, work.factor_operations
+            ),
+            "use fewer divisions or a linear element, or raise \"limits\": {\"factor_gigabytes\": G, \"factor_operations\": N} if the machine has the memory and the time, or use \"solver\": {\"linear_solver\": \"cg_amg\"} where it applies",
+        ));
     }
     Ok(())
 }
@@ -2355,5 +2499,109 @@ mod dof_numbering_tests {
         }
         assert_eq!(seen, model.dof_count);
         assert_eq!(model.dof_owner(model.dof_count), None);
+    }
+}
+
+#[cfg(test)]
+mod solve_work_tests {
+    use super::*;
+    use crate::solver::sparse::{Cholesky, UNLIMITED};
+
+    /// The matrix entries and the factor's entries and multiply-adds the assembly and the
+    /// symbolic analysis find for the block mesh `mesh` (JSON) without supports (every dof
+    /// free), and the estimate of [`block_work`].
+    fn found_and_estimated(mesh: &str) -> (SolveWork, SolveWork) {
+        let text = format!(
+            r#"{{"name": "w", "materials": {{"m": {{"E": 1.0, "nu": 0.3}}}},
+                "bodies": [{{"name": "b", "material": "m", "mesh": {mesh}}}]}}"#
+        );
+        let case = parse(&text, "w").unwrap();
+        let (pattern, points, estimate) = if crate::run3d::is_3d(&case) {
+            let model = crate::run3d::build3(&case, "w").unwrap();
+            let sys = crate::solver::linear::assemble(&model, &[]);
+            let points = model.equation_points(sys.constraints.free_dofs());
+            let MeshSpec::Block3d(b) = &case.bodies[0].mesh else {
+                unreachable!()
+            };
+            let along = [b.x.intervals(), b.y.intervals(), b.z.intervals()];
+            (sys.pattern, points, block_work(b.element, along))
+        } else {
+            let model = Model::build(&case, "w").unwrap();
+            let sys = crate::solver::linear::assemble(&model, &[]);
+            let points = model.equation_points(sys.constraints.free_dofs());
+            let MeshSpec::Block(b) = &case.bodies[0].mesh else {
+                unreachable!()
+            };
+            (
+                sys.pattern,
+                points,
+                block_work(b.element, [b.x.intervals(), b.y.intervals()]),
+            )
+        };
+        let work = Cholesky::analyse_at(&pattern, Some(&points), &UNLIMITED)
+            .unwrap()
+            .work();
+        let found = SolveWork {
+            matrix_entries: pattern.nnz() as f64,
+            factor_entries: work.entries as f64,
+            factor_operations: work.operations,
+        };
+        (found, estimate)
+    }
+
+    /// The estimate is below what the assembly and the analysis find on block meshes of every
+    /// element (so a case it refuses would be refused after its matrix was allocated), the
+    /// matrix's entries exact for quadrilaterals and hexahedra.
+    #[test]
+    fn the_block_work_estimate_is_below_what_the_solve_finds() {
+        let axis = |n: usize| format!(r#"{{"from": 0, "to": 1, "divisions": {n}}}"#);
+        let two = |e: &str, n: usize, m: usize| {
+            format!(
+                r#"{{"block": {{"element": "{e}", "x": {}, "y": {}}}}}"#,
+                axis(n),
+                axis(m)
+            )
+        };
+        let three = |e: &str, n: usize, m: usize, k: usize| {
+            format!(
+                r#"{{"block3d": {{"element": "{e}", "x": {}, "y": {}, "z": {}}}}}"#,
+                axis(n),
+                axis(m),
+                axis(k)
+            )
+        };
+        let meshes = [
+            (two("Q4", 60, 40), true),
+            (two("Q9", 30, 20), true),
+            (two("T3", 60, 40), false),
+            (two("T6", 30, 20), false),
+            (three("Hex8", 12, 10, 8), true),
+            (three("Hex8", 20, 20, 2), true),
+            (three("Hex27", 6, 5, 4), true),
+            (three("Tet4", 12, 10, 8), false),
+            (three("Tet10", 6, 5, 4), false),
+        ];
+        for (mesh, tensor) in meshes {
+            let (found, estimate) = found_and_estimated(&mesh);
+            println!(
+                "{mesh}: matrix {:.3e} of {:.3e}, factor entries {:.3e} of {:.3e}, operations {:.3e} of {:.3e}",
+                estimate.matrix_entries,
+                found.matrix_entries,
+                estimate.factor_entries,
+                found.factor_entries,
+                estimate.factor_operations,
+                found.factor_operations
+            );
+            if tensor {
+                assert_eq!(estimate.matrix_entries, found.matrix_entries, "{mesh}");
+            } else {
+                assert!(estimate.matrix_entries <= found.matrix_entries, "{mesh}");
+            }
+            assert!(estimate.factor_entries <= found.factor_entries, "{mesh}");
+            assert!(
+                estimate.factor_operations <= found.factor_operations,
+                "{mesh}"
+            );
+        }
     }
 }

@@ -45,6 +45,9 @@
 //!   `v_+ = (Z1 v1 + Z2 v2) / (Z1 + Z2)` and for a rigid master `0`. A row that opens carries no
 //!   force and is not corrected: its nodes separate with their own velocities; so is a row
 //!   whose corrected force would pull (`c_+ < 0`: it is opening), the others corrected again.
+//!   The correction is dense in the active rows (`m` columns of `M^-1 B^T`, the `m x m`
+//!   matrix `S` and its eigen-decomposition); above the case's factorization limits it is
+//!   refused, naming them.
 //! * `contact_stabilized`: the contact-stabilized Newmark method of Deuflhard, Krause & Ertel,
 //!   "A contact-stabilized Newmark method for dynamical contact problems", IJNME 73 (2008)
 //!   1274-1290, on the trapezoidal rule: the predictor `d_n + dt v_n` is first projected onto
@@ -454,7 +457,7 @@ impl<'a> Integrator<'a> {
             match dyn_.impact {
                 ImpactTreatment::Plain => {}
                 ImpactTreatment::PostImpact => {
-                    self.post_impact(&active_rows, &mut forces);
+                    self.post_impact(&active_rows, &mut forces)?;
                 }
                 ImpactTreatment::ContactStabilized => {
                     // the system's force is twice the step's mean contact force
@@ -623,15 +626,41 @@ impl<'a> Integrator<'a> {
     /// `W^-1 B^T` column by column (`W` the mass, or the diagonal `weights` per equation) and
     /// the projection `y <- y - W^-1 B^T S^+ B y`, `S = B W^-1 B^T`; returns `-S^+ B y`, the
     /// change of the row forces that goes with it.
+    ///
+    /// The projection is dense: `m` columns of `n` free equations, `S` and its eigenvectors
+    /// `m x m`, and the eigen-decomposition about `m^3` multiply-adds; above the case's
+    /// factorization limits (`limits.factor_gigabytes`, `limits.factor_operations`) it is
+    /// refused before anything is allocated (a strip of 8000 elements dropped on a rigid line
+    /// asked for 10 GB and aborted).
     fn project(
         &self,
         rows: &[Vec<(usize, f64)>],
         weights: Option<&[f64]>,
         y: &mut [f64],
-    ) -> Vec<f64> {
+    ) -> Result<Vec<f64>> {
         let sys = self.system.linear_system();
         let n = sys.n;
         let m = rows.len();
+        let (mf, nf) = (m as f64, n as f64);
+        let gigabytes = mf * (nf + 2.0 * mf) * 8.0 / 1e9;
+        let operations = mf.powi(3);
+        let limit = &self.model.factor_limit;
+        if gigabytes > limit.gigabytes || operations > limit.operations {
+            return Err(Error::Solver {
+                path: self.model.source.clone(),
+                problem: format!(
+                    "the post-impact correction would project {m} active contact rows densely \
+                     over {n} equations: {gigabytes:.2} GB and about {operations:.1e} \
+                     multiply-adds, above the limits of {} GB (limits.factor_gigabytes) and \
+                     {:.1e} multiply-adds (limits.factor_operations)",
+                    limit.gigabytes, limit.operations
+                ),
+                hint: "use \"impact\": \"contact_stabilized\" or \"plain\", or fewer slave \
+                       nodes on the interface (a coarser mesh along it), or raise the limits if \
+                       the machine has the memory and the time"
+                    .into(),
+            });
+        }
         let free = sys.constraints.free_dofs();
         // columns of W^-1 B^T over the free equations
         let columns: Vec<Vec<f64>> = rows
@@ -683,18 +712,18 @@ impl<'a> Integrator<'a> {
                 y[d] -= col[e] * mu_j;
             }
         }
-        mu.iter().map(|v| -v).collect()
+        Ok(mu.iter().map(|v| -v).collect())
     }
 
     /// The seed's post-impact correction of the active rows (see the module doc). A row whose
     /// corrected force would pull (it is opening) is released and left out, and the others are
     /// corrected again.
-    fn post_impact(&mut self, active: &[usize], forces: &mut [f64]) {
+    fn post_impact(&mut self, active: &[usize], forces: &mut [f64]) -> Result<()> {
         let mut rows_in = active.to_vec();
         while !rows_in.is_empty() {
             let rows = self.free_rows(&rows_in);
             let mut a = self.a.clone();
-            let change = self.project(&rows, None, &mut a);
+            let change = self.project(&rows, None, &mut a)?;
             let all = self.system.rows();
             let opening: Vec<usize> = rows_in
                 .iter()
@@ -718,10 +747,11 @@ impl<'a> Integrator<'a> {
                 .map(|&d| self.impedance[d])
                 .collect();
             let mut v = std::mem::take(&mut self.v);
-            self.project(&rows, Some(&weights), &mut v);
+            self.project(&rows, Some(&weights), &mut v)?;
             self.v = v;
-            return;
+            return Ok(());
         }
+        Ok(())
     }
 
     fn energies(&self) -> Energies {
