@@ -453,3 +453,44 @@ fn a_tie_glues_only_slave_nodes_with_a_master_facet_under_them() {
         );
     }
 }
+
+/// Issue 38, item 9 (no slip at open points): the Cattaneo-Mindlin indentation with Lagrange
+/// multipliers (cases/hard) has 60 open slave points beside 9 stick and 4 slip points. Each
+/// open point reported a slip and a plastic slip (-7.80e-4 at x = -16): the tangential motion
+/// of a point not in contact. Now an open point has no slip in any of the three files (empty in
+/// the CSV, `null` in the JSON, 0 in the `.vtu` where `contact_status` says open), and the
+/// stick and slip points keep theirs.
+#[test]
+fn open_points_report_no_slip() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    run(&case("cases/hard/cattaneo-lagrange-friction.json"), &out, 0);
+    let rows = csv_rows(&out.join("interface.contact.csv"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("interface.contact.json")).unwrap())
+            .unwrap();
+    let vtu = read_vtu(&out.join("interface.contact.vtu"));
+    let slip = &vtu.arrays["contact_slip"].1;
+    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+    for (k, row) in rows.iter().enumerate() {
+        *counts.entry(row["status"].clone()).or_default() += 1;
+        let point = &json["points"][k];
+        match row["status"].as_str() {
+            "open" | "unmeasured" => {
+                assert_eq!(row["slip"], "", "{row:?}");
+                assert_eq!(row["plastic_slip"], "", "{row:?}");
+                assert!(point["slip"].is_null() && point["plastic_slip"].is_null());
+                assert_eq!(slip[k], 0.0, "{row:?}");
+            }
+            "stick" | "slip" => {
+                let s = num(row, "slip");
+                assert!(s.is_finite(), "{row:?}");
+                assert_eq!(point["slip"].as_f64().unwrap(), s);
+                assert_eq!(slip[k], s);
+            }
+            other => panic!("status {other}"),
+        }
+    }
+    assert_eq!(counts["open"], 60, "{counts:?}");
+    assert!(counts["stick"] > 0 && counts["slip"] > 0, "{counts:?}");
+}

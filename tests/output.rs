@@ -302,3 +302,74 @@ fn every_stress_field_at_finite_strain_is_the_hyperelastic_law_s() {
         );
     }
 }
+
+/// Issue 38, item 9 (reactions per support set): the punch on its foundation
+/// (cases/hard/slave-past-master-end.json) is held by `bottom` in y, `bottom_left` (the corner
+/// node, also in `bottom`) in x, and here `bottom_left` in y too; the punch's `top_left` in x.
+/// Each set summed both components over all its nodes, so `bottom_left` reported the corner's
+/// y reaction 9.5496 (it belongs to `bottom`, where it was counted too: the y reactions summed
+/// to 89.55 under a load of 80) and `bottom` reported the corner's x reaction 0.0736, which it
+/// does not hold. Now each set reports its own components; the corner's y, held by both,
+/// counts once, in `bottom` (the first support that prescribes it), and `bottom_left` lists it
+/// as shared.
+#[test]
+fn each_support_set_reports_its_own_reaction() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = format!(
+        "{}/cases/hard/slave-past-master-end.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mut case: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(source).unwrap()).unwrap();
+    case["supports"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!({"body": "foundation", "set": "bottom_left", "y": 0.0}));
+    let path = dir.path().join("case.json");
+    std::fs::write(&path, case.to_string()).unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .args([
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    println!("{}", s["reactions"]);
+    let reactions = s["reactions"].as_array().unwrap();
+    assert_eq!(reactions.len(), 3, "one entry per (body, set)");
+    let of = |set: &str| reactions.iter().find(|r| r["set"] == set).unwrap();
+    let (bottom, corner, punch) = (of("bottom"), of("bottom_left"), of("top_left"));
+    let value = |r: &serde_json::Value, c: &str| r[c].as_f64().unwrap();
+    // `bottom` holds y only and carries the whole load (pressure 10 over the width 8)
+    assert_eq!(bottom["held"], serde_json::json!(["y"]));
+    assert_eq!(value(bottom, "x"), 0.0);
+    assert!(
+        (value(bottom, "y") - 80.0).abs() <= 1e-10 * 80.0,
+        "{bottom}"
+    );
+    assert_eq!(bottom["shared"], serde_json::json!([]));
+    // `bottom_left` holds x and y; its y counts in `bottom`
+    assert_eq!(corner["held"], serde_json::json!(["x", "y"]));
+    assert_eq!(value(corner, "y"), 0.0);
+    assert_eq!(
+        corner["shared"],
+        serde_json::json!([{"component": "y", "counted_in": "foundation.bottom", "nodes": 1}])
+    );
+    assert_eq!(punch["held"], serde_json::json!(["x"]));
+    assert_eq!(value(punch, "y"), 0.0);
+    // every reaction counted once: no horizontal load, and the vertical ones sum to the load
+    let total = |c: &str| reactions.iter().map(|r| value(r, c)).sum::<f64>();
+    assert!(total("x").abs() <= 1e-10 * 80.0, "{}", total("x"));
+    assert!((total("y") - 80.0).abs() <= 1e-10 * 80.0, "{}", total("y"));
+    assert!(
+        value(corner, "x") != 0.0,
+        "the corner holds the foundation in x"
+    );
+    assert!((value(corner, "x") + value(punch, "x")).abs() <= 1e-10 * 80.0);
+}

@@ -26,7 +26,9 @@
 //! * **status**: `open` (no row of the node carries force), `closed` (frictionless or tied),
 //!   `stick` or `slip` (Coulomb pairs, from the return map of [`super::friction`]).
 //! * **slip**: Coulomb pairs only, the tangential slip measure `g_t = t . (u_s - sum N_m u_m)`
-//!   at the end of the solve and its plastic part `g_t^p`.
+//!   at the end of the solve and its plastic part `g_t^p`, at closed points (stick or slip);
+//!   an open point is not in contact and has no slip (none reported, as for a frictionless
+//!   pair).
 //!
 //! A node without a row of its own (the master surface of a one-pass pair) is `unmeasured`:
 //! it has a force and a pressure but no gap, status or slip.
@@ -115,7 +117,8 @@ pub struct ContactPoint {
     /// The gap of the node's rows (`None`: unmeasured).
     pub gap: Option<f64>,
     pub status: PointStatus,
-    /// Coulomb pairs: slip measure `g_t` and plastic slip `g_t^p` (`None` elsewhere).
+    /// Coulomb pairs, at points in contact (stick or slip): slip measure `g_t` and plastic
+    /// slip `g_t^p` (`None` elsewhere: frictionless pairs, open and unmeasured points).
     pub slip: Option<f64>,
     pub plastic_slip: Option<f64>,
 }
@@ -233,12 +236,10 @@ fn one_pair(model: &Model, state: &ContactState, u: &[f64], forces: &PairForces)
                         (_, true) => PointStatus::Closed,
                         (_, false) => PointStatus::Open,
                     };
-                    (
-                        gap,
-                        status,
-                        f.friction.map(|x| x.1),
-                        f.friction.map(|x| x.2),
-                    )
+                    // an open point transmits nothing and has no slip: its slip measure
+                    // (the tangential motion of a point not in contact) is not reported
+                    let friction = f.friction.filter(|_| status != PointStatus::Open);
+                    (gap, status, friction.map(|x| x.1), friction.map(|x| x.2))
                 }
             };
             let nn = n.normal;

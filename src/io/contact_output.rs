@@ -8,9 +8,9 @@
 //!   (0 unmeasured, 1 open, 2 closed, 3 stick, 4 slip), `contact_slip`, `side` (0 slave,
 //!   1 master) and `node` (the body's local node number). VTK readers take no NaN in ASCII
 //!   data, so an unmeasured gap or slip is written as 0: `contact_status` says which points
-//!   have one.
+//!   have one (a slip only at stick and slip points: an open point has none).
 //! * `<pair>.contact.csv`: one row per point, columns [`CSV_HEADER`]; an unmeasured gap or
-//!   slip is an empty field.
+//!   slip is an empty field (the slip of open points and of frictionless pairs too).
 //! * `<pair>.contact.json`: the pair's totals and every point (`null` where unmeasured).
 //! * Body `.vtu` files of a scene with contact get `contact_force`, `contact_pressure`,
 //!   `contact_gap`, `contact_status` and `contact_slip`, zero away from contact surfaces; a

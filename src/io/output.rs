@@ -10,6 +10,20 @@
 //! orders match ours. A scene with contact adds the contact point data and the per-pair files
 //! of [`crate::io::contact_output`] (`<pair>.contact.vtu`, `.csv`, `.json`); a scene without
 //! contact writes exactly what it wrote before.
+//!
+//! **Reactions per support set** (`summary.json` `reactions`, [`ReactionSummary`]): with the
+//! nodal reactions `r = K u - f` at the prescribed dofs, set `S` reports per component `c`
+//!
+//! ```text
+//! R_S,c = sum of r_d over the dofs d = (node of S, c) that a support naming S prescribes
+//!         and that no earlier support (in the case's order) prescribes
+//! ```
+//!
+//! so every prescribed dof counts in exactly one set and the sets' reactions add up to the
+//! total reaction. A node held in x by one set and in y by another gives each set its own
+//! component; a dof held in the same component by two sets counts in the first, and the later
+//! set lists it under `shared` (the component, the set that counts it, how many nodes). A
+//! component a set does not hold reads 0 and is absent from its `held`.
 
 use crate::contact::enforcement::method;
 use crate::contact::forces::pair_forces;
@@ -19,7 +33,7 @@ use crate::harness::checks::CheckResult;
 use crate::io::contact_output::{body_point_arrays, pair_file_names, write_pair_files};
 use crate::io::paths::{file_name, OutputFolder};
 use crate::io::vtu::{lines_in_parallel, PointArray};
-use crate::model::Body;
+use crate::model::{Body, Model};
 use crate::post::{cell_stresses, nodal_stresses};
 use crate::run::Outcome;
 use crate::solver::linear::Timings;
@@ -257,13 +271,82 @@ pub struct BodySummary {
     pub stress_xy: [f64; 2],
 }
 
-/// Sum of the reactions over a supported node set.
+/// The reaction of one support set: per component, the sum of the reactions `K u - f` at the
+/// dofs the set's supports prescribe. A dof that several sets prescribe (the same node held in
+/// the same component by two sets) counts once, in the set of the first support of the case
+/// that prescribes it; a later set lists it under `shared`. A node held in x by one set and in
+/// y by another gives each set its own component. A component the set prescribes nowhere (or
+/// only where an earlier set counts it) reads 0; `held` names the components it prescribes.
 #[derive(Serialize)]
 pub struct ReactionSummary {
     pub body: String,
     pub set: String,
     pub x: f64,
     pub y: f64,
+    /// The components the set's supports prescribe (`"x"`, `"y"`).
+    pub held: Vec<&'static str>,
+    /// Dofs the set prescribes whose reaction counts in an earlier set.
+    pub shared: Vec<SharedReaction>,
+}
+
+/// Dofs of a support set whose reaction counts in another (earlier) set.
+#[derive(Serialize)]
+pub struct SharedReaction {
+    pub component: &'static str,
+    /// The set that counts them.
+    pub counted_in: String,
+    pub nodes: usize,
+}
+
+/// The reaction of every support set of `model` (see [`ReactionSummary`]).
+fn reaction_summaries(model: &Model, reactions: &[f64]) -> Vec<ReactionSummary> {
+    const COMPONENTS: [&str; 2] = ["x", "y"];
+    // the set that counts each dof: the first support prescribing it
+    let mut owner: std::collections::BTreeMap<usize, usize> = std::collections::BTreeMap::new();
+    for &(set, _, dof) in &model.support_dofs {
+        owner.entry(dof).or_insert(set);
+    }
+    model
+        .support_sets
+        .iter()
+        .enumerate()
+        .map(|(i, (bi, set))| {
+            let mut own = [0.0; 2];
+            let mut held = [false; 2];
+            let mut counted = std::collections::BTreeSet::new();
+            let mut shared: std::collections::BTreeMap<(usize, usize), usize> =
+                std::collections::BTreeMap::new();
+            for &(s, comp, dof) in model.support_dofs.iter().filter(|e| e.0 == i) {
+                held[comp] = true;
+                let first = owner[&dof];
+                if first == s {
+                    if counted.insert(dof) {
+                        own[comp] += reactions[dof];
+                    }
+                } else if counted.insert(dof) {
+                    *shared.entry((comp, first)).or_insert(0) += 1;
+                }
+            }
+            ReactionSummary {
+                body: model.bodies[*bi].name.clone(),
+                set: set.clone(),
+                x: own[0],
+                y: own[1],
+                held: (0..2).filter(|&c| held[c]).map(|c| COMPONENTS[c]).collect(),
+                shared: shared
+                    .into_iter()
+                    .map(|((comp, first), nodes)| {
+                        let (fb, fs) = &model.support_sets[first];
+                        SharedReaction {
+                            component: COMPONENTS[comp],
+                            counted_in: format!("{}.{fs}", model.bodies[*fb].name),
+                            nodes,
+                        }
+                    })
+                    .collect(),
+            }
+        })
+        .collect()
 }
 
 fn range(values: impl Iterator<Item = f64>) -> [f64; 2] {
@@ -315,21 +398,7 @@ fn summary_with(outcome: &Outcome, nodal: &[Vec<[f64; 3]>], results: &[PairResul
             }
         })
         .collect();
-    let reactions = model
-        .support_sets
-        .iter()
-        .map(|(bi, set)| {
-            let b = &model.bodies[*bi];
-            let nodes = &b.mesh.node_sets[set];
-            let sum = |c: usize| nodes.iter().map(|&n| solution.reactions[b.dof(n, c)]).sum();
-            ReactionSummary {
-                body: b.name.clone(),
-                set: set.clone(),
-                x: sum(0),
-                y: sum(1),
-            }
-        })
-        .collect();
+    let reactions = reaction_summaries(model, &solution.reactions);
     let contact = solution.contact.as_ref().map(|c| {
         let forces = pair_forces(model, c);
         let mut extent = [[f64::INFINITY, f64::NEG_INFINITY]; 2];

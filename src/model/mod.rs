@@ -184,6 +184,10 @@ pub struct Model<const D: usize = 2, K: SolidCell<D> = ElementKind> {
     pub checks: Vec<Check>,
     /// `(body index, node set)` of every support, for reaction summaries.
     pub support_sets: Vec<(usize, String)>,
+    /// `(index into support_sets, component, dof)` for every dof a support prescribes, in the
+    /// order of the case's supports (a dof two supports prescribe is listed twice, the first
+    /// support first): which set's reaction a dof counts in (2D; empty in 3D).
+    pub support_dofs: Vec<(usize, usize, usize)>,
     /// Contact pairs (empty: no contact is simulated).
     pub contact: Vec<ContactPair>,
     /// The case's sweep (used by `contact-patch table`).
@@ -300,6 +304,7 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
             physics: Physics::default(),
             checks: Vec::new(),
             support_sets: Vec::new(),
+            support_dofs: Vec::new(),
             contact: Vec::new(),
             sweep: None,
             solver: SolverSpec::default(),
@@ -991,6 +996,7 @@ impl Model {
             physics: case.physics.clone(),
             checks: Vec::new(),
             support_sets: Vec::new(),
+            support_dofs: Vec::new(),
             contact: Vec::new(),
             sweep: case.sweep.clone(),
             solver: case.solver.clone(),
@@ -1182,9 +1188,13 @@ impl Model {
                 self.body_index(&s.body).expect("found above"),
                 s.set.clone(),
             );
-            if !self.support_sets.contains(&entry) {
-                self.support_sets.push(entry);
-            }
+            let set_index = match self.support_sets.iter().position(|e| *e == entry) {
+                Some(i) => i,
+                None => {
+                    self.support_sets.push(entry);
+                    self.support_sets.len() - 1
+                }
+            };
             if s.z.is_some() {
                 return Err(Error::invalid(
                     &self.source,
@@ -1232,6 +1242,7 @@ impl Model {
                         _ => unreachable!("exact checked above"),
                     };
                     let dof = body.dof(n, comp);
+                    self.support_dofs.push((set_index, comp, dof));
                     match self.prescribed[dof] {
                         Some(old)
                             if (old - v).abs() > 1e-12 * (old.abs() + v.abs()).max(1e-300) =>
