@@ -86,7 +86,6 @@ pub(crate) fn committed_history<const D: usize>(
                         slip: f.plastic_slip,
                         normal_force: f.normal_force,
                         tangential_force: f.force,
-                        start_slip: f.slip,
                     },
                 )
             })
