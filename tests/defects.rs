@@ -733,7 +733,6 @@ fn a_study_in_which_no_cell_ran_exits_2() {
     assert!(stdout.contains("2 cells (1 could not run)"), "{stdout}");
 }
 
-
 /// `summary.json` of the output folder `out` of the scratch's working folder.
 fn summary(s: &Scratch, out: &str) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(s.work.join(out).join("summary.json")).unwrap())

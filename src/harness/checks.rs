@@ -339,7 +339,6 @@ fn untied_slave_nodes(model: &Model, state: &crate::contact::state::ContactState
         ));
     }
     out
-
 }
 
 /// The check `max_penetration` in any dimension: its words and the largest penetration

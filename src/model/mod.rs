@@ -1815,21 +1815,7 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str, notes: &mut Vec<String>) 
                     "add cells",
                 ));
             }
-            let mesh = Mesh::new(e.element, e.nodes.clone(), conn);
-            if let Some(n) = mesh.used_nodes().iter().position(|&u| !u) {
-                let p = e.nodes[n];
-                return Err(Error::invalid(
-                    source,
-                    format!("{at}.mesh.explicit.nodes[{n}]"),
-                    format!(
-                        "node {n} at ({}, {}) is used by no cell: it has no stiffness, and no \
-                         set chosen by position (top, bottom, a box) can hold it",
-                        p[0], p[1]
-                    ),
-                    "remove the node (and renumber the cells) or add the cell that uses it",
-                ));
-            }
-            Ok(mesh)
+            Ok(Mesh::new(e.element, e.nodes.clone(), conn))
         }
     }
 }
