@@ -46,9 +46,7 @@ fn find(rows: &[Constraint], r: &Constraint) -> Constraint {
 
 /// Central differences of every row's gap against every dof of the model. Rows of slave nodes
 /// at the ends of their pass's slave surface (its lowest and highest x) are skipped: there the
-/// gap has a kink where the projection leaves the master surface. (Slave nodes beyond the
-/// master's ends have no row: until defect W02 of the second report they were held against
-/// an interior master vertex, spurious rows this test counted.)
+/// gap has a kink where the projection leaves the master surface.
 fn check(model: &Model, disc: DiscretizationSpec, h: f64, tol: f64, only_closed: bool) -> usize {
     check_dofs(model, disc, h, tol, only_closed, false)
 }

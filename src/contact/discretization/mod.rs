@@ -17,7 +17,9 @@
 //!   when it sits on it); one behind the vertex's averaged normal whose closest points on both
 //!   facets at the vertex lie past it (inside the master body under a concave corner) has the
 //!   gap minus that distance, a penetration. A free end of the master surface is extended by a quarter facet
-//!   along its own curve ([`END_EXTENSION`]); a slave node beyond that gets no row.
+//!   along its own curve ([`END_EXTENSION`]); a slave node of a tie beyond that gets no row
+//!   (a contact node there is still held against the nearest shared vertex, see
+//!   `node_to_surface`).
 //! * **Two-pass**: the rows of the pass with the roles swapped are appended (pass 2).
 //! * **Rigid masters**: a line `g = n . (x_s - p)` or a circle `g = |x_s - c| - R` with
 //!   `n = (x_s - c)/|x_s - c|`; only slave dofs appear. Node-to-surface takes one pass (a
