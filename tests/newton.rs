@@ -314,3 +314,104 @@ fn newton_names_slave_nodes_that_leave_the_master_surface() {
     let d = difference(&old, &new);
     assert!(d <= 1e-9, "the schemes differ by {d:e}");
 }
+
+/// `contact-patch run` on reproducer `name` of `tests/defects/s4/`: exit code, summary.json
+/// and the output folder (kept alive by the returned temporary folder).
+fn run_reproducer(name: &str) -> (i32, Value, tempfile::TempDir) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/defects/s4");
+    let file = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| {
+            p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with(&format!("{name}-"))
+        })
+        .unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .args(["run", file.to_str().unwrap(), "--out"])
+        .arg(out.path().join("o"))
+        .output()
+        .unwrap();
+    let summary = std::fs::read_to_string(out.path().join("o/summary.json"))
+        .map(|t| serde_json::from_str(&t).unwrap())
+        .unwrap_or_else(|_| json!({ "stderr": String::from_utf8_lossy(&o.stderr) }));
+    (o.status.code().unwrap(), summary, out)
+}
+
+/// Newton's iterations of every load step of a 2D run (`contact.steps`), every step converged.
+fn converged_iterations(name: &str, summary: &Value) -> Vec<u64> {
+    summary["contact"]["steps"]
+        .as_array()
+        .unwrap_or_else(|| panic!("{name}: {summary}"))
+        .iter()
+        .map(|s| {
+            assert_eq!(s["termination"], "converged", "{name}: {s}");
+            s["iterations"].as_u64().unwrap()
+        })
+        .collect()
+}
+
+/// Defects N02 to N04 (second report): Newton's convergence test had no round-off floor under
+/// finite kinematics. N02b, the finite-strain penalty block of N02a moved rigidly by (0, 1),
+/// stalled at a relative residual near 1e-8 (the penalty's round-off `kappa eps |x|` grows
+/// with the coordinates); N04a/b, the nested Hex8 two-block patch tests at finite strain,
+/// stalled at 1.9e-12 and 2.9e-9 with every cut spent. N03, a finite Signorini block with a
+/// penalty, reached 1.8e-15 but a row with a gap zero to round-off flipped open and closed
+/// every iteration. Each converges now: N02b in N02a's iterations with N02a's answer moved.
+#[test]
+fn finite_strain_newton_converges_at_its_round_off_floor_wherever_the_problem_sits() {
+    let (code_a, at_origin, dir_a) = run_reproducer("N02a");
+    let (code_b, moved, dir_b) = run_reproducer("N02b");
+    assert_eq!((code_a, code_b), (0, 0), "{moved}");
+    assert_eq!(
+        converged_iterations("N02a", &at_origin),
+        converged_iterations("N02b", &moved)
+    );
+    // the same displacements (a vtu's displacement field), to the round-off of the moved
+    // problem's coordinates
+    let displacement = |dir: &tempfile::TempDir| -> Vec<f64> {
+        let text = std::fs::read_to_string(dir.path().join("o/block.vtu"))
+            .or_else(|_| {
+                let vtu = std::fs::read_dir(dir.path().join("o"))
+                    .unwrap()
+                    .map(|e| e.unwrap().path())
+                    .find(|p| {
+                        p.extension().is_some_and(|e| e == "vtu")
+                            && !p.to_string_lossy().contains(".contact.")
+                    })
+                    .unwrap();
+                std::fs::read_to_string(vtu)
+            })
+            .unwrap();
+        let start = text.find("Name=\"displacement\"").unwrap();
+        let from = start + text[start..].find('>').unwrap() + 1;
+        let to = from + text[from..].find("</DataArray>").unwrap();
+        text[from..to]
+            .split_whitespace()
+            .map(|t| t.parse().unwrap())
+            .collect()
+    };
+    let (ua, ub) = (displacement(&dir_a), displacement(&dir_b));
+    let scale = ua.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = ua
+        .iter()
+        .zip(&ub)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        diff <= 1e-9 * scale,
+        "moved by (0, 1): displacements differ by {:e}",
+        diff / scale
+    );
+    let (code, summary, _dir) = run_reproducer("N03");
+    assert_eq!(code, 0, "{summary}");
+    converged_iterations("N03", &summary);
+    for name in ["N04a", "N04b"] {
+        let (code, summary, _dir) = run_reproducer(name);
+        assert_eq!(code, 0, "{name}: {summary}");
+        assert_eq!(summary["contact"]["termination"], "Converged", "{name}");
+        assert_eq!(summary["finite"]["cuts"], 0, "{name}");
+    }
+}

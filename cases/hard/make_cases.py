@@ -476,15 +476,15 @@ case(
     [converged(), load_carried("interface", PUNCH_LOAD, 1e-10), {"check": "force_balance", "tol": 1e-12}],
 )
 
-# 17. Newton scheme with a stiff penalty: the same diagnosis
+# 17. Newton scheme with a stiff penalty: it ends at its round-off floor, with the diagnosis
 c = patch("C")
 c["contact"][0]["enforcement"] = enforcement("penalty", 1e9 * E / H_C)
 c["solver"] = {"scheme": "newton"}
 case(
     "newton-penalty-1e9-E-over-h",
-    "Mesh C, penalty kappa = 1e9 E / h solved by the Newton core: its residual cannot reach the Newton tolerance because the penalty forces are known only to round-off of the displacement; the solve stops at the iteration limit with a diagnosis naming the penalty and how far to lower it.",
+    "Mesh C, penalty kappa = 1e9 E / h solved by the Newton core: its penalty forces kappa A g come from gaps known only to round-off of the displacement, so its residual cannot reach the Newton tolerance. Newton ends at that round-off floor (the magnitude of each gap's terms times kappa, issue 39), converged, and the run warns that equilibrium is limited by the penalty, naming how far to lower it (until issue 39 the floor left out the penalty's gap terms and the solve stopped at the iteration limit with 'the residual stagnated' after 200 iterations).",
     c,
-    [stops("iteration_limit", "the residual stagnated")],
+    [converged()],
 )
 
 # 18. active-set cycling: the shifted punch of case 16 with a penalty (kappa = 1e5 = 100 E / h)

@@ -1160,9 +1160,8 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
         }
         residual.iter_mut().for_each(|v| *v = 0.0);
         // the magnitude of the terms summed into each row of the residual, whose round-off is
-        // the floor of the residual (small strain only: under finite kinematics it stays empty
-        // and only the relative tolerance counts)
-        let mut magnitude: Vec<f64> = Vec::new();
+        // the floor of the residual: the stiffness terms |K| |x| (under finite kinematics the
+        // tangent's, the size of the terms of f_int) and the loads, then each contact row's
         if let Some(r) = solid_residual {
             residual[..n].copy_from_slice(&r);
         } else {
@@ -1173,7 +1172,9 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
                 .iter_mut()
                 .zip(&self.sys.rhs)
                 .for_each(|(r, f)| *r -= f);
-            magnitude = vec![0.0; residual.len()];
+        }
+        let mut magnitude = vec![0.0; residual.len()];
+        {
             let abs_k: Vec<f64> = self.sys.k.iter().map(|v| v.abs()).collect();
             let abs_x: Vec<f64> = x[..n].iter().map(|v| v.abs()).collect();
             self.sys.pattern.mul(&abs_k, &abs_x, &mut magnitude[..n]);
@@ -1182,6 +1183,27 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
                 .zip(&self.sys.rhs)
                 .for_each(|(m, f)| *m += f.abs());
         }
+        // the magnitude of the terms of a row's gap: g = g0 + sum_d c_d u_d in the reference
+        // geometry; in the current one the gap is a difference of positions X + u, whose
+        // round-off grows with the coordinates (a problem moved away from the origin)
+        let gap_magnitude = |r: &Constraint<D>| -> f64 {
+            r.g0.abs()
+                + r.dofs
+                    .iter()
+                    .zip(&r.coeffs)
+                    .map(|(&d, c)| {
+                        let position = if current {
+                            let at = self.model.dof_owner(d).map_or(0.0, |o| {
+                                self.model.bodies[o.body].mesh.nodes[o.node][o.component]
+                            });
+                            at + u[d]
+                        } else {
+                            u[d]
+                        };
+                        (c * position).abs()
+                    })
+                    .sum::<f64>()
+        };
         let mut eval = Evaluation {
             force_scale: max_abs(&self.sys.rhs),
             ..Evaluation::default()
@@ -1211,7 +1233,22 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
             let key = row_key(r);
             let (lambda, on) = self.force(i, &u, x);
             let g = r.gap(&u);
-            if self.active.get(&key).copied().unwrap_or(false) != on && self.evaluations > 0 {
+            // a row that opens or closes with its force zero to the force tolerance (a gap
+            // zero to round-off) changes nothing: it does not block convergence (it flipped
+            // every iteration on a converged penalty solve, N03 of the second defect report)
+            let at_zero = match self.law(r) {
+                RowLaw::Penalty { w, .. } => {
+                    (self.augmentation.get(&key).copied().unwrap_or(0.0) - w * g).abs()
+                        <= self.force_tolerance
+                }
+                RowLaw::Multiplier => {
+                    lambda.abs() <= self.force_tolerance && g.abs() <= 1e-12 * self.model.size()
+                }
+            };
+            if self.active.get(&key).copied().unwrap_or(false) != on
+                && self.evaluations > 0
+                && !at_zero
+            {
                 eval.status_changes += 1;
             }
             let shown = if on { lambda } else { 0.0 };
@@ -1420,14 +1457,7 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
                     residual[j] = -rho * g;
                     closing_force = closing_force.max((rho * g).abs());
                     if let Some(m) = magnitude.get_mut(j) {
-                        // g = g0 + sum_d c_d u_d
-                        *m += rho
-                            * (r.g0.abs()
-                                + r.dofs
-                                    .iter()
-                                    .zip(&r.coeffs)
-                                    .map(|(&d, c)| (c * u[d]).abs())
-                                    .sum::<f64>());
+                        *m += rho * gap_magnitude(r);
                     }
                     for &(e, c) in &terms {
                         upper[self.pattern.position(e, j).expect("coupling")] = -rho * c;
@@ -1439,11 +1469,16 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
             if on {
                 eval.active += 1;
             }
+            // a penalty force w g errs by w times the round-off of its gap's terms
+            let penalty_terms = match self.law(r) {
+                RowLaw::Penalty { .. } if on => w * gap_magnitude(r),
+                _ => 0.0,
+            };
             for &(e, c) in &terms {
                 residual[e] -= force * c;
                 eval.force_scale = eval.force_scale.max((shown * c).abs());
                 if let Some(m) = magnitude.get_mut(e) {
-                    *m += (force * c).abs();
+                    *m += (force * c).abs() + penalty_terms * c.abs();
                 }
             }
             for (a, &(ea, ca)) in terms.iter().enumerate() {
