@@ -85,15 +85,7 @@ fn a_rigid_motion_without_load_reads_as_round_off() {
         let case = common::defect(name);
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("out");
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
-            .args([
-                "run",
-                case.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-            ])
-            .output()
-            .unwrap();
+        let o = common::run_case(&case, &out);
         let stdout = String::from_utf8_lossy(&o.stdout);
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(0), "{name}: {stdout}{stderr}");

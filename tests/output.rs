@@ -1,5 +1,7 @@
 //! `contact-patch run` writes `summary.json` and one `.vtu` per body; both are read back here.
 
+mod common;
+
 use std::process::Command;
 
 /// The numbers inside the `<DataArray ... Name="name" ...>` element of a VTU file's `section`
@@ -245,15 +247,7 @@ fn every_stress_field_at_finite_strain_is_the_hyperelastic_law_s() {
         .join("tests/defects/s4/W03-finite-stress-zz-small-strain-formula.json");
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
-        .args([
-            "run",
-            case.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let o = common::run_case(&case, &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let xml = std::fs::read_to_string(out.join("b.vtu")).unwrap();
     let points = data_array(&xml, "Points", None);
@@ -328,15 +322,7 @@ fn each_support_set_reports_its_own_reaction() {
     let path = dir.path().join("case.json");
     std::fs::write(&path, case.to_string()).unwrap();
     let out = dir.path().join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
-        .args([
-            "run",
-            path.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let o = common::run_case(&path, &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
