@@ -859,7 +859,7 @@ fn t02_3d_deep_penetration_warns_is_reported_and_is_a_check() {
 fn t03_3d_load_steps_are_bounded_as_in_2d() {
     let s = Scratch::new();
     for (name, got) in [("T03a", "got 0"), ("T03b", "got 1000000000")] {
-        let case = s.case(&s4(name), "case.json", |_| {});
+        let case = s.case(&defect(name), "case.json", |_| {});
         assert_refused(
             s.run(&["run", case.to_str().unwrap(), "--out", "o"], &["o"]),
             &["solver.load_steps", "must be from 1 to 100000", got],
