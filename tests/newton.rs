@@ -5,6 +5,8 @@
 //! minimum-norm multipliers, the Newton scheme stops `Singular` and says why), and Newton must
 //! converge quadratically where its tangent is exact.
 
+mod common;
+
 use contact_patch::model::{parse, Model};
 use contact_patch::run::{run_model, Outcome};
 use contact_patch::solver::active_set::Termination;
@@ -318,17 +320,7 @@ fn newton_names_slave_nodes_that_leave_the_master_surface() {
 /// `contact-patch run` on reproducer `name` of `tests/defects/s4/`: exit code, summary.json
 /// and the output folder (kept alive by the returned temporary folder).
 fn run_reproducer(name: &str) -> (i32, Value, tempfile::TempDir) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/defects/s4");
-    let file = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|p| {
-            p.file_name()
-                .unwrap()
-                .to_string_lossy()
-                .starts_with(&format!("{name}-"))
-        })
-        .unwrap();
+    let file = common::defect(name);
     let out = tempfile::tempdir().unwrap();
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
         .args(["run", file.to_str().unwrap(), "--out"])
