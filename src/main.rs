@@ -179,6 +179,11 @@ enum Command {
         /// Output folder.
         #[arg(long, default_value = "reports")]
         out: PathBuf,
+        /// Another build of the tool (a contact-patch executable) to run the same cases of the
+        /// iterations-per-step table with, listed as "before" beside this build's (its case
+        /// files and outputs go to OUT/friction-convergence-baseline).
+        #[arg(long, value_name = "BINARY")]
+        baseline: Option<PathBuf>,
     },
     /// The contact patch test at finite strain: meshes A-E of cases/patch with neo-Hookean
     /// bodies compressed by 20 %, every discretization built at finite strain, each cell
@@ -408,7 +413,9 @@ fn main() -> ExitCode {
         Command::TiedLayer { cases, levels, out } => tied_layer(&cases, &levels, &out),
         Command::Hard { paths, out } => hard(&paths, &out),
         Command::ImpactReport { paths, out, study } => impact_report(&paths, &out, study),
-        Command::FrictionConvergence { out } => friction_convergence(&out),
+        Command::FrictionConvergence { out, baseline } => {
+            friction_convergence(&out, baseline.as_deref())
+        }
         Command::FinitePatch { out } => finite_patch(&out),
         Command::Patch3d { out } => patch_3d(&out),
         Command::HertzFinite { out } => hertz_finite(&out),
@@ -1512,7 +1519,7 @@ fn patch_3d(out: &Path) -> ExitCode {
 }
 
 /// `contact-patch friction-convergence`: the residual histories of the friction tangents.
-fn friction_convergence(out: &Path) -> ExitCode {
+fn friction_convergence(out: &Path, baseline: Option<&Path>) -> ExitCode {
     let folder = match ReportFolder::new(out) {
         Ok(f) => f,
         Err(e) => {
@@ -1521,12 +1528,23 @@ fn friction_convergence(out: &Path) -> ExitCode {
         }
     };
     let result = (|| -> contact_patch::Result<()> {
-        let runs = contact_patch::harness::friction_convergence::study(Path::new("."))?;
+        use contact_patch::harness::friction_convergence as study;
+        let runs = study::study(Path::new("."))?;
+        let steps = study::step_iterations(
+            Path::new("."),
+            baseline,
+            &folder.path().join("friction-convergence-baseline"),
+        )?;
+        let shown = baseline.map(|b| b.display().to_string());
         folder.write_file(
             "friction-convergence.md",
-            &contact_patch::harness::friction_convergence::report(&runs),
+            &(study::report(&runs) + &study::step_iterations_report(&steps, shown.as_deref())),
         )?;
-        let json = serde_json::to_string_pretty(&runs).expect("runs serialize") + "\n";
+        let json = serde_json::to_string_pretty(
+            &serde_json::json!({"tangents": runs, "iterations_per_step": steps}),
+        )
+        .expect("runs serialize")
+            + "\n";
         folder.write_file("friction-convergence.json", &json)
     })();
     match result {

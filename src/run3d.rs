@@ -176,6 +176,9 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
             p.iter().cloned().enumerate(),
         ));
     }
+    warnings.extend(crate::harness::stability::friction_cannot_hold(
+        &model, &solution,
+    ));
     warnings.extend(crate::harness::stability::unstable_equilibrium(&solution));
     Ok(Outcome3 {
         name: case.name.clone(),

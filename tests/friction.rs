@@ -360,10 +360,13 @@ fn a_block_on_an_incline_slides_at_the_coulomb_limit() {
 #[test]
 fn on_a_load_path_the_block_starts_to_slide_at_the_coulomb_limit() {
     // the weight first, then the push ramped across the limit: the solve converges in every
-    // step below it and stops at the first step past it
+    // step below it, up to 0.999 of it, and stops at the first step past it, saying that the
+    // friction cannot hold the load (issue 39)
     let tan_a: f64 = 0.1;
     let limit = (tan_a + MU) / (1.0 - MU * tan_a);
-    let ramp = [0.0, 0.25, 0.5, 0.75, 0.9, 0.97, 0.99, 0.998, 1.005, 1.02];
+    let ramp = [
+        0.0, 0.25, 0.5, 0.75, 0.9, 0.97, 0.99, 0.998, 0.999, 1.005, 1.02,
+    ];
     let (g, area) = (10.0, 2.0);
     let (s, c) = (
         tan_a / (1.0 + tan_a * tan_a).sqrt(),
@@ -392,6 +395,31 @@ fn on_a_load_path_the_block_starts_to_slide_at_the_coulomb_limit() {
             assert_ne!(step.termination, Termination::Converged);
         }
     }
+    let said: Vec<&String> = o
+        .warnings
+        .iter()
+        .filter(|w| w.contains("the frictional forces cannot hold the load"))
+        .collect();
+    assert_eq!(said.len(), 1, "{:?}", o.warnings);
+    assert!(
+        said[0].contains(&format!("load step {}", past + 1)),
+        "{}",
+        said[0]
+    );
+    // the ratio of the tangential load to mu times the normal load, in the incline's frame
+    let at = ramp[past];
+    let ratio = (at * f * c - g * s) / (MU * (g * c + at * f * s));
+    assert!(
+        said[0].contains(&format!("ratio {ratio:.6}")),
+        "{ratio}: {}",
+        said[0]
+    );
+    // no remedy that cannot help (a softer penalty, more iterations)
+    assert!(
+        o.warnings.iter().all(|w| !w.contains("lower kappa")),
+        "{:?}",
+        o.warnings
+    );
     // under its weight alone (tan a < mu) the block holds; an edge node may slip locally
     // (Poisson's expansion against friction), as the counts show
     let first = steps[0].friction.as_ref().unwrap();
@@ -962,7 +990,7 @@ fn lagrange_multipliers_hold_a_block_on_an_incline_up_to_the_coulomb_limit() {
     let tan_a: f64 = 0.1;
     let limit = (tan_a + MU) / (1.0 - MU * tan_a);
     assert!((limit - 0.412371).abs() < 1e-6);
-    for ratio in [0.5, 0.98, 0.995] {
+    for ratio in [0.5, 0.98, 0.995, 0.999] {
         let o = run(&lagrange(incline(ratio * limit, tan_a, 4)));
         let share = assert_incline_balance(
             &o,
@@ -976,9 +1004,16 @@ fn lagrange_multipliers_hold_a_block_on_an_incline_up_to_the_coulomb_limit() {
             iterations_per_step(&o)
         );
     }
-    // just past the limit no equilibrium exists
+    // just past the limit no equilibrium exists, and the run says why
     let o = run(&lagrange(incline(1.01 * limit, tan_a, 4)));
     assert_ne!(termination(&o), Termination::Converged);
+    assert!(
+        o.warnings.iter().any(|w| w.contains(
+            "load step 1 has no equilibrium: the frictional forces cannot hold the load"
+        )),
+        "{:?}",
+        o.warnings
+    );
 }
 
 /// `v` with the augmented Lagrangian as the normal law of its pair (and so for friction), the
@@ -1422,4 +1457,189 @@ fn at_finite_strain_the_load_steps_carry_the_slip_history() {
         }
         println!("finite strain, {name}: the held step moved the block by {moved:.1e} of its largest displacement");
     }
+}
+
+/// A block `[0, 2] x [0, 1]` (`nu = 0`) of `element` (Q4 or Q9, 4 x 2 cells) on a rigid line
+/// with Coulomb friction under `enforcement`, loaded along `path`: its top pressed by `P` times
+/// the first factor and moved along x by the second.
+fn friction_block(element: &str, enforcement: Value, path: &[(f64, f64)]) -> Value {
+    let pressure: Vec<f64> = path.iter().map(|p| p.0).collect();
+    let slide: Vec<f64> = path.iter().map(|p| p.1).collect();
+    json!({
+        "name": "friction-block",
+        "analysis": {"plane": "strain", "thickness": 1.0},
+        "materials": {"m": {"E": 1000.0, "nu": 0.0}},
+        "bodies": [{"name": "block", "material": "m",
+            "mesh": {"block": {"element": element, "x": [0, 0.5, 1, 1.5, 2], "y": [0, 0.5, 1]}}}],
+        "supports": [{"body": "block", "set": "top", "x": 1.0, "path": slide}],
+        "loads": [{"body": "block", "set": "top", "pressure": P, "path": pressure}],
+        "contact": [{
+            "name": "base",
+            "slave": {"body": "block", "set": "bottom"},
+            "master": {"rigid": {"kind": "line", "point": [0.0, 0.0], "normal": [0.0, 1.0]}},
+            "discretization": {"kind": "node_to_surface", "passes": 1},
+            "enforcement": enforcement,
+            "interaction": {"coulomb": {"mu": MU}},
+        }],
+        "solver": {"scheme": "newton", "load_steps": path.len()},
+    })
+}
+
+/// What the friction block's closed form fixes in each step (`nu = 0`, width `W = 2`): the
+/// top moved by `d` while pressed slips at every point where the move outruns the elastic
+/// range (`|d - d^n| > 2 mu p (H / G + 1 / kappa_t)`, `H / G = 1 / 500`), the tangential
+/// force then `-mu p W sign(d - d^n)` on the block; after a slip step the same direction's
+/// traction is already in place, so the next slip step moves the bottom with the top and
+/// dissipates `mu p W |d - d^n|`. A step inside the elastic range sticks with `|F_t| < mu p
+/// W` (but for the end nodes) and dissipates next to nothing; an unloaded step carries no
+/// force. Per step: the status, the
+/// tangential force (`None`: only inside the cone), the dissipation (`None`: only `>= 0`; the
+/// first slip step after a press or a reversal shears the block as well, which the free
+/// sides of the block make a two-dimensional field).
+fn friction_block_closed_form(path: &[(f64, f64)]) -> Vec<(Status, Option<f64>, Option<f64>)> {
+    let width = 2.0;
+    let elastic = 2.0 * MU * P * (1.0 / 500.0 + 1e-4);
+    let mut last: Option<f64> = None; // the direction of the last slip step
+    let mut previous = 0.0;
+    path.iter()
+        .map(|&(pressure, d)| {
+            let step = d - previous;
+            previous = d;
+            if pressure == 0.0 {
+                return (Status::Open, Some(0.0), None);
+            }
+            if step.abs() < elastic {
+                if step != 0.0 {
+                    last = None;
+                }
+                return (Status::Stick, None, None);
+            }
+            let direction = step.signum();
+            let force = -MU * P * pressure * width * direction;
+            let dissipation =
+                (last == Some(direction)).then(|| MU * P * pressure * width * step.abs());
+            last = Some(direction);
+            (Status::Slip, Some(force), dissipation)
+        })
+        .collect()
+}
+
+/// Issue 39: a friction block pressed, slid by ten element lengths, brought back through a
+/// step that sticks and slid back past its start, with Q4 and Q9 cells and every
+/// enforcement that carries friction: every step converges (Newton after a slip starts on the
+/// cone, in stick), in a few iterations, and each step's status, tangential force and
+/// dissipation are the closed form's.
+#[test]
+fn a_friction_block_slid_back_and_forth_converges_in_every_step_to_the_closed_form() {
+    let h = 0.5;
+    let mut path = vec![(1.0, 0.0)];
+    path.extend((1..=10).map(|k| (1.0, k as f64 * h)));
+    // a small reversal sticks (the elastic range is 2 mu p (H / G + 1 / kappa_t) wide), then
+    // back past the start, and off
+    path.push((1.0, 10.0 * h - 0.0002));
+    path.extend((0..=4).rev().map(|k| (1.0, (2 * k) as f64 * h - 1.0)));
+    let penalty = 1e4;
+    let enforcements = [
+        ("penalty", json!({"kind": "penalty", "kappa": penalty})),
+        (
+            "perturbed Lagrangian",
+            json!({"kind": "perturbed_lagrange", "kappa": penalty}),
+        ),
+        (
+            "augmented Lagrangian",
+            json!({"kind": "augmented_lagrange", "kappa": penalty}),
+        ),
+        ("Lagrange", json!({"kind": "lagrange"})),
+    ];
+    for element in ["Q4", "Q9"] {
+        for (name, enforcement) in &enforcements {
+            let o = run(&friction_block(element, enforcement.clone(), &path));
+            let expected = friction_block_closed_form(&path);
+            let state = o.solution.contact.as_ref().unwrap();
+            let label = format!("{element}, {name}");
+            assert_eq!(
+                state.steps.len(),
+                path.len(),
+                "{label}: {:?}",
+                state.termination
+            );
+            let iterations: Vec<usize> = state.steps.iter().map(|s| s.iterations).collect();
+            println!("{label}: iterations per step {iterations:?}");
+            for (step, (status, force, dissipation)) in state.steps.iter().zip(&expected) {
+                let what = format!("{label}, step {}", step.step);
+                assert_eq!(step.termination, Termination::Converged, "{what}");
+                let f = step.friction.as_ref().unwrap();
+                let points = f.open + f.stick + f.slip;
+                let count = match status {
+                    // unloaded: open, or closed at a zero gap with a force of round-off
+                    Status::Open => f.open + f.stick + f.slip,
+                    // the two end nodes, where the free sides concentrate the traction, may
+                    // go on slipping through a small reversal
+                    Status::Stick => f.stick + f.slip.min(2),
+                    // (an end node may lift off: the drag tips the block, whose sides are free)
+                    Status::Slip => f.slip + f.open.min(2),
+                };
+                assert_eq!(count, points, "{what}: {f:?}, expected {status:?}");
+                let bound = MU * P * 2.0;
+                match force {
+                    Some(force) => assert!(
+                        (f.tangential_force[0] - force).abs() <= 1e-9 * bound,
+                        "{what}: {f:?}, expected {force}"
+                    ),
+                    None => assert!(f.tangential_force[0].abs() < bound, "{what}: {f:?}"),
+                }
+                match dissipation {
+                    Some(d) => assert!(
+                        (f.dissipation - d).abs() <= 1e-9 * (1.0 + d),
+                        "{what}: {f:?}, expected {d}"
+                    ),
+                    None => assert!(f.dissipation >= 0.0, "{what}: {f:?}"),
+                }
+            }
+            // the penalty laws in at most 5 iterations a step (the augmented Lagrangian's
+            // count includes its Uzawa passes; Lagrange multipliers have their own sets)
+            if name.starts_with("penalty") || name.starts_with("perturbed") {
+                let worst = iterations.iter().max().copied().unwrap_or(0);
+                assert!(worst <= 5, "{label}: {iterations:?}");
+            }
+        }
+    }
+}
+
+/// The iterations-per-step table of `contact-patch friction-convergence` (issue 39): every
+/// discretization and enforcement of the slip patch's sweep, the friction blocks and defect
+/// N01, with this very build as the baseline: the baseline runner (a case file, `run`, its
+/// summary) reads the same iterations and endings the in-process solves give, and every
+/// penalty-type cell converges.
+#[test]
+fn the_iterations_per_step_table_reads_a_baseline_build_as_it_solves_in_process() {
+    use contact_patch::harness::friction_convergence::{step_iterations, step_iterations_report};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let work = tempfile::tempdir().unwrap();
+    let binary = Path::new(env!("CARGO_BIN_EXE_contact-patch"));
+    let rows = step_iterations(root, Some(binary), work.path()).unwrap();
+    assert!(rows.len() >= 50, "{}", rows.len());
+    assert!(rows.iter().any(|r| r.problem.starts_with("defect N01")));
+    for r in &rows {
+        let (iterations, termination) = r.baseline.clone().unwrap();
+        let what = format!("{} / {} / {}", r.problem, r.discretization, r.enforcement);
+        if r.termination == "converged" {
+            assert_eq!(
+                (&iterations, termination.as_str()),
+                (&r.iterations, "converged"),
+                "{what}"
+            );
+        } else {
+            assert!(termination != "converged", "{what}: {termination}");
+        }
+        if r.enforcement == "penalty" || r.enforcement == "perturbed_lagrange" {
+            assert!(
+                r.termination == "converged" || r.termination.starts_with("refused: "),
+                "{what}: {}",
+                r.termination
+            );
+        }
+    }
+    let report = step_iterations_report(&rows, Some("this build"));
+    assert!(report.contains("| before | after |"), "{report}");
 }

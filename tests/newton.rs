@@ -407,3 +407,25 @@ fn finite_strain_newton_converges_at_its_round_off_floor_wherever_the_problem_si
         assert_eq!(summary["finite"]["cuts"], 0, "{name}");
     }
 }
+
+/// Defect N01 (second report): an 8 x 4 block pressed onto a rigid line (penalty Coulomb,
+/// mu 0.3) and then moved at its top stopped at its second step, `IterationLimit` after 200
+/// iterations: a node that slipped in step 1 started step 2 with a trial force on the cone only
+/// up to round-off, on the slip branch without tangential stiffness, and the iterates ran
+/// away. Now the trial force at a step's start is the committed force to the last bit, the
+/// point sticks, and each step converges in a few iterations, with 7 points in stick and 2 in
+/// slip at the end (the reference's plain semi-smooth Newton: 2 iterations).
+#[test]
+fn friction_newton_converges_in_the_step_after_a_slip() {
+    let (code, summary, _dir) = run_reproducer("N01");
+    assert_eq!(code, 0, "{summary}");
+    let iterations = converged_iterations("N01", &summary);
+    assert_eq!(iterations.len(), 2, "{iterations:?}");
+    assert!(iterations.iter().all(|&k| k <= 5), "{iterations:?}");
+    let last = &summary["contact"]["steps"][1]["friction"];
+    assert_eq!(
+        (&last["stick"], &last["slip"]),
+        (&json!(7), &json!(2)),
+        "{last}"
+    );
+}

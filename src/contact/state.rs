@@ -86,6 +86,7 @@ pub(crate) fn committed_history<const D: usize>(
                         slip: f.plastic_slip,
                         normal_force: f.normal_force,
                         tangential_force: f.force,
+                        start_slip: f.slip,
                     },
                 )
             })
@@ -175,4 +176,13 @@ pub struct IterationRecord {
     /// absent elsewhere.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stability: Option<Stability>,
+    /// The length of the Newton step that reached this iterate, as a share of the full step:
+    /// below 1 where the line search shortened it ([`crate::solver::newton::ARMIJO`]); 1 for a
+    /// full step and for a scheme without line search (absent from the output then).
+    #[serde(skip_serializing_if = "is_full_step")]
+    pub step_length: f64,
+}
+
+fn is_full_step(length: &f64) -> bool {
+    *length == 1.0
 }

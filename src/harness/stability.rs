@@ -24,6 +24,15 @@
 //!   Multiplier Methods*, 1982, ch. 2; Laursen, *Computational Contact and Impact Mechanics*,
 //!   2002, sec. 5.3), so a penalty far below the stiffness of the bodies, `E / h`, needs
 //!   thousands of iterations; the diagnosis gives the measured rate and a penalty that works.
+//! * A load step that has no equilibrium: a body without supports, pressed by its load onto
+//!   flat rigid masters of one normal `n` with Coulomb friction, is in equilibrium only if the
+//!   contact forces carry its load `F`; their tangential sum is at most `mu` times their
+//!   normal sum (Coulomb at every point, `|sum lambda_t| <= sum |lambda_t| <= mu sum
+//!   lambda_n`), so a load with `|F_t| > mu F_n` (`F_n = -F . n`, the part pressing the body
+//!   on) or one that pulls the body off (`F_n <= 0`, `F != 0`) has none: the body slides (or
+//!   flies) away and the slip grows without bound. A failed step is then named for that
+//!   cause, not for Newton's iteration limit (a block on an incline pushed past
+//!   `F / G = (tan a + mu) / (1 - mu tan a)`).
 
 use crate::contact::enforcement::{method, Method};
 use crate::contact::state::{ContactState, Termination};
@@ -288,14 +297,114 @@ fn iterative_stall(model: &Model, state: &ContactState) -> Option<String> {
 /// The stability warnings of a run: equilibrium not at round-off, a stalled iteration, an
 /// unstable equilibrium.
 pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
-    let stall = stall_diagnosis(model, solution);
+    // a step without equilibrium explains any stall: no penalty or iteration count helps
+    let no_equilibrium = friction_cannot_hold(model, solution);
+    let stall = if no_equilibrium.is_some() {
+        None
+    } else {
+        stall_diagnosis(model, solution)
+    };
     equilibrium_warning(model, solution)
         .into_iter()
+        .chain(no_equilibrium)
         .chain(stall)
         .chain(energy_growth(model, solution))
         .chain(unstable_equilibrium(solution))
         .collect()
 }
+
+/// Why a static load step that did not converge has no equilibrium at all (see the module
+/// notes): a body without supports whose contact pairs are all slave sides on flat rigid
+/// masters of one normal, with Coulomb friction, loaded in that step beyond what the friction
+/// can hold (`|F_t| > mu F_n`, [`NO_HOLD_MARGIN`]) or pulled off the masters. `None` for a
+/// converged solve or any other cause.
+pub fn friction_cannot_hold<const D: usize, K: crate::model::space::SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+) -> Option<String> {
+    use crate::io::scene::{Interaction, RigidSurface};
+    use crate::model::MasterSide;
+    let state = solution.contact.as_ref()?;
+    if state.termination == Termination::Converged || solution.dynamics.is_some() {
+        return None;
+    }
+    let step = state.steps.last()?.step;
+    let n = model.solver.load_steps.max(step);
+    let at = model.at_step(step, n);
+    model.bodies.iter().enumerate().find_map(|(b, body)| {
+        let dofs = body.dof_offset..body.dof_offset + D * body.mesh.nodes.len();
+        if dofs.clone().any(|d| model.prescribed.get(d).is_some_and(Option::is_some)) {
+            return None;
+        }
+        // the pairs that hold the body: each a slave side on a flat rigid master with friction
+        let mut holding = model.contact.iter().filter(|p| {
+            p.slave.0 == b || matches!(&p.master, MasterSide::Body { body: m, .. } if *m == b)
+        });
+        let mut normal: Option<[f64; D]> = None;
+        let mut mu = 0.0f64;
+        let mut names = Vec::new();
+        let all_held = holding.all(|p| {
+            let (MasterSide::Rigid(surface), Interaction::Coulomb { mu: m, .. }) =
+                (&p.master, &p.interaction)
+            else {
+                return false;
+            };
+            let direction: Vec<f64> = match surface {
+                RigidSurface::Line { normal, .. } => normal.to_vec(),
+                RigidSurface::Plane { normal, .. } => normal.to_vec(),
+                _ => return false,
+            };
+            if direction.len() != D || p.slave.0 != b {
+                return false;
+            }
+            let length = direction.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let unit: [f64; D] = std::array::from_fn(|i| direction[i] / length);
+            let same = normal.is_none_or(|n0| {
+                n0.iter().zip(&unit).map(|(a, c)| a * c).sum::<f64>() >= 1.0 - 1e-12
+            });
+            normal.get_or_insert(unit);
+            mu = mu.max(*m);
+            names.push(format!("'{}'", p.name));
+            same
+        });
+        let normal = normal?;
+        if !all_held {
+            return None;
+        }
+        let mut load = [0.0; D];
+        for d in dofs {
+            load[(d - body.dof_offset) % D] += at.external_force.get(d).copied().unwrap_or(0.0);
+        }
+        let size = load.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let along: f64 = load.iter().zip(&normal).map(|(a, c)| a * c).sum();
+        let pressing = -along;
+        let tangential = load
+            .iter()
+            .zip(&normal)
+            .map(|(a, c)| (a - along * c).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let body_name = &body.name;
+        let pairs = names.join(", ");
+        if size > 0.0 && pressing <= NO_HOLD_MARGIN * size {
+            return Some(format!(
+                "load step {step} has no equilibrium: its load on body '{body_name}' (resultant {size:.4e}) does not press the body onto its masters {pairs} (normal part {pressing:.4e}) and nothing else holds it, so it moves away without bound; support the body or load it towards the masters"
+            ));
+        }
+        (tangential > mu * pressing * (1.0 + NO_HOLD_MARGIN)).then(|| {
+            format!(
+                "load step {step} has no equilibrium: the frictional forces cannot hold the load, and the slip grows without bound: the load on body '{body_name}' pushes it along its masters {pairs} with {tangential:.6e}, more than mu = {mu} times the {pressing:.6e} that presses it on (mu F_n = {:.6e}, ratio {:.6}); keep the tangential load at or below mu times the normal load, raise mu, or support the body",
+                mu * pressing,
+                tangential / (mu * pressing).max(f64::MIN_POSITIVE)
+            )
+        })
+    })
+}
+
+/// The relative margin by which a load must exceed the friction's hold (`|F_t| > mu F_n (1 +
+/// margin)`) before a failed step is said to have no equilibrium: the round-off of the load's
+/// resultant, summed from the nodal forces.
+pub const NO_HOLD_MARGIN: f64 = 1e-9;
 
 /// A warning when a finite-kinematics solve converged to a state that is not a stable
 /// equilibrium: the last Newton iteration of the last load step records

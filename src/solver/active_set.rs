@@ -2371,6 +2371,7 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
                 repeated_set: repeated,
                 cycling_remedy: !held.is_empty(),
                 stability: None,
+                step_length: 1.0,
             });
             let converged = match method {
                 Method::Lagrange | Method::Elimination => stable,
@@ -2562,6 +2563,7 @@ impl<const D: usize, K: Discretize<D>> Kernel<'_, D, K> {
                     repeated_set: false,
                     cycling_remedy: false,
                     stability: None,
+                    step_length: 1.0,
                 });
                 previous_forces = forces;
                 seen.push(std::mem::replace(&mut active, next));
