@@ -181,7 +181,7 @@ enum Command {
         out: PathBuf,
         /// Another build of the tool (a contact-patch executable) to run the same cases of the
         /// iterations-per-step table with, listed as "before" beside this build's (its case
-        /// files and outputs go to OUT/friction-convergence-baseline).
+        /// files and outputs go to a scratch folder in OUT, removed after the run).
         #[arg(long, value_name = "BINARY")]
         baseline: Option<PathBuf>,
     },
@@ -1530,11 +1530,16 @@ fn friction_convergence(out: &Path, baseline: Option<&Path>) -> ExitCode {
     let result = (|| -> contact_patch::Result<()> {
         use contact_patch::harness::friction_convergence as study;
         let runs = study::study(Path::new("."))?;
-        let steps = study::step_iterations(
-            Path::new("."),
-            baseline,
-            &folder.path().join("friction-convergence-baseline"),
-        )?;
+        // the baseline's case files and outputs: a scratch folder of this run, removed after
+        let work = folder.path().join(format!(
+            ".friction-convergence-baseline-{}",
+            std::process::id()
+        ));
+        let steps = study::step_iterations(Path::new("."), baseline, &work);
+        if baseline.is_some() {
+            let _ = std::fs::remove_dir_all(&work);
+        }
+        let steps = steps?;
         let shown = baseline.map(|b| b.display().to_string());
         folder.write_file(
             "friction-convergence.md",
