@@ -19,7 +19,8 @@
 //!   the dragged slab sticks below and slips at `mu N` above the limit; the penalty's forces
 //!   approach the Lagrange ones as `1/kappa` (kappa 1e3 to 1e8); the penalty's Newton
 //!   iteration, which diverged into a cycle on the partial-slip cube at kappa 1e5 and 1e8,
-//!   converges there once restarted with the line search on the residual norm; a punch dragged over its foundation by mortar
+//!   converges there in at most 5 iterations a step with every step under the line search on
+//!   the residual norm; a punch dragged over its foundation by mortar
 //!   rows slips at `mu N` with the forces on the two bodies in balance; rotation invariance
 //!   of mortar friction; a two-body slab one element thick reproduces 2D plane-strain mortar
 //!   and Lagrange friction.
@@ -831,9 +832,10 @@ fn the_penalty_newton_iteration_converges_in_partial_slip_at_every_kappa() {
     // the cube with nu = 0.3 dragged into partial slip, the drag in one or two steps after the
     // press: the full semi-smooth Newton step diverged at kappa = 1e5 and 1e8 (residual from
     // 0.25 to 1 of the force scale, contact forces up to 7e4 times the load) and ended in a
-    // cycle (`active_set_cycling`); restarted with the line search on the residual norm, every
-    // solve converges to an answer (the normal forces carry the load, no point outside the
-    // cone, stick and slip both present). (kappa = 1e3 sticks everywhere: left out.)
+    // cycle (`active_set_cycling`); with every step under the line search on the residual norm
+    // (issue 39; until then it restarted from the first iterate after the cycle), every solve
+    // converges to an answer (the normal forces carry the load, no point outside the cone,
+    // stick and slip both present). (kappa = 1e3 sticks everywhere: left out.)
     let angle = 0.7f64;
     let d = 4e-3;
     for steps in [2usize, 3] {
@@ -854,10 +856,10 @@ fn the_penalty_newton_iteration_converges_in_partial_slip_at_every_kappa() {
             let state = o.solution.contact.as_ref().unwrap();
             let iterations: Vec<usize> = state.steps.iter().map(|s| s.iterations).collect();
             println!("kappa {kappa:e}, {steps} steps: iterations per step {iterations:?}");
-            // (measured: at most 60, at kappa = 1e8 in two steps, the iterations up to the
-            // cycle included; the solver's limit is 200)
+            // (measured: at most 5; with the restart after a cycle, up to 60 at kappa = 1e8 in
+            // two steps, the iterations up to the cycle included)
             assert!(
-                iterations.iter().all(|&i| i <= 64),
+                iterations.iter().all(|&i| i <= 5),
                 "{kappa} {steps}: {iterations:?}"
             );
             let (_, n, statuses) = totals(state);
