@@ -1459,30 +1459,12 @@ fn at_finite_strain_the_load_steps_carry_the_slip_history() {
     }
 }
 
-/// A block `[0, 2] x [0, 1]` (`nu = 0`) of `element` (Q4 or Q9, 4 x 2 cells) on a rigid line
-/// with Coulomb friction under `enforcement`, loaded along `path`: its top pressed by `P` times
-/// the first factor and moved along x by the second.
+/// The friction block of `contact-patch friction-convergence` (one case, shared) under
+/// `enforcement`, loaded along `path`.
 fn friction_block(element: &str, enforcement: Value, path: &[(f64, f64)]) -> Value {
-    let pressure: Vec<f64> = path.iter().map(|p| p.0).collect();
-    let slide: Vec<f64> = path.iter().map(|p| p.1).collect();
-    json!({
-        "name": "friction-block",
-        "analysis": {"plane": "strain", "thickness": 1.0},
-        "materials": {"m": {"E": 1000.0, "nu": 0.0}},
-        "bodies": [{"name": "block", "material": "m",
-            "mesh": {"block": {"element": element, "x": [0, 0.5, 1, 1.5, 2], "y": [0, 0.5, 1]}}}],
-        "supports": [{"body": "block", "set": "top", "x": 1.0, "path": slide}],
-        "loads": [{"body": "block", "set": "top", "pressure": P, "path": pressure}],
-        "contact": [{
-            "name": "base",
-            "slave": {"body": "block", "set": "bottom"},
-            "master": {"rigid": {"kind": "line", "point": [0.0, 0.0], "normal": [0.0, 1.0]}},
-            "discretization": {"kind": "node_to_surface", "passes": 1},
-            "enforcement": enforcement,
-            "interaction": {"coulomb": {"mu": MU}},
-        }],
-        "solver": {"scheme": "newton", "load_steps": path.len()},
-    })
+    let mut v = contact_patch::harness::friction_convergence::friction_block(element, path);
+    v["contact"][0]["enforcement"] = enforcement;
+    v
 }
 
 /// What the friction block's closed form fixes in each step (`nu = 0`, width `W = 2`): the
@@ -1531,13 +1513,7 @@ fn friction_block_closed_form(path: &[(f64, f64)]) -> Vec<(Status, Option<f64>, 
 /// dissipation are the closed form's.
 #[test]
 fn a_friction_block_slid_back_and_forth_converges_in_every_step_to_the_closed_form() {
-    let h = 0.5;
-    let mut path = vec![(1.0, 0.0)];
-    path.extend((1..=10).map(|k| (1.0, k as f64 * h)));
-    // a small reversal sticks (the elastic range is 2 mu p (H / G + 1 / kappa_t) wide), then
-    // back past the start, and off
-    path.push((1.0, 10.0 * h - 0.0002));
-    path.extend((0..=4).rev().map(|k| (1.0, (2 * k) as f64 * h - 1.0)));
+    let path = contact_patch::harness::friction_convergence::friction_block_path();
     let penalty = 1e4;
     let enforcements = [
         ("penalty", json!({"kind": "penalty", "kappa": penalty})),

@@ -67,23 +67,39 @@ fn incline(ratio: f64) -> Value {
         1.0 / (1.0 + tan_a * tan_a).sqrt(),
     );
     let f = ratio * limit * g;
+    let load =
+        json!([{"body": "block", "body_force": [(f * c - g * s) / area, -(g * c + f * s) / area]}]);
+    block_on_rigid_line("incline", "Q4", 0.3, json!([]), load, 4)
+}
+
+/// A block `[0, 2] x [0, 1]` (E = 1000, Poisson's ratio `nu`) of `element` cells (4 x 2) on the
+/// rigid line `y = 0`, its bottom the slave of a node-to-surface pair with Coulomb friction
+/// (mu = 0.3, penalty 1e4), under `supports` and `loads`, in `steps` load steps (Newton).
+fn block_on_rigid_line(
+    name: &str,
+    element: &str,
+    nu: f64,
+    supports: Value,
+    loads: Value,
+    steps: usize,
+) -> Value {
     json!({
-        "name": "incline",
+        "name": name,
         "analysis": {"plane": "strain", "thickness": 1.0},
-        "materials": {"m": {"E": 1000.0, "nu": 0.3}},
+        "materials": {"m": {"E": 1000.0, "nu": nu}},
         "bodies": [{"name": "block", "material": "m",
-            "mesh": {"block": {"element": "Q4", "x": [0, 0.5, 1, 1.5, 2], "y": [0, 0.5, 1]}}}],
-        "supports": [],
-        "loads": [{"body": "block", "body_force": [(f * c - g * s) / area, -(g * c + f * s) / area]}],
+            "mesh": {"block": {"element": element, "x": [0, 0.5, 1, 1.5, 2], "y": [0, 0.5, 1]}}}],
+        "supports": supports,
+        "loads": loads,
         "contact": [{
             "name": "base",
             "slave": {"body": "block", "set": "bottom"},
             "master": {"rigid": {"kind": "line", "point": [0.0, 0.0], "normal": [0.0, 1.0]}},
             "discretization": {"kind": "node_to_surface", "passes": 1},
             "enforcement": {"kind": "penalty", "kappa": 1e4},
-            "interaction": {"coulomb": {"mu": mu}},
+            "interaction": {"coulomb": {"mu": 0.3}},
         }],
-        "solver": {"scheme": "newton", "load_steps": 4},
+        "solver": {"scheme": "newton", "load_steps": steps},
     })
 }
 
@@ -245,33 +261,33 @@ fn reversed_slip_patch(patch: &Value) -> Value {
     v
 }
 
-/// The friction block of `tests/friction.rs` (`a_friction_block_slid_back_and_forth...`).
-fn friction_block(element: &str) -> Value {
+/// The load path of the friction block ([`friction_block`]): (pressure factor, top slide) per
+/// step: pressed, slid by ten element lengths (0.5 each), brought back by 0.0002 (inside the
+/// elastic range), slid back past its start to -1.
+pub fn friction_block_path() -> Vec<(f64, f64)> {
     let h = 0.5;
     let mut path = vec![(1.0, 0.0)];
     path.extend((1..=10).map(|k| (1.0, k as f64 * h)));
     path.push((1.0, 10.0 * h - 0.0002));
     path.extend((0..=4).rev().map(|k| (1.0, (2 * k) as f64 * h - 1.0)));
+    path
+}
+
+/// The friction block (`tests/friction.rs`): a block `[0, 2] x [0, 1]` (E = 1000, `nu = 0`)
+/// of `element` (Q4 or Q9, 4 x 2 cells) on a rigid line with Coulomb friction (mu = 0.3,
+/// penalty 1e4), its top pressed by 10 times the first factor of `path` and moved along x by
+/// the second.
+pub fn friction_block(element: &str, path: &[(f64, f64)]) -> Value {
     let pressure: Vec<f64> = path.iter().map(|p| p.0).collect();
     let slide: Vec<f64> = path.iter().map(|p| p.1).collect();
-    json!({
-        "name": format!("friction-block-{element}"),
-        "analysis": {"plane": "strain", "thickness": 1.0},
-        "materials": {"m": {"E": 1000.0, "nu": 0.0}},
-        "bodies": [{"name": "block", "material": "m",
-            "mesh": {"block": {"element": element, "x": [0, 0.5, 1, 1.5, 2], "y": [0, 0.5, 1]}}}],
-        "supports": [{"body": "block", "set": "top", "x": 1.0, "path": slide}],
-        "loads": [{"body": "block", "set": "top", "pressure": 10.0, "path": pressure}],
-        "contact": [{
-            "name": "base",
-            "slave": {"body": "block", "set": "bottom"},
-            "master": {"rigid": {"kind": "line", "point": [0.0, 0.0], "normal": [0.0, 1.0]}},
-            "discretization": {"kind": "node_to_surface", "passes": 1},
-            "enforcement": {"kind": "penalty", "kappa": 1e4},
-            "interaction": {"coulomb": {"mu": 0.3}},
-        }],
-        "solver": {"scheme": "newton", "load_steps": path.len()},
-    })
+    block_on_rigid_line(
+        &format!("friction-block-{element}"),
+        element,
+        0.0,
+        json!([{"body": "block", "set": "top", "x": 1.0, "path": slide}]),
+        json!([{"body": "block", "set": "top", "pressure": 10.0, "path": pressure}]),
+        path.len(),
+    )
 }
 
 /// A short name of a discretization or enforcement of the sweep.
@@ -330,7 +346,8 @@ fn sweep_cases(patch: &Value, reproducer: Option<Value>) -> Vec<(String, String,
             ));
         }
     }
-    let blocks = ["Q4", "Q9"].map(|e| (format!("friction block {e}"), friction_block(e)));
+    let path = friction_block_path();
+    let blocks = ["Q4", "Q9"].map(|e| (format!("friction block {e}"), friction_block(e, &path)));
     let n01 = reproducer.map(|v| ("defect N01 (8 x 4 block, 2 steps)".to_string(), v));
     for (problem, block) in blocks.into_iter().chain(n01) {
         for e in &enforcements {
