@@ -1033,6 +1033,17 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
         })
     }
 
+    /// Lagrange-multiplier friction: a tangential penalty's return map is continuous in the
+    /// slip, where the multipliers' stick/slip sets jump.
+    fn cycle_advice(&self) -> Option<String> {
+        self.rows
+            .iter()
+            .any(|r| !r.tangents.is_empty() && matches!(self.law(r), RowLaw::Multiplier))
+            .then(|| {
+                "for Lagrange-multiplier friction consider a tangential penalty (penalty or augmented Lagrangian enforcement with kappa_t), whose return map is continuous in the slip".to_string()
+            })
+    }
+
     fn pattern_version(&self) -> usize {
         self.version
     }
