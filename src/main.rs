@@ -1535,8 +1535,17 @@ fn friction_convergence(out: &Path, baseline: Option<&Path>) -> ExitCode {
             ".friction-convergence-baseline-{}",
             std::process::id()
         ));
+        // only a folder this run creates is removed: one that is there already is refused
+        if baseline.is_some() && work.exists() {
+            return Err(contact_patch::error::Error::invalid(
+                work.display(),
+                "--baseline",
+                "the scratch folder for the baseline's runs exists already",
+                "remove it, or choose another --out folder",
+            ));
+        }
         let steps = study::step_iterations(Path::new("."), baseline, &work);
-        if baseline.is_some() {
+        if baseline.is_some() && work.exists() {
             let _ = std::fs::remove_dir_all(&work);
         }
         let steps = steps?;

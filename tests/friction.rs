@@ -1619,3 +1619,42 @@ fn the_iterations_per_step_table_reads_a_baseline_build_as_it_solves_in_process(
     let report = step_iterations_report(&rows, Some("this build"));
     assert!(report.contains("| before | after |"), "{report}");
 }
+
+/// `friction-convergence --baseline` runs the baseline build in a scratch folder inside the
+/// output folder and removes only that folder: the files already in the output folder survive,
+/// and nothing of the scratch folder is left.
+#[test]
+fn the_baseline_scratch_folder_is_removed_and_nothing_else() {
+    let out = tempfile::tempdir().unwrap();
+    let keep = out.path().join("keep.txt");
+    std::fs::write(&keep, "must survive").unwrap();
+    std::fs::create_dir(out.path().join("sub")).unwrap();
+    std::fs::write(out.path().join("sub/also.txt"), "must survive").unwrap();
+    let binary = env!("CARGO_BIN_EXE_contact-patch");
+    let o = std::process::Command::new(binary)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["friction-convergence", "--baseline", binary, "--out"])
+        .arg(out.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read_to_string(&keep).unwrap(), "must survive");
+    assert_eq!(
+        std::fs::read_to_string(out.path().join("sub/also.txt")).unwrap(),
+        "must survive"
+    );
+    let mut names: Vec<String> = std::fs::read_dir(out.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "friction-convergence.json",
+            "friction-convergence.md",
+            "keep.txt",
+            "sub"
+        ]
+    );
+}
