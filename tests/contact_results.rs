@@ -494,3 +494,47 @@ fn open_points_report_no_slip() {
     assert_eq!(counts["open"], 60, "{counts:?}");
     assert!(counts["stick"] > 0 && counts["slip"] > 0, "{counts:?}");
 }
+
+/// Issue 38, item 2 (the contact half of defect W02): W02a's slave surface (the lower body's
+/// top, x in [0, 4]) is wider than its master (the upper body's bottom, x in [1, 3], two
+/// facets), here as a frictionless contact pair pressed by 10. A slave node past the master's
+/// free end (beyond the quarter-facet extension) has no facet under it. It was held against
+/// the nearest vertex that two facets share, the interior vertex (2, 1): x = 0.5 reported the
+/// gap 1.5, a distance to a point of the master it is nowhere near. Now such a node has no row:
+/// `unmeasured`, no gap, no force; the nodes under the master are closed at the pressure 10.
+#[test]
+fn a_contact_node_past_the_masters_end_has_no_row() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = edited(
+        "tests/defects/s4/W02a-tied-nts-slave-past-free-end.json",
+        dir.path(),
+        |c| {
+            c["contact"][0]["interaction"] = serde_json::json!("frictionless");
+            // the upper body slides freely on the lower one: hold its x at one point
+            c["bodies"][1]["node_sets"] = serde_json::json!({"corner": {"point": [1.0, 2.0]}});
+            c["supports"]
+                .as_array_mut()
+                .unwrap()
+                .push(serde_json::json!({"body": "upper", "set": "corner", "x": 0.0}));
+        },
+    );
+    let out = dir.path().join("out");
+    run(&path, &out, 0);
+    let rows = csv_rows(&out.join("tie.contact.csv"));
+    let slave: Vec<_> = rows.iter().filter(|r| r["side"] == "slave").collect();
+    assert_eq!(slave.len(), 9);
+    for row in slave {
+        let x = num(row, "x");
+        if (1.0..=3.0).contains(&x) {
+            assert_eq!(row["status"], "closed", "{row:?}");
+            // (the ends' nodes carry the half of their tributary that the master covers)
+            if x > 1.0 && x < 3.0 {
+                assert!((num(row, "pressure") - 10.0).abs() < 1e-9, "{row:?}");
+            }
+        } else {
+            assert_eq!(row["status"], "unmeasured", "{row:?}");
+            assert_eq!(row["gap"], "", "{row:?}");
+            assert_eq!(num(row, "force_y"), 0.0, "{row:?}");
+        }
+    }
+}
