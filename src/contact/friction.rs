@@ -345,8 +345,10 @@ pub fn augmented_return_map(
     let (stick, s, follows_trial) = match held {
         Some((Status::Stick, _)) => (true, [0.0; MAX_TANGENTS], false),
         Some((Status::Slip, s)) => (false, s, false),
+        // on the cone to round-off: stick, as the penalty map (a point that slipped starts
+        // its next step with the committed force, on the cone)
         _ => (
-            trial_length <= bound,
+            trial_length <= bound * (1.0 + CONE_ROUND_OFF),
             direction(k, &trial, trial_length),
             true,
         ),

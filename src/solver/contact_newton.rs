@@ -393,7 +393,11 @@ impl<'a, const D: usize, K: NewtonDimension<D>> ContactSystem<'a, D, K> {
 
     /// Augmented-Lagrangian Coulomb rows start a load step from the forces of the last one as
     /// their Uzawa multipliers (see [`crate::contact::friction`]; frictionless rows restart
-    /// from zero, as before).
+    /// from zero, as before), and from the stick point where the point ended it, the slip
+    /// `g_t^n`: the trial force `lambda_bar_t - w_t (g_t - g_t^n)` at the start of the step is
+    /// then the committed force to the last bit, as the penalty map's. (The last step's stick
+    /// point differs from `g_t^n` by what its Uzawa iteration left: `w_t` times that residual
+    /// was the difference between the committed force and the next step's first trial.)
     fn carry_uzawa_multipliers(&mut self) {
         for r in &self.rows {
             let key = row_key(r);
@@ -402,11 +406,12 @@ impl<'a, const D: usize, K: NewtonDimension<D>> ContactSystem<'a, D, K> {
                     update: Some(_), ..
                 },
                 Some(c),
-            ) = (self.law(r), self.committed.get(&key))
+            ) = (self.law(r), self.committed.get_mut(&key))
             else {
                 continue;
             };
             if c.normal_force > 0.0 {
+                c.slip = c.start_slip;
                 self.augmentation.insert(key, c.normal_force);
                 self.tangential_augmentation.insert(key, c.tangential_force);
             }
