@@ -1658,3 +1658,104 @@ fn the_baseline_scratch_folder_is_removed_and_nothing_else() {
         ]
     );
 }
+
+/// Issue 39, item 1: the state a step starts from is exact. The friction block is pressed and
+/// slid by 5 (every point slips), or slid by 5 and moved back by 0.0002 (a reversal inside the
+/// elastic range: the points stick, but for the ends), and then the same load is applied again
+/// (a step that changes nothing). Starting from the committed forces and slips to the last
+/// bit (the penalty map's trial `lambda_t^n - w_t (g_t - g_t^n)`; the augmented Lagrangian's
+/// Uzawa multipliers with the stick point where the point ended), the repeated step is solved
+/// at its first iterate: every point that slipped sits on the cone and sticks there, the
+/// tangential force is the last step's to round-off, and nothing is dissipated. (An augmented
+/// Lagrangian start from the last step's stick point missed the committed force of a sticking
+/// point by `w_t` times what its Uzawa iteration left of `g_t^n - g_t^p`.)
+#[test]
+fn a_repeated_load_step_starts_and_ends_at_the_committed_state() {
+    let paths = [
+        ("after a slip", vec![(1.0, 0.0), (1.0, 5.0), (1.0, 5.0)]),
+        (
+            "after a reversal",
+            vec![(1.0, 0.0), (1.0, 5.0), (1.0, 4.9998), (1.0, 4.9998)],
+        ),
+    ];
+    let enforcements = [
+        ("penalty", json!({"kind": "penalty", "kappa": 1e4})),
+        (
+            "perturbed Lagrangian",
+            json!({"kind": "perturbed_lagrange", "kappa": 1e4}),
+        ),
+        (
+            "augmented Lagrangian",
+            json!({"kind": "augmented_lagrange", "kappa": 1e4}),
+        ),
+        (
+            "augmented Lagrangian, outer loop",
+            json!({"kind": "augmented_lagrange", "kappa": 1e4, "update": "outer_loop"}),
+        ),
+        ("Lagrange", json!({"kind": "lagrange"})),
+    ];
+    for (when, path) in &paths {
+        for element in ["Q4", "Q9"] {
+            for (name, enforcement) in &enforcements {
+                let label = format!("{element}, {name}, {when}");
+                let o = run(&friction_block(element, enforcement.clone(), path));
+                let state = o.solution.contact.as_ref().unwrap();
+                let n = path.len();
+                assert_eq!(state.steps.len(), n, "{label}: {:?}", state.termination);
+                let (last, repeated) = (&state.steps[n - 2], &state.steps[n - 1]);
+                assert_eq!(repeated.termination, Termination::Converged, "{label}");
+                let (a, b) = (
+                    last.friction.as_ref().unwrap(),
+                    repeated.friction.as_ref().unwrap(),
+                );
+                if *when == "after a slip" {
+                    // slid by 5 (ten element lengths): every closed point slips
+                    assert_eq!(a.stick, 0, "{label}: {a:?}");
+                }
+                assert!(a.slip + a.stick > 0, "{label}: {a:?}");
+                // the repeated step: the penalty laws' points stick where they were (on the
+                // cone if they slipped) with their force. With multipliers the status of a
+                // point on the cone that does not move is a tie: the augmented Lagrangian's
+                // normal force restarts from its multiplier, the committed force, minus
+                // `w_n g_n^n` (the gap its Uzawa iteration left, within its tolerance), so a
+                // point on the cone may go on slipping by that much; a Lagrange point with
+                // `|lambda_t| = mu lambda_n` and no slip is on both branches. Their force and
+                // dissipation are fixed all the same
+                let penalty_law = name.starts_with("penalty") || name.starts_with("perturbed");
+                let closed = a.slip + a.stick;
+                if penalty_law {
+                    assert_eq!(
+                        (b.slip, b.stick, b.open),
+                        (0, closed, a.open),
+                        "{label}: {b:?}"
+                    );
+                } else {
+                    assert_eq!(
+                        (b.slip + b.stick, b.open),
+                        (closed, a.open),
+                        "{label}: {b:?}"
+                    );
+                }
+                // (the penalty laws and the augmented Lagrangian solve the repeated step at its
+                // first iterate; Lagrange multipliers restart from zero in every step and
+                // iterate back to the cone, within Newton's tolerance)
+                let bound = MU * P * 2.0;
+                let tol = if name == &"Lagrange" { 1e-9 } else { 1e-12 } * bound;
+                assert!(
+                    (b.tangential_force[0] - a.tangential_force[0]).abs() <= tol,
+                    "{label}: {} then {}",
+                    a.tangential_force[0],
+                    b.tangential_force[0]
+                );
+                assert!(b.dissipation.abs() <= tol, "{label}: {b:?}");
+                if name != &"Lagrange" {
+                    assert_eq!(repeated.iterations, 0, "{label}");
+                }
+                println!(
+                    "{label}: the repeated step in {} iterations, {:?}",
+                    repeated.iterations, b
+                );
+            }
+        }
+    }
+}
