@@ -1921,7 +1921,7 @@ fn merge(parts: &[PathBuf], out: &Path) -> ExitCode {
                 study: spec,
                 cells,
             } => {
-                let s = study::from_parts(*spec, source)?;
+                let s = study::from_parts(*spec, source, "merge")?;
                 let command = format!("contact-patch merge ({} shards)", parts.len());
                 for f in study::write_reports(&folder, &s, &cells, &command)? {
                     println!("wrote {}", folder.shown(&f).display());

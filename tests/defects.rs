@@ -581,6 +581,89 @@ fn c02_hostile_shard_files_are_refused_naming_the_field() {
     assert_eq!(code, 0, "{stdout}\n{stderr}");
 }
 
+/// `merge` took a study part's study and cells as written (found by the `shard` family of
+/// `tests/fuzz.rs`): a cell whose `labels` lost an entry panicked in the window table
+/// (`Vec::remove` out of bounds), an axis with fewer `labels` than values panicked when the
+/// labels were made (index out of bounds), and a `window` naming no axis hit an `expect`. The
+/// study a part carries now gets every check of a study file that needs no base case, and each
+/// cell must carry the labels of its grid coordinates; each is refused naming the part file
+/// and the field.
+#[test]
+fn c02_a_study_part_is_checked_as_a_study_file_and_its_cells_against_it() {
+    let s = Scratch::new();
+    let dir = s4("C02-merge-hostile-shards");
+    let parts = ["study-total-1e15-part1.json", "study-total-1e15-part2.json"];
+    let read = |p: &str| -> serde_json::Value {
+        let text = std::fs::read_to_string(dir.join(p)).unwrap();
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["total"] = serde_json::json!(2);
+        v
+    };
+    let window =
+        serde_json::json!({"axis": "enforcement", "max_iterations": 50, "max_condition": 1e12});
+    type Edit = fn(&mut serde_json::Value, &serde_json::Value);
+    let cases: [(&str, Edit, &[&str]); 4] = [
+        (
+            "a cell's labels emptied, with a window",
+            |v, w| {
+                v["study"]["window"] = w.clone();
+                v["cells"][0]["labels"] = serde_json::json!([]);
+            },
+            &[
+                "study-total-1e15-part1.json: cells[0].labels",
+                "[] are not the labels of cell",
+            ],
+        ),
+        (
+            "a cell's label of another value",
+            |v, _| v["cells"][0]["labels"] = serde_json::json!(["penalty"]),
+            &[
+                "study-total-1e15-part1.json: cells[0].labels",
+                "[\"penalty\"]",
+            ],
+        ),
+        (
+            "one label for two values",
+            |v, _| v["study"]["axes"][0]["labels"] = serde_json::json!(["only one"]),
+            &[
+                "study-total-1e15-part1.json: axes[0] 'enforcement'",
+                "1 labels for 2 values",
+            ],
+        ),
+        (
+            "a window naming no axis",
+            |v, w| {
+                v["study"]["window"] = w.clone();
+                v["study"]["window"]["axis"] = serde_json::json!("nope");
+            },
+            &[
+                "study-total-1e15-part1.json: along / window.axis",
+                "names no axis: 'nope'",
+            ],
+        ),
+    ];
+    for (what, edit, needles) in cases {
+        let mut first = read(parts[0]);
+        let mut second = read(parts[1]);
+        edit(&mut first, &window);
+        // the second part carries the same study, so only the first part's cells differ
+        second["study"] = first["study"].clone();
+        std::fs::write(s.work.join(parts[0]), first.to_string()).unwrap();
+        std::fs::write(s.work.join(parts[1]), second.to_string()).unwrap();
+        let result = s.run(&["merge", parts[0], parts[1], "--out", "D"], &["D"]);
+        assert_eq!(result.0, 2, "{what}:\n{}", result.2);
+        assert_refused(result, needles);
+    }
+    // unedited (the total their study makes), with the window, the parts merge
+    for p in parts {
+        let mut v = read(p);
+        v["study"]["window"] = window.clone();
+        std::fs::write(s.work.join(p), v.to_string()).unwrap();
+    }
+    let (code, stdout, stderr) = s.run(&["merge", parts[0], parts[1], "--out", "D"], &["D"]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+}
+
 /// `messages/` of the s4 report: each message names the field, the file or the section, and
 /// the accepted forms, where cb6f864 said "untagged enum", "trailing characters", "expected
 /// value", "Unknown error occurred", a degenerate constraint, or printed 1e308 with 309 digits.

@@ -15,6 +15,23 @@
 //! folder of several mutants, and as `table CASE --out DIR` on mutants of the sweep cases
 //! (`cases/patch`, `cases/tied`).
 //!
+//! It also mutates the result files the tool reads (about one run in five), made valid by the
+//! binary itself before the fuzzing (not counted in the time budget): family `vtu`, the body
+//! files `run` writes for a few cases ([`VTU_BASES`]: 2D and 3D, one and two bodies, contact,
+//! tie and friction), given to `judge CASE RESULTS` (a file or a folder of `<body>.vtu`,
+//! sometimes with `--junit FILE` or a hostile `--match-tol`) and to `table CASE --results DIR
+//! --code NAME --out DIR` (swept cases, sometimes a hostile `--code`), with attribute values
+//! (`NumberOfPoints`, `NumberOfCells`, `NumberOfComponents`, `offset`, `format`, `type`,
+//! `Name`, ...) huge, negative, zero, non-numeric or removed, a DataArray's values changed,
+//! removed, repeated or emptied, elements removed, repeated, renamed or nested, an array made
+//! binary or appended, bytes that are not UTF-8 (or the whole file in UTF-16), the text truncated
+//! or damaged; family `shard`, the partial files of two `table --shard K/N` splits and two
+//! `study --shard K/N` splits (timings set to 0), given to `merge PARTS --out DIR` with shard
+//! numbers and totals replaced (huge, zero, negative, fractional, strings), units removed,
+//! repeated, emptied or given other indices, a part of another split in place of one, a part left
+//! out, given twice or joined by a file that is no part, or any mutation of the case files above
+//! applied to a part's JSON.
+//!
 //! Every run happens in a fresh scratch folder three levels below a temporary root
 //! (`ROOT/run-N/a/b/scratch`), holding sentinel files, the case file(s) and a working folder
 //! `scratch/work/` (with its own sentinel) that is the process's current folder. The output goes
@@ -25,11 +42,11 @@
 //!
 //! - it exits with 0, 1 or 2 within the per-run limit (`CONTACT_PATCH_FUZZ_RUN_SECONDS`, default
 //!   60 s; a timeout, a signal, a panic or any other code fails it) and says something (stdout
-//!   or stderr); an exit 2 of `run` or `table` has a message on stderr; `check` names every case
+//!   or stderr); an exit 2 of any command but `check` has a message on stderr; `check` names every case
 //!   it was given (its errors go to its table on stdout);
 //! - every file that existed before is still there with the same content, and every new file
 //!   lies inside the output the tool may write (the `--out` target, `work/out/` without `--out`,
-//!   nothing for `check`). Pre-existing files are protected even inside the `--out` target:
+//!   the `--junit` file of `judge`, nothing for `check` and `judge` without it). Pre-existing files are protected even inside the `--out` target:
 //!   with `--out .` the working folder's sentinel must survive.
 //!
 //! Children run with `RUST_BACKTRACE=1`, 4 GiB of address space, 1 GiB file size and no core
@@ -41,10 +58,10 @@
 //! before the end may add up to the per-run limit) or a run count (`CONTACT_PATCH_FUZZ_RUNS`); the
 //! seed can be changed with `CONTACT_PATCH_FUZZ_SEED`, and `CONTACT_PATCH_FUZZ_FAMILY` (a family
 //! named in the per-family count, e.g. `3d`, `finite strain`, `gmsh`) mutates the cases of that
-//! family only. At the end the test prints (straight to
+//! family only (`vtu` or `shard`: those result files only). At the end the test prints (straight to
 //! stderr, so it shows in CI even when the test passes) the number of runs, the runs per family
 //! of the mutated cases (2D or 3D, contact, friction, finite strain, dynamics, Gmsh, explicit
-//! mesh, sweep), the count of each exit code, of each command and of each mutation kind. All failures are collected, grouped into
+//! mesh, sweep) and result files (`vtu`, `shard`), the count of each exit code, of each command and of each mutation kind. All failures are collected, grouped into
 //! classes and reported at once; the inputs of the first few failures of each class are saved
 //! under `target/fuzz-failures/` with the command, stdout and stderr, to be replayed by hand, and
 //! `report.txt` there lists every failure.
@@ -392,9 +409,14 @@ const KINDS: &[(&str, usize)] = &[
 ];
 
 fn pick_kind(rng: &mut Rng) -> &'static str {
-    let total: usize = KINDS.iter().map(|k| k.1).sum();
+    pick_weighted(rng, KINDS)
+}
+
+/// An entry of `table` drawn with its weight.
+fn pick_weighted<T: Copy>(rng: &mut Rng, table: &[(T, usize)]) -> T {
+    let total: usize = table.iter().map(|k| k.1).sum();
     let mut r = rng.below(total);
-    for &(kind, w) in KINDS {
+    for &(kind, w) in table {
         if r < w {
             return kind;
         }
@@ -590,6 +612,47 @@ fn field_pattern(description: &str) -> String {
     out
 }
 
+/// `bytes` cut at a random byte, with what was done.
+fn truncated(rng: &mut Rng, bytes: &[u8]) -> (String, Vec<u8>) {
+    let n = rng.below(bytes.len().max(1));
+    (
+        format!("truncated to {n} of {} bytes", bytes.len()),
+        bytes[..n.min(bytes.len())].to_vec(),
+    )
+}
+
+/// `bytes` with one to eight bytes overwritten, inserted or removed (characters of JSON
+/// syntax, NUL, invalid UTF-8, or any byte), with what was done.
+fn byte_damaged(rng: &mut Rng, bytes: &[u8]) -> (String, Vec<u8>) {
+    const BYTES: &[u8] = b"\"{}[],:\\0-e.\x00\xff\xc3/ ";
+    let mut b = bytes.to_vec();
+    let mut edits = Vec::new();
+    for _ in 0..1 + rng.below(8) {
+        let at = rng.below(b.len().max(1));
+        let byte = if rng.chance(0.5) {
+            *rng.pick(BYTES)
+        } else {
+            rng.next_u64() as u8
+        };
+        match rng.below(3) {
+            0 if !b.is_empty() => {
+                edits.push(format!("@{at}={byte:#04x}"));
+                b[at] = byte;
+            }
+            1 => {
+                edits.push(format!("@{at}+{byte:#04x}"));
+                b.insert(at.min(b.len()), byte);
+            }
+            _ if !b.is_empty() => {
+                edits.push(format!("@{at}-"));
+                b.remove(at);
+            }
+            _ => {}
+        }
+    }
+    (format!("byte damage {}", edits.join(" ")), b)
+}
+
 /// One mutant of `base`.
 fn mutate(rng: &mut Rng, base: &Base, ctx: &Ctx) -> Mutant {
     let kind = pick_kind(rng);
@@ -606,40 +669,12 @@ fn mutate(rng: &mut Rng, base: &Base, ctx: &Ctx) -> Mutant {
     };
     match kind {
         "truncate" => {
-            let n = rng.below(text.len());
-            done(
-                format!("truncated to {n} of {} bytes", text.len()),
-                text[..n].to_vec(),
-            )
+            let (d, b) = truncated(rng, text);
+            done(d, b)
         }
         "byte_damage" => {
-            const BYTES: &[u8] = b"\"{}[],:\\0-e.\x00\xff\xc3/ ";
-            let mut b = text.to_vec();
-            let mut edits = Vec::new();
-            for _ in 0..1 + rng.below(8) {
-                let at = rng.below(b.len().max(1));
-                let byte = if rng.chance(0.5) {
-                    *rng.pick(BYTES)
-                } else {
-                    rng.next_u64() as u8
-                };
-                match rng.below(3) {
-                    0 if !b.is_empty() => {
-                        edits.push(format!("@{at}={byte:#04x}"));
-                        b[at] = byte;
-                    }
-                    1 => {
-                        edits.push(format!("@{at}+{byte:#04x}"));
-                        b.insert(at.min(b.len()), byte);
-                    }
-                    _ if !b.is_empty() => {
-                        edits.push(format!("@{at}-"));
-                        b.remove(at);
-                    }
-                    _ => {}
-                }
-            }
-            done(format!("byte damage {}", edits.join(" ")), b)
+            let (d, b) = byte_damaged(rng, text);
+            done(d, b)
         }
         "bom" => {
             let mut b = b"\xef\xbb\xbf".to_vec();
@@ -916,9 +951,37 @@ impl Out {
 
 /// What to run; case paths are relative to the scratch folder.
 enum Cmd {
-    Run { case: String, out: Out },
-    Check { folder: String, cases: Vec<String> },
-    Table { case: String, out: String },
+    Run {
+        case: String,
+        out: Out,
+    },
+    Check {
+        folder: String,
+        cases: Vec<String>,
+    },
+    Table {
+        case: String,
+        out: String,
+    },
+    /// `judge CASE RESULTS [--junit FILE] [--match-tol X]`
+    Judge {
+        case: String,
+        results: String,
+        junit: Option<String>,
+        match_tol: Option<String>,
+    },
+    /// `table CASE --results DIR --code NAME --out OUT`
+    TableResults {
+        case: String,
+        results: String,
+        code: String,
+        out: String,
+    },
+    /// `merge PARTS... --out OUT`
+    Merge {
+        parts: Vec<String>,
+        out: String,
+    },
 }
 
 impl Cmd {
@@ -927,6 +990,10 @@ impl Cmd {
             Cmd::Run { out, .. } => out.label(),
             Cmd::Check { .. } => "check FOLDER",
             Cmd::Table { .. } => "table CASE --out DIR",
+            Cmd::Judge { junit: None, .. } => "judge CASE RESULTS",
+            Cmd::Judge { junit: Some(_), .. } => "judge CASE RESULTS --junit FILE",
+            Cmd::TableResults { .. } => "table CASE --results DIR --code NAME",
+            Cmd::Merge { .. } => "merge PARTS --out DIR",
         }
     }
 }
@@ -1022,6 +1089,47 @@ impl Scratch {
                 vec!["table".into(), up(case), "--out".into(), out.clone()],
                 vec![work.join(out)],
             ),
+            Cmd::Judge {
+                case,
+                results,
+                junit,
+                match_tol,
+            } => {
+                let mut args = vec!["judge".to_string(), up(case), up(results)];
+                let mut allowed = Vec::new();
+                if let Some(j) = junit {
+                    args.extend(["--junit".to_string(), j.clone()]);
+                    allowed.push(work.join(j));
+                }
+                if let Some(t) = match_tol {
+                    args.extend(["--match-tol".to_string(), t.clone()]);
+                }
+                (args, allowed)
+            }
+            Cmd::TableResults {
+                case,
+                results,
+                code,
+                out,
+            } => (
+                vec![
+                    "table".into(),
+                    up(case),
+                    "--results".into(),
+                    up(results),
+                    "--code".into(),
+                    code.clone(),
+                    "--out".into(),
+                    out.clone(),
+                ],
+                vec![work.join(out)],
+            ),
+            Cmd::Merge { parts, out } => {
+                let mut args = vec!["merge".to_string()];
+                args.extend(parts.iter().map(|p| up(p)));
+                args.extend(["--out".to_string(), out.clone()]);
+                (args, vec![work.join(out)])
+            }
         }
     }
 }
@@ -1524,7 +1632,988 @@ fn seed() -> u64 {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Result files: the `.vtu` files `judge` and `table --results` read (family `vtu`) and the
+// partial files `merge` reads (family `shard`), made valid by the binary itself before the
+// fuzzing and then mutated.
+
+/// Cases whose own results (the body files of `run`) are the valid `.vtu` files mutated: Q4 and
+/// T6 single-body patches, the two-body contact patch and a tied patch (swept, so also read by
+/// `table --results`), a block on a rigid line, a Coulomb patch, a Hex8 patch and a 3D mortar
+/// punch.
+const VTU_BASES: &[&str] = &[
+    "cases/patch-single/q4-distorted.json",
+    "cases/patch-single/t6-distorted.json",
+    "cases/patch/patch-A-nu0.3.json",
+    "cases/tied/tied-B-normal.json",
+    "cases/contact/signorini-block-on-rigid-line.json",
+    "cases/contact/coulomb-patch-slip.json",
+    "cases/3d/patch-hex8.json",
+    "tests/data/fuzz/3d-punch-mortar.json",
+];
+
+/// A case and its valid results.
+struct VtuBase {
+    rel: String,
+    case: Vec<u8>,
+    /// The case's `name`: `table --results DIR` looks for `DIR/<name>.vtu` or `DIR/<name>/`.
+    name: String,
+    sweep: bool,
+    /// `(body name, bytes of <body>.vtu)` for every body of the case.
+    files: Vec<(String, Vec<u8>)>,
+}
+
+/// The partial files of one sharded command (each a [`Base`] for [`mutate`]).
+struct ShardRun {
+    label: &'static str,
+    parts: Vec<Base>,
+}
+
+/// The valid result files both families start from.
+struct Fixtures {
+    vtu: Vec<VtuBase>,
+    shards: Vec<ShardRun>,
+}
+
+/// Run the binary for a fixture; it must exit 0 (or 1: a table with a failing cell).
+fn make_fixture(args: &[&str], cwd: &Path) {
+    let o = Command::new(BIN)
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("the binary starts");
+    assert!(
+        matches!(o.status.code(), Some(0 | 1)),
+        "fixture `contact-patch {}` failed: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+/// Keys of a partial file whose values are timings or memory: set to 0 so that the bytes of a
+/// fixture, and so every mutant, depend on the seed only.
+fn without_timings(v: &mut Value) {
+    match v {
+        Value::Object(m) => {
+            for (k, x) in m.iter_mut() {
+                if k.contains("seconds") || k.contains("time") || k.contains("memory") {
+                    if x.is_number() {
+                        *x = json!(0.0);
+                    } else if let Value::Object(inner) = x {
+                        for t in inner.values_mut().filter(|t| t.is_number()) {
+                            *t = json!(0.0);
+                        }
+                    }
+                } else {
+                    without_timings(x);
+                }
+            }
+        }
+        Value::Array(a) => a.iter_mut().for_each(without_timings),
+        _ => {}
+    }
+}
+
+/// The study of `tests/shard.rs` made smaller: the first `n` values of each axis of
+/// `cases/studies/penalty-window.study.json` (`n` cells per axis), with its base beside it.
+fn small_study(n: usize) -> Value {
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text =
+        fs::read_to_string(manifest.join("cases/studies/penalty-window.study.json")).unwrap();
+    let mut v: Value = serde_json::from_str(&text).unwrap();
+    for axis in v["axes"].as_array_mut().unwrap() {
+        for key in ["values", "labels"] {
+            if let Some(a) = axis.get_mut(key).and_then(Value::as_array_mut) {
+                a.truncate(n);
+            }
+        }
+    }
+    v
+}
+
+/// Make the fixtures in `dir`: each [`VTU_BASES`] case run, and the partial files of two table
+/// splits (two cases in 2 shards, three cases in 3) and of two studies (2 x 2 x 2 cells in 2
+/// shards, 3 x 3 x 3 in 3), all run with relative names from `dir/shards`.
+fn fixtures(dir: &Path) -> Fixtures {
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut vtu = Vec::new();
+    for (i, rel) in VTU_BASES.iter().enumerate() {
+        let out = dir.join(format!("vtu-{i}"));
+        make_fixture(&["run", rel, "--out", out.to_str().unwrap()], manifest);
+        let case = fs::read(manifest.join(rel)).unwrap();
+        let v: Value = serde_json::from_slice(&case).unwrap();
+        let files: Vec<(String, Vec<u8>)> = v["bodies"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|b| b["name"].as_str())
+            .map(|b| {
+                let bytes = fs::read(out.join(format!("{b}.vtu")))
+                    .unwrap_or_else(|e| panic!("{rel}: {b}.vtu: {e}"));
+                (b.to_string(), bytes)
+            })
+            .collect();
+        assert!(!files.is_empty(), "{rel}: no body file");
+        vtu.push(VtuBase {
+            rel: rel.to_string(),
+            name: v["name"].as_str().unwrap().to_string(),
+            sweep: v.get("sweep").is_some(),
+            case,
+            files,
+        });
+    }
+    let work = dir.join("shards");
+    fs::create_dir_all(&work).unwrap();
+    for c in [
+        "cases/patch/patch-A-nu0.3.json",
+        "cases/patch/patch-C-nu0.3.json",
+        "cases/tied/tied-B-normal.json",
+        "cases/studies/penalty-window-patch-A.json",
+    ] {
+        let name = Path::new(c).file_name().unwrap();
+        fs::copy(manifest.join(c), work.join(name)).unwrap();
+    }
+    for (n, file) in [(2, "window-2.study.json"), (3, "window-3.study.json")] {
+        fs::write(work.join(file), pretty(&small_study(n))).unwrap();
+    }
+    let splits: [(&'static str, usize, Vec<&str>); 4] = [
+        (
+            "table, 2 cases in 2 shards",
+            2,
+            vec!["table", "patch-A-nu0.3.json", "patch-C-nu0.3.json"],
+        ),
+        (
+            "table, 3 cases in 3 shards",
+            3,
+            vec![
+                "table",
+                "patch-A-nu0.3.json",
+                "patch-C-nu0.3.json",
+                "tied-B-normal.json",
+            ],
+        ),
+        (
+            "study, 8 cells in 2 shards",
+            2,
+            vec!["study", "window-2.study.json"],
+        ),
+        (
+            "study, 27 cells in 3 shards",
+            3,
+            vec!["study", "window-3.study.json"],
+        ),
+    ];
+    let mut shards = Vec::new();
+    for (s, (label, count, command)) in splits.into_iter().enumerate() {
+        let out = format!("parts-{s}");
+        let mut parts = Vec::new();
+        for k in 1..=count {
+            let shard = format!("{k}/{count}");
+            let mut args = command.clone();
+            args.extend(["--out", &out, "--shard", &shard]);
+            make_fixture(&args, &work);
+            let name = if command[0] == "table" {
+                "table".to_string()
+            } else {
+                "penalty-window".to_string()
+            };
+            let file = format!("{name}.shard-{k}-of-{count}.json");
+            let mut value: Value =
+                serde_json::from_slice(&fs::read(work.join(&out).join(&file)).unwrap())
+                    .unwrap_or_else(|e| panic!("{label}: {file}: {e}"));
+            without_timings(&mut value);
+            let text = pretty(&value);
+            parts.push(Base {
+                rel: format!("{out}/{file}"),
+                text,
+                value,
+                families: vec!["shard"],
+                attachments: Vec::new(),
+            });
+        }
+        shards.push(ShardRun { label, parts });
+    }
+    Fixtures { vtu, shards }
+}
+
+/// The `.vtu` mutation kinds and their weights.
+const VTU_KINDS: &[(&str, usize)] = &[
+    ("vtu_attribute", 26),
+    ("vtu_values", 18),
+    ("vtu_element", 14),
+    ("vtu_encoding", 8),
+    ("vtu_non_utf8", 6),
+    ("truncate", 8),
+    ("byte_damage", 8),
+    ("bom", 2),
+    ("stacked", 10),
+];
+
+/// The attributes whose values are mutated.
+const VTU_ATTRIBUTES: &[&str] = &[
+    "NumberOfPoints",
+    "NumberOfCells",
+    "NumberOfComponents",
+    "offset",
+    "format",
+    "type",
+    "Name",
+    "byte_order",
+    "header_type",
+    "version",
+    "RangeMin",
+    "RangeMax",
+];
+
+/// `(attribute, start, end)` of every value of the attributes [`VTU_ATTRIBUTES`] in `text`
+/// (the byte range between the quotes).
+fn vtu_attribute_values(text: &str) -> Vec<(&'static str, usize, usize)> {
+    let mut out = Vec::new();
+    for &a in VTU_ATTRIBUTES {
+        let pattern = format!("{a}=\"");
+        let mut from = 0;
+        while let Some(i) = text[from..].find(&pattern) {
+            let start = from + i + pattern.len();
+            let preceded = text[..from + i].ends_with(char::is_whitespace);
+            let Some(len) = text[start..].find('"') else {
+                break;
+            };
+            if preceded {
+                out.push((a, start, start + len));
+            }
+            from = start + len;
+        }
+    }
+    out.sort_by_key(|x| x.1);
+    out
+}
+
+/// The byte ranges of each `<tag ...>...</tag>` (or `<tag .../>`) element: `(start of the
+/// element, start of its content, end of its content, end of the element)`.
+fn vtu_elements(text: &str, tag: &str) -> Vec<(usize, usize, usize, usize)> {
+    let (open, close) = (format!("<{tag}"), format!("</{tag}>"));
+    let mut out = Vec::new();
+    let mut from = 0;
+    while let Some(i) = text[from..].find(&open) {
+        let start = from + i;
+        let Some(gt) = text[start..].find('>') else {
+            break;
+        };
+        let head_end = start + gt + 1;
+        let after = text.as_bytes().get(start + open.len()).copied();
+        if !matches!(after, Some(b' ' | b'>' | b'\n' | b'\t' | b'/')) {
+            from = start + open.len();
+            continue;
+        }
+        if text[..head_end].ends_with("/>") {
+            out.push((start, head_end, head_end, head_end));
+            from = head_end;
+        } else if let Some(j) = text[head_end..].find(&close) {
+            let content_end = head_end + j;
+            out.push((start, head_end, content_end, content_end + close.len()));
+            from = content_end + close.len();
+        } else {
+            break;
+        }
+    }
+    out
+}
+
+/// A replacement for a value of attribute `a` that held `old`.
+fn vtu_attribute_value(rng: &mut Rng, a: &str, old: &str) -> String {
+    const SIZES: &[&str] = &[
+        "1000000000000",
+        "2e62",
+        "18446744073709551615",
+        "18446744073709551616",
+        "9223372036854775807",
+        "4294967296",
+        "1000000000",
+        "-1",
+        "-3",
+        "0",
+        "1",
+        "2",
+        "3",
+        "4",
+        "6",
+        "9",
+        "abc",
+        "",
+        "1.5",
+        "NaN",
+        " 3 ",
+        "0x10",
+        "+2",
+        "1e3",
+        "3 3",
+    ];
+    match a {
+        "format" => rng
+            .pick(&["binary", "appended", "Binary", "ASCII", "", "ascii ", "raw"])
+            .to_string(),
+        "type" => rng
+            .pick(&[
+                "Float32",
+                "Float64",
+                "Int32",
+                "Int64",
+                "UInt8",
+                "UInt64",
+                "String",
+                "Bogus",
+                "",
+                "PolyData",
+                "ImageData",
+            ])
+            .to_string(),
+        "Name" => rng
+            .pick(&[
+                "",
+                "displacement",
+                "stress",
+                "contact_pressure",
+                "contact_force",
+                "contact_gap",
+                "contact_status",
+                "Points",
+                "with space",
+                "ünïcødé-名前",
+                "&amp;lt;",
+            ])
+            .to_string(),
+        _ => match old.trim().parse::<i64>() {
+            Ok(n) if rng.chance(0.3) => match rng.below(4) {
+                0 => n.saturating_add(1),
+                1 => n.saturating_sub(1),
+                2 => n.saturating_mul(2),
+                _ => n.saturating_neg(),
+            }
+            .to_string(),
+            _ => rng.pick(SIZES).to_string(),
+        },
+    }
+}
+
+/// One mutation of the text of a `.vtu` file (`kind` one of the structural [`VTU_KINDS`]);
+/// `None` when the text has nothing it acts on.
+fn vtu_text_mutation(kind: &str, rng: &mut Rng, text: &mut String) -> Option<String> {
+    match kind {
+        "vtu_attribute" => {
+            let spans = vtu_attribute_values(text);
+            if spans.is_empty() {
+                return None;
+            }
+            let &(a, start, end) = rng.pick(&spans);
+            let old = text[start..end].to_string();
+            if rng.chance(0.12) {
+                // the attribute removed, with its leading space
+                let name_start = start - a.len() - 2;
+                text.replace_range(name_start - 1..end + 1, "");
+                return Some(format!("attribute {a}=\"{old}\" removed"));
+            }
+            let new = vtu_attribute_value(rng, a, &old);
+            text.replace_range(start..end, &new);
+            Some(format!("{a}=\"{old}\" -> \"{new}\""))
+        }
+        "vtu_values" => {
+            let arrays: Vec<_> = vtu_elements(text, "DataArray")
+                .into_iter()
+                .filter(|e| e.2 > e.1)
+                .collect();
+            if arrays.is_empty() {
+                return None;
+            }
+            let &(_, start, end, _) = rng.pick(&arrays);
+            let mut tokens: Vec<String> = text[start..end]
+                .split_whitespace()
+                .map(String::from)
+                .collect();
+            let what = match rng.below(6) {
+                0 if !tokens.is_empty() => {
+                    let at = rng.below(tokens.len());
+                    let new = *rng.pick(&[
+                        "1e308",
+                        "-1e308",
+                        "1e999",
+                        "NaN",
+                        "nan",
+                        "inf",
+                        "-inf",
+                        "Infinity",
+                        "abc",
+                        "-",
+                        "1,5",
+                        "0x1p3",
+                        "1e-320",
+                        "18446744073709551616",
+                        "--1",
+                        ".",
+                        "1e",
+                        "&#0;",
+                    ]);
+                    let d = format!("value {at} {:?} -> {new:?}", tokens[at]);
+                    tokens[at] = new.to_string();
+                    d
+                }
+                1 if !tokens.is_empty() => {
+                    let n = 1 + rng.below(tokens.len().min(4));
+                    let at = rng.below(tokens.len() - n + 1);
+                    tokens.drain(at..at + n);
+                    format!("{n} values removed at {at}")
+                }
+                2 => {
+                    let n = 1 + rng.below(4);
+                    for _ in 0..n {
+                        tokens.push(format!("{}", rng.below(10)));
+                    }
+                    format!("{n} values appended")
+                }
+                3 => {
+                    tokens.clear();
+                    "values emptied".into()
+                }
+                4 => {
+                    let copies = 2 + rng.below(4);
+                    let one = tokens.clone();
+                    for _ in 1..copies {
+                        tokens.extend(one.iter().cloned());
+                    }
+                    format!("values repeated {copies} times")
+                }
+                _ => {
+                    let n = tokens.len();
+                    tokens.reverse();
+                    format!("{n} values reversed")
+                }
+            };
+            let mut joined = tokens.join(" ");
+            if !joined.is_empty() {
+                joined = format!("\n{joined}\n");
+            }
+            text.replace_range(start..end, &joined);
+            Some(format!("a DataArray's {what}"))
+        }
+        "vtu_element" => {
+            let tag = *rng.pick(&[
+                "DataArray",
+                "DataArray",
+                "DataArray",
+                "Points",
+                "PointData",
+                "Cells",
+                "Piece",
+            ]);
+            let elements = vtu_elements(text, tag);
+            if elements.is_empty() {
+                return None;
+            }
+            let &(start, _, _, end) = rng.pick(&elements);
+            let element = text[start..end].to_string();
+            Some(match rng.below(4) {
+                0 => {
+                    text.replace_range(start..end, "");
+                    format!("a <{tag}> removed")
+                }
+                1 => {
+                    text.insert_str(end, &element);
+                    format!("a <{tag}> given twice")
+                }
+                2 => {
+                    let new = *rng.pick(&["CellData", "FieldData", "Bogus", "Point", "dataarray"]);
+                    let renamed = element
+                        .replacen(&format!("<{tag}"), &format!("<{new}"), 1)
+                        .replace(&format!("</{tag}>"), &format!("</{new}>"));
+                    text.replace_range(start..end, &renamed);
+                    format!("a <{tag}> renamed <{new}>")
+                }
+                _ => {
+                    let nested = format!("<{tag}>{element}</{tag}>");
+                    text.replace_range(start..end, &nested);
+                    format!("a <{tag}> nested in another")
+                }
+            })
+        }
+        "vtu_encoding" => {
+            let arrays: Vec<_> = vtu_elements(text, "DataArray")
+                .into_iter()
+                .filter(|e| e.2 > e.1)
+                .collect();
+            if arrays.is_empty() {
+                return None;
+            }
+            let &(start, content_start, content_end, _) = rng.pick(&arrays);
+            const B64: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+            let junk: String = (0..8 + rng.below(64))
+                .map(|_| *rng.pick(B64) as char)
+                .collect();
+            let head = &text[start..content_start];
+            let head = match head.find("format=\"ascii\"") {
+                Some(i) => {
+                    let mut h = head.to_string();
+                    let new = if rng.chance(0.5) {
+                        "format=\"binary\""
+                    } else {
+                        "format=\"appended\" offset=\"0\""
+                    };
+                    h.replace_range(i..i + "format=\"ascii\"".len(), new);
+                    h
+                }
+                None => head.to_string(),
+            };
+            let appended = head.contains("appended");
+            let content = if appended {
+                String::new()
+            } else {
+                junk.clone()
+            };
+            text.replace_range(start..content_end, &format!("{head}{content}"));
+            if appended {
+                if let Some(i) = text.rfind("</VTKFile>") {
+                    text.insert_str(
+                        i,
+                        &format!("<AppendedData encoding=\"raw\">_{junk}</AppendedData>\n"),
+                    );
+                }
+            }
+            Some(format!(
+                "a DataArray made {} ({} bytes of data)",
+                if appended { "appended" } else { "binary" },
+                junk.len()
+            ))
+        }
+        _ => unreachable!("not a .vtu text mutation: {kind}"),
+    }
+}
+
+/// Bytes that are not UTF-8 put into `text`: in an attribute value, in a DataArray's values, at
+/// a random place, or the whole file recoded as UTF-16.
+fn vtu_non_utf8(rng: &mut Rng, text: &str) -> (String, Vec<u8>) {
+    const BAD: &[&[u8]] = &[
+        b"\xff",
+        b"\xfe\xff",
+        b"\xc3",
+        b"\x80",
+        b"\xed\xa0\x80",
+        b"\xf8\x88\x80\x80\x80",
+    ];
+    let bad = *rng.pick(BAD);
+    let spans = vtu_attribute_values(text);
+    let arrays = vtu_elements(text, "DataArray");
+    let at = match rng.below(4) {
+        0 if !spans.is_empty() => rng.pick(&spans).1,
+        1 if !arrays.is_empty() => rng.pick(&arrays).1,
+        2 => {
+            let mut b = vec![0xff, 0xfe];
+            for u in text.encode_utf16() {
+                b.extend_from_slice(&u.to_le_bytes());
+            }
+            return ("recoded as UTF-16 with a byte-order mark".into(), b);
+        }
+        _ => rng.below(text.len().max(1)),
+    };
+    let at = (0..=at)
+        .rev()
+        .find(|&i| text.is_char_boundary(i))
+        .unwrap_or(0);
+    let mut b = text.as_bytes()[..at].to_vec();
+    b.extend_from_slice(bad);
+    b.extend_from_slice(&text.as_bytes()[at..]);
+    (format!("bytes {bad:x?} (not UTF-8) at byte {at}"), b)
+}
+
+/// One mutant of a `.vtu` file.
+fn mutate_vtu(rng: &mut Rng, bytes: &[u8]) -> Mutant {
+    let kind = pick_weighted(rng, VTU_KINDS);
+    let mut text = String::from_utf8(bytes.to_vec()).expect("our .vtu files are UTF-8");
+    let (description, bytes) = match kind {
+        "truncate" => truncated(rng, bytes),
+        "byte_damage" => byte_damaged(rng, bytes),
+        "bom" => {
+            let mut b = b"\xef\xbb\xbf".to_vec();
+            b.extend_from_slice(bytes);
+            ("UTF-8 byte-order mark in front".into(), b)
+        }
+        "vtu_non_utf8" => vtu_non_utf8(rng, &text),
+        "stacked" => {
+            let mut d = Vec::new();
+            for _ in 0..2 + rng.below(2) {
+                let k = *rng.pick(&["vtu_attribute", "vtu_values", "vtu_element", "vtu_encoding"]);
+                if let Some(x) = vtu_text_mutation(k, rng, &mut text) {
+                    d.push(format!("{k}: {x}"));
+                }
+            }
+            (d.join("; "), text.into_bytes())
+        }
+        k => match vtu_text_mutation(k, rng, &mut text) {
+            Some(d) => (d, text.into_bytes()),
+            None => ("nothing to mutate: unchanged".into(), bytes.to_vec()),
+        },
+    };
+    Mutant {
+        kind,
+        cause: kind.to_string(),
+        description,
+        bytes,
+    }
+}
+
+/// A `judge` or `table --results` run on the results of a [`VTU_BASES`] case with one body
+/// file mutated (sometimes each of them), laid out as the command reads them: `judge CASE
+/// FILE.vtu` for a single body (sometimes its folder), `judge CASE FOLDER` with one
+/// `<body>.vtu` each, `table CASE --results DIR --code NAME` with `DIR/<case name>.vtu` or
+/// `DIR/<case name>/<body>.vtu`; `--junit`, `--match-tol` and `--code` sometimes hostile.
+fn vtu_trial(rng: &mut Rng, index: usize, fx: &[VtuBase]) -> Trial {
+    let base = rng.pick(fx);
+    let n = base.files.len();
+    let target = rng.below(n);
+    let each = n > 1 && rng.chance(0.2);
+    let table = base.sweep && rng.chance(0.4);
+    let shared = rng.chance(if n == 1 { 0.8 } else { 0.15 });
+    let mut inputs: Inputs = vec![("case.json".into(), base.case.clone())];
+    let (mut kinds, mut descs) = (Vec::new(), Vec::new());
+    let folder = if table {
+        format!("results/{}", base.name)
+    } else {
+        "results".to_string()
+    };
+    for (j, (body, bytes)) in base.files.iter().enumerate() {
+        if shared && j != target {
+            continue;
+        }
+        let bytes = if j == target || (each && rng.chance(0.5)) {
+            let m = mutate_vtu(rng, bytes);
+            kinds.push(m.kind);
+            descs.push(format!("{body}.vtu {}: {}", m.kind, m.description));
+            m.bytes
+        } else {
+            bytes.clone()
+        };
+        let rel = if shared {
+            format!("{folder}.vtu")
+        } else {
+            format!("{folder}/{body}.vtu")
+        };
+        inputs.push((rel, bytes));
+    }
+    let results = if shared {
+        format!("{folder}.vtu")
+    } else {
+        folder
+    };
+    let cmd = if table {
+        let code = if rng.chance(0.85) {
+            "other-code".to_string()
+        } else {
+            rng.pick(&[
+                "",
+                "../escape",
+                "a/b",
+                "with space",
+                "ünïcødé",
+                "-x",
+                "--out",
+            ])
+            .to_string()
+        };
+        Cmd::TableResults {
+            case: "case.json".into(),
+            results: "results".into(),
+            code,
+            out: format!("tables-{index}"),
+        }
+    } else {
+        let junit = rng.chance(0.2).then(|| format!("junit-{index}.xml"));
+        let match_tol = rng.chance(0.1).then(|| {
+            rng.pick(&["0", "-1", "1e308", "NaN", "inf", "1", "abc", "1e-300"])
+                .to_string()
+        });
+        Cmd::Judge {
+            case: "case.json".into(),
+            results,
+            junit,
+            match_tol,
+        }
+    };
+    let vtu_cause = kinds.join("+");
+    Trial {
+        kinds,
+        families: vec!["vtu"],
+        cause: vtu_cause,
+        description: format!(
+            "{} ({}): {}",
+            base.rel,
+            cmd_label_hint(&base.files),
+            descs.join(" | ")
+        ),
+        inputs,
+        cmd,
+    }
+}
+
+/// The bodies of a results set, for a trial's description.
+fn cmd_label_hint(files: &[(String, Vec<u8>)]) -> String {
+    let names: Vec<&str> = files.iter().map(|f| f.0.as_str()).collect();
+    format!("bodies {}", names.join(", "))
+}
+
+/// The shard mutation kinds and their weights; `json` applies a mutation of the case family
+/// ([`mutate`]) to one part.
+const SHARD_KINDS: &[(&str, usize)] = &[
+    ("shard_numbers", 22),
+    ("shard_units", 16),
+    ("shard_mix", 12),
+    ("shard_set", 10),
+    ("json", 40),
+];
+
+/// A replacement of a shard number (`index`, `count` or `total`).
+fn shard_number(rng: &mut Rng) -> Value {
+    rng.pick(&[
+        json!(0),
+        json!(-1),
+        json!(1),
+        json!(2),
+        json!(3),
+        json!(5),
+        json!(10_000),
+        json!(10_001),
+        json!(1_000_000_000_000_000u64),
+        json!(1_000_000_000_000_000_000u64),
+        json!(u64::MAX),
+        json!(4_294_967_296u64),
+        json!(1.5),
+        json!(1e300),
+        json!("1"),
+        Value::Null,
+    ])
+    .clone()
+}
+
+/// The path of the unit list of a part (`ran` of a table, `cells` of a study) and of the
+/// index in unit `i`.
+fn unit_paths(v: &Value) -> (JPath, Box<dyn Fn(usize) -> JPath>) {
+    if v.get("ran").is_some() {
+        (
+            vec![Seg::Key("ran".into())],
+            Box::new(|i| vec![Seg::Key("ran".into()), Seg::Index(i), Seg::Index(0)]),
+        )
+    } else {
+        (
+            vec![Seg::Key("cells".into())],
+            Box::new(|i| {
+                vec![
+                    Seg::Key("cells".into()),
+                    Seg::Index(i),
+                    Seg::Key("index".into()),
+                ]
+            }),
+        )
+    }
+}
+
+/// A `merge` of the parts of one sharded command with one or more of them mutated, mixed with
+/// another command's parts, dropped, repeated or joined by a file that is no part.
+fn shard_trial(
+    rng: &mut Rng,
+    index: usize,
+    runs: &[ShardRun],
+    vtu: &[VtuBase],
+    scratch: &Scratch,
+    unsafe_redrawn: &mut usize,
+) -> Trial {
+    let ctx = scratch.ctx();
+    let allowed = scratch.allowed_absolute();
+    let r = rng.below(runs.len());
+    let run = &runs[r];
+    // (file name, bytes) in the order given to merge
+    let mut parts: Vec<(String, Vec<u8>)> = run
+        .parts
+        .iter()
+        .map(|p| {
+            let name = Path::new(&p.rel).file_name().unwrap();
+            (
+                name.to_string_lossy().into_owned(),
+                p.text.clone().into_bytes(),
+            )
+        })
+        .collect();
+    let j = rng.below(parts.len());
+    let kind = pick_weighted(rng, SHARD_KINDS);
+    let mut value = run.parts[j].value.clone();
+    let (mut kind_used, mut cause) = (kind, kind.to_string());
+    let description = match kind {
+        "shard_numbers" => {
+            let mut fields = vec![
+                vec![Seg::Key("shard".into()), Seg::Key("index".into())],
+                vec![Seg::Key("shard".into()), Seg::Key("count".into())],
+            ];
+            if value.get("total").is_some() {
+                fields.push(vec![Seg::Key("total".into())]);
+            }
+            let mut d = Vec::new();
+            for _ in 0..1 + rng.below(2) {
+                let p = rng.pick(&fields).clone();
+                let new = shard_number(rng);
+                d.push(format!("{} = {}", show(&p), short(&new)));
+                *node_mut(&mut value, &p) = new;
+            }
+            parts[j].1 = pretty(&value).into_bytes();
+            d.join(", ")
+        }
+        "shard_units" => {
+            let (list, index_of) = unit_paths(&value);
+            let len = node(&value, &list).as_array().map_or(0, Vec::len);
+            let d = match rng.below(5) {
+                0 if len > 0 => {
+                    let i = rng.below(len);
+                    node_mut(&mut value, &list)
+                        .as_array_mut()
+                        .unwrap()
+                        .remove(i);
+                    format!("{}[{i}] removed", show(&list))
+                }
+                1 if len > 0 => {
+                    let i = rng.below(len);
+                    let a = node_mut(&mut value, &list).as_array_mut().unwrap();
+                    let unit = a[i].clone();
+                    a.push(unit);
+                    format!("{}[{i}] given twice", show(&list))
+                }
+                2 if len > 0 => {
+                    let i = rng.below(len);
+                    let new = rng
+                        .pick(&[
+                            json!(u64::MAX),
+                            json!(1_000_000_000_000u64),
+                            json!(-1),
+                            json!(len),
+                            json!(len + 1),
+                            json!(100),
+                            json!(0),
+                            json!(1.5),
+                            Value::Null,
+                        ])
+                        .clone();
+                    let p = index_of(i);
+                    let d = format!("{} = {}", show(&p), short(&new));
+                    *node_mut(&mut value, &p) = new;
+                    d
+                }
+                3 if value.get("errors").is_some() => {
+                    let at = rng
+                        .pick(&[json!(0), json!(u64::MAX), json!(99), json!(-1)])
+                        .clone();
+                    let e = json!([at, "an error"]);
+                    let d = format!("errors += {}", short(&e));
+                    if let Some(a) = value["errors"].as_array_mut() {
+                        a.push(e);
+                    }
+                    d
+                }
+                _ => {
+                    *node_mut(&mut value, &list) = json!([]);
+                    format!("{} emptied", show(&list))
+                }
+            };
+            parts[j].1 = pretty(&value).into_bytes();
+            d
+        }
+        "shard_mix" => {
+            let o = rng.below(runs.len());
+            let other = &runs[o].parts[rng.below(runs[o].parts.len())];
+            let name = Path::new(&other.rel)
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .into_owned();
+            let d = format!(
+                "{} replaced by {} of \"{}\"",
+                parts[j].0, name, runs[o].label
+            );
+            parts[j] = (format!("other-{name}"), other.text.clone().into_bytes());
+            d
+        }
+        "shard_set" => match rng.below(4) {
+            0 if parts.len() > 1 => {
+                let (name, _) = parts.remove(j);
+                format!("{name} left out")
+            }
+            1 => {
+                let p = parts[j].clone();
+                let d = format!("{} given twice", p.0);
+                parts.push(p);
+                d
+            }
+            2 => {
+                let stranger: (String, Vec<u8>) = match rng.below(5) {
+                    0 => ("case.json".into(), vtu[0].case.clone()),
+                    1 => ("body.vtu".into(), vtu[0].files[0].1.clone()),
+                    2 => ("empty.json".into(), Vec::new()),
+                    3 => ("object.json".into(), b"{}".to_vec()),
+                    _ => (
+                        "kind-only.json".into(),
+                        br#"{"kind": "table", "shard": {"index": 1, "count": 1}}"#.to_vec(),
+                    ),
+                };
+                let d = format!("{} among the parts", stranger.0);
+                parts.insert(rng.below(parts.len() + 1), stranger);
+                d
+            }
+            _ => {
+                parts.reverse();
+                "parts given in reverse order".into()
+            }
+        },
+        _ => {
+            let m = loop {
+                let m = mutate(rng, &run.parts[j], &ctx);
+                if stays_in_scratch(&m.bytes, &allowed) {
+                    break m;
+                }
+                *unsafe_redrawn += 1;
+            };
+            kind_used = m.kind;
+            cause = format!("json {}", m.cause);
+            parts[j].1 = m.bytes;
+            format!("{}: {}", m.kind, m.description)
+        }
+    };
+    // a name repeated on the command line is one file given twice; others get their own file
+    let mut inputs: Inputs = Vec::new();
+    let mut names = Vec::new();
+    for (name, bytes) in parts {
+        let rel = format!("parts/{name}");
+        if !inputs.iter().any(|(r, _)| *r == rel) {
+            inputs.push((rel.clone(), bytes));
+        }
+        names.push(rel);
+    }
+    Trial {
+        kinds: vec![kind_used],
+        families: vec!["shard"],
+        cause,
+        description: format!("{} ({}): {description}", run.label, run.parts[j].rel),
+        inputs,
+        cmd: Cmd::Merge {
+            parts: names,
+            out: format!("merged-{index}"),
+        },
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
 // The fuzz test.
+
+/// What a run mutates: a case, a `.vtu` results file, or shard parts.
+#[derive(Clone, Copy, PartialEq)]
+enum Source {
+    Case,
+    Vtu,
+    Shard,
+}
+
+/// The sources and their weights (per cent of the runs).
+const SOURCES: &[(Source, usize)] = &[(Source::Case, 80), (Source::Vtu, 12), (Source::Shard, 8)];
 
 /// The trial of run `index` (a function of the seed and the index only, given the scratch).
 fn draw_trial(
@@ -1656,11 +2745,20 @@ fn mutated_cases_keep_the_invariants() {
         bases.len() > 20 && bases.iter().any(|b| b.value.get("sweep").is_some()),
         "the catalogue"
     );
-    // one family only (`CONTACT_PATCH_FUZZ_FAMILY`, a name of the per-family count)
+    // one family only (`CONTACT_PATCH_FUZZ_FAMILY`, a name of the per-family count): `vtu` and
+    // `shard` are the result files, any other name selects the cases of that family
     let family: String = env_or("CONTACT_PATCH_FUZZ_FAMILY", String::new());
+    let mut sources: Vec<(Source, usize)> = SOURCES.to_vec();
     if !family.is_empty() {
-        bases.retain(|b| b.families.contains(&family.as_str()));
-        assert!(!bases.is_empty(), "no case of the family {family:?}");
+        match family.as_str() {
+            "vtu" => sources.retain(|s| s.0 == Source::Vtu),
+            "shard" => sources.retain(|s| s.0 == Source::Shard),
+            _ => {
+                sources.retain(|s| s.0 == Source::Case);
+                bases.retain(|b| b.families.contains(&family.as_str()));
+                assert!(!bases.is_empty(), "no case of the family {family:?}");
+            }
+        }
     }
     let sweeps: Vec<&Base> = bases
         .iter()
@@ -1670,6 +2768,16 @@ fn mutated_cases_keep_the_invariants() {
         .prefix("contact-patch-fuzz-")
         .tempdir()
         .unwrap();
+    let made = Instant::now();
+    let fx = if sources.iter().any(|s| s.0 != Source::Case) {
+        fixtures(&root.path().join("fixtures"))
+    } else {
+        Fixtures {
+            vtu: Vec::new(),
+            shards: Vec::new(),
+        }
+    };
+    let fixture_seconds = made.elapsed().as_secs_f64();
     let failures_dir = failures_dir("fuzz");
     let _ = fs::remove_dir_all(&failures_dir);
 
@@ -1691,7 +2799,15 @@ fn mutated_cases_keep_the_invariants() {
                 let mut rng = Rng::new(seed ^ (index as u64).wrapping_mul(0xD6E8_FEB8_6659_FD93));
                 let scratch = Scratch::new(root.path().join(format!("run-{index}")));
                 let mut redrawn = 0;
-                let trial = draw_trial(&mut rng, index, &bases, &sweeps, &scratch, &mut redrawn);
+                let trial = match pick_weighted(&mut rng, &sources) {
+                    Source::Case => {
+                        draw_trial(&mut rng, index, &bases, &sweeps, &scratch, &mut redrawn)
+                    }
+                    Source::Vtu => vtu_trial(&mut rng, index, &fx.vtu),
+                    Source::Shard => {
+                        shard_trial(&mut rng, index, &fx.shards, &fx.vtu, &scratch, &mut redrawn)
+                    }
+                };
                 let verdict = run_trial(&scratch, &trial);
                 {
                     let mut st = stats.lock().unwrap();
@@ -1737,7 +2853,8 @@ fn mutated_cases_keep_the_invariants() {
     };
     say(&format!(
         "\nfuzz: seed {seed:#x}, {} runs in {elapsed:.1} s (budget {:.0} s, {WORKERS} workers, \
-         limit {:.0} s a run), {} failing\n  runs per family: {}\n  exit codes: {}\n  commands: {}\n  \
+         limit {:.0} s a run; result-file fixtures made in {fixture_seconds:.1} s), {} failing\n  \
+         runs per family: {}\n  exit codes: {}\n  commands: {}\n  \
          mutations: {}\n  mutants drawn again because a name could leave the scratch folder: {}\n",
         st.runs,
         budget.as_secs_f64(),

@@ -12,9 +12,11 @@
 //! parts of different studies or catalogues, different `N`, a shard given twice (overlap) and
 //! a shard missing, naming them; otherwise it orders the units by index, which is the order of
 //! one unsharded run, and writes the same Markdown and JSON. The shard numbers read from a
-//! file get the check `--shard K/N` gets ([`Shard::new`]), and a study part's `total` must be
-//! the grid of the study it carries (within that study's cell limit), before anything is sized
-//! from them: a hostile or edited file is refused naming the file and the field.
+//! file get the check `--shard K/N` gets ([`Shard::new`]), a study part's study gets the checks of
+//! a study file that need no base case, its `total` must be the grid of that study (within its
+//! cell limit) and each of its cells must carry the labels of its grid coordinates, before
+//! anything is sized or looked up from them: a hostile or edited file is refused naming the file
+//! and the field.
 
 use crate::error::{Error, Result};
 use crate::harness::study::{StudyCell, StudySpec};
@@ -134,7 +136,17 @@ pub fn read_parts(paths: &[std::path::PathBuf]) -> Result<Vec<(String, Part)>> {
                     "give the files the shards wrote (`--shard K/N`), unedited",
                 )
             })?;
-            if let Part::Study { study, total, .. } = &part {
+            if let Part::Study {
+                study,
+                total,
+                cells,
+                source,
+                ..
+            } = &part
+            {
+                let checked =
+                    crate::harness::study::from_parts(study.clone(), source.clone(), &shown)?;
+                checked.check_recorded_cells(cells, &shown)?;
                 let grid = study.checked_cells(&shown)?;
                 if *total != grid {
                     return Err(Error::invalid(

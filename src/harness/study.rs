@@ -280,14 +280,24 @@ pub fn load_study(path: &Path) -> Result<Study> {
     study.checked()
 }
 
-/// A study as its shards recorded it (for `merge`): the labels from the spec, the base case
-/// not read again (nothing is run).
-pub fn from_parts(spec: StudySpec, source: String) -> Result<Study> {
+/// A study as its shards recorded it (for `merge`): the spec gets every check of a study file
+/// that does not need the base case (errors name `shown`, the partial file it came from), the
+/// labels come from the spec, and the base case is not read again (nothing is run).
+pub fn from_parts(spec: StudySpec, source: String, shown: &str) -> Result<Study> {
     let base_path = Path::new(&source)
         .parent()
         .unwrap_or(Path::new(""))
         .join(&spec.base);
-    let labels = spec
+    let mut study = Study {
+        spec,
+        source,
+        base_path,
+        base: Value::Null,
+        labels: Vec::new(),
+    };
+    study.check_spec(shown)?;
+    study.labels = study
+        .spec
         .axes
         .iter()
         .map(|a| {
@@ -296,19 +306,42 @@ pub fn from_parts(spec: StudySpec, source: String) -> Result<Study> {
                 .collect()
         })
         .collect();
-    Ok(Study {
-        spec,
-        source,
-        base_path,
-        base: Value::Null,
-        labels,
-    })
+    Ok(study)
 }
 
 impl Study {
-    fn checked(mut self) -> Result<Study> {
+    /// Cells recorded by a shard (read from the partial file `shown`) must be cells of this
+    /// study: each cell's labels are the labels of its grid coordinates (so one per axis).
+    pub fn check_recorded_cells(&self, cells: &[StudyCell], shown: &str) -> Result<()> {
+        for (i, c) in cells.iter().enumerate() {
+            let want: Vec<&String> = self
+                .coordinates(c.index)
+                .iter()
+                .zip(&self.labels)
+                .map(|(&j, l)| &l[j])
+                .collect();
+            let got: Vec<&String> = c.labels.iter().collect();
+            if got != want {
+                return Err(refused(
+                    shown,
+                    format!("cells[{i}].labels"),
+                    format!(
+                        "{got:?} are not the labels of cell {} of the study's grid, {want:?}",
+                        c.index
+                    ),
+                    "give the files the shards wrote (`study --shard K/N`), unedited",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The checks of the spec that need no base case (errors name `src`): a usable name, axes
+    /// with values, labels and names, the grid within its limit, `along` and `window` naming
+    /// axes.
+    fn check_spec(&self, src: &str) -> Result<()> {
         let s = &self.spec;
-        let src = self.source.clone();
+        let src = src.to_string();
         if crate::io::paths::name_problem(&s.name).is_some() {
             crate::io::paths::file_name("study name", &s.name, "")?;
         }
@@ -397,6 +430,13 @@ impl Study {
                 ));
             }
         }
+        Ok(())
+    }
+
+    fn checked(mut self) -> Result<Study> {
+        let src = self.source.clone();
+        self.check_spec(&src)?;
+        let s = &self.spec;
         // every value of every axis, applied to the base after the first value of each
         // earlier axis (a later axis may set a field of an earlier one's value), must give a
         // case
