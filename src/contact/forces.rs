@@ -15,11 +15,43 @@
 //! that body's dofs; a rigid master takes minus the force on the slave.
 //!
 //! **Pressures.** At a node `a` of a contact surface with outward unit normal `n_a` and
-//! tributary area `A_a = t int N_a ds` (thickness `t`), the traction is `f_a / A_a`; the contact
-//! pressure is `p_a = -f_a . n_a / A_a`. It does not depend on which body is the slave, nor on
-//! how a mortar row is normalized (a row's own `lambda / A` is a multiplier coefficient, not a
-//! traction: at a slave node whose support barely overlaps the master it reached 19,976 where
-//! the traction is 1, defect D13).
+//! tributary area `A_a = t int N_a ds` (thickness `t`) wholly covered by the master, the
+//! traction is `f_a / A_a`: the contact pressure is `p_a = -f_a . n_a / A_a` and the shear
+//! traction `tau_a = f_a . t_a / A_a`, `t_a = (-n_y, n_x)`. It does not depend on which body is
+//! the slave, nor on how a mortar row is normalized (a row's own `lambda / A` is a multiplier
+//! coefficient, not a traction: at a slave node whose support barely overlaps the master it
+//! reached 19,976 where the traction is 1, defect D13).
+//!
+//! **Recovery where a facet is partly covered.** Where the master ends over a slave facet, only
+//! part of the node's tributary transmits force: a mortar row at node `a` integrates `N_a` over
+//! the covered pieces alone, so a uniform pressure `p` gives `f_a . n_a = -p C_a` with the
+//! covered tributary `C_a = sum_e c_a^e`, `c_a^e = t int_{covered part of e} N_a ds` (the rows'
+//! [`crate::contact::Constraint::cover`]; node-based rows and rigid masters cover the whole
+//! tributary of a node that has a row). `f_a / A_a` then reads `p C_a / A_a` (98.48 and 95.24
+//! where the pressure is 100); `f_a / C_a` is exact for a uniform pressure but not bounded: a
+//! node whose covered share is a sliver (`C_a -> 0`) carries a force that its tiny share does
+//! not scale (173.9 where the traction is 1 after a slide, defect D13). So each component `F_a`
+//! of the nodal force (normal, tangential) is recovered facet by facet:
+//!
+//! ```text
+//! L_e = sum_{a in e} c_a^e                                 the facet's covered area
+//! v_e = sum_{a in e, C_a > 0} F_a (c_a^e / C_a) / L_e        its mean (the force it transmits / L_e)
+//! ```
+//!
+//! and at node `a`: without cover (`C_a = 0`, no row) `F_a / A_a`; where each facet at `a`
+//! covers `a`'s share wholly or not at all, `F_a / C_a` (the force over the covered tributary;
+//! `F_a / A_a` to the bit at every node of node-based rows and at every interior node); where a
+//! facet covers it in part, the covered-area-weighted mean `sum_e L_e v_e / sum_e L_e` of the
+//! means of its covered facets that are not slivers (a sliver: covered on less than
+//! [`SLIVER_SHARE`], a tenth, of its area); if all are slivers, `F_a / A_a`. Every value is
+//! exact for a uniform traction (`F_a = v C_a` gives `v_e = v`) except at a node whose only
+//! covered facets are slivers. On a sliver the value stays bounded: a sliver's mean, whose
+//! covered area may be any small number, is never used; the means used are convex
+//! combinations of `F_b / C_b` over facets covered on at least a tenth. (D13: the node whose
+//! support a sliver of 0.0033 covers reads 0.0148, its neighbour, whose force carries the
+//! concentration at the master's corner, the mean 2.57 of its covered facet, where `F / C`
+//! reads 173.9 and 3.8.) The pair's transmitted normal force is `sum_a -f_a . n_a` (not `sum_a
+//! p_a A_a`), its closed area the sum of the covered `C_a`.
 //!
 //! **Penetration.** A frictionless row penetrates by `max(0, -g)`. A tie's rows measure the jump
 //! `d = u_s - u_m` one component at a time; the normal overlap at the slave node is
@@ -32,7 +64,7 @@
 //! linearized: the reference configuration, or `X + u_k` with contact geometry in the current
 //! configuration.
 
-use super::discretization::geometry::Surface;
+use super::discretization::geometry::{NodeData, Surface};
 use super::state::ContactState;
 use crate::model::{Body, MasterSide, Model};
 use std::collections::BTreeMap;
@@ -46,12 +78,21 @@ pub struct NodalTraction {
     pub point: [f64; 2],
     /// Tributary area `t int N_a ds`.
     pub area: f64,
+    /// The part of it that the pair's rows at the node cover, `C_a` (module notes; 0 at a node
+    /// without rows).
+    pub covered_area: f64,
     /// Outward unit normal of the surface at the node.
     pub normal: [f64; 2],
     /// Nodal contact force `f_a`.
     pub force: [f64; 2],
-    /// `-f_a . n_a / A_a` (compression positive).
+    /// The recovered traction `-p_a n_a + tau_a t_a` (module notes).
+    pub traction: [f64; 2],
+    /// The recovered pressure `p_a` (compression positive; `-f_a . n_a / A_a` where the node's
+    /// tributary is wholly covered).
     pub pressure: f64,
+    /// The recovered shear traction `tau_a` along `t_a = (-n_y, n_x)` (`f_a . t_a / A_a` where
+    /// the node's tributary is wholly covered).
+    pub shear: f64,
     /// Whether a row of the pair has this node as its slave node.
     pub carries_rows: bool,
 }
@@ -203,19 +244,56 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
         on_master = [-on_slave[0], -on_slave[1]];
     }
 
+    // the covered tributaries of the rows, per surface (pass 1: the slave surface, pass 2: the
+    // master body's), node and facet
+    let mut cover: Vec<Cover> = vec![BTreeMap::new(); surfaces.len()];
+    for r in state.rows.iter().filter(|r| r.pair == k) {
+        let Some(c) = usize::from(r.pass)
+            .checked_sub(1)
+            .and_then(|side| cover.get_mut(side))
+        else {
+            continue;
+        };
+        let facets = c.entry(r.slave_node).or_default();
+        for &(f, w) in &r.cover {
+            let e = facets.entry(f).or_insert(0.0f64);
+            *e = e.max(w);
+        }
+    }
     let mut nodes = Vec::new();
-    for s in &surfaces {
+    for (s, cover) in surfaces.iter().zip(&cover) {
+        let force = |n: usize| nodal.get(&(s.body, n)).copied().unwrap_or([0.0; 2]);
+        let component = |along: &dyn Fn(&NodeData) -> [f64; 2]| -> BTreeMap<usize, f64> {
+            s.nodes
+                .iter()
+                .map(|(&n, data)| {
+                    let (f, d) = (force(n), along(data));
+                    (n, f[0] * d[0] + f[1] * d[1])
+                })
+                .collect()
+        };
+        let pressure = recovered(s, cover, &component(&|d| [-d.normal[0], -d.normal[1]]));
+        let shear = recovered(s, cover, &component(&|d| [-d.normal[1], d.normal[0]]));
         for (&n, data) in &s.nodes {
-            let f = nodal.get(&(s.body, n)).copied().unwrap_or([0.0; 2]);
-            let pressure = -(f[0] * data.normal[0] + f[1] * data.normal[1]) / data.area;
+            let (nn, p, tau) = (data.normal, pressure[&n], shear[&n]);
+            // the whole tributary where it is covered to round-off
+            let covered_area = cover.get(&n).map_or(0.0, |c| c.values().sum());
+            let covered_area = if (covered_area - data.area).abs() <= 1e-14 * data.area {
+                data.area
+            } else {
+                covered_area
+            };
             nodes.push(NodalTraction {
                 body: s.body,
                 node: n,
                 point: position(s.body, n),
                 area: data.area,
-                normal: data.normal,
-                force: f,
-                pressure,
+                covered_area,
+                normal: nn,
+                force: force(n),
+                traction: [-p * nn[0] - tau * nn[1], -p * nn[1] + tau * nn[0]],
+                pressure: p,
+                shear: tau,
                 carries_rows: slave_nodes.contains(&(s.body, n)),
             });
         }
@@ -233,6 +311,105 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
         nodes,
         penetration,
     }
+}
+
+/// The covered tributary `c_a^e` of each node `a` of a surface on each facet `e` that holds it
+/// ([`crate::contact::Constraint::cover`]).
+pub type Cover = BTreeMap<usize, BTreeMap<usize, f64>>;
+
+/// A facet covered on less than this share of its area is a sliver: its mean traction is not
+/// used (module notes, **Recovery**).
+pub const SLIVER_SHARE: f64 = 0.1;
+
+/// The nodal values `v_a` of a traction component recovered from the nodal forces' component
+/// `F_a` (`values`) on `surface`, in any dimension (module notes, **Recovery**): with the
+/// covered tributary `C_a = sum_e c_a^e`, each facet's covered area `L_e = sum_a c_a^e` and,
+/// unless it is a sliver (`L_e < SLIVER_SHARE` of its area), its mean `v_e = sum_{a, C_a > 0}
+/// F_a (c_a^e / C_a) / L_e`,
+///
+/// ```text
+/// v_a = F_a / A_a                                   no cover (C_a = 0)
+/// v_a = F_a / sum_{e at a, c_a^e > 0} A_a^e         each facet at a covers a's share wholly or not at all
+/// v_a = sum_e L_e v_e / sum_e L_e                   over the facets at a with c_a^e > 0 that are
+///                                                   not slivers, where one covers a's share in part
+/// v_a = F_a / A_a                                   if all those are slivers
+/// ```
+pub fn recovered<const D: usize, K>(
+    surface: &Surface<D, K>,
+    cover: &Cover,
+    values: &BTreeMap<usize, f64>,
+) -> BTreeMap<usize, f64> {
+    let covered = |n: usize| cover.get(&n).map_or(0.0, |c| c.values().sum::<f64>());
+    let share = |n: usize, f: usize| {
+        cover
+            .get(&n)
+            .and_then(|c| c.get(&f))
+            .copied()
+            .unwrap_or(0.0)
+    };
+    // each facet's covered area and, unless it is a sliver, its mean value
+    let means: Vec<Option<(f64, f64)>> = surface
+        .facets
+        .iter()
+        .zip(&surface.facet_weights)
+        .enumerate()
+        .map(|(f, (nodes, whole))| {
+            let (mut force, mut length) = (0.0, 0.0);
+            for &n in nodes {
+                let c = share(n, f);
+                if c > 0.0 {
+                    force += values[&n] * c / covered(n);
+                    length += c;
+                }
+            }
+            let area: f64 = whole.iter().sum();
+            (length > 0.0 && length >= SLIVER_SHARE * area).then(|| (length, force / length))
+        })
+        .collect();
+    // per node: whether a facet covers its share in part, the tributary on uncovered facets,
+    // and the covered-area-weighted sum of its facets' means
+    #[derive(Default)]
+    struct AtNode {
+        partly: bool,
+        uncovered: f64,
+        weighted: f64,
+        length: f64,
+    }
+    let mut at: BTreeMap<usize, AtNode> = BTreeMap::new();
+    for (f, (nodes, whole)) in surface
+        .facets
+        .iter()
+        .zip(&surface.facet_weights)
+        .enumerate()
+    {
+        for (&n, &a) in nodes.iter().zip(whole) {
+            let e = at.entry(n).or_default();
+            let c = share(n, f);
+            if c <= 0.0 {
+                e.uncovered += a;
+                continue;
+            }
+            e.partly |= a - c > 1e-14 * a;
+            if let Some((length, mean)) = means[f] {
+                e.weighted += length * mean;
+                e.length += length;
+            }
+        }
+    }
+    surface
+        .nodes
+        .iter()
+        .map(|(&n, data)| {
+            let v = values[&n];
+            let value = match at.get(&n) {
+                Some(e) if covered(n) > 0.0 && !e.partly => v / (data.area - e.uncovered),
+                Some(e) if covered(n) > 0.0 && e.length > 0.0 => e.weighted / e.length,
+                _ => v / data.area,
+            };
+            // + 0.0: a node without force has value 0, not -0
+            (n, value + 0.0)
+        })
+        .collect()
 }
 
 /// The largest penetration of pair `k` in `state`, in any dimension: frictionless rows one by

@@ -81,6 +81,15 @@ pub struct Constraint<const D: usize = 2> {
     /// entries sum to `area`. Only the perturbed Lagrangian uses it (see
     /// [`enforcement`]): `C = A^-1 M A^-1 / kappa`.
     pub mass: Vec<(usize, f64)>,
+    /// The part of the slave node's tributary that this row's master covers, facet by facet:
+    /// `(facet, t int_{covered part of the facet} N_a ds)`, `facet` an index into the pair's
+    /// slave facets of this pass (the facets of its [`discretization::geometry::Surface`]).
+    /// Node-based rows and rigid masters cover the node's whole tributary (`N_a` integrated
+    /// over each facet that holds it: a node has a row where a master facet lies under it);
+    /// mortar rows between bodies the pieces of the slave facets that a master facet overlaps.
+    /// Empty where it is not computed (3D mortar): the node then counts as not covered. Only
+    /// the recovery of the nodal traction uses it ([`forces`]).
+    pub cover: Vec<(usize, f64)>,
     /// The tangential slip measures of a frictional (Coulomb) pair, one per tangent direction
     /// (`D - 1`: one in 2D, an orthonormal pair of the tangent plane in 3D), empty elsewhere:
     /// physics is opt-in, a frictionless scene builds no tangential row.

@@ -95,7 +95,9 @@ fn worst(a: f64, e: f64) -> f64 {
 
 /// Max over the nodes of `pair` (all pairs if `None`) that carry rows, in the forces `forces`
 /// of the solution (from [`pair_forces`]), of
-/// `|f_a / A_a - sigma_exact n_a| / scale` (ties: the whole traction; frictionless pairs: its
+/// `|t_a - sigma_exact n_a| / scale`, `t_a` the recovered nodal traction of
+/// [`crate::contact::forces`] (`f_a / A_a` where the node's tributary is wholly covered; ties:
+/// the whole traction; frictionless pairs: its
 /// normal component, the pressure), with `scale` the given one or, if `None`, `max |sigma_exact|`
 /// at the node (the problem's stress magnitude where that is 0). Infinite when the solve
 /// produced no contact state.
@@ -139,7 +141,7 @@ pub fn pressure_error_of(
                 .max(f64::MIN_POSITIVE);
             let nn = n.normal;
             let exact_traction = [s[0] * nn[0] + s[2] * nn[1], s[2] * nn[0] + s[1] * nn[1]];
-            let traction = [n.force[0] / n.area, n.force[1] / n.area];
+            let traction = n.traction;
             let e = if tied {
                 (traction[0] - exact_traction[0])
                     .abs()

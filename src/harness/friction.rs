@@ -148,7 +148,7 @@ pub(crate) fn measure(
                 let t = [-nn[1], nn[0]];
                 let exact_traction = [s[0] * nn[0] + s[2] * nn[1], s[2] * nn[0] + s[1] * nn[1]];
                 let along = |v: [f64; 2]| v[0] * t[0] + v[1] * t[1];
-                let e = (along(n.force) / n.area - along(exact_traction)).abs() / pressure.abs();
+                let e = (along(n.traction) - along(exact_traction)).abs() / pressure.abs();
                 tangential_error = if e.is_nan() || e > tangential_error {
                     e
                 } else {

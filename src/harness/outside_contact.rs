@@ -207,14 +207,20 @@ pub fn read(model: &Model, results: &Results, matched: &[Vec<usize>]) -> Result<
                     net_moment += x[0] * force[1] - x[1] * force[0];
                     force_scale += force[0].hypot(force[1]);
                     let marked_off = status.is_some_and(|st| st.at(point)[0] == 0.0);
+                    // another code's nodal values: its traction is its force per tributary
+                    // area (no covered share is known)
+                    let nn = data.normal;
                     nodes.push(NodalTraction {
                         body: surface.body,
                         node: n,
                         point: x,
                         area: data.area,
-                        normal: data.normal,
+                        covered_area: data.area,
+                        normal: nn,
                         force,
+                        traction: [force[0] / data.area, force[1] / data.area],
                         pressure,
+                        shear: (-force[0] * nn[1] + force[1] * nn[0]) / data.area,
                         carries_rows: rows && !marked_off,
                     });
                 }

@@ -229,8 +229,9 @@ pub struct PairSummary {
     /// Coulomb pairs: total tangential force, stick/slip/open counts, dissipation.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub friction: Option<crate::contact::friction::FrictionSummary>,
-    /// `sum_a p_a A_a` over the slave surface, the tributary area of its closed points, and the
-    /// points of each status (both surfaces; see [`crate::contact::results`]).
+    /// The normal force the pair transmits (`sum_a -f_a . n_a` over the slave surface), the
+    /// covered tributary area of its closed points, and the points of each status (both
+    /// surfaces; see [`crate::contact::results`]).
     pub normal_force: f64,
     pub closed_area: f64,
     pub point_status: PointStatusCounts,

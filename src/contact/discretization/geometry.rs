@@ -188,6 +188,9 @@ pub struct Surface<const D: usize = 2, K = EdgeKind> {
     pub coords: Vec<Vec<[f64; D]>>,
     /// Unique nodes of the surface with their weight (area) and unit normal.
     pub nodes: BTreeMap<usize, NodeData<D>>,
+    /// Each facet's share of its nodes' weights, `t int M_a dA` over that facet alone (facet
+    /// node order); a node's `area` is the sum of its shares over the facets that hold it.
+    pub facet_weights: Vec<Vec<f64>>,
 }
 
 /// A 3D surface of Quad4, Quad9, Tri3 or Tri6 faces.
@@ -308,6 +311,22 @@ impl Surface3 {
     }
 }
 
+impl<const D: usize, K> Surface<D, K> {
+    /// The whole tributary of `node` facet by facet: `(facet, t int M_a dA)` over each facet of
+    /// the surface that holds it (`facet` an index into [`Surface::facets`]).
+    pub fn tributaries(&self, node: usize) -> Vec<(usize, f64)> {
+        self.facets
+            .iter()
+            .zip(&self.facet_weights)
+            .enumerate()
+            .filter_map(|(f, (nodes, w))| {
+                let a = nodes.iter().position(|&n| n == node)?;
+                Some((f, w[a]))
+            })
+            .collect()
+    }
+}
+
 impl<const D: usize, K: FacetShape<D>> Surface<D, K> {
     /// The surface of facets given by their node ids and positions (facet node order), with
     /// the nodal weights and normals computed from them; `thickness` multiplies the weights
@@ -325,11 +344,13 @@ impl<const D: usize, K: FacetShape<D>> Surface<D, K> {
             facets: Vec::new(),
             coords: Vec::new(),
             nodes: BTreeMap::new(),
+            facet_weights: Vec::new(),
         };
         let mut sums: BTreeMap<usize, (f64, [f64; D], [f64; D])> = BTreeMap::new();
         let k = kind.node_count();
         let rule = kind.surface_rule();
         for (nodes, coords) in facet_nodes.into_iter().zip(facet_coords) {
+            let mut shares = vec![0.0; k];
             for &(s, w) in &rule {
                 let mut m = [0.0; MAX_FACET_NODES];
                 kind.weight_basis(s, &mut m[..k]);
@@ -340,6 +361,7 @@ impl<const D: usize, K: FacetShape<D>> Surface<D, K> {
                 for a in 0..k {
                     let e = sums.entry(nodes[a]).or_insert((0.0, [0.0; D], coords[a]));
                     e.0 += w * m[a] * len * thickness;
+                    shares[a] += w * m[a] * len * thickness;
                     for i in 0..D {
                         e.1[i] += w * m[a] * len * normal[i];
                     }
@@ -347,6 +369,7 @@ impl<const D: usize, K: FacetShape<D>> Surface<D, K> {
             }
             out.facets.push(nodes);
             out.coords.push(coords);
+            out.facet_weights.push(shares);
         }
         for (node, (area, n, position)) in sums {
             let l = dot(n, n).sqrt();

@@ -364,6 +364,7 @@ pub(crate) fn weighted_row(
         pair: 0,
         bilateral,
         mass: Vec::new(),
+        cover: slave.tributaries(node),
         tangents: Vec::new(),
         segment: None,
         nodal_normal: None,

@@ -170,6 +170,38 @@ pub(crate) fn mortar_integrals(
     (d, m, pieces)
 }
 
+/// The covered tributary of each slave node facet by facet, `(facet, t int N_a ds)` over the
+/// `pieces` of each slave facet (the parts a master facet overlaps; [`mortar_integrals`]), by
+/// `gauss` on each piece: what [`crate::contact::Constraint::cover`] holds for a mortar row.
+pub(crate) fn covered_tributaries(
+    slave: &Surface,
+    pieces: &[Vec<SubSegment>],
+    gauss: &[(f64, f64)],
+    thickness: f64,
+) -> BTreeMap<usize, Vec<(usize, f64)>> {
+    let mut cover: BTreeMap<usize, Vec<(usize, f64)>> = BTreeMap::new();
+    for (f, facet_pieces) in pieces.iter().enumerate() {
+        let coords = &slave.coords[f];
+        let mut shares = [0.0; 3];
+        for piece in facet_pieces {
+            let (a, b) = (piece.ends[0].0, piece.ends[1].0);
+            for &(eta, wq) in gauss {
+                let s = a + 0.5 * (b - a) * (eta + 1.0);
+                let (_, t) = facet_point(slave.kind, coords, s);
+                let jac = t[0].hypot(t[1]) * 0.5 * (b - a) * thickness;
+                let (n_s, _) = edge_shape(slave.kind, s);
+                for (share, n) in shares.iter_mut().zip(n_s) {
+                    *share += wq * jac * n;
+                }
+            }
+        }
+        for (&node, &share) in slave.facets[f].iter().zip(&shares) {
+            cover.entry(node).or_default().push((f, share));
+        }
+    }
+    cover
+}
+
 /// Gauss points per sub-segment: 3 between Line2 facets, 4 where either is Line3.
 pub(crate) fn gauss_rule(slave: EdgeKind, master: EdgeKind) -> Vec<(f64, f64)> {
     gauss_legendre(if slave == EdgeKind::Line3 || master == EdgeKind::Line3 {
@@ -193,6 +225,12 @@ pub(crate) fn mortar_rows(
     let mb = &model.bodies[master.body];
     let radius = rows.search_distance.unwrap_or_else(|| master.facet_size());
     let (d, m, pieces) = mortar_integrals(slave, master, space, radius, model.thickness);
+    let cover = covered_tributaries(
+        slave,
+        &pieces,
+        &gauss_rule(slave.kind, master.kind),
+        model.thickness,
+    );
     let linearize = model.physics.kinematics == Kinematics::Finite && !rows.tied;
     for (&j, dj) in &d {
         let area: f64 = dj.values().sum();
@@ -229,6 +267,9 @@ pub(crate) fn mortar_rows(
             area,
             1,
         );
+        for r in &mut rows.out[before..] {
+            r.cover = cover.get(&j).cloned().unwrap_or_default();
+        }
         if linearize {
             let row = rows.out.last_mut().expect("the row was just pushed");
             let dof = |master: bool, node: usize, i: usize| {

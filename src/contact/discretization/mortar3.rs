@@ -1061,6 +1061,8 @@ fn weighted_row(
         pair: numbering.pair,
         bilateral: false,
         mass: Vec::new(),
+        // the covered share of 3D mortar facets is not computed (no 3D nodal pressure)
+        cover: Vec::new(),
         tangents: Vec::new(),
         segment: None,
         nodal_normal: None,

@@ -231,6 +231,7 @@ pub fn node_row<const D: usize, K>(
         pair: settings.pair,
         bilateral: false,
         mass: Vec::new(),
+        cover: slave.tributaries(node),
         tangents: Vec::new(),
         segment: None,
         nodal_normal: None,
