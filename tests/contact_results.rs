@@ -536,6 +536,8 @@ fn a_contact_node_past_the_masters_end_has_no_row() {
             assert_eq!(row["gap"], "", "{row:?}");
             assert_eq!(num(row, "force_y"), 0.0, "{row:?}");
         }
+    }
+}
 
 /// Issue 38, item 9 (the pressure at the edge of a partly covered slave facet): W07 presses a
 /// block by a uniform 100 onto a base whose top is two master surfaces, one per pair, so that

@@ -359,3 +359,114 @@ fn each_support_set_reports_its_own_reaction() {
     );
     assert!((value(corner, "x") + value(punch, "x")).abs() <= 1e-10 * 80.0);
 }
+
+/// Issue 38, item 3 (every field of the law the run used), with contact: W03's neo-Hookean
+/// cell under the dead top traction (0, -100), its bottom now held by frictionless contact
+/// with a rigid line y = 0 (Lagrange multipliers, node-to-surface, finite kinematics) instead
+/// of rollers. The homogeneous stretch `F = diag(l1, l2)` is exact as before, so every field
+/// written is checked against it: the body's stress ranges in `summary.json` (Cauchy,
+/// `sigma_yy = -100 / l1`, `sigma_xx = sigma_xy = 0`), the displacement ranges, the pair's
+/// total force (the dead load, 100 on the reference width 1) and its largest pressure, and per
+/// point in `<pair>.contact.csv`: the force (50 a node), the tributary area of the current
+/// surface (`l1 / 2`), the pressure per that area (`100 / l1 = -sigma_yy`: a true traction, as
+/// `src/contact/results.rs` states), the gap (zero to round-off) and the status (closed).
+#[test]
+fn every_field_with_contact_at_finite_strain_is_the_law_s() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut case: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(
+            root.join("tests/defects/s4/W03-finite-stress-zz-small-strain-formula.json"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    case["supports"] = serde_json::json!([{"body": "b", "set": "bottom_left", "x": 0.0}]);
+    case["physics"]["contact_geometry"] = serde_json::json!("current");
+    case["contact"] = serde_json::json!([{
+        "name": "ground",
+        "slave": {"body": "b", "set": "bottom"},
+        "master": {"rigid": {"kind": "line", "point": [0.0, 0.0], "normal": [0.0, 1.0]}},
+        "discretization": {"kind": "node_to_surface", "passes": 1},
+        "enforcement": {"kind": "lagrange"}
+    }]);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.json");
+    std::fs::write(&path, serde_json::to_string(&case).unwrap()).unwrap();
+    let out = dir.path().join("out");
+    let o = common::run_case(&path, &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let body = &summary["bodies"][0];
+    let range = |field: &str| -> [f64; 2] {
+        let r = body[field]
+            .as_array()
+            .unwrap_or_else(|| panic!("{field}: {body}"));
+        [r[0].as_f64().unwrap(), r[1].as_f64().unwrap()]
+    };
+    // the stretches: u_x at x = 1 and u_y at y = 1 (the bottom rests on the line at y = 0)
+    let (ux, uy) = (range("u_x"), range("u_y"));
+    let (l1, l2) = (1.0 + ux[1], 1.0 + uy[0]);
+    assert_eq!(ux[0], 0.0, "{body}");
+    assert!(uy[1].abs() < 1e-9, "the bottom sits on the line: {body}");
+    let (e, nu) = (1000.0f64, 0.3f64);
+    let (mu, lambda) = (
+        e / (2.0 * (1.0 + nu)),
+        e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+    );
+    let j = l1 * l2;
+    let law = [
+        (mu * (l1 * l1 - 1.0) + lambda * j.ln()) / j,
+        (mu * (l2 * l2 - 1.0) + lambda * j.ln()) / j,
+    ];
+    // W03's stretch (the rollers' answer), and the law's equilibrium with the dead load
+    assert!(
+        (l1 - 1.03762).abs() < 1e-5 && (l2 - 0.91573).abs() < 1e-5,
+        "{l1} {l2}"
+    );
+    assert!(
+        law[0].abs() < 1e-9 && (law[1] + 100.0 / l1).abs() < 1e-9,
+        "{law:?}"
+    );
+    for (field, value) in [
+        ("stress_xx", law[0]),
+        ("stress_yy", law[1]),
+        ("stress_xy", 0.0),
+    ] {
+        for v in range(field) {
+            assert!((v - value).abs() < 1e-9, "{field}: {v}, law {value}");
+        }
+    }
+    let contact = &summary["contact"];
+    let total = contact["total_force"].as_array().unwrap();
+    assert!(total[0].as_f64().unwrap().abs() < 1e-9, "{contact}");
+    assert!(
+        (total[1].as_f64().unwrap() - 100.0).abs() < 1e-9,
+        "{contact}"
+    );
+    let pressure = 100.0 / l1;
+    assert!(
+        (contact["max_pressure"].as_f64().unwrap() - pressure).abs() < 1e-9,
+        "{contact}"
+    );
+    let text = std::fs::read_to_string(out.join("ground.contact.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let column = |row: &[&str], name: &str| -> f64 {
+        let k = header.iter().position(|h| *h == name).unwrap();
+        row[k].parse().unwrap_or_else(|_| panic!("{name}: {row:?}"))
+    };
+    let mut points = 0;
+    for line in lines {
+        let row: Vec<&str> = line.split(',').collect();
+        let status = header.iter().position(|h| *h == "status").unwrap();
+        assert_eq!(row[status], "closed", "{line}");
+        assert!((column(&row, "force_y") - 50.0).abs() < 1e-9, "{line}");
+        assert!(column(&row, "force_x").abs() < 1e-9, "{line}");
+        assert!((column(&row, "pressure") - pressure).abs() < 1e-9, "{line}");
+        assert!(column(&row, "gap").abs() < 1e-12, "{line}");
+        assert!((column(&row, "area") - l1 / 2.0).abs() < 1e-12, "{line}");
+        points += 1;
+    }
+    assert_eq!(points, 2);
+}

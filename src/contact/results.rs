@@ -53,6 +53,11 @@
 //! a uniform pressure `p` gives normal force = `p` x closed area), the largest pressure and the
 //! counts of each status.
 //!
+//! Under finite kinematics (or contact geometry in the current configuration) the surfaces,
+//! their normals and tributary areas are those of the rows' configuration `X + u`
+//! ([`super::forces`]): the pressure and shear are true (Cauchy) tractions, force per current
+//! area (`tests/output.rs` checks them against a neo-Hookean block's closed form).
+//!
 //! Positions are reference coordinates (the rows' configuration may be `X + u`: see
 //! [`super::forces`]); the displacement at each node is given beside them.
 

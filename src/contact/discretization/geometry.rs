@@ -191,6 +191,8 @@ pub struct Surface<const D: usize = 2, K = EdgeKind> {
     /// Each facet's share of its nodes' weights, `t int M_a dA` over that facet alone (facet
     /// node order); a node's `area` is the sum of its shares over the facets that hold it.
     pub facet_weights: Vec<Vec<f64>>,
+    /// The same by node: `(facet, share)` over the facets that hold it ([`Surface::tributaries`]).
+    node_tributaries: BTreeMap<usize, Vec<(usize, f64)>>,
 }
 
 /// A 3D surface of Quad4, Quad9, Tri3 or Tri6 faces.
@@ -315,15 +317,10 @@ impl<const D: usize, K> Surface<D, K> {
     /// The whole tributary of `node` facet by facet: `(facet, t int M_a dA)` over each facet of
     /// the surface that holds it (`facet` an index into [`Surface::facets`]).
     pub fn tributaries(&self, node: usize) -> Vec<(usize, f64)> {
-        self.facets
-            .iter()
-            .zip(&self.facet_weights)
-            .enumerate()
-            .filter_map(|(f, (nodes, w))| {
-                let a = nodes.iter().position(|&n| n == node)?;
-                Some((f, w[a]))
-            })
-            .collect()
+        self.node_tributaries
+            .get(&node)
+            .cloned()
+            .unwrap_or_default()
     }
 }
 
@@ -345,6 +342,7 @@ impl<const D: usize, K: FacetShape<D>> Surface<D, K> {
             coords: Vec::new(),
             nodes: BTreeMap::new(),
             facet_weights: Vec::new(),
+            node_tributaries: BTreeMap::new(),
         };
         let mut sums: BTreeMap<usize, (f64, [f64; D], [f64; D])> = BTreeMap::new();
         let k = kind.node_count();
@@ -366,6 +364,12 @@ impl<const D: usize, K: FacetShape<D>> Surface<D, K> {
                         e.1[i] += w * m[a] * len * normal[i];
                     }
                 }
+            }
+            for (&node, &share) in nodes.iter().zip(&shares) {
+                out.node_tributaries
+                    .entry(node)
+                    .or_default()
+                    .push((out.facets.len(), share));
             }
             out.facets.push(nodes);
             out.coords.push(coords);
