@@ -1887,6 +1887,14 @@ fn vtu_attribute_values(text: &str) -> Vec<(&'static str, usize, usize)> {
     out
 }
 
+/// The `DataArray` elements of `text` that hold something ([`vtu_elements`]' tuples).
+fn filled_data_arrays(text: &str) -> Vec<(usize, usize, usize, usize)> {
+    vtu_elements(text, "DataArray")
+        .into_iter()
+        .filter(|e| e.2 > e.1)
+        .collect()
+}
+
 /// The byte ranges of each `<tag ...>...</tag>` (or `<tag .../>`) element: `(start of the
 /// element, start of its content, end of its content, end of the element)`.
 fn vtu_elements(text: &str, tag: &str) -> Vec<(usize, usize, usize, usize)> {
@@ -2016,10 +2024,7 @@ fn vtu_text_mutation(kind: &str, rng: &mut Rng, text: &mut String) -> Option<Str
             Some(format!("{a}=\"{old}\" -> \"{new}\""))
         }
         "vtu_values" => {
-            let arrays: Vec<_> = vtu_elements(text, "DataArray")
-                .into_iter()
-                .filter(|e| e.2 > e.1)
-                .collect();
+            let arrays = filled_data_arrays(text);
             if arrays.is_empty() {
                 return None;
             }
@@ -2134,10 +2139,7 @@ fn vtu_text_mutation(kind: &str, rng: &mut Rng, text: &mut String) -> Option<Str
             })
         }
         "vtu_encoding" => {
-            let arrays: Vec<_> = vtu_elements(text, "DataArray")
-                .into_iter()
-                .filter(|e| e.2 > e.1)
-                .collect();
+            let arrays = filled_data_arrays(text);
             if arrays.is_empty() {
                 return None;
             }
