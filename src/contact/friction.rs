@@ -443,7 +443,9 @@ pub fn multiplier_status(
     let (force, dg) = (tangential(lambda_t), tangential(increment));
     let trial: Tangential = std::array::from_fn(|a| force[a] - c * dg[a]);
     let trial_length = length(k, &trial);
-    if trial_length <= mu * lambda_n.max(0.0) {
+    // a point on the cone whose slip does not change sticks (its force, carried from the
+    // last step, may exceed the bound by the cone's round-off)
+    if trial_length <= mu * lambda_n.max(0.0) * (1.0 + CONE_ROUND_OFF) {
         set.status = Status::Stick;
         return set;
     }

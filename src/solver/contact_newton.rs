@@ -136,8 +136,11 @@
 //! The stick rows keep the saddle-point matrix symmetric; a slip row's equation couples `mu_t`
 //! to `mu_n` alone, not to the displacements its column acts on: the tangent is unsymmetric and
 //! factored by LU, also with `friction_tangent: "symmetrized"` (this row is the set's equation,
-//! not a linearization to drop). The multipliers of a step start at zero, so every closed point
-//! sticks in the first iteration of a step; the stick position `g_t^n` is committed per load step.
+//! not a linearization to drop). The multipliers of a point closed at the end of the last load
+//! step start the next one from its forces, and its stick position `g_t^n` is where it ended
+//! that step: its first trial force is the committed force (on the cone to round-off if it
+//! slipped, where it sticks). A point new to the step starts from zero multipliers and sticks in
+//! its first iteration.
 //!
 //! A body held by nothing but contact rows that are open at the start has a singular tangent:
 //! in the first evaluation the rows that would hold it are closed, nearest first
@@ -418,6 +421,35 @@ impl<'a, const D: usize, K: NewtonDimension<D>> ContactSystem<'a, D, K> {
         }
     }
 
+    /// The forces point `r` ended the last load step with, when it was closed then (normal
+    /// force positive): the multipliers a Lagrange row starts the step from.
+    fn carried_force(&self, r: &Constraint<D>) -> Option<&Committed> {
+        self.committed
+            .get(&row_key(r))
+            .filter(|c| c.normal_force > 0.0)
+    }
+
+    /// Start the multipliers of the Lagrange frictional rows in `x` from the forces their
+    /// points ended the last load step with, `x_j = lambda / rho` (the rest stay zero). With the
+    /// stick point `g_t^n` where the point ended that step, the first iterate of a step is the
+    /// committed state to the last bit: a point that slipped sits on the cone and sticks there
+    /// ([`multiplier_status`] within [`crate::contact::friction::CONE_ROUND_OFF`]), and a step
+    /// that changes nothing is solved at its first iterate. (From zero multipliers every point
+    /// stuck in the first iteration and Newton iterated back to the cone.)
+    fn start_multipliers(&self, x: &mut [f64]) {
+        for (i, r) in self.rows.iter().enumerate() {
+            let (Some(j), Some(c)) = (self.multiplier[i], self.carried_force(r)) else {
+                continue;
+            };
+            x[j] = c.normal_force / self.rho;
+            if let Some(jt) = self.tangential[i] {
+                for a in 0..r.tangents.len() {
+                    x[jt + a] = c.tangential_force[a] / self.rho;
+                }
+            }
+        }
+    }
+
     /// The committed slip of point `key` (zero for a point the last step did not have).
     fn committed_slip(&self, key: &RowKey) -> Tangential {
         self.committed
@@ -577,8 +609,8 @@ impl<'a, const D: usize, K: NewtonDimension<D>> ContactSystem<'a, D, K> {
         let (mu, _) = self.coulomb(r)?;
         let j = self.tangential[i]?;
         let k = r.tangents.len();
-        if on && self.evaluations == 0 {
-            // a step starts with zero multipliers: every closed point sticks in its first
+        if on && self.evaluations == 0 && self.carried_force(r).is_none() {
+            // a point new to the step starts with zero multipliers: it sticks in its first
             // iteration (a bound mu lambda_n = 0 would make any round-off slip a slip)
             return Some(MultiplierSet {
                 status: Status::Stick,
@@ -1047,6 +1079,14 @@ impl<const D: usize, K: NewtonDimension<D>> System for ContactSystem<'_, D, K> {
             .then(|| {
                 "for Lagrange-multiplier friction consider a tangential penalty (penalty or augmented Lagrangian enforcement with kappa_t), whose return map is continuous in the slip".to_string()
             })
+    }
+
+    fn smaller_increment(&self) -> &'static str {
+        if self.model.dynamics.is_some() {
+            "take a smaller time step (physics.dynamics.dt)"
+        } else {
+            "apply the load in more load steps (solver.load_steps)"
+        }
     }
 
     fn pattern_version(&self) -> usize {
@@ -1735,6 +1775,7 @@ pub(crate) fn solve_step<const D: usize, K: NewtonDimension<D>>(
             x[e] = u[d];
         }
     }
+    system.start_multipliers(&mut x);
     let first = x.clone();
     let mut inverted = false;
     let mut cut = false;

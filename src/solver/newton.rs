@@ -187,9 +187,14 @@ pub trait System {
     }
     /// What else may help when the iteration cycles with nothing left to change (appended to
     /// the [`Termination::ActiveSetCycling`] message after `; `), for the kind of rows this
-    /// system has. `None`: only the general advice (more load steps, a smaller time step).
+    /// system has. `None`: only the general advice ([`System::smaller_increment`]).
     fn cycle_advice(&self) -> Option<String> {
         None
+    }
+    /// How this system's increment is made smaller, the general advice after a cycle: the
+    /// load steps of a static solve (the default), the time step of a dynamic one.
+    fn smaller_increment(&self) -> &'static str {
+        "apply the load in more load steps (solver.load_steps)"
     }
 }
 
@@ -412,9 +417,10 @@ pub fn solve_with(
                         .map(|a| format!("; {a}"))
                         .unwrap_or_default();
                     break Termination::ActiveSetCycling(format!(
-                        "Newton iteration {solves} repeats the residual {relative:.3e} of iteration {} while {} contact point(s) change status at every iteration (open, closed, stick or slip){tried}: the semi-smooth Newton iteration cycles between sets, none of which is the solution; apply the load in more load steps (solver.load_steps) or take a smaller time step{advice}",
+                        "Newton iteration {solves} repeats the residual {relative:.3e} of iteration {} while {} contact point(s) change status at every iteration (open, closed, stick or slip){tried}: the semi-smooth Newton iteration cycles between sets, none of which is the solution; {}{advice}",
                         solves - period,
-                        eval.status_changes
+                        eval.status_changes,
+                        system.smaller_increment()
                     ));
                 }
             }
@@ -1015,7 +1021,9 @@ mod tests {
             panic!("{:?}", plain.termination)
         };
         // the advice of a system without friction rows: no remedy for other kinds of rows
+        // and of a static solve: load steps, not a time step it does not have
         assert!(why.contains("more load steps"), "{why}");
+        assert!(!why.contains("time step"), "{why}");
         assert!(!why.contains("friction"), "{why}");
         let mut x = vec![x_c];
         let searched = solve(&mut arctan(true), &mut x, settings).unwrap();
