@@ -8,7 +8,7 @@
 //! factorization vs assembly, `numeric_cholesky` vs `numeric_cholesky_faer_llt`), never as
 //! absolute times across machines.
 
-use contact_patch::fe::{point_values, ElementKind, QuadPoint};
+use contact_patch::fe::{ElementKind, QuadPoint, ReferenceCell};
 use contact_patch::model::{parse, Model};
 use contact_patch::solid::{element_stiffness, Elasticity, MAX_DOFS};
 use contact_patch::solver::linear::{assemble, for_each_element_stiffness};
@@ -46,7 +46,7 @@ fn element_stiffness_reference(
     let d: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| material.d[(i, j)]));
     let d = &d;
     for q in rule {
-        let pv = point_values(kind, coords, q.xi);
+        let pv = kind.point_values(coords, q.xi);
         let w = q.weight * pv.det_j * thickness;
         for b in 0..nn {
             let [bx, by] = pv.dndx[b];

@@ -70,6 +70,12 @@ pub trait ReferenceCell<const D: usize>: Copy + std::fmt::Debug + PartialEq {
     fn shape(self, xi: [f64; D], n: &mut [f64], dn: &mut [[f64; D]]);
     /// VTK cell type id.
     fn vtk_cell_type(self) -> u8;
+    /// The geometry at a natural point, [`PointValues`] with the node capacity of the cell
+    /// family (the most nodes one of its cells has).
+    type PointValues: PointGeometry<D>;
+    /// Shape values, Cartesian gradients and `det J` at `xi` of the cell with nodes `coords`
+    /// (element order): [`point_values`] with the family's capacity.
+    fn point_values(self, coords: &[[f64; D]], xi: [f64; D]) -> Self::PointValues;
 }
 
 impl ReferenceCell<2> for ElementKind {
@@ -96,6 +102,10 @@ impl ReferenceCell<2> for ElementKind {
     }
     fn vtk_cell_type(self) -> u8 {
         ElementKind::vtk_cell_type(self)
+    }
+    type PointValues = PointValues<2, MAX_NODES>;
+    fn point_values(self, coords: &[[f64; 2]], xi: [f64; 2]) -> PointValues {
+        point_values(self, coords, xi)
     }
 }
 
@@ -438,49 +448,154 @@ pub fn triangle_rule(degree: usize) -> Vec<QuadPoint> {
     }
 }
 
-/// Geometry of an element at one natural point: shape values, Cartesian derivatives and `det J`.
+/// Geometry of a cell at one natural point: shape values `n`, Cartesian gradients `dndx`,
+/// `det J` and the point `x`. `N` is the capacity of the node arrays (the most nodes a cell of
+/// the family has: [`MAX_NODES`] in 2D, [`crate::fe3d::MAX_SOLID_NODES`] in 3D); the entries
+/// past the cell's node count are zero.
 #[derive(Clone, Debug)]
-pub struct PointValues {
-    pub n: [f64; MAX_NODES],
-    pub dndx: [[f64; 2]; MAX_NODES],
+pub struct PointValues<const D: usize = 2, const N: usize = MAX_NODES> {
+    pub n: [f64; N],
+    pub dndx: [[f64; D]; N],
     pub det_j: f64,
-    pub x: [f64; 2],
+    pub x: [f64; D],
 }
 
-/// Evaluate shape values, Cartesian gradients and the Jacobian determinant at `xi` for an
-/// element with nodal coordinates `coords` (in element node order).
-pub fn point_values(kind: ElementKind, coords: &[[f64; 2]], xi: [f64; 2]) -> PointValues {
+/// What code generic over the cell reads of its [`PointValues`], whatever their capacity.
+pub trait PointGeometry<const D: usize> {
+    /// `det J`.
+    fn jacobian_determinant(&self) -> f64;
+    /// The point `x(xi)`.
+    fn point(&self) -> [f64; D];
+}
+
+impl<const D: usize, const N: usize> PointGeometry<D> for PointValues<D, N> {
+    fn jacobian_determinant(&self) -> f64 {
+        self.det_j
+    }
+    fn point(&self) -> [f64; D] {
+        self.x
+    }
+}
+
+/// Shape values, Cartesian gradients `dN_a/dx = J^-T dN_a/dxi` and `det J` at `xi` for a cell
+/// of kind `kind` with nodes `coords` (element order), `J = dx/dxi`; the gradients are zero
+/// where `det J = 0`. One function for every dimension (the cells' own
+/// [`ReferenceCell::point_values`] fix the capacity `N`).
+pub fn point_values<const D: usize, const N: usize, C: ReferenceCell<D>>(
+    kind: C,
+    coords: &[[f64; D]],
+    xi: [f64; D],
+) -> PointValues<D, N> {
     let nn = kind.node_count();
-    let mut n = [0.0; MAX_NODES];
-    let mut dn = [[0.0; 2]; MAX_NODES];
+    let mut n = [0.0; N];
+    let mut dn = [[0.0; D]; N];
     kind.shape(xi, &mut n[..nn], &mut dn[..nn]);
-    // J = dx/dxi: J[i][j] = d x_i / d xi_j
-    let mut j = [[0.0; 2]; 2];
-    let mut x = [0.0; 2];
+    // J[i][k] = d x_i / d xi_k
+    let mut j = [[0.0; D]; D];
+    let mut x = [0.0; D];
     for a in 0..nn {
-        for i in 0..2 {
+        for i in 0..D {
             x[i] += n[a] * coords[a][i];
-            for k in 0..2 {
+            for k in 0..D {
                 j[i][k] += coords[a][i] * dn[a][k];
             }
         }
     }
-    let det_j = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-    let mut dndx = [[0.0; 2]; MAX_NODES];
+    let (det_j, cofactor) = determinant_and_cofactor(&j);
+    let mut dndx = [[0.0; D]; N];
     if det_j != 0.0 {
-        let inv = [
-            [j[1][1] / det_j, -j[0][1] / det_j],
-            [-j[1][0] / det_j, j[0][0] / det_j],
-        ];
+        // J^-T = cof J / det J: dN/dx_i = sum_k (cof J)_ik / det J dN/dxi_k
+        let mut inverse_t = [[0.0; D]; D];
+        for i in 0..D {
+            for k in 0..D {
+                inverse_t[i][k] = cofactor[i][k] / det_j;
+            }
+        }
         for a in 0..nn {
-            // dN/dx_i = dN/dxi_k * dxi_k/dx_i
-            dndx[a] = [
-                dn[a][0] * inv[0][0] + dn[a][1] * inv[1][0],
-                dn[a][0] * inv[0][1] + dn[a][1] * inv[1][1],
-            ];
+            for i in 0..D {
+                dndx[a][i] = (0..D).fold(0.0, |s, k| s + inverse_t[i][k] * dn[a][k]);
+            }
         }
     }
     PointValues { n, dndx, det_j, x }
+}
+
+/// `det J` and the cofactor matrix `cof J = det J J^-T` of a 2x2 or 3x3 matrix (the cofactor
+/// expansion along the first row; in 3D each cofactor is the 2x2 minor of the cyclically next
+/// rows and columns).
+pub fn determinant_and_cofactor<const D: usize>(j: &[[f64; D]; D]) -> (f64, [[f64; D]; D]) {
+    let mut cofactor = [[0.0; D]; D];
+    match D {
+        1 => cofactor[0][0] = 1.0,
+        2 => {
+            cofactor[0][0] = j[1][1];
+            cofactor[0][1] = -j[1][0];
+            cofactor[1][0] = -j[0][1];
+            cofactor[1][1] = j[0][0];
+        }
+        3 => {
+            for (r, row) in cofactor.iter_mut().enumerate() {
+                let (r0, r1) = ((r + 1) % 3, (r + 2) % 3);
+                for (c, entry) in row.iter_mut().enumerate() {
+                    let (c0, c1) = ((c + 1) % 3, (c + 2) % 3);
+                    *entry = j[r0][c0] * j[r1][c1] - j[r0][c1] * j[r1][c0];
+                }
+            }
+        }
+        _ => unreachable!("cells have 1, 2 or 3 natural coordinates"),
+    }
+    let det = (1..D).fold(j[0][0] * cofactor[0][0], |s, k| {
+        s + j[0][k] * cofactor[0][k]
+    });
+    (det, cofactor)
+}
+
+/// A cell whose Jacobian is not positive at a node or a quadrature point: `det J` there, the
+/// point, and whether it is negative (inverted) rather than zero.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct BadGeometry<const D: usize = 2> {
+    pub det_j: f64,
+    pub at: [f64; D],
+    pub inverted: bool,
+}
+
+/// Check that `det J` is positive, relative to the cell's size (its bounding-box diagonal to
+/// the power `D`), at the nodes and the points of `rule` (the stiffness rule).
+pub fn check_geometry<const D: usize, C: ReferenceCell<D>>(
+    kind: C,
+    coords: &[[f64; D]],
+    rule: &[QuadPoint<D>],
+) -> Result<(), BadGeometry<D>> {
+    let mut lo = [f64::INFINITY; D];
+    let mut hi = [f64::NEG_INFINITY; D];
+    for p in coords {
+        for i in 0..D {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    let diagonal_squared: f64 = (0..D).map(|i| (hi[i] - lo[i]).powi(2)).sum();
+    let scale = diagonal_squared
+        .sqrt()
+        .powi(D as i32)
+        .max(f64::MIN_POSITIVE);
+    let points = kind
+        .node_coordinates()
+        .iter()
+        .copied()
+        .chain(rule.iter().map(|q| q.xi));
+    for xi in points {
+        let pv = kind.point_values(coords, xi);
+        let det_j = pv.jacobian_determinant();
+        if det_j.is_nan() || det_j <= 1e-10 * scale {
+            return Err(BadGeometry {
+                det_j,
+                at: pv.point(),
+                inverted: det_j < 0.0,
+            });
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -605,5 +720,57 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn inverted_and_degenerate_elements_are_detected() {
+        let good = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        assert!(check_geometry(ElementKind::Q4, &good, &ElementKind::Q4.stiffness_rule()).is_ok());
+        let clockwise = vec![[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]];
+        assert!(
+            check_geometry(
+                ElementKind::Q4,
+                &clockwise,
+                &ElementKind::Q4.stiffness_rule()
+            )
+            .unwrap_err()
+            .inverted
+        );
+        let collapsed = vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]];
+        let err = check_geometry(
+            ElementKind::T3,
+            &collapsed,
+            &ElementKind::T3.stiffness_rule(),
+        )
+        .unwrap_err();
+        assert!(!err.inverted && err.det_j.abs() < 1e-12);
+        // a bow-tie (non-convex beyond repair) is inverted somewhere inside
+        let bowtie = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
+        assert!(
+            check_geometry(ElementKind::Q4, &bowtie, &ElementKind::Q4.stiffness_rule()).is_err()
+        );
+    }
+
+    #[test]
+    fn an_inverted_or_flat_solid_is_detected_as_a_quadrilateral_is() {
+        use crate::fe3d::SolidKind;
+        let cube: Vec<[f64; 3]> = SolidKind::Hex8.node_coordinates().to_vec();
+        let rule = SolidKind::Hex8.stiffness_rule();
+        assert!(check_geometry(SolidKind::Hex8, &cube, &rule).is_ok());
+        // the top and bottom faces swapped: det J < 0 everywhere
+        let mut mirrored = cube.clone();
+        mirrored.rotate_left(4);
+        let err = check_geometry(SolidKind::Hex8, &mirrored, &rule).unwrap_err();
+        assert!(err.inverted && err.det_j < 0.0, "{err:?}");
+        // a flat tetrahedron (its fourth corner on the base plane): det J = 0
+        let flat = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
+        let err =
+            check_geometry(SolidKind::Tet4, &flat, &SolidKind::Tet4.stiffness_rule()).unwrap_err();
+        assert!(!err.inverted && err.det_j.abs() < 1e-12, "{err:?}");
     }
 }

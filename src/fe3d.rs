@@ -35,8 +35,10 @@
 //! `(1 - u)^2 (1 - v)` (Stroud, Approximate Calculation of Multiple Integrals, 1971), `n`
 //! Gauss-Legendre points per direction being exact for total degree `2 n - 3`.
 
-use crate::fe::{gauss_legendre, lagrange_1d_quadratic, ElementKind, QuadPoint, ReferenceCell};
-use nalgebra::{Matrix3, Vector3};
+use crate::fe::{
+    gauss_legendre, lagrange_1d_quadratic, point_values, ElementKind, PointValues, QuadPoint,
+    ReferenceCell,
+};
 use serde::{Deserialize, Serialize};
 
 /// A 3D reference element type.
@@ -292,6 +294,10 @@ impl ReferenceCell<3> for SolidKind {
             SolidKind::Tet10 => 24,
         }
     }
+    type PointValues = PointValues<3, MAX_SOLID_NODES>;
+    fn point_values(self, coords: &[[f64; 3]], xi: [f64; 3]) -> Self::PointValues {
+        point_values(self, coords, xi)
+    }
 }
 
 /// Tensor-product Gauss rule with `n^3` points on `[-1, 1]^3`.
@@ -356,75 +362,10 @@ pub fn tetrahedron_conical(n: usize) -> Vec<QuadPoint<3>> {
     out
 }
 
-/// `det J` of a 3x3 matrix by the rule of Sarrus (nalgebra's `determinant` needs its `std`
-/// feature, which the crate leaves off).
-pub fn determinant3(j: &Matrix3<f64>) -> f64 {
-    j[(0, 0)] * (j[(1, 1)] * j[(2, 2)] - j[(1, 2)] * j[(2, 1)])
-        - j[(0, 1)] * (j[(1, 0)] * j[(2, 2)] - j[(1, 2)] * j[(2, 0)])
-        + j[(0, 2)] * (j[(1, 0)] * j[(2, 1)] - j[(1, 1)] * j[(2, 0)])
-}
-
-/// The cofactor matrix `cof J = det J J^-T`.
-pub fn cofactor3(j: &Matrix3<f64>) -> Matrix3<f64> {
-    let c = |r0: usize, r1: usize, c0: usize, c1: usize| {
-        j[(r0, c0)] * j[(r1, c1)] - j[(r0, c1)] * j[(r1, c0)]
-    };
-    Matrix3::new(
-        c(1, 2, 1, 2),
-        -c(1, 2, 0, 2),
-        c(1, 2, 0, 1),
-        -c(0, 2, 1, 2),
-        c(0, 2, 0, 2),
-        -c(0, 2, 0, 1),
-        c(0, 1, 1, 2),
-        -c(0, 1, 0, 2),
-        c(0, 1, 0, 1),
-    )
-}
-
-/// Geometry of a 3D element at one natural point: shape values, Cartesian derivatives, the
-/// Jacobian determinant and the point.
-#[derive(Clone, Debug)]
-pub struct SolidPointValues {
-    pub n: [f64; MAX_SOLID_NODES],
-    pub dndx: [[f64; 3]; MAX_SOLID_NODES],
-    pub det_j: f64,
-    pub x: [f64; 3],
-}
-
-/// Shape values, Cartesian gradients `dN_a/dx = J^-T dN_a/dxi` and `det J` at `xi` for an
-/// element with nodes `coords` (element order); the gradients are zero where `det J = 0`.
-pub fn solid_point_values(kind: SolidKind, coords: &[[f64; 3]], xi: [f64; 3]) -> SolidPointValues {
-    let nn = kind.node_count();
-    let mut n = [0.0; MAX_SOLID_NODES];
-    let mut dn = [[0.0; 3]; MAX_SOLID_NODES];
-    kind.shape(xi, &mut n[..nn], &mut dn[..nn]);
-    let mut j = Matrix3::zeros();
-    let mut x = [0.0; 3];
-    for a in 0..nn {
-        for i in 0..3 {
-            x[i] += n[a] * coords[a][i];
-            for k in 0..3 {
-                j[(i, k)] += coords[a][i] * dn[a][k];
-            }
-        }
-    }
-    let det_j = determinant3(&j);
-    let mut dndx = [[0.0; 3]; MAX_SOLID_NODES];
-    if det_j != 0.0 {
-        let inv_t = cofactor3(&j) / det_j;
-        for a in 0..nn {
-            // dN/dx_i = dN/dxi_k dxi_k/dx_i, i.e. J^-T dN/dxi
-            let g = inv_t * Vector3::from(dn[a]);
-            dndx[a] = [g[0], g[1], g[2]];
-        }
-    }
-    SolidPointValues { n, dndx, det_j, x }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::{Matrix3, Vector3};
 
     fn fact(k: u32) -> f64 {
         (1..=k).map(f64::from).product()
@@ -620,8 +561,9 @@ mod tests {
                 .map(|p| (a * Vector3::from(*p) + c).into())
                 .collect();
             let xi = [0.2, 0.1, 0.3];
-            let pv = solid_point_values(kind, &coords, xi);
-            assert!((pv.det_j - determinant3(&a)).abs() < 1e-14);
+            let pv = kind.point_values(&coords, xi);
+            // det A by the rule of Sarrus
+            assert!((pv.det_j - 1.1955).abs() < 1e-14, "{}", pv.det_j);
             let x = a * Vector3::from(xi) + c;
             for i in 0..3 {
                 assert!((pv.x[i] - x[i]).abs() < 1e-14);

@@ -42,7 +42,7 @@ use contact_patch::harness::{baseline, junit};
 use contact_patch::io::output::write_run;
 use contact_patch::io::paths::{file_name, NamedFile, OutputFolder, ReportFolder};
 use contact_patch::io::scene::Catalogue;
-use contact_patch::run::{run_case, Outcome};
+use contact_patch::run::{run_case, run_checked, Outcome};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -527,7 +527,7 @@ fn run3(
             Some(folder) => folder,
             None => OutputFolder::new(&Path::new("out").join(file_name(
                 "case name",
-                &outcome.name,
+                &outcome.model.name,
                 "",
             )?))?,
         };
@@ -551,7 +551,7 @@ fn run3(
                 .collect();
             println!(
                 "{}: 3D, {} dofs ({})",
-                o.name,
+                o.model.name,
                 o.model.dof_count,
                 cells.join(", ")
             );
@@ -691,13 +691,13 @@ fn check(paths: &[PathBuf], junit_path: Option<&Path>) -> ExitCode {
             b.set_message(case.display().to_string());
         }
         let start = std::time::Instant::now();
-        let result = guarded(case, || run_case(case, &mut |_| {}));
+        let result = guarded(case, || run_checked(case, &mut |_| {}));
         let shown = case.display().to_string();
         suites.push(junit::TestSuite {
             name: shown.clone(),
             seconds: start.elapsed().as_secs_f64(),
             cases: match &result {
-                Ok(outcome) => junit::check_cases(&outcome.model.name, &outcome.checks),
+                Ok(outcome) => junit::check_cases(&outcome.name, &outcome.checks),
                 Err(e) => vec![junit::error_case(&shown, "run", e)],
             },
         });
@@ -708,7 +708,7 @@ fn check(paths: &[PathBuf], junit_path: Option<&Path>) -> ExitCode {
                     "{} ({} checks, {:.3}s)",
                     case.display(),
                     outcome.checks.len(),
-                    outcome.solution.timings.total
+                    outcome.seconds
                 );
                 match &bar {
                     Some(b) => b.println(format!(

@@ -701,7 +701,7 @@ mod tests {
             assert_eq!(m.node_sets["top_back_right"].len(), 1);
             // every cell has a positive volume
             for c in 0..m.cell_count() {
-                let pv = crate::fe3d::solid_point_values(kind, &m.cell_coords(c), kind.centre());
+                let pv = kind.point_values(&m.cell_coords(c), kind.centre());
                 assert!(pv.det_j > 0.0, "{kind:?} cell {c}: det J = {}", pv.det_j);
             }
         }

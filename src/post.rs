@@ -14,7 +14,7 @@
 //! * Relative L2 displacement error: `sqrt(int |u_h - u|^2 dA / int |u|^2 dA)`, with a Gauss rule
 //!   richer than the stiffness rule (see `fe::ElementKind::error_rule`).
 
-use crate::fe::point_values;
+use crate::fe::ReferenceCell;
 use crate::harness::exact::ExactField;
 use crate::model::space::SolidCell;
 use crate::model::{Body, Model};
@@ -194,7 +194,7 @@ pub fn relative_l2_displacement_error(model: &Model, u: &[f64], exact: &ExactFie
             let coords = body.mesh.cell_coords(c);
             cell_displacements(body, u, c, &mut ue);
             for q in &rule {
-                let pv = point_values(kind, &coords, q.xi);
+                let pv = kind.point_values(&coords, q.xi);
                 let mut uh = [0.0; 2];
                 for a in 0..kind.node_count() {
                     uh[0] += pv.n[a] * ue[2 * a];
@@ -300,7 +300,7 @@ impl<'a> CellLocator<'a> {
         let body = self.body;
         let (c, xi) = self.locate(p)?;
         let coords = body.mesh.cell_coords(c);
-        let pv = point_values(body.mesh.kind, &coords, xi);
+        let pv = body.mesh.kind.point_values(&coords, xi);
         let mut ue = Vec::with_capacity(MAX_DOFS);
         cell_displacements(body, u, c, &mut ue);
         let mut uh = [0.0; 2];

@@ -76,10 +76,9 @@ use crate::io::scene::{
 use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
 use crate::model::{Body3, MasterSide, Model3};
-use crate::solid3d::{check_geometry3, facet_traction_load, strain_at3, Elasticity3};
+use crate::solid3d::{facet_traction_load, strain_at3, Elasticity3};
 use crate::solid_finite::Hyperelastic;
 use crate::solid_finite3::displacement_gradient_at3;
-use crate::solver::linear::Solution;
 use std::path::Path;
 
 /// Whether the case has a 3D body (and so runs here).
@@ -97,36 +96,8 @@ pub fn read_3d_case(path: &Path) -> Option<Case> {
     is_3d(&case).then_some(case)
 }
 
-/// Everything a 3D run produced.
-#[derive(Clone, Debug)]
-pub struct Outcome3 {
-    pub name: String,
-    pub model: Model3,
-    pub solution: Solution<3>,
-    pub checks: Vec<CheckResult>,
-    /// What the run should say although no check failed: penetration above
-    /// [`crate::harness::checks::PENETRATION_WARNING_SHARE`] of the contact element size
-    /// ([`crate::harness::checks::penetration_warnings`]), an unstable equilibrium
-    /// ([`crate::harness::stability::unstable_equilibrium`]).
-    pub warnings: Vec<String>,
-    /// The largest penetration of each contact pair (empty without contact).
-    pub penetrations: Vec<Penetration<3>>,
-}
-
-impl Outcome3 {
-    /// Every check passes and the contact solve (if any) converged.
-    pub fn passed(&self) -> bool {
-        self.checks.iter().all(|c| c.passed) && self.converged()
-    }
-
-    /// Whether the contact solve converged (`true` without contact).
-    pub fn converged(&self) -> bool {
-        self.solution
-            .contact
-            .as_ref()
-            .is_none_or(|c| c.termination == crate::contact::state::Termination::Converged)
-    }
-}
+/// What a 3D run produced: the one [`crate::run::Outcome`] of both dimensions.
+pub type Outcome3 = crate::run::Outcome<3, SolidKind>;
 
 /// Run the 3D case `case` read from `source`.
 pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
@@ -144,7 +115,7 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
         .contact
         .as_ref()
         .map(|state| penetrations3(&model, state));
-    let checks = case
+    let mut checks: Vec<CheckResult> = case
         .checks
         .iter()
         .map(|check| match check {
@@ -168,6 +139,10 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
             _ => unreachable!("build3 refuses every other check"),
         })
         .collect();
+    checks.extend(crate::harness::checks::unconverged(
+        &model.checks,
+        &solution,
+    ));
     let mut warnings: Vec<String> = Vec::new();
     if let (Some(state), Some(p)) = (&solution.contact, &penetrations) {
         warnings.extend(penetration_warnings(
@@ -181,12 +156,10 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
     ));
     warnings.extend(crate::harness::stability::unstable_equilibrium(&solution));
     Ok(Outcome3 {
-        name: case.name.clone(),
         model,
         solution,
         checks,
         warnings,
-        penetrations: penetrations.unwrap_or_default(),
     })
 }
 
@@ -364,19 +337,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
                 "fix the breaks or moves",
             )
         })?;
-        for c in 0..mesh.cell_count() {
-            if let Err(bad) = check_geometry3(mesh.kind, &mesh.cell_coords(c)) {
-                return Err(Error::invalid(
-                    source,
-                    format!("{at}: element {c} (nodes {:?})", mesh.cell(c)),
-                    format!(
-                        "the element is inverted or degenerate: det J = {:.3e} at ({:.6}, {:.6}, {:.6})",
-                        bad.det_j, bad.at[0], bad.at[1], bad.at[2]
-                    ),
-                    "keep the moves small against the element size",
-                ));
-            }
-        }
+        crate::model::check_cells(&mesh, source, &at)?;
         bodies.push(Body3 {
             name: spec.name.clone(),
             material_name: spec.material.clone(),
@@ -839,8 +800,8 @@ fn contact_summary(outcome: &Outcome3) -> Option<serde_json::Value> {
             force[i] += f * r.normal[i];
         }
     }
-    let pairs: Vec<serde_json::Value> = outcome
-        .penetrations
+    let penetrations = penetrations3(&outcome.model, state);
+    let pairs: Vec<serde_json::Value> = penetrations
         .iter()
         .enumerate()
         .map(|(k, p)| {
@@ -859,8 +820,7 @@ fn contact_summary(outcome: &Outcome3) -> Option<serde_json::Value> {
             pair
         })
         .collect();
-    let most =
-        |get: fn(&Penetration<3>) -> f64| outcome.penetrations.iter().map(get).fold(0.0, f64::max);
+    let most = |get: fn(&Penetration<3>) -> f64| penetrations.iter().map(get).fold(0.0, f64::max);
     let mut summary = serde_json::json!({
         "termination": format!("{:?}", state.termination),
         "iterations": state.iterations,
@@ -901,7 +861,7 @@ pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
         })
         .collect();
     let mut summary = serde_json::json!({
-        "case": outcome.name,
+        "case": outcome.model.name,
         "dimension": 3,
         "bodies": bodies,
         "dofs": model.dof_count,

@@ -40,7 +40,7 @@
 //! (see `add_material_tangent`). Global vectors and matrices (assembly, factorization) stay in
 //! `solve`/`sparse` (faer).
 
-use crate::fe::{point_values, ElementKind, QuadPoint, MAX_NODES};
+use crate::fe::{ElementKind, QuadPoint, ReferenceCell, MAX_NODES};
 use crate::io::scene::Plane;
 use nalgebra::{
     Const, Matrix, Matrix2, Matrix3, Matrix3x2, MatrixViewMut, SMatrix, SVector, StorageMut,
@@ -126,44 +126,6 @@ impl Elasticity {
             ),
         }
     }
-}
-
-/// An element whose Jacobian is not positive somewhere.
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub struct BadGeometry {
-    pub det_j: f64,
-    pub at: [f64; 2],
-    pub inverted: bool,
-}
-
-/// Check that `det J` is positive (relative to the element size) at the nodes and the
-/// quadrature points of the stiffness rule.
-pub fn check_geometry(kind: ElementKind, coords: &[[f64; 2]]) -> Result<(), BadGeometry> {
-    let mut lo = [f64::INFINITY; 2];
-    let mut hi = [f64::NEG_INFINITY; 2];
-    for p in coords {
-        for i in 0..2 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
-        }
-    }
-    let scale = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2)).max(f64::MIN_POSITIVE);
-    let points = kind
-        .node_coordinates()
-        .iter()
-        .copied()
-        .chain(kind.stiffness_rule().into_iter().map(|q| q.xi));
-    for xi in points {
-        let pv = point_values(kind, coords, xi);
-        if pv.det_j.is_nan() || pv.det_j <= 1e-10 * scale {
-            return Err(BadGeometry {
-                det_j: pv.det_j,
-                at: pv.x,
-                inverted: pv.det_j < 0.0,
-            });
-        }
-    }
-    Ok(())
 }
 
 /// How strains follow from displacements in this module's kernels: small strain. Finite
@@ -461,7 +423,7 @@ pub fn strain_at(
     ue: &[f64],
     xi: [f64; 2],
 ) -> ([f64; 3], [f64; 2]) {
-    let pv = point_values(kind, coords, xi);
+    let pv = kind.point_values(coords, xi);
     let mut e = [0.0; 3];
     for a in 0..kind.node_count() {
         let [dx, dy] = pv.dndx[a];
@@ -761,24 +723,6 @@ mod tests {
             }
         }
     }
-
-    #[test]
-    fn inverted_and_degenerate_elements_are_detected() {
-        let good = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-        assert!(check_geometry(ElementKind::Q4, &good).is_ok());
-        let clockwise = vec![[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]];
-        assert!(
-            check_geometry(ElementKind::Q4, &clockwise)
-                .unwrap_err()
-                .inverted
-        );
-        let collapsed = vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]];
-        let err = check_geometry(ElementKind::T3, &collapsed).unwrap_err();
-        assert!(!err.inverted && err.det_j.abs() < 1e-12);
-        // a bow-tie (non-convex beyond repair) is inverted somewhere inside
-        let bowtie = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
-        assert!(check_geometry(ElementKind::Q4, &bowtie).is_err());
-    }
 }
 
 /// The quadrature rule of [`element_mass`]: exact for `N_a N_b det J` on straight-sided
@@ -805,7 +749,7 @@ pub fn element_mass(
     let me = &mut me[..n * n];
     me.fill(0.0);
     for q in mass_rule(kind) {
-        let pv = point_values(kind, coords, q.xi);
+        let pv = kind.point_values(coords, q.xi);
         let w = q.weight * pv.det_j * density * thickness;
         for a in 0..n {
             for b in 0..n {

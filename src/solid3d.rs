@@ -18,8 +18,9 @@
 //! facet's 2D reference element ([`facet_traction_load`]); both with rich rules
 //! ([`SolidKind::error_rule`], Gauss 5x5 or Radon's 7-point rule on facets).
 
+use crate::fe::PointValues;
 use crate::fe::{gauss_square, triangle_rule, ElementKind, QuadPoint, ReferenceCell};
-use crate::fe3d::{solid_point_values, SolidKind, SolidPointValues, MAX_SOLID_NODES};
+use crate::fe3d::{SolidKind, MAX_SOLID_NODES};
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 /// The `6 x 6` constitutive matrix.
@@ -98,43 +99,6 @@ pub fn voigt_strain(h: &Matrix3<f64>) -> [f64; 6] {
     ]
 }
 
-/// An element whose Jacobian is not positive at a node or a quadrature point.
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub struct BadGeometry3 {
-    pub det_j: f64,
-    pub at: [f64; 3],
-}
-
-/// Check that `det J` is positive (relative to the element size cubed) at the nodes and the
-/// points of the stiffness rule.
-pub fn check_geometry3(kind: SolidKind, coords: &[[f64; 3]]) -> Result<(), BadGeometry3> {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in coords {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
-        }
-    }
-    let diagonal = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt();
-    let scale = diagonal.powi(3).max(f64::MIN_POSITIVE);
-    let points = kind
-        .node_coordinates()
-        .iter()
-        .copied()
-        .chain(kind.stiffness_rule().into_iter().map(|q| q.xi));
-    for xi in points {
-        let pv = solid_point_values(kind, coords, xi);
-        if pv.det_j.is_nan() || pv.det_j <= 1e-10 * scale {
-            return Err(BadGeometry3 {
-                det_j: pv.det_j,
-                at: pv.x,
-            });
-        }
-    }
-    Ok(())
-}
-
 /// Element stiffness `K_e = int B^T D B dV` (row-major, `3 n x 3 n`, dof order
 /// `[u_x0, u_y0, u_z0, u_x1, ...]`) with the rule `rule`.
 pub fn element_stiffness3(
@@ -150,7 +114,7 @@ pub fn element_stiffness3(
     ke.fill(0.0);
     let mut blocks = [StrainBlock::zeros(); MAX_SOLID_NODES];
     for q in rule {
-        let pv = solid_point_values(kind, coords, q.xi);
+        let pv = kind.point_values(coords, q.xi);
         if pv.det_j == 0.0 {
             continue;
         }
@@ -173,7 +137,11 @@ pub fn element_stiffness3(
 }
 
 /// The displacement gradient `H = sum_a u_a (dN_a/dx)^T` at one point.
-fn displacement_gradient(pv: &SolidPointValues, nn: usize, u_e: &[f64]) -> Matrix3<f64> {
+fn displacement_gradient(
+    pv: &PointValues<3, MAX_SOLID_NODES>,
+    nn: usize,
+    u_e: &[f64],
+) -> Matrix3<f64> {
     let mut h = Matrix3::zeros();
     for a in 0..nn {
         for i in 0..3 {
@@ -196,7 +164,7 @@ pub fn element_internal_force3(
     let nn = kind.node_count();
     let mut f = vec![0.0; 3 * nn];
     for q in rule {
-        let pv = solid_point_values(kind, coords, q.xi);
+        let pv = kind.point_values(coords, q.xi);
         if pv.det_j == 0.0 {
             continue;
         }
@@ -219,7 +187,7 @@ pub fn strain_at3(
     u_e: &[f64],
     xi: [f64; 3],
 ) -> ([f64; 6], [f64; 3]) {
-    let pv = solid_point_values(kind, coords, xi);
+    let pv = kind.point_values(coords, xi);
     (
         voigt_strain(&displacement_gradient(&pv, kind.node_count(), u_e)),
         pv.x,
@@ -235,7 +203,7 @@ pub fn body_force_load(
     let nn = kind.node_count();
     let mut f = vec![0.0; 3 * nn];
     for q in kind.error_rule() {
-        let pv = solid_point_values(kind, coords, q.xi);
+        let pv = kind.point_values(coords, q.xi);
         let b = body_force(pv.x);
         let w = q.weight * pv.det_j;
         for a in 0..nn {

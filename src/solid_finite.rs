@@ -44,7 +44,7 @@
 //! **Stress.** The Cauchy stress on the deformed configuration is
 //! `sigma = F S F^T / J`, `sigma_33 = S_33 / J`.
 
-use crate::fe::{point_values, ElementKind, QuadPoint, MAX_NODES};
+use crate::fe::{ElementKind, QuadPoint, ReferenceCell, MAX_NODES};
 use crate::solid::{ElementMatrix, ElementVector};
 use nalgebra::{Matrix2, Matrix3, Matrix3x2, Vector2};
 
@@ -237,7 +237,7 @@ pub fn displacement_gradient_at(
     u_e: &[f64],
     xi: [f64; 2],
 ) -> (Matrix2<f64>, [f64; 2]) {
-    let pv = point_values(kind, coords, xi);
+    let pv = kind.point_values(coords, xi);
     let n = kind.node_count();
     (displacement_gradient(&pv.dndx[..n], u_e), pv.x)
 }
@@ -254,7 +254,7 @@ fn points(
 ) -> Result<(), Inverted> {
     let n = kind.node_count();
     for (q, point) in rule.iter().enumerate() {
-        let pv = point_values(kind, coords, point.xi);
+        let pv = kind.point_values(coords, point.xi);
         if pv.det_j == 0.0 {
             continue;
         }

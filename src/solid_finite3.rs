@@ -37,7 +37,7 @@
 //! (Voigt `[xx, yy, zz, yz, xz, xy]`).
 
 use crate::fe::{QuadPoint, ReferenceCell};
-use crate::fe3d::{solid_point_values, SolidKind, MAX_SOLID_NODES};
+use crate::fe3d::{SolidKind, MAX_SOLID_NODES};
 use crate::solid_finite::{Hyperelastic, Inverted};
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
@@ -156,7 +156,7 @@ pub fn displacement_gradient_at3(
     u_e: &[f64],
     xi: [f64; 3],
 ) -> (Matrix3<f64>, [f64; 3]) {
-    let pv = solid_point_values(kind, coords, xi);
+    let pv = kind.point_values(coords, xi);
     let n = kind.node_count();
     (displacement_gradient(&pv.dndx[..n], u_e), pv.x)
 }
@@ -172,7 +172,7 @@ fn points3(
 ) -> Result<(), Inverted<3>> {
     let n = kind.node_count();
     for (q, point) in rule.iter().enumerate() {
-        let pv = solid_point_values(kind, coords, point.xi);
+        let pv = kind.point_values(coords, point.xi);
         if pv.det_j == 0.0 {
             continue;
         }

@@ -5,7 +5,7 @@
 //! refinement study `cases/friction-bench/` (its finer levels take minutes), judged against the
 //! closed forms by `tests/cattaneo.rs`. A case without checks is itself a failure: it could not fail.
 
-use contact_patch::run::run_case;
+use contact_patch::run::{run_case, run_checked};
 use std::path::{Path, PathBuf};
 
 fn case_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -44,26 +44,8 @@ fn every_case_passes_its_checks() {
     );
     let mut failures = Vec::new();
     for f in &files {
-        // a 3D case runs through the 3D path (contact_patch::run3d)
-        if let Some(case) = contact_patch::run3d::read_3d_case(f) {
-            match contact_patch::run3d::run_case3(&case, &f.display().to_string()) {
-                Ok(o) if o.checks.is_empty() => {
-                    failures.push(format!("{}: declares no checks", f.display()))
-                }
-                Ok(o) => failures.extend(o.checks.iter().filter(|c| !c.passed).map(|c| {
-                    format!(
-                        "{}: {} (error {:e} > tol {:e})",
-                        f.display(),
-                        c.check,
-                        c.error,
-                        c.tol
-                    )
-                })),
-                Err(e) => failures.push(format!("{}: {e}", f.display())),
-            }
-            continue;
-        }
-        match run_case(f, &mut |_| {}) {
+        // 2D and 3D cases alike (`contact-patch check` runs them the same way)
+        match run_checked(f, &mut |_| {}) {
             Ok(o) => {
                 if o.checks.is_empty() {
                     failures.push(format!("{}: declares no checks", f.display()));

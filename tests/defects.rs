@@ -397,6 +397,20 @@ fn messages_name_the_field_and_the_cause() {
     let (_, _, e) = run(&case);
     assert!(!e.contains("zero-area"), "{e}");
     assert_refused(run(&case), &["overflow"]);
+    // A 3D cell turned inside out by a move of its interior node past the next layer (z = 0.7)
+    // is named with its nodes, the point and the sign, as a 2D one is (one check for both).
+    let hex8 = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/3d/patch-hex8.json");
+    let case = s.case(&hex8, "inverted-hex8.json", |v| {
+        v["bodies"][0]["mesh"]["block3d"]["moves"][0]["to"] = serde_json::json!([0.3, 0.35, 0.9])
+    });
+    assert_refused(
+        run(&case),
+        &[
+            "bodies[0] 'block': element ",
+            "the element is inverted (negative Jacobian): det J = -",
+            "number the corners as VTK does",
+        ],
+    );
 }
 
 #[test]

@@ -364,7 +364,7 @@ fn what_3d_does_not_have_yet_is_refused_and_2d_cases_refuse_3d_fields() {
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains("3D cases run with `contact-patch run` only"),
+        err.contains("3D cases run with `contact-patch run`, `check` and `judge`"),
         "{err}"
     );
     let text = std::fs::read_to_string(root.join("cases/patch-single/q4-distorted.json")).unwrap();
@@ -377,4 +377,47 @@ fn what_3d_does_not_have_yet_is_refused_and_2d_cases_refuse_3d_fields() {
     .unwrap_err()
     .to_string();
     assert!(err.contains("but body 'patch' is 2D"), "{err}");
+}
+
+/// `contact-patch check` takes 3D cases as it takes 2D ones: the repository's 3D cases pass,
+/// and a 3D check that fails is a failure of the case (exit 1), listed with its error. (It
+/// refused them: "3D cases run with `contact-patch run` only".)
+#[test]
+fn check_runs_3d_cases_and_reports_their_verdicts() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let check = |args: &[&std::path::Path]| {
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+            .arg("check")
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            output.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&output.stdout).into_owned(),
+            String::from_utf8_lossy(&output.stderr).into_owned(),
+        )
+    };
+    let folder = root.join("cases/3d");
+    let (code, stdout, stderr) = check(&[&folder]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    for element in ["hex8", "hex27", "tet4", "tet10"] {
+        assert!(
+            stdout.contains(&format!(
+                "pass {}",
+                folder.join(format!("patch-{element}.json")).display()
+            )),
+            "{element}: {stdout}"
+        );
+    }
+    assert!(stdout.contains("all 4 cases pass"), "{stdout}");
+    // the exact stress is sigma_zz = -2: expecting -3 fails the check, not the run
+    let (_dir, wrong) = edited_case(|c| c["checks"][0]["stress"][2] = serde_json::json!(-3.0));
+    let (code, stdout, stderr) = check(&[&wrong]);
+    assert_eq!(code, 1, "{stdout}\n{stderr}");
+    assert!(stdout.contains("FAIL "), "{stdout}");
+    assert!(
+        stdout.contains("uniform stress [0.0, 0.0, -3.0, 0.0, 0.0, 0.0]"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("1 of 1 cases failed"), "{stdout}");
 }

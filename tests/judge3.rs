@@ -45,7 +45,7 @@ fn our_3d_results_judged_as_outside_results_give_the_direct_verdicts() {
     for path in CASES {
         let case = read_3d_case(&root().join(path)).unwrap();
         let direct = run_case3(&case, path).unwrap();
-        let folder = OutputFolder::new(&tmp.path().join(&direct.name)).unwrap();
+        let folder = OutputFolder::new(&tmp.path().join(&direct.model.name)).unwrap();
         write_run3(&folder, &direct).unwrap();
         let results = load_results3(&direct.model, folder.path()).unwrap();
         let j = judge3(&direct.model, &results, 1e-8).unwrap();

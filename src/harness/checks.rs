@@ -379,6 +379,31 @@ pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
     evaluate_with(model, solution, forces.as_deref())
 }
 
+/// The failing check a contact solve that did not converge adds to the declared `checks` (2D
+/// and 3D), so that none of them can pass on an unconverged solution; `None` when it converged,
+/// without contact, or when the case names its expected termination (it judges it itself).
+pub fn unconverged<const D: usize>(
+    checks: &[Check],
+    solution: &crate::solver::linear::Solution<D>,
+) -> Option<CheckResult> {
+    let expects_termination = checks
+        .iter()
+        .any(|c| matches!(c, Check::TerminatesWith { .. }));
+    solution
+        .contact
+        .as_ref()
+        .filter(|_| !expects_termination)
+        .and_then(|c| match &c.termination {
+            crate::solver::active_set::Termination::Converged => None,
+            t => Some(CheckResult {
+                check: format!("the contact solve converged (it ended: {t:?})"),
+                error: f64::INFINITY,
+                tol: 0.0,
+                passed: false,
+            }),
+        })
+}
+
 /// [`evaluate`] with the contact forces given: those of our solve (`solution.contact`), or,
 /// for another code's results, the ones [`crate::harness::outside_contact`] read (then
 /// `solution.contact` is `None`). `None`: no contact forces, every contact check fails.
@@ -391,24 +416,7 @@ pub fn evaluate_with(
     let magnitudes = Magnitudes::of(model, solution);
     let has_forces = contact_forces.is_some();
     let forces: &[PairForces] = contact_forces.unwrap_or(&[]);
-    // a case that names its expected termination judges it itself
-    let expects_termination = model
-        .checks
-        .iter()
-        .any(|c| matches!(c, Check::TerminatesWith { .. }));
-    let convergence = solution
-        .contact
-        .as_ref()
-        .filter(|_| !expects_termination)
-        .and_then(|c| match &c.termination {
-            crate::solver::active_set::Termination::Converged => None,
-            t => Some(CheckResult {
-                check: format!("the contact solve converged (it ended: {t:?})"),
-                error: f64::INFINITY,
-                tol: 0.0,
-                passed: false,
-            }),
-        });
+    let convergence = unconverged(&model.checks, solution);
     let declared: Vec<CheckResult> = model
         .checks
         .iter()

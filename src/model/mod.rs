@@ -26,7 +26,8 @@ pub mod stable_step;
 
 use crate::contact::enforcement::Family;
 use crate::error::{Error, Result};
-use crate::fe::{point_values, ElementKind};
+use crate::fe::check_geometry;
+use crate::fe::{ElementKind, ReferenceCell};
 use crate::fe3d::SolidKind;
 use crate::harness::exact::ExactField;
 use crate::io::paths::{name_problem, NAME_RULE};
@@ -37,7 +38,7 @@ use crate::io::scene::{
     MAX_SOLVER_COUNT,
 };
 use crate::mesh::{block, Facet, Mesh};
-use crate::solid::{check_geometry, Elasticity};
+use crate::solid::Elasticity;
 use crate::solid_finite::Hyperelastic;
 use space::SolidCell;
 
@@ -1742,8 +1743,8 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str, notes: &mut Vec<String>) 
         MeshSpec::Block3d(_) => Err(Error::invalid(
             source,
             format!("{at}.mesh.block3d"),
-            "a 3D body in a case that goes through the 2D model: 3D cases run with `contact-patch run` only, alone (one 3D body, no 2D bodies beside it); tables, sweeps, studies, exports and the other commands are 2D for now",
-            "run the case with `contact-patch run CASE`, or give the body a 2D mesh",
+            "a 3D body in a case that goes through the 2D model: 3D cases run with `contact-patch run`, `check` and `judge`, with 3D bodies only (no 2D bodies beside them); tables, sweeps, studies and exports are 2D for now",
+            "run the case with `contact-patch run CASE` or `contact-patch check CASE`, or give the body a 2D mesh",
         )),
         MeshSpec::Block(b) => {
             let xs = b.x.values();
@@ -2098,33 +2099,43 @@ fn check_work(case: &Case, source: &str, at: &str, work: &SolveWork) -> Result<(
     Ok(())
 }
 
-/// Every cell must have a positive Jacobian at its nodes and quadrature points.
-fn check_cells(mesh: &Mesh, source: &str, at: &str) -> Result<()> {
+/// Every cell must have a positive Jacobian at its nodes and quadrature points (2D and 3D).
+pub(crate) fn check_cells<const D: usize, K: SolidCell<D>>(
+    mesh: &Mesh<D, K>,
+    source: &str,
+    at: &str,
+) -> Result<()> {
     for c in 0..mesh.cell_count() {
         let coords = mesh.cell_coords(c);
-        if let Err(bad) = check_geometry(mesh.kind, &coords) {
+        if let Err(bad) = check_geometry(mesh.kind, &coords, &mesh.kind.stiffness_rule()) {
             let overflow = !bad.det_j.is_finite()
                 || coords
                     .iter()
-                    .any(|p| !(p[0] * p[0] + p[1] * p[1]).is_finite());
+                    .any(|p| !p.iter().map(|x| x * x).sum::<f64>().is_finite());
             let what = if overflow {
                 "too large to compute with: its coordinates overflow"
             } else if bad.inverted {
                 "inverted (negative Jacobian)"
-            } else {
+            } else if D == 2 {
                 "degenerate (zero-area)"
+            } else {
+                "degenerate (zero-volume)"
             };
+            let point: Vec<String> = bad.at.iter().map(|x| format!("{x:.6}")).collect();
             return Err(Error::invalid(
                 source,
                 format!("{at}: element {c} (nodes {:?})", mesh.cell(c)),
                 format!(
-                    "the element is {what}: det J = {:.3e} at ({:.6}, {:.6})",
-                    bad.det_j, bad.at[0], bad.at[1]
+                    "the element is {what}: det J = {:.3e} at ({})",
+                    bad.det_j,
+                    point.join(", ")
                 ),
-                if !overflow {
+                if overflow {
+                    "coordinates must stay far below 1e154 (their squares must be finite); choose other length units"
+                } else if D == 2 {
                     "list the corners counter-clockwise, keep every interior angle below 180 degrees and mid-side nodes near the middle of their sides"
                 } else {
-                    "coordinates must stay far below 1e154 (their squares must be finite); choose other length units"
+                    "number the corners as VTK does (a hexahedron's bottom face counter-clockwise seen from above, then the top face above it; a tetrahedron's base counter-clockwise seen from its apex), keep the moves small against the element size and mid-edge nodes near the middle of their edges"
                 },
             ));
         }
@@ -2452,7 +2463,7 @@ fn add_body_force(body: &Body, b: [f64; 2], thickness: f64, force: &mut [f64]) {
         let coords = body.mesh.cell_coords(c);
         let cell = body.mesh.cell(c);
         for q in &rule {
-            let pv = point_values(kind, &coords, q.xi);
+            let pv = kind.point_values(&coords, q.xi);
             let w = q.weight * pv.det_j * thickness;
             for (a, &node) in cell.iter().enumerate() {
                 for i in 0..2 {

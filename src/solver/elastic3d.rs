@@ -12,7 +12,6 @@
 //! each element ([`crate::fe3d::SolidKind::error_rule`]).
 
 use crate::fe::ReferenceCell;
-use crate::fe3d::solid_point_values;
 use crate::mesh::{Facet, Mesh3};
 use crate::model::{Body3, Model3};
 use crate::solid3d::{body_force_load, facet_traction_load, voigt_strain, Elasticity3};
@@ -157,7 +156,7 @@ impl Solid3 {
             let coords = self.mesh.cell_coords(c);
             let cell = self.mesh.cell(c);
             for q in kind.error_rule() {
-                let pv = solid_point_values(kind, &coords, q.xi);
+                let pv = kind.point_values(&coords, q.xi);
                 let w = q.weight * pv.det_j;
                 let mut uh = [0.0; 3];
                 let mut hh = Matrix3::zeros();
