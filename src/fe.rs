@@ -26,6 +26,7 @@
 //! of a solid (Quad4, Quad9, Tri3, Tri6) are the 2D reference elements Q4, Q9, T3, T6 of this
 //! module. Code written against the trait (e.g. [`crate::mesh::Mesh`]) serves both dimensions.
 
+use nalgebra::SMatrix;
 use serde::{Deserialize, Serialize};
 
 /// A reference element type.
@@ -466,6 +467,8 @@ pub trait PointGeometry<const D: usize> {
     fn jacobian_determinant(&self) -> f64;
     /// The point `x(xi)`.
     fn point(&self) -> [f64; D];
+    /// The Cartesian gradients `dN_a/dx` (entries past the cell's node count zero).
+    fn gradients(&self) -> &[[f64; D]];
 }
 
 impl<const D: usize, const N: usize> PointGeometry<D> for PointValues<D, N> {
@@ -475,6 +478,37 @@ impl<const D: usize, const N: usize> PointGeometry<D> for PointValues<D, N> {
     fn point(&self) -> [f64; D] {
         self.x
     }
+    fn gradients(&self) -> &[[f64; D]] {
+        &self.dndx
+    }
+}
+
+/// `H_ik = sum_a u_a,i dN_a/dx_k`: the gradient of the field with nodal values `u_e` (`D` per
+/// node, `[u_x0, u_y0, ...]`) from the gradients `dndx` of its nodes; with reference gradients
+/// the displacement gradient `H = F - I`.
+pub fn field_gradient<const D: usize>(dndx: &[[f64; D]], u_e: &[f64]) -> SMatrix<f64, D, D> {
+    let mut h = SMatrix::<f64, D, D>::zeros();
+    for (a, g) in dndx.iter().enumerate() {
+        for i in 0..D {
+            for k in 0..D {
+                h[(i, k)] += u_e[D * a + i] * g[k];
+            }
+        }
+    }
+    h
+}
+
+/// The displacement gradient `H = F - I` at natural point `xi` of a cell of kind `kind` with
+/// reference nodes `coords` and displacements `u_e`, with the reference position of the point.
+pub fn displacement_gradient_at<const D: usize, C: ReferenceCell<D>>(
+    kind: C,
+    coords: &[[f64; D]],
+    u_e: &[f64],
+    xi: [f64; D],
+) -> (SMatrix<f64, D, D>, [f64; D]) {
+    let pv = kind.point_values(coords, xi);
+    let n = kind.node_count();
+    (field_gradient(&pv.gradients()[..n], u_e), pv.point())
 }
 
 /// Shape values, Cartesian gradients `dN_a/dx = J^-T dN_a/dxi` and `det J` at `xi` for a cell

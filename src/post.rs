@@ -14,12 +14,13 @@
 //! * Relative L2 displacement error: `sqrt(int |u_h - u|^2 dA / int |u|^2 dA)`, with a Gauss rule
 //!   richer than the stiffness rule (see `fe::ElementKind::error_rule`).
 
+use crate::fe::displacement_gradient_at;
 use crate::fe::ReferenceCell;
 use crate::harness::exact::ExactField;
 use crate::model::space::SolidCell;
 use crate::model::{Body, Model};
 use crate::solid::{strain_at, MAX_DOFS};
-use crate::solid_finite::{displacement_gradient_at, jacobian};
+use crate::solid_finite::jacobian;
 
 /// Element displacements of cell `c` of `body`.
 pub fn cell_displacements(body: &Body, u: &[f64], c: usize, out: &mut Vec<f64>) {

@@ -65,6 +65,7 @@ use crate::contact::discretization::geometry::Surface3;
 use crate::contact::forces::{element_sizes, pair_penetration, Penetration};
 use crate::contact::state::ContactState;
 use crate::error::{Error, Result};
+use crate::fe::displacement_gradient_at;
 use crate::fe::ReferenceCell;
 use crate::fe3d::SolidKind;
 use crate::harness::checks::{max_penetration_check, penetration_warnings, CheckResult};
@@ -78,7 +79,6 @@ use crate::mesh::block3;
 use crate::model::{Body3, MasterSide, Model3};
 use crate::solid3d::{facet_traction_load, strain_at3, Elasticity3};
 use crate::solid_finite::Hyperelastic;
-use crate::solid_finite3::displacement_gradient_at3;
 use std::path::Path;
 
 /// Whether the case has a 3D body (and so runs here).
@@ -202,7 +202,7 @@ fn stress_at(body: &Body3, coords: &[[f64; 3]], u_e: &[f64], xi: [f64; 3]) -> ([
     let kind = body.mesh.kind;
     match &body.hyperelastic {
         Some(law) => {
-            let (h, x) = displacement_gradient_at3(kind, coords, u_e, xi);
+            let (h, x) = displacement_gradient_at(kind, coords, u_e, xi);
             (x, law.cauchy3(&h))
         }
         None => {

@@ -18,8 +18,9 @@
 //! facet's 2D reference element ([`facet_traction_load`]); both with rich rules
 //! ([`SolidKind::error_rule`], Gauss 5x5 or Radon's 7-point rule on facets).
 
-use crate::fe::PointValues;
-use crate::fe::{gauss_square, triangle_rule, ElementKind, QuadPoint, ReferenceCell};
+use crate::fe::{
+    field_gradient, gauss_square, triangle_rule, ElementKind, QuadPoint, ReferenceCell,
+};
 use crate::fe3d::{SolidKind, MAX_SOLID_NODES};
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
@@ -136,23 +137,6 @@ pub fn element_stiffness3(
     }
 }
 
-/// The displacement gradient `H = sum_a u_a (dN_a/dx)^T` at one point.
-fn displacement_gradient(
-    pv: &PointValues<3, MAX_SOLID_NODES>,
-    nn: usize,
-    u_e: &[f64],
-) -> Matrix3<f64> {
-    let mut h = Matrix3::zeros();
-    for a in 0..nn {
-        for i in 0..3 {
-            for j in 0..3 {
-                h[(i, j)] += u_e[3 * a + i] * pv.dndx[a][j];
-            }
-        }
-    }
-    h
-}
-
 /// Internal force `f_int(u_e) = int B^T D eps(u_e) dV` of one element (length `3 n`).
 pub fn element_internal_force3(
     kind: SolidKind,
@@ -168,7 +152,7 @@ pub fn element_internal_force3(
         if pv.det_j == 0.0 {
             continue;
         }
-        let eps = voigt_strain(&displacement_gradient(&pv, nn, u_e));
+        let eps = voigt_strain(&field_gradient(&pv.dndx[..nn], u_e));
         let w_sigma = material.d * SMatrix::<f64, 6, 1>::from(eps) * (q.weight * pv.det_j);
         for a in 0..nn {
             let fa: Vector3<f64> = strain_block(pv.dndx[a]).tr_mul(&w_sigma);
@@ -189,7 +173,7 @@ pub fn strain_at3(
 ) -> ([f64; 6], [f64; 3]) {
     let pv = kind.point_values(coords, xi);
     (
-        voigt_strain(&displacement_gradient(&pv, kind.node_count(), u_e)),
+        voigt_strain(&field_gradient(&pv.dndx[..kind.node_count()], u_e)),
         pv.x,
     )
 }

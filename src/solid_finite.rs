@@ -44,7 +44,9 @@
 //! **Stress.** The Cauchy stress on the deformed configuration is
 //! `sigma = F S F^T / J`, `sigma_33 = S_33 / J`.
 
-use crate::fe::{ElementKind, QuadPoint, ReferenceCell, MAX_NODES};
+use crate::fe::{
+    displacement_gradient_at, field_gradient, ElementKind, QuadPoint, ReferenceCell, MAX_NODES,
+};
 use crate::solid::{ElementMatrix, ElementVector};
 use nalgebra::{Matrix2, Matrix3, Matrix3x2, Vector2};
 
@@ -203,20 +205,6 @@ impl<const D: usize> std::fmt::Display for Inverted<D> {
     }
 }
 
-/// The displacement gradient `H = F - I = sum_a u_a (grad_0 N_a)^T` from the reference
-/// gradients `dndx` of `n` nodes and the element displacements `u_e` (`[u_x0, u_y0, ...]`).
-fn displacement_gradient(dndx: &[[f64; 2]], u_e: &[f64]) -> Matrix2<f64> {
-    let mut f = Matrix2::zeros();
-    for (a, g) in dndx.iter().enumerate() {
-        for i in 0..2 {
-            for k in 0..2 {
-                f[(i, k)] += u_e[2 * a + i] * g[k];
-            }
-        }
-    }
-    f
-}
-
 /// The deformation gradient at natural point `xi` of an element with reference nodes `coords`
 /// and displacements `u_e`, with the reference position of the point.
 pub fn deformation_gradient_at(
@@ -227,19 +215,6 @@ pub fn deformation_gradient_at(
 ) -> (Matrix2<f64>, [f64; 2]) {
     let (h, x) = displacement_gradient_at(kind, coords, u_e, xi);
     (Matrix2::identity() + h, x)
-}
-
-/// The displacement gradient `H = F - I` at natural point `xi` (see
-/// [`deformation_gradient_at`]), with the reference position of the point.
-pub fn displacement_gradient_at(
-    kind: ElementKind,
-    coords: &[[f64; 2]],
-    u_e: &[f64],
-    xi: [f64; 2],
-) -> (Matrix2<f64>, [f64; 2]) {
-    let pv = kind.point_values(coords, xi);
-    let n = kind.node_count();
-    (displacement_gradient(&pv.dndx[..n], u_e), pv.x)
 }
 
 /// The reference gradients and weights `w = w_q det J_0 t` of the rule's points, and `H` there;
@@ -258,7 +233,7 @@ fn points(
         if pv.det_j == 0.0 {
             continue;
         }
-        let h = displacement_gradient(&pv.dndx[..n], u_e);
+        let h = field_gradient(&pv.dndx[..n], u_e);
         let det_f = jacobian(&h);
         if det_f.is_nan() || det_f <= 0.0 {
             return Err(Inverted {

@@ -36,7 +36,7 @@
 //! **Stress.** The Cauchy stress on the deformed configuration is `sigma = F S F^T / J`
 //! (Voigt `[xx, yy, zz, yz, xz, xy]`).
 
-use crate::fe::{QuadPoint, ReferenceCell};
+use crate::fe::{field_gradient, QuadPoint, ReferenceCell};
 use crate::fe3d::{SolidKind, MAX_SOLID_NODES};
 use crate::solid_finite::{Hyperelastic, Inverted};
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -135,32 +135,6 @@ impl Hyperelastic {
     }
 }
 
-/// `H = sum_a u_a (grad_0 N_a)^T` from the reference gradients of `n` nodes.
-fn displacement_gradient(dndx: &[[f64; 3]], u_e: &[f64]) -> Matrix3<f64> {
-    let mut h = Matrix3::zeros();
-    for (a, g) in dndx.iter().enumerate() {
-        for i in 0..3 {
-            for k in 0..3 {
-                h[(i, k)] += u_e[3 * a + i] * g[k];
-            }
-        }
-    }
-    h
-}
-
-/// The displacement gradient `H = F - I` at natural point `xi` of a cell with reference
-/// nodes `coords` and displacements `u_e`, with the reference position of the point.
-pub fn displacement_gradient_at3(
-    kind: SolidKind,
-    coords: &[[f64; 3]],
-    u_e: &[f64],
-    xi: [f64; 3],
-) -> (Matrix3<f64>, [f64; 3]) {
-    let pv = kind.point_values(coords, xi);
-    let n = kind.node_count();
-    (displacement_gradient(&pv.dndx[..n], u_e), pv.x)
-}
-
 /// Calls `visit(dndx, w, H)` at every point of `rule` (reference gradients, weight
 /// `w_q det J_0`); `Err` at the first point with `det F <= 0`.
 fn points3(
@@ -176,7 +150,7 @@ fn points3(
         if pv.det_j == 0.0 {
             continue;
         }
-        let h = displacement_gradient(&pv.dndx[..n], u_e);
+        let h = field_gradient(&pv.dndx[..n], u_e);
         let det_f = jacobian3(&h);
         if det_f.is_nan() || det_f <= 0.0 {
             return Err(Inverted {
@@ -275,6 +249,7 @@ pub fn element_residual_and_tangent3(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fe::displacement_gradient_at;
     use crate::solid3d::{element_stiffness3, facet_traction_load, Elasticity3};
 
     const KINDS: [SolidKind; 4] = [
@@ -441,7 +416,7 @@ mod tests {
                 let coords = distorted_patch_cell(kind);
                 let u = homogeneous(&coords, &target, c);
                 for q in kind.stiffness_rule() {
-                    let (h, _) = displacement_gradient_at3(kind, &coords, &u, q.xi);
+                    let (h, _) = displacement_gradient_at(kind, &coords, &u, q.xi);
                     let f = Matrix3::identity() + h;
                     assert!((f - target).abs().max() < 1e-13, "{kind:?}: {f}");
                 }
@@ -513,7 +488,7 @@ mod tests {
                         largest(f.iter().copied()) < 1e-12 * E,
                         "{kind:?} {angle}: {f:?}"
                     );
-                    let (h, _) = displacement_gradient_at3(kind, &coords, &u, kind.centre());
+                    let (h, _) = displacement_gradient_at(kind, &coords, &u, kind.centre());
                     assert!(largest(law.cauchy3(&h)) < 1e-12 * E);
                 }
             }

@@ -19,10 +19,10 @@
 //!   Lagrange multipliers as `O(1/kappa)`; one element thick against the 2D plane-strain case;
 //! * what is not built refused with the reason.
 
+use contact_patch::fe::displacement_gradient_at;
 use contact_patch::model::Model3;
 use contact_patch::run3d::{build3, run_case3, Outcome3};
 use contact_patch::solid_finite::{lame, Hyperelastic};
-use contact_patch::solid_finite3::displacement_gradient_at3;
 use contact_patch::solver::linear::Solution;
 use nalgebra::{Matrix3, Vector3};
 use serde_json::{json, Value};
@@ -83,7 +83,7 @@ fn point_states(model: &Model3, u: &[f64]) -> Vec<(Matrix3<f64>, [f64; 6])> {
         let ue: Vec<f64> = dofs.iter().map(|&d| u[d]).collect();
         let coords = body.mesh.cell_coords(c);
         for q in kind.stiffness_rule() {
-            let (h, _) = displacement_gradient_at3(kind, &coords, &ue, q.xi);
+            let (h, _) = displacement_gradient_at(kind, &coords, &ue, q.xi);
             out.push((Matrix3::identity() + h, law.cauchy3(&h)));
         }
     }
