@@ -267,12 +267,10 @@ fn edited_case(
     (dir, path)
 }
 
-fn run_binary(path: &std::path::Path, out: &std::path::Path) -> (i32, String, String) {
+/// The tool with `args`: (exit code, stdout, stderr).
+fn contact_patch(args: &[&std::ffi::OsStr]) -> (i32, String, String) {
     let output = std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
-        .arg("run")
-        .arg(path)
-        .arg("--out")
-        .arg(out)
+        .args(args)
         .output()
         .unwrap();
     (
@@ -280,6 +278,15 @@ fn run_binary(path: &std::path::Path, out: &std::path::Path) -> (i32, String, St
         String::from_utf8_lossy(&output.stdout).into_owned(),
         String::from_utf8_lossy(&output.stderr).into_owned(),
     )
+}
+
+fn run_binary(path: &std::path::Path, out: &std::path::Path) -> (i32, String, String) {
+    contact_patch(&[
+        "run".as_ref(),
+        path.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ])
 }
 
 #[test]
@@ -385,20 +392,9 @@ fn what_3d_does_not_have_yet_is_refused_and_2d_cases_refuse_3d_fields() {
 #[test]
 fn check_runs_3d_cases_and_reports_their_verdicts() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let check = |args: &[&std::path::Path]| {
-        let output = std::process::Command::new(env!("CARGO_BIN_EXE_contact-patch"))
-            .arg("check")
-            .args(args)
-            .output()
-            .unwrap();
-        (
-            output.status.code().unwrap_or(-1),
-            String::from_utf8_lossy(&output.stdout).into_owned(),
-            String::from_utf8_lossy(&output.stderr).into_owned(),
-        )
-    };
+    let check = |case: &std::path::Path| contact_patch(&["check".as_ref(), case.as_os_str()]);
     let folder = root.join("cases/3d");
-    let (code, stdout, stderr) = check(&[&folder]);
+    let (code, stdout, stderr) = check(&folder);
     assert_eq!(code, 0, "{stdout}\n{stderr}");
     for element in ["hex8", "hex27", "tet4", "tet10"] {
         assert!(
@@ -412,7 +408,7 @@ fn check_runs_3d_cases_and_reports_their_verdicts() {
     assert!(stdout.contains("all 4 cases pass"), "{stdout}");
     // the exact stress is sigma_zz = -2: expecting -3 fails the check, not the run
     let (_dir, wrong) = edited_case(|c| c["checks"][0]["stress"][2] = serde_json::json!(-3.0));
-    let (code, stdout, stderr) = check(&[&wrong]);
+    let (code, stdout, stderr) = check(&wrong);
     assert_eq!(code, 1, "{stdout}\n{stderr}");
     assert!(stdout.contains("FAIL "), "{stdout}");
     assert!(
