@@ -62,7 +62,6 @@ impl<const D: usize, K: SolidCell<D>> Outcome<D, K> {
             checks: self.checks.clone(),
             warnings: self.warnings.clone(),
             seconds: self.solution.timings.total,
-            failed_solve: self.failed_solve().map(str::to_string),
         }
     }
 }
@@ -75,14 +74,6 @@ pub struct Verdicts {
     pub warnings: Vec<String>,
     /// The run's wall time, meshing to checks.
     pub seconds: f64,
-    /// [`Outcome::failed_solve`].
-    pub failed_solve: Option<String>,
-}
-
-impl Verdicts {
-    pub fn passed(&self) -> bool {
-        self.checks.iter().all(|c| c.passed)
-    }
 }
 
 /// Run the case file at `path`, 2D or 3D, for its verdicts.
