@@ -527,16 +527,23 @@ fn a_contact_node_past_the_masters_end_has_no_row() {
         let x = num(row, "x");
         if (1.0..=3.0).contains(&x) {
             assert_eq!(row["status"], "closed", "{row:?}");
-            // (the ends' nodes carry the half of their tributary that the master covers)
-            if x > 1.0 && x < 3.0 {
-                assert!((num(row, "pressure") - 10.0).abs() < 1e-9, "{row:?}");
-            }
+            // the ends' nodes carry the half of their tributary that the master covers, and
+            // read their force over that half (issue 38, item 9: they read 5 over the whole
+            // tributary before)
+            assert!((num(row, "pressure") - 10.0).abs() < 1e-9, "{row:?}");
         } else {
             assert_eq!(row["status"], "unmeasured", "{row:?}");
             assert_eq!(row["gap"], "", "{row:?}");
             assert_eq!(num(row, "force_y"), 0.0, "{row:?}");
         }
     }
+    // the closed area is the master's length (2, the ends' nodes covering half their
+    // tributaries), and the force it transmits the pressure 10 over it
+    let totals = &summary(&out)["contact"]["pairs"][0];
+    let closed_area = totals["closed_area"].as_f64().unwrap();
+    assert!((closed_area - 2.0).abs() < 1e-12, "{totals}");
+    let normal_force = totals["normal_force"].as_f64().unwrap();
+    assert!((normal_force - 10.0 * closed_area).abs() < 1e-9, "{totals}");
 }
 
 /// Issue 38, item 9 (the pressure at the edge of a partly covered slave facet): W07 presses a

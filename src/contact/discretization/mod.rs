@@ -62,7 +62,8 @@ pub(crate) const OUT_OF_REACH: &str = "no slave node lies within the search dist
 
 use crate::contact::Constraint;
 use crate::io::scene::{
-    DiscretizationSpec, Interaction, Kinematics, NormalChoice, RigidSurface, SlaveNormalVariation,
+    DiscretizationSpec, Interaction, Kinematics, MultiplierSpace, NormalChoice, RigidSurface,
+    SlaveNormalVariation,
 };
 use crate::model::{ContactPair, MasterSide, Model};
 use geometry::{closest_point, edge_shape, facet_point, ray_point, unit_normal, Surface};
@@ -294,8 +295,11 @@ pub fn constraints(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>,
             let master = Surface::new(*body, &model.bodies[*body], facets, model.thickness);
             let variation = slave_normal_variation.unwrap_or_default();
             node_to_surface(&mut rows, &slave, &master, *normal, variation, 1);
+            cover_where_the_master_ends(&mut rows, 0, &slave, &master);
             if *passes == 2 {
+                let start = rows.out.len();
                 node_to_surface(&mut rows, &master, &slave, *normal, variation, 2);
+                cover_where_the_master_ends(&mut rows, start, &master, &slave);
             }
         }
         (DiscretizationSpec::Mortar { multiplier }, MasterSide::Body { body, facets }) => {
@@ -728,6 +732,59 @@ fn node_to_surface(
             rows.node(slave, s, nu, g0, Some((master, &[v], &[1.0])), pass);
             if linearize {
                 attach_segment(rows, slave, s, master, &[v], MasterPoint::Vertex { side });
+            }
+        }
+    }
+}
+
+/// The cover ([`Constraint::cover`]) of the node-to-surface rows `rows.out[start..]` of `slave`
+/// against `master`: a slave facet that the master overlaps only in part (the master ends over
+/// it) covers each of its nodes by `t int N_a ds` over the overlapped pieces, found as mortar
+/// segments them ([`mortar::mortar_integrals`]); every other facet at a row's node covers the
+/// node's whole share of it (to the bit, as before). The forces are unchanged: a node-based
+/// row acts at its node whatever the cover; the cover only tells the recovery of the nodal
+/// traction ([`crate::contact::forces`]) which part of the node's tributary transmits its
+/// force. At a slave node over a master's free end the outer facet transmits nothing, and the
+/// node's force over its whole tributary read half the pressure (5 where it is 10, issue 38,
+/// item 9).
+fn cover_where_the_master_ends(rows: &mut Rows, start: usize, slave: &Surface, master: &Surface) {
+    if rows.out.len() == start {
+        return;
+    }
+    let model = rows.model;
+    let radius = rows.search_distance.unwrap_or_else(|| master.facet_size());
+    let (_, _, pieces) = mortar::mortar_integrals(
+        slave,
+        master,
+        MultiplierSpace::Standard,
+        radius,
+        model.thickness,
+    );
+    let shares = mortar::covered_tributaries(
+        slave,
+        &pieces,
+        &mortar::gauss_rule(slave.kind, master.kind),
+        model.thickness,
+    );
+    // the facets the master overlaps in part (their covered area short of the whole)
+    let mut covered = vec![0.0; slave.facets.len()];
+    for node_shares in shares.values() {
+        for &(f, c) in node_shares {
+            covered[f] += c;
+        }
+    }
+    let partly: Vec<bool> = covered
+        .iter()
+        .zip(&slave.facet_weights)
+        .map(|(&c, whole)| c < (1.0 - 1e-12) * whole.iter().sum::<f64>())
+        .collect();
+    for row in &mut rows.out[start..] {
+        let node_shares = shares.get(&row.slave_node);
+        for (f, c) in &mut row.cover {
+            if partly[*f] {
+                *c = node_shares
+                    .and_then(|s| s.iter().find(|(g, _)| g == f))
+                    .map_or(0.0, |&(_, share)| share);
             }
         }
     }
