@@ -81,19 +81,28 @@ use crate::solid3d::{facet_traction_load, strain_at3, Elasticity3};
 use crate::solid_finite::Hyperelastic;
 use std::path::Path;
 
-/// Whether the case has a 3D body (and so runs here).
-pub fn is_3d(case: &Case) -> bool {
-    case.bodies
-        .iter()
-        .any(|b| matches!(b.mesh, MeshSpec::Block3d(_)))
+/// Whether the case read from `source` has a 3D body (and so runs here): a `block3d` mesh, or
+/// a Gmsh file with tetrahedra or hexahedra (the file named relative to `source`'s folder; a
+/// file that cannot be read is left to the 2D model, which names what is wrong with it).
+pub fn is_3d(case: &Case, source: &str) -> bool {
+    let folder = Path::new(source).parent().unwrap_or(Path::new(""));
+    case.bodies.iter().any(|b| match &b.mesh {
+        MeshSpec::Block3d(_) => true,
+        MeshSpec::Gmsh(g) => std::fs::read(folder.join(&g.file))
+            .ok()
+            .and_then(|bytes| crate::io::gmsh_read::read_msh(&bytes).ok())
+            .is_some_and(|content| crate::io::gmsh_read::cell_dimension(&content) == 3),
+        _ => false,
+    })
 }
 
 /// The case at `path` when it parses and is 3D; `None` otherwise (the 2D path reads it again
 /// and reports what is wrong with it).
 pub fn read_3d_case(path: &Path) -> Option<Case> {
     let text = std::fs::read_to_string(path).ok()?;
-    let case = crate::model::parse(&text, &path.display().to_string()).ok()?;
-    is_3d(&case).then_some(case)
+    let source = path.display().to_string();
+    let case = crate::model::parse(&text, &source).ok()?;
+    is_3d(&case, &source).then_some(case)
 }
 
 /// What a 3D run produced: the one [`crate::run::Outcome`] of both dimensions.
@@ -271,13 +280,13 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
     if let Some(k) = case
         .bodies
         .iter()
-        .position(|b| !matches!(b.mesh, MeshSpec::Block3d(_)))
+        .position(|b| matches!(b.mesh, MeshSpec::Block(_) | MeshSpec::Explicit(_)))
     {
         return Err(Error::invalid(
             source,
             format!("bodies[{k}] '{}'", case.bodies[k].name),
             "the body is 2D and another body of the case 3D; 2D and 3D bodies do not meet",
-            "give every body a \"block3d\" mesh, or run the 2D bodies as a case of their own",
+            "give every body a \"block3d\" mesh or a Gmsh mesh of tetrahedra or hexahedra, or run the 2D bodies as a case of their own",
         ));
     }
     crate::model::check_size(case, source)?;
@@ -301,42 +310,24 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
                 "give every body a unique name",
             ));
         }
-        let MeshSpec::Block3d(block) = &spec.mesh else {
-            unreachable!("every body was checked to be 3D above")
-        };
         if !spec.node_sets.is_empty() || !spec.facet_sets.is_empty() {
             return Err(not_built(
                 source,
                 &at,
                 "user-defined node and facet sets",
-                "use the automatic sets: left/right (x), front/back (y), bottom/top (z), the corners such as bottom_front_left, and all",
+                "use the automatic sets: left/right (x), front/back (y), bottom/top (z), the corners such as bottom_front_left, and all; or a Gmsh mesh whose physical groups are the sets",
             ));
         }
         let (material, hyperelastic) = material3(case, &spec.material, source, &at)?;
-        let (xs, ys, zs) = (block.x.values(), block.y.values(), block.z.values());
-        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-        if !(finite(&xs) && finite(&ys) && finite(&zs))
-            || block
-                .moves
-                .iter()
-                .any(|m| !(finite(&m.from) && finite(&m.to)))
-        {
-            return Err(Error::invalid(
-                source,
-                format!("{at}.mesh.block3d"),
-                "a break or a move is not finite",
-                "give finite coordinates",
-            ));
-        }
-        let moves: Vec<_> = block.moves.iter().map(|m| (m.from, m.to)).collect();
-        let mesh = block3(block.element, &xs, &ys, &zs, &moves).map_err(|e| {
-            Error::invalid(
-                source,
-                format!("{at}.mesh.block3d"),
-                e,
-                "fix the breaks or moves",
-            )
-        })?;
+        let mesh = match &spec.mesh {
+            MeshSpec::Block3d(block) => block_mesh3(block, source, &at)?,
+            MeshSpec::Gmsh(g) => {
+                let (mesh, _) = crate::model::read_gmsh_mesh::<3, SolidKind>(g, source, &at)?;
+                crate::model::check_read_size(case, &bodies, &mesh, source, &at)?;
+                mesh
+            }
+            _ => unreachable!("every body was checked to be 3D above"),
+        };
         crate::model::check_cells(&mesh, source, &at)?;
         bodies.push(Body3 {
             name: spec.name.clone(),
@@ -399,6 +390,38 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
     }
     model.checks = case.checks.clone();
     Ok(model)
+}
+
+/// The mesh of a `block3d` spec, its breaks and moves finite.
+fn block_mesh3(
+    block: &crate::io::scene::Block3dSpec,
+    source: &str,
+    at: &str,
+) -> Result<crate::mesh::Mesh3> {
+    let (xs, ys, zs) = (block.x.values(), block.y.values(), block.z.values());
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    if !(finite(&xs) && finite(&ys) && finite(&zs))
+        || block
+            .moves
+            .iter()
+            .any(|m| !(finite(&m.from) && finite(&m.to)))
+    {
+        return Err(Error::invalid(
+            source,
+            format!("{at}.mesh.block3d"),
+            "a break or a move is not finite",
+            "give finite coordinates",
+        ));
+    }
+    let moves: Vec<_> = block.moves.iter().map(|m| (m.from, m.to)).collect();
+    block3(block.element, &xs, &ys, &zs, &moves).map_err(|e| {
+        Error::invalid(
+            source,
+            format!("{at}.mesh.block3d"),
+            e,
+            "fix the breaks or moves",
+        )
+    })
 }
 
 /// What finite kinematics solves in 3D, refused otherwise with the reason: frictionless

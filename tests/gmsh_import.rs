@@ -2,7 +2,10 @@
 //! `cases/gmsh/` (written by `cases/gmsh/make_meshes.py` with the `gmsh` package) pass the
 //! patch test to round-off and Hertz's closed form; a mesh written clockwise is renumbered and
 //! still passes; a missing file, a missing physical group and an unknown element type are
-//! refused with exit code 2, naming the file and the place in it.
+//! refused with exit code 2, naming the file and the place in it. In 3D (`cases/gmsh/3d/`,
+//! `make_meshes.py` there): the traction patch test on Tet4, Tet10, Hex8 and Hex27 meshes, a
+//! contact patch test between two bodies of one file, an elastic sphere on a rigid plane
+//! against Hertz under refinement, and an inverted hexahedron refused.
 
 use contact_patch::fe::ElementKind;
 use contact_patch::model::admit::load;
@@ -261,7 +264,9 @@ fn truncated_files_are_refused_without_a_panic() {
         let bytes = std::fs::read(case("cases/gmsh").join(file)).unwrap();
         let mut refused = 0;
         for cut in (0..bytes.len()).step_by(7) {
-            match read_msh(&bytes[..cut]).and_then(|c| body_mesh(&c, Some("patch"))) {
+            match read_msh(&bytes[..cut])
+                .and_then(|c| body_mesh::<2, contact_patch::fe::ElementKind>(&c, Some("patch")))
+            {
                 Ok(_) => {}
                 Err(e) => {
                     assert!(
@@ -276,4 +281,240 @@ fn truncated_files_are_refused_without_a_panic() {
         // a cut before $EndElements cannot give the whole mesh
         assert!(refused * 7 >= bytes.len() * 9 / 10, "{file}: {refused}");
     }
+}
+
+// ---- 3D: Gmsh meshes of tetrahedra and hexahedra (cases/gmsh/3d, make_meshes.py) ----
+
+/// The 3D case at `rel` run through the library: its outcome.
+fn run_3d(rel: &str) -> contact_patch::run3d::Outcome3 {
+    let path = case(rel);
+    let parsed = contact_patch::run3d::read_3d_case(&path)
+        .unwrap_or_else(|| panic!("{rel} is read as a 3D case"));
+    contact_patch::run3d::run_case3(&parsed, &path.display().to_string())
+        .unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
+/// Each solid kind from its Gmsh file (MSH 4.1 ASCII and binary, MSH 2.2 ASCII): the cell
+/// count Gmsh wrote, the physical surfaces as facet sets that cover their planes, the physical
+/// points as node sets, and the traction patch test to round-off.
+#[test]
+fn gmsh_3d_patch_tests_pass_on_every_solid_kind() {
+    use contact_patch::fe3d::SolidKind;
+    for (name, kind, cells) in [
+        ("tet4", SolidKind::Tet4, 317),
+        ("tet10", SolidKind::Tet10, 317),
+        ("hex8", SolidKind::Hex8, 488),
+        ("hex27", SolidKind::Hex27, 488),
+    ] {
+        let o = run_3d(&format!("cases/gmsh/3d/patch-{name}.json"));
+        let mesh = &o.model.bodies[0].mesh;
+        assert_eq!((mesh.kind, mesh.cell_count()), (kind, cells), "{name}");
+        for (set, z) in [("base", 0.0), ("lid", 1.2)] {
+            // the facets' nodes are every node on the plane z = `z`
+            let mut on_facets: Vec<usize> = mesh.facet_sets[set]
+                .iter()
+                .flat_map(|&f| mesh.facet_nodes(f))
+                .collect();
+            on_facets.sort_unstable();
+            on_facets.dedup();
+            let on_plane: Vec<usize> = (0..mesh.nodes.len())
+                .filter(|&n| (mesh.nodes[n][2] - z).abs() < 1e-12)
+                .collect();
+            assert_eq!(on_facets, on_plane, "{name} {set}");
+            assert_eq!(mesh.node_sets[set], on_plane, "{name} {set}");
+        }
+        assert_eq!(mesh.nodes[mesh.node_sets["origin"][0]], [0.0; 3]);
+        assert_eq!(mesh.nodes[mesh.node_sets["x_end"][0]], [1.0, 0.0, 0.0]);
+        assert!(o.converged(), "{name}");
+        println!("{name}: uniform stress error {:.2e}", o.checks[0].error);
+        assert!(o.checks.iter().all(|c| c.passed), "{name}: {:?}", o.checks);
+    }
+}
+
+/// Two bodies from one Gmsh file (a Hex8 punch on a Tet4 foundation, the interface's nodes not
+/// matching): mortar with standard multipliers passes the contact patch test, and the pair
+/// carries the load, 10 on the unit square.
+#[test]
+fn gmsh_3d_punch_on_foundation_passes_the_contact_patch_test() {
+    let o = run_3d("cases/gmsh/3d/punch-on-foundation.json");
+    let [foundation, punch] = [&o.model.bodies[0].mesh, &o.model.bodies[1].mesh];
+    let on_interface = |mesh: &contact_patch::mesh::Mesh3, set: &str| -> Vec<[f64; 3]> {
+        mesh.node_sets[set].iter().map(|&n| mesh.nodes[n]).collect()
+    };
+    let slave = on_interface(punch, "punch_bottom");
+    let master = on_interface(foundation, "foundation_top");
+    assert_eq!(slave.len(), 25, "a 4 x 4 grid of Quad4 faces");
+    let shared = slave.iter().filter(|p| master.contains(p)).count();
+    assert!(shared < slave.len(), "the interface does not match");
+    assert!(o.converged());
+    println!(
+        "punch on foundation: uniform stress error {:.2e}",
+        o.checks[0].error
+    );
+    assert!(o.checks.iter().all(|c| c.passed), "{:?}", o.checks);
+    let state = o.solution.contact.as_ref().unwrap();
+    let load: f64 = state
+        .rows
+        .iter()
+        .zip(&state.forces)
+        .map(|(r, f)| -f * r.normal[2])
+        .sum();
+    assert!((load.abs() - 10.0).abs() < 1e-9, "{load}");
+}
+
+/// Hertz's closed form for an elastic sphere on a rigid plane (Johnson, Contact Mechanics, eqs.
+/// 4.22 and 4.23), written here from the formula: the contact radius `a` and the peak pressure
+/// `p0` under the load `load`.
+fn hertz_sphere(load: f64, radius: f64, e: f64, nu: f64) -> (f64, f64) {
+    let e_star = e / (1.0 - nu * nu);
+    let a = (3.0 * load * radius / (4.0 * e_star)).cbrt();
+    (a, 3.0 * load / (2.0 * std::f64::consts::PI * a * a))
+}
+
+/// The Gmsh-meshed sphere (a quarter of its lower half, Tet4, size h at the contact) pressed on
+/// the rigid plane, at h = 0.4, 0.2, 0.1: the contact forces carry the pressure's load (0.1
+/// times the area of the flat face's triangles, a polygon inside the quarter disc) to round-off;
+/// their second-moment radius (for Hertz's pressure, int p r^2 / int p = 2 a^2 / 5) and the
+/// pressure at the pole (the pole's force over its tributary area) approach Hertz's `a` and `p0`
+/// for that load as the mesh is refined: 5.1e-2, 9.8e-3, 5.5e-3 off `a` and 9.2e-2, 4.7e-2,
+/// 2.0e-2 off `p0` (`cargo test --release --test gmsh_import sphere -- --nocapture`).
+#[test]
+fn gmsh_sphere_on_a_rigid_plane_against_hertz_under_refinement() {
+    let (radius, e, nu, pressure) = (10.0, 200.0, 0.3, 0.1);
+    let mut errors = Vec::new();
+    for h in ["0.4", "0.2", "0.1"] {
+        let o = run_3d(&format!("cases/gmsh/3d/hertz-sphere-h{h}.json"));
+        assert!(o.converged(), "h = {h}");
+        assert!(o.checks.iter().all(|c| c.passed), "h = {h}: {:?}", o.checks);
+        let mesh = &o.model.bodies[0].mesh;
+        let flat_area: f64 = mesh.facet_sets["flat"]
+            .iter()
+            .map(|&f| {
+                let n = mesh.facet_nodes(f);
+                let [a, b, c] = [mesh.nodes[n[0]], mesh.nodes[n[1]], mesh.nodes[n[2]]];
+                let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
+                0.5 * (u[0] * v[1] - u[1] * v[0]).abs()
+            })
+            .sum();
+        let load = 4.0 * pressure * flat_area;
+        let (a, p0) = hertz_sphere(load, radius, e, nu);
+        let state = o.solution.contact.as_ref().unwrap();
+        let closed: Vec<usize> = (0..state.rows.len())
+            .filter(|&i| state.active[i] && state.forces[i] > 0.0)
+            .collect();
+        let r2 = |i: usize| {
+            let p = state.rows[i].point;
+            p[0] * p[0] + p[1] * p[1]
+        };
+        // a quarter of the sphere: its forces carry a quarter of the load
+        let quarter: f64 = closed
+            .iter()
+            .map(|&i| state.forces[i] * state.rows[i].normal[2].abs())
+            .sum();
+        let sum: f64 = closed.iter().map(|&i| state.forces[i]).sum();
+        let moment: f64 = closed.iter().map(|&i| state.forces[i] * r2(i)).sum();
+        let moment_radius = (2.5 * moment / sum).sqrt();
+        let pole = (0..state.rows.len())
+            .find(|&i| r2(i) < 1e-24)
+            .expect("a node at the pole");
+        let peak = state.forces[pole] / state.rows[pole].area;
+        let outermost = closed.iter().map(|&i| r2(i).sqrt()).fold(0.0, f64::max);
+        println!(
+            "h = {h}: load {:.10} (P = {load:.10}), {} closed rows, outermost at r = {outermost:.4}; \
+             second-moment radius {moment_radius:.5} (a = {a:.5}, {:+.2e}); pole pressure \
+             {peak:.4} (p0 = {p0:.4}, {:+.2e})",
+            4.0 * quarter,
+            closed.len(),
+            moment_radius / a - 1.0,
+            peak / p0 - 1.0
+        );
+        assert!(
+            (4.0 * quarter - load).abs() < 1e-9 * load,
+            "h = {h}: {quarter}"
+        );
+        errors.push(((moment_radius / a - 1.0).abs(), (peak / p0 - 1.0).abs()));
+    }
+    for pair in errors.windows(2) {
+        assert!(pair[1].0 < pair[0].0, "the radius converges: {errors:?}");
+        assert!(pair[1].1 < pair[0].1, "the peak converges: {errors:?}");
+    }
+    // at h = 0.1 (measured 5.5e-3 and 2.05e-2)
+    let (radius_error, peak_error) = errors[2];
+    assert!(radius_error < 0.01 && peak_error < 0.03, "{errors:?}");
+}
+
+/// The 3D Gmsh cases through the binary: `check` passes them all; `run` writes each body's
+/// cells with their VTK types (10, tetrahedron; 12, hexahedron).
+#[test]
+fn gmsh_3d_cases_pass_check_and_run_writes_their_cells() {
+    let o = Command::new(env!("CARGO_BIN_EXE_contact-patch"))
+        .args(["check", case("cases/gmsh/3d").to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    for name in [
+        "patch-tet4",
+        "patch-tet10",
+        "patch-hex8",
+        "patch-hex27",
+        "punch-on-foundation",
+        "hertz-sphere-h0.1",
+    ] {
+        assert!(stdout.contains(name), "{name}: {stdout}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let (code, stderr) = run(&case("cases/gmsh/3d/punch-on-foundation.json"), &out);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(summary(&out)["passed"], true);
+    for (body, vtk_type, cells) in [("foundation", "10", 388), ("punch", "12", 32)] {
+        let vtu = std::fs::read_to_string(out.join(format!("{body}.vtu"))).unwrap();
+        let types = vtu.split("Name=\"types\"").nth(1).unwrap();
+        let types = &types[types.find('>').unwrap() + 1..types.find("</DataArray>").unwrap()];
+        assert_eq!(
+            types.split_whitespace().collect::<Vec<_>>(),
+            vec![vtk_type; cells],
+            "{body}"
+        );
+    }
+}
+
+/// A Gmsh hexahedron numbered with its top face first (inverted) is refused with the element,
+/// the reason and the fix; nothing is written.
+#[test]
+fn an_inverted_gmsh_hexahedron_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let nodes: String = (0..8)
+        .map(|i| format!("{} {} {} {}\n", i + 1, i & 1, (i >> 1) & 1, i >> 2))
+        .collect();
+    // corners 1 2 4 3 are the bottom (z = 0) counter-clockwise seen from above; listing the
+    // top 5 6 8 7 first turns the cell inside out
+    let msh = format!(
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n3 1 \"cube\"\n$EndPhysicalNames\n\
+         $Nodes\n8\n{nodes}$EndNodes\n$Elements\n1\n1 5 2 1 1 5 6 8 7 1 2 4 3\n$EndElements\n"
+    );
+    std::fs::write(dir.path().join("cube.msh"), msh).unwrap();
+    let case_text = serde_json::json!({
+        "name": "cube",
+        "materials": {"m": {"E": 1.0, "nu": 0.3}},
+        "bodies": [{"name": "cube", "material": "m",
+                    "mesh": {"gmsh": {"file": "cube.msh", "physical": "cube"}}}],
+        "supports": [{"body": "cube", "set": "all", "x": 0.0, "y": 0.0, "z": 0.0}],
+        "checks": [{"check": "uniform_stress_3d", "stress": [0, 0, 0, 0, 0, 0], "tol": 1e-10}]
+    });
+    let file = dir.path().join("case.json");
+    std::fs::write(&file, case_text.to_string()).unwrap();
+    let out = dir.path().join("out");
+    let (code, e) = run(&file, &out);
+    assert_eq!(code, 2, "{e}");
+    assert!(e.contains("bodies[0] 'cube': element 0"), "{e}");
+    assert!(e.contains("inverted (negative Jacobian)"), "{e}");
+    assert!(e.contains("hint:"), "{e}");
+    assert!(!out.exists());
 }

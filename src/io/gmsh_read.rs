@@ -29,7 +29,8 @@
 //! of the body belongs to another body and is left out; one that lies partly on the body is
 //! refused with the element that does not fit.
 
-use crate::fe::ElementKind;
+use crate::fe::{ElementKind, ReferenceCell};
+use crate::fe3d::SolidKind;
 use crate::mesh::{Facet, Mesh};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
@@ -81,6 +82,7 @@ fn element_dimension(gmsh_type: i32) -> Option<i32> {
         15 => Some(0),
         1 | 8 => Some(1),
         2 | 3 | 9 | 10 => Some(2),
+        4 | 5 | 11 | 12 => Some(3),
         _ => None,
     }
 }
@@ -91,20 +93,24 @@ fn element_node_count(gmsh_type: i32) -> Option<usize> {
         15 => Some(1),
         1 => Some(2),
         8 | 2 => Some(3),
-        3 => Some(4),
+        3 | 4 => Some(4),
         9 => Some(6),
+        5 => Some(8),
         10 => Some(9),
+        11 => Some(10),
+        12 => Some(27),
         _ => None,
     }
 }
 
-fn cell_kind(gmsh_type: i32) -> Option<ElementKind> {
+/// The corner count of a Gmsh element type this reader takes (its first nodes are corners).
+fn corner_count(gmsh_type: i32) -> usize {
     match gmsh_type {
-        2 => Some(ElementKind::T3),
-        9 => Some(ElementKind::T6),
-        3 => Some(ElementKind::Q4),
-        10 => Some(ElementKind::Q9),
-        _ => None,
+        15 => 1,
+        1 | 8 => 2,
+        2 | 9 => 3,
+        3 | 10 | 4 | 11 => 4,
+        _ => 8,
     }
 }
 
@@ -533,7 +539,92 @@ fn read_v22(bytes: &[u8]) -> Read<MshContent> {
     Ok(content)
 }
 
-const SUPPORTED: &str = "mesh with 3- or 6-node triangles or 4- or 9-node quadrangles (Gmsh: Mesh.RecombineAll = 1 for quadrangles, Mesh.ElementOrder = 2 and Mesh.SecondOrderIncomplete = 0 for 9-node ones), lines and points on the boundary";
+/// A cell kind that a body's Gmsh elements are read into, in `D` dimensions: which Gmsh element
+/// types it takes, how their nodes map onto [`ReferenceCell`]'s numbering, and what the reader
+/// says of the meshes it takes.
+pub trait GmshCell<const D: usize>: ReferenceCell<D> + PartialEq + std::fmt::Debug {
+    /// The kind of Gmsh element type `gmsh_type`, `None` for a type that is not a cell here.
+    fn from_gmsh(gmsh_type: i32) -> Option<Self>;
+    /// Node `i` of the cell in this crate's numbering is node `order[i]` of the Gmsh element.
+    fn gmsh_order(self) -> &'static [usize];
+    /// The renumbering that turns a cell with these corners inside out to a positive one
+    /// (2D: a cell whose corners run clockwise; 3D: none, an inverted cell is refused by the
+    /// model's geometry check with its Jacobian), `None` when the cell is already positive.
+    fn mirrored(self, corners: &[[f64; D]]) -> Option<&'static [usize]>;
+    /// The meshes this dimension reads, for the messages.
+    const SUPPORTED: &'static str;
+}
+
+const SUPPORTED_2D: &str = "mesh with 3- or 6-node triangles or 4- or 9-node quadrangles (Gmsh: Mesh.RecombineAll = 1 for quadrangles, Mesh.ElementOrder = 2 and Mesh.SecondOrderIncomplete = 0 for 9-node ones), lines and points on the boundary";
+const SUPPORTED_3D: &str = "mesh with 4- or 10-node tetrahedra or 8- or 27-node hexahedra (Gmsh: Mesh.RecombineAll = 1 with transfinite volumes for hexahedra, Mesh.ElementOrder = 2 and Mesh.SecondOrderIncomplete = 0 for 27-node ones), surfaces, lines and points on the boundary";
+/// Every element type the reader takes.
+const SUPPORTED: &str = "mesh with triangles or quadrangles (2D bodies) or tetrahedra or hexahedra (3D bodies), linear or quadratic (9-node quadrangles, 27-node hexahedra), and lines, points and surfaces on the boundary";
+
+impl GmshCell<2> for ElementKind {
+    fn from_gmsh(gmsh_type: i32) -> Option<Self> {
+        match gmsh_type {
+            2 => Some(ElementKind::T3),
+            9 => Some(ElementKind::T6),
+            3 => Some(ElementKind::Q4),
+            10 => Some(ElementKind::Q9),
+            _ => None,
+        }
+    }
+    fn gmsh_order(self) -> &'static [usize] {
+        // Gmsh numbers these as crate::fe does (corners, mid-sides, the Q9 centre)
+        &[0, 1, 2, 3, 4, 5, 6, 7, 8][..self.node_count()]
+    }
+    fn mirrored(self, corners: &[[f64; 2]]) -> Option<&'static [usize]> {
+        (signed_area(corners) < 0.0).then(|| mirrored_order(self))
+    }
+    const SUPPORTED: &'static str = SUPPORTED_2D;
+}
+
+/// Gmsh's Tet10 has the mid-edge nodes 8 on edge 2-3 and 9 on edge 1-3, VTK's the other way
+/// round; Gmsh's Hex27 numbers the mid-edge nodes edge by edge from corner 0 (0-1, 0-3, 0-4,
+/// 1-2, 1-5, 2-3, 2-6, 3-7, 4-5, 4-7, 5-6, 6-7) and the face centres bottom, front, left,
+/// right, back, top (Gmsh reference manual, "Node ordering"; checked against Gmsh's own
+/// reference coordinates in the tests).
+const TET10_FROM_GMSH: [usize; 10] = [0, 1, 2, 3, 4, 5, 6, 7, 9, 8];
+const HEX27_FROM_GMSH: [usize; 27] = [
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 11, 13, 9, 16, 18, 19, 17, 10, 12, 14, 15, 22, 23, 21, 24, 20, 25,
+    26,
+];
+
+impl GmshCell<3> for SolidKind {
+    fn from_gmsh(gmsh_type: i32) -> Option<Self> {
+        match gmsh_type {
+            4 => Some(SolidKind::Tet4),
+            11 => Some(SolidKind::Tet10),
+            5 => Some(SolidKind::Hex8),
+            12 => Some(SolidKind::Hex27),
+            _ => None,
+        }
+    }
+    fn gmsh_order(self) -> &'static [usize] {
+        match self {
+            SolidKind::Tet4 => &[0, 1, 2, 3],
+            SolidKind::Tet10 => &TET10_FROM_GMSH,
+            SolidKind::Hex8 => &[0, 1, 2, 3, 4, 5, 6, 7],
+            SolidKind::Hex27 => &HEX27_FROM_GMSH,
+        }
+    }
+    fn mirrored(self, _corners: &[[f64; 3]]) -> Option<&'static [usize]> {
+        None
+    }
+    const SUPPORTED: &'static str = SUPPORTED_3D;
+}
+
+/// The highest dimension of the cells in `content` (3 for a file with tetrahedra or
+/// hexahedra): the dimension of a body read from it.
+pub fn cell_dimension(content: &MshContent) -> i32 {
+    content
+        .elements
+        .iter()
+        .filter_map(|e| element_dimension(e.gmsh_type))
+        .max()
+        .unwrap_or(0)
+}
 
 /// The signed area of the polygon through `corners`.
 fn signed_area(corners: &[[f64; 2]]) -> f64 {
@@ -559,10 +650,25 @@ pub fn mirrored_order(kind: ElementKind) -> &'static [usize] {
     }
 }
 
-/// A body's mesh and sets from `content`: the 2D elements of physical surface `physical`
-/// (every 2D element if `None`), the other groups as sets (see the module text). Also returns
-/// the number of cells mirrored from clockwise to counter-clockwise.
-pub fn body_mesh(content: &MshContent, physical: Option<&str>) -> Read<(Mesh, usize)> {
+/// The Gmsh name of the groups of dimension `dim`, for the messages.
+fn group_word(dim: usize) -> &'static str {
+    match dim {
+        3 => "volume",
+        2 => "surface",
+        1 => "curve",
+        _ => "point",
+    }
+}
+
+/// A body's mesh and sets from `content`, in `D` dimensions: the `D`-dimensional elements of
+/// physical group `physical` (every one if `None`), the other groups as sets (see the module
+/// text). Also returns the number of cells mirrored to a positive orientation.
+pub fn body_mesh<const D: usize, K: GmshCell<D>>(
+    content: &MshContent,
+    physical: Option<&str>,
+) -> Read<(Mesh<D, K>, usize)> {
+    let dim = D as i32;
+    let word = group_word(D);
     let group_name = |dim: i32, tag: i32| -> String {
         content
             .names
@@ -579,13 +685,13 @@ pub fn body_mesh(content: &MshContent, physical: Option<&str>) -> Read<(Mesh, us
             ));
         }
     }
-    // the 2D elements of the body
-    let surface_tag = match physical {
+    // the cells of the body
+    let body_tag = match physical {
         Some(name) => {
             let found = content
                 .names
                 .iter()
-                .find(|((d, _), n)| *d == 2 && n.as_str() == name)
+                .find(|((d, _), n)| *d == dim && n.as_str() == name)
                 .map(|((_, t), _)| *t);
             match found {
                 Some(t) => Some(t),
@@ -593,13 +699,14 @@ pub fn body_mesh(content: &MshContent, physical: Option<&str>) -> Read<(Mesh, us
                     let known: Vec<&String> = content
                         .names
                         .iter()
-                        .filter(|((d, _), _)| *d == 2)
+                        .filter(|((d, _), _)| *d == dim)
                         .map(|(_, n)| n)
                         .collect();
+                    let gmsh_word = if D == 3 { "Volume" } else { "Surface" };
                     return Err(MshError::new(
                         "$PhysicalNames",
-                        format!("the file has no physical surface named '{name}'"),
-                        format!("name one of its physical surfaces {known:?}, or add Physical Surface(\"{name}\") in Gmsh"),
+                        format!("the file has no physical {word} named '{name}'"),
+                        format!("name one of its physical {word}s {known:?}, or add Physical {gmsh_word}(\"{name}\") in Gmsh"),
                     ));
                 }
             }
@@ -609,20 +716,28 @@ pub fn body_mesh(content: &MshContent, physical: Option<&str>) -> Read<(Mesh, us
     let cells: Vec<&MshElement> = content
         .elements
         .iter()
-        .filter(|e| element_dimension(e.gmsh_type) == Some(2))
-        .filter(|e| surface_tag.is_none_or(|t| e.physical.contains(&t)))
+        .filter(|e| element_dimension(e.gmsh_type) == Some(dim))
+        .filter(|e| body_tag.is_none_or(|t| e.physical.contains(&t)))
         .collect();
     let Some(first) = cells.first() else {
         return Err(MshError::new(
             "$Elements",
             match physical {
-                Some(name) => format!("the physical surface '{name}' has no 2D elements"),
-                None => "the file has no 2D elements".to_string(),
+                Some(name) => format!("the physical {word} '{name}' has no {D}D elements"),
+                None => format!("the file has no {D}D elements"),
             },
-            "mesh the surface in 2D (gmsh -2) and save every element of the physical surface",
+            format!(
+                "mesh the {word} in {D}D (gmsh -{D}) and save every element of the physical {word}"
+            ),
         ));
     };
-    let kind = cell_kind(first.gmsh_type).expect("2D types are cell kinds");
+    let Some(kind) = K::from_gmsh(first.gmsh_type) else {
+        return Err(MshError::new(
+            format!("element {}", first.tag),
+            format!("Gmsh element type {} is not a {D}D cell", first.gmsh_type),
+            K::SUPPORTED,
+        ));
+    };
     if let Some(other) = cells.iter().find(|e| e.gmsh_type != first.gmsh_type) {
         return Err(MshError::new(
             format!("element {}", other.tag),
@@ -630,7 +745,11 @@ pub fn body_mesh(content: &MshContent, physical: Option<&str>) -> Read<(Mesh, us
                 "the body mixes Gmsh element types {} and {}; a body has one element kind",
                 first.gmsh_type, other.gmsh_type
             ),
-            "recombine every triangle (Mesh.RecombineAll = 1) or none, or split the body in two",
+            if D == 3 {
+                "mesh the body with tetrahedra only or hexahedra only (Mesh.RecombineAll and transfinite volumes everywhere or nowhere), or split the body in two"
+            } else {
+                "recombine every triangle (Mesh.RecombineAll = 1) or none, or split the body in two"
+            },
         ));
     }
     // nodes: those of the cells, in ascending tag
@@ -654,14 +773,14 @@ pub fn body_mesh(content: &MshContent, physical: Option<&str>) -> Read<(Mesh, us
     let mut nodes = Vec::with_capacity(tags.len());
     for &t in &tags {
         let p = content.nodes[&t];
-        if !(p[0].is_finite() && p[1].is_finite()) {
+        if !p.iter().all(|x| x.is_finite()) {
             return Err(MshError::new(
                 format!("node {t}"),
                 "the coordinates are not finite",
                 "fix the geometry",
             ));
         }
-        if p[2] != 0.0 {
+        if D == 2 && p[2] != 0.0 {
             return Err(MshError::new(
                 format!("node {t}"),
                 format!(
@@ -671,46 +790,50 @@ pub fn body_mesh(content: &MshContent, physical: Option<&str>) -> Read<(Mesh, us
                 "draw the geometry in the x-y plane",
             ));
         }
-        nodes.push([p[0], p[1]]);
+        nodes.push(std::array::from_fn::<f64, D, _>(|i| p[i]));
     }
     let corners = kind.corner_count();
+    let order = kind.gmsh_order();
     let mut mirrored = 0;
     let mut connectivity = Vec::with_capacity(cells.len() * kind.node_count());
     for e in &cells {
-        let ids: Vec<usize> = e.nodes.iter().map(|t| local[t]).collect();
-        let pts: Vec<[f64; 2]> = ids[..corners].iter().map(|&i| nodes[i]).collect();
-        if signed_area(&pts) < 0.0 {
-            mirrored += 1;
-            connectivity.extend(mirrored_order(kind).iter().map(|&i| ids[i]));
-        } else {
-            connectivity.extend_from_slice(&ids);
+        let ids: Vec<usize> = order.iter().map(|&i| local[&e.nodes[i]]).collect();
+        let pts: Vec<[f64; D]> = ids[..corners].iter().map(|&i| nodes[i]).collect();
+        match kind.mirrored(&pts) {
+            Some(mirror) => {
+                mirrored += 1;
+                connectivity.extend(mirror.iter().map(|&i| ids[i]));
+            }
+            None => connectivity.extend_from_slice(&ids),
         }
     }
     let mut mesh = Mesh::new(kind, nodes, connectivity);
-    // facets by their end nodes
-    let boundary: HashMap<(usize, usize), Facet> = mesh
+    // boundary facets by their sorted corner nodes
+    let boundary: HashMap<Vec<usize>, Facet> = mesh
         .boundary_facets()
         .into_iter()
         .map(|f| {
             let n = mesh.facet_nodes(f);
-            ((n[0].min(n[1]), n[0].max(n[1])), f)
+            let mut key = n[..kind.facet_corner_count(f.edge)].to_vec();
+            key.sort_unstable();
+            (key, f)
         })
         .collect();
     let mut node_sets: BTreeMap<String, BTreeSet<usize>> = BTreeMap::new();
     let mut facet_sets: BTreeMap<String, Vec<Facet>> = BTreeMap::new();
-    // every physical group other than the body's own surface, with its elements
+    // every physical group other than the body's own, with its elements
     let mut groups: BTreeMap<(i32, i32), Vec<&MshElement>> = BTreeMap::new();
     for e in &content.elements {
-        let dim = element_dimension(e.gmsh_type).expect("checked above");
+        let element_dim = element_dimension(e.gmsh_type).expect("checked above");
         for &p in &e.physical {
-            if dim == 2 && surface_tag == Some(p) {
+            if element_dim == dim && body_tag == Some(p) {
                 continue;
             }
-            groups.entry((dim, p)).or_default().push(e);
+            groups.entry((element_dim, p)).or_default().push(e);
         }
     }
-    for (&(dim, tag), elements) in &groups {
-        let name = group_name(dim, tag);
+    for (&(group_dim, tag), elements) in &groups {
+        let name = group_name(group_dim, tag);
         let on_body = |e: &MshElement| e.nodes.iter().filter(|t| local.contains_key(t)).count();
         let touching = elements.iter().filter(|e| on_body(e) > 0).count();
         if touching == 0 {
@@ -727,22 +850,32 @@ pub fn body_mesh(content: &MshContent, physical: Option<&str>) -> Read<(Mesh, us
         for e in elements {
             set.extend(e.nodes.iter().map(|t| local[t]));
         }
-        if dim == 1 {
+        if group_dim == dim - 1 {
             let mut facets = Vec::with_capacity(elements.len());
             for e in elements {
-                let (a, b) = (local[&e.nodes[0]], local[&e.nodes[1]]);
-                let facet = boundary.get(&(a.min(b), a.max(b))).copied().filter(|f| {
-                    // a Line3's mid-node must be the facet's mid-node
-                    e.nodes.len() == 2 || mesh.facet_nodes(*f).get(2) == Some(&local[&e.nodes[2]])
+                let element_nodes: BTreeSet<usize> = e.nodes.iter().map(|t| local[t]).collect();
+                let mut key: Vec<usize> = e.nodes[..corner_count(e.gmsh_type)]
+                    .iter()
+                    .map(|t| local[t])
+                    .collect();
+                key.sort_unstable();
+                // the element's nodes must be the facet's, mid-side nodes too
+                let facet = boundary.get(&key).copied().filter(|f| {
+                    mesh.facet_nodes(*f).into_iter().collect::<BTreeSet<_>>() == element_nodes
                 });
                 match facet {
                     Some(f) => facets.push(f),
                     None => {
+                        let (what, fix) = if D == 3 {
+                            ("the face is not a boundary face of the body's cells", "put only boundary surfaces in a 2D physical group of a body (faces of the same order as the cells)")
+                        } else {
+                            ("the line is not a boundary edge of the body's cells", "put only boundary curves in a 1D physical group of a body (lines of the same order as the cells)")
+                        };
                         return Err(MshError::new(
                             format!("element {} of physical group '{name}'", e.tag),
-                            "the line is not a boundary edge of the body's cells",
-                            "put only boundary curves in a 1D physical group of a body (lines of the same order as the cells)",
-                        ))
+                            what,
+                            fix,
+                        ));
                     }
                 }
             }
@@ -756,7 +889,11 @@ pub fn body_mesh(content: &MshContent, physical: Option<&str>) -> Read<(Mesh, us
             return Err(MshError::new(
                 format!("physical group '{name}'"),
                 format!("'{name}' is a built-in set name"),
-                "rename the physical group; the built-in sets are left, right, bottom, top, the corners and all",
+                if D == 3 {
+                    "rename the physical group; the built-in sets are left, right, front, back, bottom, top, the corners and all"
+                } else {
+                    "rename the physical group; the built-in sets are left, right, bottom, top, the corners and all"
+                },
             ));
         }
         mesh.node_sets.insert(name, nodes.into_iter().collect());
@@ -803,7 +940,7 @@ $EndElements
     fn a_v22_file_becomes_cells_and_sets_with_a_clockwise_cell_mirrored() {
         let content = read_msh(TWO_QUADS_V22.as_bytes()).unwrap();
         assert_eq!(content.version, "2.2");
-        let (mesh, mirrored) = body_mesh(&content, Some("plate")).unwrap();
+        let (mesh, mirrored) = body_mesh::<2, ElementKind>(&content, Some("plate")).unwrap();
         assert_eq!(mirrored, 1);
         assert_eq!(mesh.kind, ElementKind::Q4);
         // nodes in ascending tag: 10..15 -> 0..5
@@ -848,7 +985,8 @@ $EndElements
         let text = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n9\n\
             1 0 0 0\n2 2 0 0\n3 2 2 0\n4 0 2 0\n5 1 0 0\n6 2 1 0\n7 1 2 0\n8 0 1 0\n9 1 1 0\n$EndNodes\n\
             $Elements\n1\n1 10 2 0 1 1 2 3 4 5 6 7 8 9\n$EndElements\n";
-        let (mesh, mirrored) = body_mesh(&read_msh(text.as_bytes()).unwrap(), None).unwrap();
+        let (mesh, mirrored) =
+            body_mesh::<2, ElementKind>(&read_msh(text.as_bytes()).unwrap(), None).unwrap();
         assert_eq!((mesh.kind, mirrored), (ElementKind::Q9, 0));
         assert_eq!(mesh.cell(0), &[0, 1, 2, 3, 4, 5, 6, 7, 8]);
         // edge 1 = corners 1-2 with mid-node 5 at (2, 1)
@@ -858,7 +996,7 @@ $EndElements
 
     fn error_of(text: &str, physical: Option<&str>) -> MshError {
         read_msh(text.as_bytes())
-            .and_then(|c| body_mesh(&c, physical))
+            .and_then(|c| body_mesh::<2, ElementKind>(&c, physical))
             .map(|_| ())
             .unwrap_err()
     }
@@ -878,10 +1016,10 @@ $EndElements
 
     #[test]
     fn an_unknown_element_type_is_named_with_its_line() {
-        let text = TWO_QUADS_V22.replace("5 3 2 3 1 11 14 15 12", "5 4 2 3 1 11 14 15 12");
+        let text = TWO_QUADS_V22.replace("5 3 2 3 1 11 14 15 12", "5 6 2 3 1 11 14 15 12 10 13");
         let e = error_of(&text, Some("plate"));
         assert_eq!(e.place, "line 25 (element 5)");
-        assert!(e.problem.contains("element type 4 is not read"), "{e:?}");
+        assert!(e.problem.contains("element type 6 is not read"), "{e:?}");
     }
 
     #[test]
@@ -920,11 +1058,188 @@ $EndElements
         let text = crate::io::gmsh::msh(&[("slab", &mesh)]);
         let content = read_msh(text.as_bytes()).unwrap();
         assert_eq!(content.version, "4.1");
-        let (back, mirrored) = body_mesh(&content, Some("slab")).unwrap();
+        let (back, mirrored) = body_mesh::<2, ElementKind>(&content, Some("slab")).unwrap();
         assert_eq!(mirrored, 0);
         assert_eq!(back.nodes, mesh.nodes);
         assert_eq!(back.connectivity, mesh.connectivity);
         assert_eq!(back.facet_sets["slab/top"], mesh.facet_sets["top"]);
         assert_eq!(back.node_sets["slab/top"], mesh.node_sets["top"]);
+    }
+
+    /// Gmsh's reference coordinates of its Tet10 (on the unit tetrahedron) and Hex27 (on
+    /// [-1, 1]^3) nodes, in Gmsh's order (gmsh 4.15.2, `gmsh.model.mesh.getElementProperties`):
+    /// read through `gmsh_order`, they are our cells' reference nodes one for one.
+    #[test]
+    fn gmsh_node_orders_give_our_reference_nodes() {
+        use crate::fe::ReferenceCell;
+        const GMSH_TET10: [[f64; 3]; 10] = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.5, 0.0, 0.0],
+            [0.5, 0.5, 0.0],
+            [0.0, 0.5, 0.0],
+            [0.0, 0.0, 0.5],
+            [0.0, 0.5, 0.5],
+            [0.5, 0.0, 0.5],
+        ];
+        const GMSH_HEX27: [[f64; 3]; 27] = [
+            [-1.0, -1.0, -1.0],
+            [1.0, -1.0, -1.0],
+            [1.0, 1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+            [-1.0, -1.0, 1.0],
+            [1.0, -1.0, 1.0],
+            [1.0, 1.0, 1.0],
+            [-1.0, 1.0, 1.0],
+            [0.0, -1.0, -1.0],
+            [-1.0, 0.0, -1.0],
+            [-1.0, -1.0, 0.0],
+            [1.0, 0.0, -1.0],
+            [1.0, -1.0, 0.0],
+            [0.0, 1.0, -1.0],
+            [1.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+            [0.0, -1.0, 1.0],
+            [-1.0, 0.0, 1.0],
+            [1.0, 0.0, 1.0],
+            [0.0, 1.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [0.0, -1.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, 0.0],
+        ];
+        for (kind, gmsh) in [
+            (SolidKind::Tet10, &GMSH_TET10[..]),
+            (SolidKind::Hex27, &GMSH_HEX27[..]),
+        ] {
+            let ours = kind.node_coordinates();
+            let order = kind.gmsh_order();
+            assert_eq!(order.len(), ours.len());
+            for (i, &g) in order.iter().enumerate() {
+                assert_eq!(
+                    ours[i], gmsh[g],
+                    "{kind:?}: our node {i} is Gmsh's node {g}"
+                );
+            }
+        }
+        // the corners of the linear cells are in the same order
+        for kind in [SolidKind::Tet4, SolidKind::Hex8] {
+            assert_eq!(
+                kind.gmsh_order(),
+                (0..kind.node_count()).collect::<Vec<_>>()
+            );
+        }
+    }
+
+    /// Two Hex8 cells on [0, 2] x [0, 1] x [0, 1] in MSH 2.2 with the bottom face of the first
+    /// as the physical surface "floor", the edge x = 0, y = 0 as the curve "post" and the
+    /// volume "solid".
+    const TWO_HEXES_V22: &str = "$MeshFormat
+2.2 0 8
+$EndMeshFormat
+$PhysicalNames
+3
+1 1 \"post\"
+2 2 \"floor\"
+3 3 \"solid\"
+$EndPhysicalNames
+$Nodes
+12
+1 0 0 0
+2 1 0 0
+3 2 0 0
+4 0 1 0
+5 1 1 0
+6 2 1 0
+7 0 0 1
+8 1 0 1
+9 2 0 1
+10 0 1 1
+11 1 1 1
+12 2 1 1
+$EndNodes
+$Elements
+4
+1 1 2 1 1 1 7
+2 3 2 2 2 1 2 5 4
+3 5 2 3 3 1 2 5 4 7 8 11 10
+4 5 2 3 3 2 3 6 5 8 9 12 11
+$EndElements
+";
+
+    fn error_of_3d(text: &str, physical: Option<&str>) -> MshError {
+        read_msh(text.as_bytes())
+            .and_then(|c| body_mesh::<3, SolidKind>(&c, physical))
+            .map(|_| ())
+            .unwrap_err()
+    }
+
+    #[test]
+    fn a_3d_body_reads_its_surfaces_as_facet_sets_and_curves_as_node_sets() {
+        let content = read_msh(TWO_HEXES_V22.as_bytes()).unwrap();
+        assert_eq!(cell_dimension(&content), 3);
+        let (mesh, mirrored) = body_mesh::<3, SolidKind>(&content, Some("solid")).unwrap();
+        assert_eq!(mirrored, 0);
+        assert_eq!(
+            (mesh.kind, mesh.cell_count(), mesh.nodes.len()),
+            (SolidKind::Hex8, 2, 12)
+        );
+        assert_eq!(mesh.facet_sets["floor"].len(), 1);
+        let floor: BTreeSet<usize> = mesh
+            .facet_nodes(mesh.facet_sets["floor"][0])
+            .into_iter()
+            .collect();
+        let expected: BTreeSet<usize> = [0, 1, 3, 4].into_iter().collect();
+        assert_eq!(floor, expected, "the face 1 2 5 4 (tags) is nodes 0 1 4 3");
+        assert_eq!(mesh.node_sets["floor"], vec![0, 1, 3, 4]);
+        assert_eq!(mesh.node_sets["post"], vec![0, 6]);
+        assert!(
+            !mesh.facet_sets.contains_key("post"),
+            "a curve is no facet set in 3D"
+        );
+        // the built-in sets of a 3D mesh are there too
+        assert_eq!(mesh.node_sets["bottom"].len(), 6);
+    }
+
+    #[test]
+    fn a_3d_group_inside_the_body_or_across_kinds_is_refused() {
+        // the face x = 1 between the two cells
+        let inner = TWO_HEXES_V22.replace("2 3 2 2 2 1 2 5 4", "2 3 2 2 2 2 5 11 8");
+        let e = error_of_3d(&inner, Some("solid"));
+        assert_eq!(e.place, "element 2 of physical group 'floor'");
+        assert!(e.problem.contains("not a boundary face"), "{e:?}");
+        // a tetrahedron in the hexahedra's volume
+        let mixed = TWO_HEXES_V22
+            .replace("$Elements\n4\n", "$Elements\n5\n")
+            .replace("$EndElements", "5 4 2 3 3 3 6 9 12\n$EndElements");
+        let e = error_of_3d(&mixed, Some("solid"));
+        assert!(
+            e.problem.contains("mixes Gmsh element types 5 and 4"),
+            "{e:?}"
+        );
+        assert!(
+            e.hint.contains("tetrahedra only or hexahedra only"),
+            "{e:?}"
+        );
+        // a name that is no physical volume: the volumes there are are listed
+        let e = error_of_3d(TWO_HEXES_V22, Some("floor"));
+        assert!(
+            e.problem.contains("no physical volume named 'floor'"),
+            "{e:?}"
+        );
+        assert!(e.hint.contains("[\"solid\"]"), "{e:?}");
+        // a curve that leaves the body (node 13 is no node of its cells)
+        let partly = TWO_HEXES_V22
+            .replace("$Nodes\n12\n", "$Nodes\n13\n")
+            .replace("$EndNodes", "13 0 0 2\n$EndNodes")
+            .replace("1 1 2 1 1 1 7", "1 1 2 1 1 7 13");
+        let e = error_of_3d(&partly, Some("solid"));
+        assert_eq!(e.place, "element 1 of physical group 'post'");
+        assert!(e.problem.contains("lies partly on this body"), "{e:?}");
     }
 }

@@ -1823,7 +1823,11 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str, notes: &mut Vec<String>) 
 
 /// The mesh of a body from a Gmsh file, the file named relative to the case file's folder
 /// (`source`), and the number of cells renumbered from clockwise.
-fn read_gmsh_mesh(g: &GmshMeshSpec, source: &str, at: &str) -> Result<(Mesh, usize)> {
+pub(crate) fn read_gmsh_mesh<const D: usize, K: crate::io::gmsh_read::GmshCell<D>>(
+    g: &GmshMeshSpec,
+    source: &str,
+    at: &str,
+) -> Result<(Mesh<D, K>, usize)> {
     let folder = std::path::Path::new(source)
         .parent()
         .unwrap_or(std::path::Path::new(""));
@@ -1903,7 +1907,13 @@ pub(crate) fn check_solver_settings(case: &Case, source: &str) -> Result<()> {
 
 /// The nodes read from Gmsh files count against `limits.nodes` once read (a block's or an
 /// explicit mesh's count is checked from the spec by [`check_size`]).
-fn check_read_size(case: &Case, built: &[Body], mesh: &Mesh, source: &str, at: &str) -> Result<()> {
+pub(crate) fn check_read_size<const D: usize, K: SolidCell<D>>(
+    case: &Case,
+    built: &[Body<D, K>],
+    mesh: &Mesh<D, K>,
+    source: &str,
+    at: &str,
+) -> Result<()> {
     let total: usize = built.iter().map(|b| b.mesh.nodes.len()).sum::<usize>() + mesh.nodes.len();
     if total > case.limits.nodes {
         return Err(Error::invalid(
@@ -2524,7 +2534,7 @@ mod solve_work_tests {
                 "bodies": [{{"name": "b", "material": "m", "mesh": {mesh}}}]}}"#
         );
         let case = parse(&text, "w").unwrap();
-        let (pattern, points, estimate) = if crate::run3d::is_3d(&case) {
+        let (pattern, points, estimate) = if crate::run3d::is_3d(&case, "") {
             let model = crate::run3d::build3(&case, "w").unwrap();
             let sys = crate::solver::linear::assemble(&model, &[]);
             let points = model.equation_points(sys.constraints.free_dofs());
