@@ -52,7 +52,10 @@
 //! relative to the contact element size ([`crate::contact::forces::pair_penetration`]): a
 //! warning above [`crate::harness::checks::PENETRATION_WARNING_SHARE`], the fields
 //! `max_penetration` and `max_penetration_share` of `summary.json` (`contact`, and per pair
-//! under `contact.pairs`), and the check `max_penetration`.
+//! under `contact.pairs`), and the check `max_penetration`. Supports are the 2D model's
+//! ([`crate::model::Model::apply_supports`]: one conflict rule, one load path), and
+//! `summary.json` lists each support set's reaction (`reactions`, x, y and z, every prescribed
+//! dof counted in one set: [`crate::io::output::ReactionSummary`]).
 //!
 //! The check `uniform_stress_3d` is the 3D uniform-stress check: the largest difference over
 //! the quadrature points of the stiffness rule and the six components, relative to the
@@ -72,7 +75,7 @@ use crate::harness::checks::{max_penetration_check, penetration_warnings, CheckR
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
 use crate::io::scene::{
     Case, Check, ContactGeometry, DiscretizationSpec, Interaction, Kinematics, MaterialModel,
-    MeshSpec, Prescribed, Scheme,
+    MeshSpec, Scheme,
 };
 use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
@@ -348,7 +351,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
         operations: case.limits.factor_operations,
     };
     model.iteration_dofs = case.limits.iteration_dofs;
-    apply_supports3(&mut model, case)?;
+    model.apply_supports(case)?;
     apply_pressures3(&mut model, case)?;
     model.resolve_contact(case)?;
     if finite {
@@ -614,79 +617,6 @@ fn material3(
     Ok((Elasticity3::new(mat.youngs_modulus, mat.nu), hyperelastic))
 }
 
-/// The supports of the case: prescribed components of node sets.
-fn apply_supports3(model: &mut Model3, case: &Case) -> Result<()> {
-    let source = model.source.clone();
-    for (k, s) in case.supports.iter().enumerate() {
-        let at = format!("supports[{k}]");
-        let b = model.find_body(&s.body, &at)?;
-        let nodes = model.find_node_set(b, &s.set, &at)?.to_vec();
-        let bi = model.body_index(&s.body).expect("found above");
-        let factors = crate::model::load_path_factors(case, s.path.as_deref(), &source, &at)?;
-        let mut path_dofs = Vec::new();
-        if s.x.is_none() && s.y.is_none() && s.z.is_none() {
-            return Err(Error::invalid(
-                &source,
-                &at,
-                "the support fixes no component",
-                "add \"x\", \"y\" and/or \"z\" (numbers)",
-            ));
-        }
-        for (comp, value) in [(0, s.x), (1, s.y), (2, s.z)] {
-            let v = match value {
-                None => continue,
-                Some(Prescribed::Value(v)) if v.is_finite() => v,
-                Some(Prescribed::Value(_)) => {
-                    return Err(Error::invalid(
-                        &source,
-                        &at,
-                        "the prescribed value is not finite",
-                        "give a finite number",
-                    ))
-                }
-                Some(Prescribed::Exact(_)) => {
-                    return Err(not_built(
-                        &source,
-                        &at,
-                        "\"exact\" as a prescribed value",
-                        "give a number",
-                    ))
-                }
-            };
-            for &n in &nodes {
-                let dof = model.bodies[bi].dof(n, comp);
-                if factors.is_some() {
-                    path_dofs.push(dof);
-                }
-                match model.prescribed[dof] {
-                    Some(old) if old != v => {
-                        return Err(Error::invalid(
-                            &source,
-                            &at,
-                            format!(
-                                "node {n} of body '{}' gets u_{} = {v} here but {old} from an earlier support",
-                                s.body,
-                                ["x", "y", "z"][comp]
-                            ),
-                            "remove one of the conflicting supports or make their values agree",
-                        ))
-                    }
-                    _ => model.prescribed[dof] = Some(v),
-                }
-            }
-        }
-        if let Some(factors) = factors {
-            model.load_path.push(crate::model::PathPart {
-                force: Vec::new(),
-                dofs: path_dofs,
-                factors,
-            });
-        }
-        model.support_sets.push((bi, s.set.clone()));
-    }
-    Ok(())
-}
-
 /// The pressures of the case: `t = -p n` on facet sets, as consistent nodal forces.
 fn apply_pressures3(model: &mut Model3, case: &Case) -> Result<()> {
     let source = model.source.clone();
@@ -890,6 +820,7 @@ pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
         "dofs": model.dof_count,
         "relative_residual": outcome.solution.relative_residual,
         "timings": outcome.solution.timings,
+        "reactions": crate::io::output::reaction_summaries(model, &outcome.solution.reactions),
         "contact": contact_summary(outcome),
         "passed": outcome.passed(),
         "warnings": outcome.warnings,

@@ -518,3 +518,29 @@ fn an_inverted_gmsh_hexahedron_is_refused() {
     assert!(e.contains("hint:"), "{e}");
     assert!(!out.exists());
 }
+
+/// A 3D run's `summary.json` lists each support set's reaction, x, y and z: the base carries
+/// the lid's load (pressure 2 on 1 x 0.8) in z, the two points that hold the rigid motions
+/// carry nothing (the exact state needs no force there).
+#[test]
+fn a_3d_summary_lists_each_support_sets_reaction() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let (code, stderr) = run(&case("cases/gmsh/3d/patch-hex8.json"), &out);
+    assert_eq!(code, 0, "{stderr}");
+    let reactions = summary(&out)["reactions"].clone();
+    let sets: Vec<&str> = reactions
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["set"].as_str().unwrap())
+        .collect();
+    assert_eq!(sets, ["base", "origin", "x_end"]);
+    let value = |k: usize, c: &str| reactions[k][c].as_f64().unwrap();
+    assert!((value(0, "z") - 1.6).abs() < 1e-12, "{reactions}");
+    assert_eq!(reactions[0]["held"], serde_json::json!(["z"]));
+    assert_eq!(reactions[1]["held"], serde_json::json!(["x", "y"]));
+    for (k, c) in [(0, "x"), (0, "y"), (1, "x"), (1, "y"), (1, "z"), (2, "y")] {
+        assert!(value(k, c).abs() < 1e-12, "{k} {c}: {reactions}");
+    }
+}

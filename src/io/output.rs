@@ -33,7 +33,8 @@ use crate::harness::checks::CheckResult;
 use crate::io::contact_output::{body_point_arrays, pair_file_names, write_pair_files};
 use crate::io::paths::{file_name, OutputFolder};
 use crate::io::vtu::{lines_in_parallel, PointArray};
-use crate::model::{Body, Model};
+use crate::model::space::SolidCell;
+use crate::model::Body;
 use crate::post::{cell_stresses, nodal_stresses};
 use crate::run::Outcome;
 use crate::solver::linear::Timings;
@@ -284,7 +285,10 @@ pub struct ReactionSummary {
     pub set: String,
     pub x: f64,
     pub y: f64,
-    /// The components the set's supports prescribe (`"x"`, `"y"`).
+    /// The z component (3D bodies only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub z: Option<f64>,
+    /// The components the set's supports prescribe (`"x"`, `"y"`, `"z"`).
     pub held: Vec<&'static str>,
     /// Dofs the set prescribes whose reaction counts in an earlier set.
     pub shared: Vec<SharedReaction>,
@@ -299,9 +303,12 @@ pub struct SharedReaction {
     pub nodes: usize,
 }
 
-/// The reaction of every support set of `model` (see [`ReactionSummary`]).
-fn reaction_summaries(model: &Model, reactions: &[f64]) -> Vec<ReactionSummary> {
-    const COMPONENTS: [&str; 2] = ["x", "y"];
+/// The reaction of every support set of `model` (see [`ReactionSummary`]), 2D and 3D.
+pub(crate) fn reaction_summaries<const D: usize, K: SolidCell<D>>(
+    model: &crate::model::Model<D, K>,
+    reactions: &[f64],
+) -> Vec<ReactionSummary> {
+    const COMPONENTS: [&str; 3] = ["x", "y", "z"];
     // the set that counts each dof: the first support prescribing it
     let mut owner: std::collections::BTreeMap<usize, usize> = std::collections::BTreeMap::new();
     for &(set, _, dof) in &model.support_dofs {
@@ -312,8 +319,8 @@ fn reaction_summaries(model: &Model, reactions: &[f64]) -> Vec<ReactionSummary> 
         .iter()
         .enumerate()
         .map(|(i, (bi, set))| {
-            let mut own = [0.0; 2];
-            let mut held = [false; 2];
+            let mut own = [0.0; 3];
+            let mut held = [false; 3];
             let mut counted = std::collections::BTreeSet::new();
             let mut shared: std::collections::BTreeMap<(usize, usize), usize> =
                 std::collections::BTreeMap::new();
@@ -333,7 +340,8 @@ fn reaction_summaries(model: &Model, reactions: &[f64]) -> Vec<ReactionSummary> 
                 set: set.clone(),
                 x: own[0],
                 y: own[1],
-                held: (0..2).filter(|&c| held[c]).map(|c| COMPONENTS[c]).collect(),
+                z: (D == 3).then_some(own[2]),
+                held: (0..D).filter(|&c| held[c]).map(|c| COMPONENTS[c]).collect(),
                 shared: shared
                     .into_iter()
                     .map(|((comp, first), nodes)| {

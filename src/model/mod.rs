@@ -187,7 +187,7 @@ pub struct Model<const D: usize = 2, K: SolidCell<D> = ElementKind> {
     pub support_sets: Vec<(usize, String)>,
     /// `(index into support_sets, component, dof)` for every dof a support prescribes, in the
     /// order of the case's supports (a dof two supports prescribe is listed twice, the first
-    /// support first): which set's reaction a dof counts in (2D; empty in 3D).
+    /// support first): which set's reaction a dof counts in.
     pub support_dofs: Vec<(usize, usize, usize)>,
     /// Contact pairs (empty: no contact is simulated).
     pub contact: Vec<ContactPair>,
@@ -280,6 +280,130 @@ pub fn parse(text: &str, source: &str) -> Result<Case> {
 pub type Model3 = Model<3, SolidKind>;
 
 impl<const D: usize, K: SolidCell<D>> Model<D, K> {
+    fn require_exact(&self, location: &str) -> Result<ExactField> {
+        self.exact.clone().ok_or_else(|| {
+            Error::invalid(
+                &self.source,
+                location,
+                "\"exact\" is used but the case defines no exact solution",
+                "add an \"exact\" section (e.g. {\"kind\": \"uniform_stress\", \"stress\": [0, -10, 0]}) or give a number",
+            )
+        })
+    }
+
+    /// The case's supports: the prescribed components of node sets (a number, or `"exact"`
+    /// for the exact field's value in 2D), each dof listed in [`Model::support_dofs`] under its
+    /// set for the reactions; two supports that prescribe one dof must agree to 1e-12
+    /// (relative). 2D and 3D alike: a component past the dimension (`z` in 2D) is refused.
+    pub(crate) fn apply_supports(&mut self, case: &Case) -> Result<()> {
+        const AXES: [&str; 3] = ["x", "y", "z"];
+        for (k, s) in case.supports.iter().enumerate() {
+            let at = format!("supports[{k}]");
+            self.find_body(&s.body, &at)?;
+            let bi = self.body_index(&s.body).expect("found above");
+            let nodes = self.find_node_set(&self.bodies[bi], &s.set, &at)?.to_vec();
+            let entry = (bi, s.set.clone());
+            let set_index = match self.support_sets.iter().position(|e| *e == entry) {
+                Some(i) => i,
+                None => {
+                    self.support_sets.push(entry);
+                    self.support_sets.len() - 1
+                }
+            };
+            let given = [s.x, s.y, s.z];
+            if D == 2 && s.z.is_some() {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    format!(
+                        "the support gives a z component, but body '{}' is 2D",
+                        s.body
+                    ),
+                    "remove \"z\" (a 2D body has the components x and y)",
+                ));
+            }
+            if given.iter().all(Option::is_none) {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    "the support fixes no component",
+                    if D == 2 {
+                        "add \"x\" and/or \"y\" (a number, or \"exact\")"
+                    } else {
+                        "add \"x\", \"y\" and/or \"z\" (numbers)"
+                    },
+                ));
+            }
+            let factors = load_path_factors(case, s.path.as_deref(), &self.source, &at)?;
+            let mut path_dofs = Vec::new();
+            for (comp, value) in given.into_iter().enumerate().take(D) {
+                let Some(value) = value else { continue };
+                if let Prescribed::Value(v) = value {
+                    if !v.is_finite() {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "the prescribed value is not finite",
+                            "give a finite number",
+                        ));
+                    }
+                }
+                let exact = match value {
+                    Prescribed::Exact(_) if D == 3 => {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "\"exact\" as a prescribed value in 3D is not built yet",
+                            "give a number",
+                        ))
+                    }
+                    Prescribed::Exact(_) => Some(self.require_exact(&at)?),
+                    Prescribed::Value(_) => None,
+                };
+                let body = &self.bodies[bi];
+                for &n in &nodes {
+                    let p = body.mesh.nodes[n];
+                    let v = match (value, &exact) {
+                        (Prescribed::Value(v), _) => v,
+                        (_, Some(f)) => K::exact_displacement(f, p, &body.material)
+                            .expect("exact fields are refused in 3D above")[comp],
+                        _ => unreachable!("exact checked above"),
+                    };
+                    let dof = body.dof(n, comp);
+                    if factors.is_some() {
+                        path_dofs.push(dof);
+                    }
+                    self.support_dofs.push((set_index, comp, dof));
+                    match self.prescribed[dof] {
+                        Some(old)
+                            if (old - v).abs() > 1e-12 * (old.abs() + v.abs()).max(1e-300) =>
+                        {
+                            let at_point: Vec<String> = p.iter().map(|x| x.to_string()).collect();
+                            return Err(Error::invalid(
+                                &self.source,
+                                &at,
+                                format!(
+                                    "node {n} of body '{}' at ({}) gets u_{} = {v} here but {old} from an earlier support",
+                                    body.name, at_point.join(", "), AXES[comp]
+                                ),
+                                "remove one of the conflicting supports or make their values agree",
+                            ));
+                        }
+                        _ => self.prescribed[dof] = Some(v),
+                    }
+                }
+            }
+            if let Some(factors) = factors {
+                self.load_path.push(PathPart {
+                    force: Vec::new(),
+                    dofs: path_dofs,
+                    factors,
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// A model of `bodies` (numbered from dof 0 in order) named `name`, read from `source`:
     /// nothing prescribed, no loads, no contact, the default physics, solver and limits; the
     /// caller fills in what its scene has.
@@ -1165,111 +1289,6 @@ impl Model {
                 format!("\"{}\" means nothing here: {why}", variation.name()),
                 "remove \"slave_normal_variation\", or use \"normal\": \"slave\" with \"physics\": {\"kinematics\": \"finite\"} between deformable bodies",
             ));
-        }
-        Ok(())
-    }
-
-    fn require_exact(&self, location: &str) -> Result<ExactField> {
-        self.exact.clone().ok_or_else(|| {
-            Error::invalid(
-                &self.source,
-                location,
-                "\"exact\" is used but the case defines no exact solution",
-                "add an \"exact\" section (e.g. {\"kind\": \"uniform_stress\", \"stress\": [0, -10, 0]}) or give a number",
-            )
-        })
-    }
-
-    fn apply_supports(&mut self, case: &Case) -> Result<()> {
-        for (k, s) in case.supports.iter().enumerate() {
-            let at = format!("supports[{k}]");
-            let body = self.find_body(&s.body, &at)?.clone();
-            let nodes = self.find_node_set(&body, &s.set, &at)?.to_vec();
-            let entry = (
-                self.body_index(&s.body).expect("found above"),
-                s.set.clone(),
-            );
-            let set_index = match self.support_sets.iter().position(|e| *e == entry) {
-                Some(i) => i,
-                None => {
-                    self.support_sets.push(entry);
-                    self.support_sets.len() - 1
-                }
-            };
-            if s.z.is_some() {
-                return Err(Error::invalid(
-                    &self.source,
-                    &at,
-                    format!(
-                        "the support gives a z component, but body '{}' is 2D",
-                        s.body
-                    ),
-                    "remove \"z\" (a 2D body has the components x and y)",
-                ));
-            }
-            if s.x.is_none() && s.y.is_none() {
-                return Err(Error::invalid(
-                    &self.source,
-                    &at,
-                    "the support fixes no component",
-                    "add \"x\" and/or \"y\" (a number, or \"exact\")",
-                ));
-            }
-            let factors = self.load_path_factors(case, s.path.as_deref(), &at)?;
-            let mut path_dofs = Vec::new();
-            for (comp, value) in [(0, s.x), (1, s.y)] {
-                let Some(value) = value else { continue };
-                if factors.is_some() {
-                    path_dofs.extend(nodes.iter().map(|&n| body.dof(n, comp)));
-                }
-                if let Prescribed::Value(v) = value {
-                    if !v.is_finite() {
-                        return Err(Error::invalid(
-                            &self.source,
-                            &at,
-                            "the prescribed value is not finite",
-                            "give a finite number",
-                        ));
-                    }
-                }
-                let exact = match value {
-                    Prescribed::Exact(_) => Some(self.require_exact(&at)?),
-                    Prescribed::Value(_) => None,
-                };
-                for &n in &nodes {
-                    let v = match (value, &exact) {
-                        (Prescribed::Value(v), _) => v,
-                        (_, Some(f)) => f.displacement(body.mesh.nodes[n], &body.material)[comp],
-                        _ => unreachable!("exact checked above"),
-                    };
-                    let dof = body.dof(n, comp);
-                    self.support_dofs.push((set_index, comp, dof));
-                    match self.prescribed[dof] {
-                        Some(old)
-                            if (old - v).abs() > 1e-12 * (old.abs() + v.abs()).max(1e-300) =>
-                        {
-                            let p = body.mesh.nodes[n];
-                            return Err(Error::invalid(
-                                &self.source,
-                                &at,
-                                format!(
-                                    "node {n} of body '{}' at ({}, {}) gets u_{} = {v} here but {old} from an earlier support",
-                                    body.name, p[0], p[1], ["x", "y"][comp]
-                                ),
-                                "remove one of the conflicting supports or make their values agree",
-                            ));
-                        }
-                        _ => self.prescribed[dof] = Some(v),
-                    }
-                }
-            }
-            if let Some(factors) = factors {
-                self.load_path.push(PathPart {
-                    force: Vec::new(),
-                    dofs: path_dofs,
-                    factors,
-                });
-            }
         }
         Ok(())
     }

@@ -12,6 +12,7 @@
 
 use crate::fe::{ElementKind, QuadPoint, ReferenceCell};
 use crate::fe3d::SolidKind;
+use crate::harness::exact::ExactField;
 use crate::model::Model;
 use crate::solid::{element_internal_force, element_stiffness, Elasticity, Kinematics};
 use crate::solid3d::{element_internal_force3, element_stiffness3, Elasticity3};
@@ -77,6 +78,14 @@ pub trait SolidCell<const D: usize>: ReferenceCell<D> + Send + Sync + 'static {
 
     /// Young's modulus of `material` (scales, messages).
     fn youngs_modulus(material: &Self::Material) -> f64;
+
+    /// The exact field's displacement at `p` for `material` (2D; `None` in 3D, which has no
+    /// exact fields).
+    fn exact_displacement(
+        field: &ExactField,
+        p: [f64; D],
+        material: &Self::Material,
+    ) -> Option<[f64; D]>;
 
     /// The axis names of the components, `x, y(, z)`.
     fn axis_name(component: usize) -> &'static str {
@@ -157,6 +166,14 @@ impl SolidCell<2> for ElementKind {
     fn youngs_modulus(material: &Elasticity) -> f64 {
         material.youngs_modulus
     }
+
+    fn exact_displacement(
+        field: &ExactField,
+        p: [f64; 2],
+        material: &Elasticity,
+    ) -> Option<[f64; 2]> {
+        Some(field.displacement(p, material))
+    }
 }
 
 impl SolidCell<3> for SolidKind {
@@ -212,5 +229,9 @@ impl SolidCell<3> for SolidKind {
 
     fn youngs_modulus(material: &Elasticity3) -> f64 {
         material.youngs_modulus
+    }
+
+    fn exact_displacement(_: &ExactField, _: [f64; 3], _: &Elasticity3) -> Option<[f64; 3]> {
+        None
     }
 }
