@@ -469,6 +469,8 @@ pub trait PointGeometry<const D: usize> {
     fn point(&self) -> [f64; D];
     /// The Cartesian gradients `dN_a/dx` (entries past the cell's node count zero).
     fn gradients(&self) -> &[[f64; D]];
+    /// The shape values `N_a` (entries past the cell's node count zero).
+    fn values(&self) -> &[f64];
 }
 
 impl<const D: usize, const N: usize> PointGeometry<D> for PointValues<D, N> {
@@ -480,6 +482,9 @@ impl<const D: usize, const N: usize> PointGeometry<D> for PointValues<D, N> {
     }
     fn gradients(&self) -> &[[f64; D]] {
         &self.dndx
+    }
+    fn values(&self) -> &[f64] {
+        &self.n
     }
 }
 

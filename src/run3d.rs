@@ -80,7 +80,7 @@ use crate::io::scene::{
 use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
 use crate::model::{Body3, MasterSide, Model3};
-use crate::solid3d::{facet_traction_load, strain_at3, Elasticity3};
+use crate::solid3d::{strain_at3, Elasticity3};
 use crate::solid_finite::Hyperelastic;
 use std::path::Path;
 
@@ -352,7 +352,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
     };
     model.iteration_dofs = case.limits.iteration_dofs;
     model.apply_supports(case)?;
-    apply_pressures3(&mut model, case)?;
+    model.apply_loads(case)?;
     model.resolve_contact(case)?;
     if finite {
         check_finite3(&model, case)?;
@@ -615,67 +615,6 @@ fn material3(
         _ => None,
     };
     Ok((Elasticity3::new(mat.youngs_modulus, mat.nu), hyperelastic))
-}
-
-/// The pressures of the case: `t = -p n` on facet sets, as consistent nodal forces.
-fn apply_pressures3(model: &mut Model3, case: &Case) -> Result<()> {
-    let source = model.source.clone();
-    for (k, load) in case.loads.iter().enumerate() {
-        let at = format!("loads[{k}]");
-        let factors = crate::model::load_path_factors(case, load.path.as_deref(), &source, &at)?;
-        let (Some(p), None, None, None) =
-            (load.pressure, &load.traction, load.body_force, load.force)
-        else {
-            return Err(not_built(
-                &source,
-                &at,
-                "a traction, force or body force (their components are 2D in the case format)",
-                "give a \"pressure\" on a facet set",
-            ));
-        };
-        if !p.is_finite() {
-            return Err(Error::invalid(
-                &source,
-                &at,
-                "the pressure is not finite",
-                "give a finite number",
-            ));
-        }
-        let Some(set) = &load.set else {
-            return Err(Error::invalid(
-                &source,
-                &at,
-                "a pressure needs a facet \"set\"",
-                "add \"set\": e.g. \"top\"",
-            ));
-        };
-        let body = model.find_body(&load.body, &at)?;
-        let facets = model.find_facet_set(body, set, &at)?.to_vec();
-        let facet_kind = body.mesh.kind.facet_kind();
-        let mut force = vec![0.0; model.dof_count];
-        for &f in &facets {
-            let nodes = body.mesh.facet_nodes(f);
-            let coords: Vec<[f64; 3]> = nodes.iter().map(|&n| body.mesh.nodes[n]).collect();
-            let fe = facet_traction_load(facet_kind, &coords, &|_, n| n.map(|v| -p * v));
-            for (a, &n) in nodes.iter().enumerate() {
-                for i in 0..3 {
-                    force[body.dof(n, i)] += fe[3 * a + i];
-                }
-            }
-        }
-        for (f, v) in model.external_force.iter_mut().zip(&force) {
-            *f += v;
-        }
-        if let Some(factors) = factors {
-            // a pressure on a path of its own (its force is in the total too)
-            model.load_path.push(crate::model::PathPart {
-                force,
-                dofs: Vec::new(),
-                factors,
-            });
-        }
-    }
-    Ok(())
 }
 
 /// The nodal stress of `body`: the mean over the cells around each node of the stress at the

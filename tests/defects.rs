@@ -700,20 +700,36 @@ fn s4_messages_name_the_field_and_the_accepted_forms() {
             &["support's displacement component", "a number, or \"exact\""],
         );
     }
-    for value in [
-        serde_json::json!("exat"),
-        serde_json::json!([0, 1, 2]),
-        serde_json::json!(5),
-    ] {
-        let case = s.case(&good_case(), "case.json", |v| {
+    let with_traction = |value: serde_json::Value| {
+        s.case(&good_case(), "case.json", |v| {
             let load = v["loads"][0].as_object_mut().unwrap();
             load.remove("pressure");
             load.insert("traction".into(), value);
-        });
-        let r = run(&case);
+        })
+    };
+    for value in [
+        serde_json::json!("exat"),
+        serde_json::json!([0, 1, 2, 3]),
+        serde_json::json!(5),
+    ] {
+        let r = run(&with_traction(value));
         never(&r.2, &["untagged enum"]);
-        assert_refused(r, &["a load's `traction`", "[t_x, t_y]", "\"exact\""]);
+        assert_refused(
+            r,
+            &[
+                "a load's `traction`",
+                "[t_x, t_y] (2D)",
+                "[t_x, t_y, t_z] (3D)",
+                "\"exact\"",
+            ],
+        );
     }
+    // three numbers are a 3D traction: the 2D body says so
+    let r = run(&with_traction(serde_json::json!([0, 1, 2])));
+    assert_refused(
+        r,
+        &["the traction has 3 components, but body", "is 2D", "[x, y]"],
+    );
     // 1e308 in exponent form wherever a message prints it
     let case = s.case(&good_case(), "case.json", |v| {
         v["materials"]["m"]["nu"] = 1e308.into()

@@ -351,7 +351,7 @@ fn what_3d_does_not_have_yet_is_refused_and_2d_cases_refuse_3d_fields() {
                 c["loads"] =
                     serde_json::json!([{"body": "block", "set": "top", "traction": [1, 0]}])
             }),
-            "in 3D is not built yet",
+            "the traction has 2 components, but body 'block' is 3D",
         ),
         (
             Box::new(|c: &mut serde_json::Value| {
@@ -384,6 +384,20 @@ fn what_3d_does_not_have_yet_is_refused_and_2d_cases_refuse_3d_fields() {
     .unwrap_err()
     .to_string();
     assert!(err.contains("but body 'patch' is 2D"), "{err}");
+    // a 3D vector on a 2D body
+    let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
+    case["loads"][0] = serde_json::json!({"body": "patch", "set": "south", "traction": [0, -1, 0]});
+    let err = contact_patch::model::Model::build(
+        &contact_patch::model::parse(&case.to_string(), "q4-3d-traction").unwrap(),
+        "q4-3d-traction",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("the traction has 3 components, but body 'patch' is 2D"),
+        "{err}"
+    );
+    assert!(err.contains("give the traction as [x, y]"), "{err}");
 }
 
 /// `contact-patch check` takes 3D cases as it takes 2D ones: the repository's 3D cases pass,
@@ -416,4 +430,117 @@ fn check_runs_3d_cases_and_reports_their_verdicts() {
         "{stdout}"
     );
     assert!(stdout.contains("1 of 1 cases failed"), "{stdout}");
+}
+
+/// A 3D case of one distorted-free block `[0, 1] x [0, 0.8] x [0, 1.2]` of `element` cells with
+/// `supports` and `loads` (JSON), run through the library.
+fn block_case(
+    element: &str,
+    supports: serde_json::Value,
+    loads: serde_json::Value,
+) -> contact_patch::run3d::Outcome3 {
+    let case = serde_json::json!({
+        "name": "loads-3d",
+        "materials": {"m": {"E": 200.0, "nu": 0.3}},
+        "bodies": [{"name": "block", "material": "m", "mesh": {"block3d": {"element": element,
+            "x": [0.0, 0.4, 1.0], "y": [0.0, 0.3, 0.8], "z": [0.0, 0.5, 1.2],
+            "moves": [{"from": [0.4, 0.3, 0.5], "to": [0.45, 0.27, 0.56]}]}}}],
+        "supports": supports,
+        "loads": loads,
+        "checks": [{"check": "uniform_stress_3d", "stress": [0, 0, 0, 0, 0, 0], "tol": 1e-10}]
+    });
+    let parsed = contact_patch::model::parse(&case.to_string(), "loads-3d").unwrap();
+    contact_patch::run3d::run_case3(&parsed, "loads-3d").unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Traction vectors on the six faces of a distorted block, `t = sigma n` of a uniform stress
+/// with every shear component, and the three corners that hold the rigid motions at the exact
+/// displacement `u = eps x`: the solve gives `sigma` to round-off on every element.
+#[test]
+fn traction_vectors_on_every_face_give_a_uniform_stress_with_shear() {
+    let sigma = [3.0, -2.0, 1.5, 0.7, -0.4, 0.9]; // xx, yy, zz, yz, xz, xy
+                                                  // Hooke's law inverted: eps = ((1 + nu) sigma - nu tr(sigma) I) / E
+    let (young, nu) = (200.0, 0.3);
+    let s = [
+        [sigma[0], sigma[5], sigma[4]],
+        [sigma[5], sigma[1], sigma[3]],
+        [sigma[4], sigma[3], sigma[2]],
+    ];
+    let trace = sigma[0] + sigma[1] + sigma[2];
+    let e: [[f64; 3]; 3] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            ((1.0 + nu) * s[i][j] - if i == j { nu * trace } else { 0.0 }) / young
+        })
+    });
+    let u =
+        |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| (0..3).map(|j| e[i][j] * x[j]).sum()) };
+    let t = |n: [f64; 3]| -> Vec<f64> {
+        (0..3)
+            .map(|i| (0..3).map(|j| s[i][j] * n[j]).sum())
+            .collect()
+    };
+    let loads = serde_json::json!([
+        {"body": "block", "set": "left", "traction": t([-1.0, 0.0, 0.0])},
+        {"body": "block", "set": "right", "traction": t([1.0, 0.0, 0.0])},
+        {"body": "block", "set": "front", "traction": t([0.0, -1.0, 0.0])},
+        {"body": "block", "set": "back", "traction": t([0.0, 1.0, 0.0])},
+        {"body": "block", "set": "bottom", "traction": t([0.0, 0.0, -1.0])},
+        {"body": "block", "set": "top", "traction": t([0.0, 0.0, 1.0])}
+    ]);
+    let [ux, uy] = [u([1.0, 0.0, 0.0]), u([0.0, 0.8, 0.0])];
+    let supports = serde_json::json!([
+        {"body": "block", "set": "bottom_front_left", "x": 0.0, "y": 0.0, "z": 0.0},
+        {"body": "block", "set": "bottom_front_right", "y": ux[1], "z": ux[2]},
+        {"body": "block", "set": "bottom_back_left", "z": uy[2]}
+    ]);
+    for element in ["Hex8", "Tet4", "Hex27", "Tet10"] {
+        let o = block_case(element, supports.clone(), loads.clone());
+        let error =
+            contact_patch::run3d::uniform_stress_check3(&o.model, &o.solution.u, &sigma, 1e-10);
+        println!("{element}: {:.2e}", error.error);
+        assert!(error.passed, "{element}: {}", error.error);
+        // the reactions of the three corners vanish: the tractions balance on their own
+        let summary =
+            contact_patch::io::output::reaction_summaries(&o.model, &o.solution.reactions);
+        for r in &summary {
+            let z = r.z.unwrap();
+            assert!(
+                r.x.abs().max(r.y.abs()).max(z.abs()) < 1e-10,
+                "{element} {}: {} {} {z}",
+                r.set,
+                r.x,
+                r.y
+            );
+        }
+    }
+}
+
+/// A body force `b` on the block (every element) and a point force at a corner: the bottom's
+/// reaction is `-(b V + F)` in every component held, to round-off (consistent nodal forces
+/// integrate a constant exactly).
+#[test]
+fn body_forces_and_point_forces_reach_the_supports() {
+    let (b, f) = ([0.5, -0.25, -2.0], [0.0, 0.0, -0.3]);
+    let volume = 1.0 * 0.8 * 1.2;
+    let supports =
+        serde_json::json!([{"body": "block", "set": "bottom", "x": 0.0, "y": 0.0, "z": 0.0}]);
+    let loads = serde_json::json!([
+        {"body": "block", "body_force": b},
+        {"body": "block", "set": "top_back_right", "force": f}
+    ]);
+    for element in ["Hex8", "Tet4", "Hex27", "Tet10"] {
+        let o = block_case(element, supports.clone(), loads.clone());
+        let summary =
+            contact_patch::io::output::reaction_summaries(&o.model, &o.solution.reactions);
+        let r = &summary[0];
+        let got = [r.x, r.y, r.z.unwrap()];
+        for i in 0..3 {
+            let expected = -(b[i] * volume + f[i]);
+            assert!(
+                (got[i] - expected).abs() < 1e-12,
+                "{element} {i}: {} against {expected}",
+                got[i]
+            );
+        }
+    }
 }

@@ -304,7 +304,7 @@ pub struct SharedReaction {
 }
 
 /// The reaction of every support set of `model` (see [`ReactionSummary`]), 2D and 3D.
-pub(crate) fn reaction_summaries<const D: usize, K: SolidCell<D>>(
+pub fn reaction_summaries<const D: usize, K: SolidCell<D>>(
     model: &crate::model::Model<D, K>,
     reactions: &[f64],
 ) -> Vec<ReactionSummary> {

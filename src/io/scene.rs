@@ -1041,15 +1041,67 @@ pub struct Support {
     pub path: Option<Vec<f64>>,
 }
 
-/// A traction vector, or `"exact"` (sigma_exact . n).
-#[derive(Copy, Clone, Debug, Serialize, JsonSchema)]
+/// The components of a load's vector: `[x, y]` for a 2D body, `[x, y, z]` for a 3D one (the
+/// model checks the count against the body's dimension).
+#[derive(Clone, Debug, PartialEq, Serialize, JsonSchema)]
+#[serde(transparent)]
+pub struct LoadVector(#[schemars(length(min = 2, max = 3))] pub Vec<f64>);
+
+/// Two or three numbers; any other count is refused naming both forms.
+impl<'de> Deserialize<'de> for LoadVector {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Components;
+        impl<'de> serde::de::Visitor<'de> for Components {
+            type Value = LoadVector;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a vector [x, y] (2D body) or [x, y, z] (3D body)")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                seq: A,
+            ) -> Result<LoadVector, A::Error> {
+                components(seq, &self).map(LoadVector)
+            }
+        }
+        d.deserialize_seq(Components)
+    }
+}
+
+/// Two or three numbers from `seq`, or an error naming what `expected` describes and how many
+/// numbers were given.
+fn components<'de, A: serde::de::SeqAccess<'de>>(
+    mut seq: A,
+    expected: &dyn serde::de::Expected,
+) -> Result<Vec<f64>, A::Error> {
+    let mut out = Vec::with_capacity(3);
+    while let Some(v) = seq.next_element::<f64>()? {
+        out.push(v);
+        if out.len() > 3 {
+            break;
+        }
+    }
+    let mut given = out.len();
+    if given > 3 {
+        while seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+            given += 1;
+        }
+    }
+    if !(2..=3).contains(&given) {
+        return Err(serde::de::Error::invalid_length(given, expected));
+    }
+    Ok(out)
+}
+
+/// A traction vector (`[t_x, t_y]` in 2D, `[t_x, t_y, t_z]` in 3D), or `"exact"`
+/// (sigma_exact . n).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
 #[serde(untagged)]
 pub enum TractionSpec {
-    Vector([f64; 2]),
+    Vector(LoadVector),
     Exact(FromExact),
 }
 
-/// A list of two numbers becomes [`TractionSpec::Vector`], the string `"exact"`
+/// A list of two or three numbers becomes [`TractionSpec::Vector`], the string `"exact"`
 /// [`TractionSpec::Exact`]; anything else is refused naming the field and both forms.
 impl<'de> Deserialize<'de> for TractionSpec {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
@@ -1058,15 +1110,15 @@ impl<'de> Deserialize<'de> for TractionSpec {
             type Value = TractionSpec;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str(
-                    "a load's `traction`: a vector [t_x, t_y] (force per area), or \"exact\" \
-                     for sigma_exact . n of the case's exact solution",
+                    "a load's `traction`: a vector [t_x, t_y] (2D) or [t_x, t_y, t_z] (3D), force \
+                     per area, or \"exact\" for sigma_exact . n of the case's exact solution",
                 )
             }
             fn visit_seq<A: serde::de::SeqAccess<'de>>(
                 self,
                 seq: A,
             ) -> Result<TractionSpec, A::Error> {
-                coordinates(seq, &self).map(TractionSpec::Vector)
+                components(seq, &self).map(|v| TractionSpec::Vector(LoadVector(v)))
             }
             fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<TractionSpec, E> {
                 match v {
@@ -1133,13 +1185,13 @@ pub struct Load {
     /// Traction (force per area) in global components.
     #[serde(default)]
     pub traction: Option<TractionSpec>,
-    /// Force per volume.
+    /// Force per volume, `[b_x, b_y]` (2D) or `[b_x, b_y, b_z]` (3D).
     #[serde(default)]
-    pub body_force: Option<[f64; 2]>,
-    /// A concentrated force `[f_x, f_y]` (total, for the case's thickness) at every node of the
-    /// node set `set`.
+    pub body_force: Option<LoadVector>,
+    /// A concentrated force `[f_x, f_y]` (2D: total, for the case's thickness) or
+    /// `[f_x, f_y, f_z]` (3D) at every node of the node set `set`.
     #[serde(default)]
-    pub force: Option<[f64; 2]>,
+    pub force: Option<LoadVector>,
     /// The factor of the load at each load step (one per step of `solver.load_steps`; default:
     /// proportional, `k / n` at step `k`): a load path, e.g. a normal load `[1, 1]` and a
     /// tangential one `[0, 1]` (friction is path dependent).

@@ -27,7 +27,7 @@ pub mod stable_step;
 use crate::contact::enforcement::Family;
 use crate::error::{Error, Result};
 use crate::fe::check_geometry;
-use crate::fe::{ElementKind, ReferenceCell};
+use crate::fe::ElementKind;
 use crate::fe3d::SolidKind;
 use crate::harness::exact::ExactField;
 use crate::io::paths::{name_problem, NAME_RULE};
@@ -280,6 +280,163 @@ pub fn parse(text: &str, source: &str) -> Result<Case> {
 pub type Model3 = Model<3, SolidKind>;
 
 impl<const D: usize, K: SolidCell<D>> Model<D, K> {
+    /// The case's loads into [`Model::external_force`] (a load on a `path` also into
+    /// [`Model::load_path`]): concentrated forces on node sets, body forces, and pressures and
+    /// tractions on facet sets, 2D and 3D; a vector's components must be the body's (`[x, y]`
+    /// or `[x, y, z]`).
+    pub(crate) fn apply_loads(&mut self, case: &Case) -> Result<()> {
+        for (k, load) in case.loads.iter().enumerate() {
+            let at = format!("loads[{k}]");
+            self.find_body(&load.body, &at)?;
+            let bi = self.body_index(&load.body).expect("found above");
+            let given = [
+                load.pressure.is_some(),
+                load.traction.is_some(),
+                load.body_force.is_some(),
+                load.force.is_some(),
+            ];
+            if given.iter().filter(|&&g| g).count() != 1 {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    "a load needs exactly one of \"pressure\", \"traction\", \"force\" or \"body_force\"",
+                    "split it into one load per kind",
+                ));
+            }
+            let factors = load_path_factors(case, load.path.as_deref(), &self.source, &at)?;
+            let Some(factors) = factors else {
+                self.apply_load(load, bi, &at)?;
+                continue;
+            };
+            // a load on a path is assembled on its own, then added to the total
+            let total = std::mem::replace(&mut self.external_force, vec![0.0; self.dof_count]);
+            let result = self.apply_load(load, bi, &at);
+            let force = std::mem::replace(&mut self.external_force, total);
+            result?;
+            for (f, p) in self.external_force.iter_mut().zip(&force) {
+                *f += p;
+            }
+            self.load_path.push(PathPart {
+                force,
+                dofs: Vec::new(),
+                factors,
+            });
+        }
+        Ok(())
+    }
+
+    /// The `D` components of the load vector `v` (`what` names it in the message).
+    fn load_vector(&self, v: &[f64], what: &str, body: &str, at: &str) -> Result<[f64; D]> {
+        if v.len() != D {
+            let form = if D == 2 { "[x, y]" } else { "[x, y, z]" };
+            return Err(Error::invalid(
+                &self.source,
+                at,
+                format!(
+                    "the {what} has {} components, but body '{body}' is {D}D",
+                    v.len()
+                ),
+                format!("give the {what} as {form}"),
+            ));
+        }
+        if !v.iter().all(|x| x.is_finite()) {
+            return Err(Error::invalid(
+                &self.source,
+                at,
+                format!("the {what} is not finite"),
+                "give finite numbers",
+            ));
+        }
+        Ok(std::array::from_fn(|i| v[i]))
+    }
+
+    /// Assemble one load on body `bi` into `external_force`.
+    fn apply_load(&mut self, load: &crate::io::scene::Load, bi: usize, at: &str) -> Result<()> {
+        let body_name = &self.bodies[bi].name;
+        if let Some(force) = &load.force {
+            let Some(set) = &load.set else {
+                return Err(Error::invalid(
+                    &self.source,
+                    at,
+                    "a concentrated force needs a node \"set\"",
+                    "add \"set\": the name of a node set of the body (e.g. a \"point\" set)",
+                ));
+            };
+            let force = self.load_vector(&force.0, "force", body_name, at)?;
+            let body = &self.bodies[bi];
+            for &n in self.find_node_set(body, set, at)? {
+                for (i, f) in force.iter().enumerate() {
+                    self.external_force[body.dof(n, i)] += f;
+                }
+            }
+            return Ok(());
+        }
+        if let Some(b) = &load.body_force {
+            if load.set.is_some() {
+                return Err(Error::invalid(
+                    &self.source,
+                    at,
+                    "a body force acts on the whole body and takes no \"set\"",
+                    "remove \"set\"",
+                ));
+            }
+            let b = self.load_vector(&b.0, "body force", body_name, at)?;
+            add_body_force(
+                &self.bodies[bi],
+                b,
+                self.thickness,
+                &mut self.external_force,
+            );
+            return Ok(());
+        }
+        let Some(set) = &load.set else {
+            return Err(Error::invalid(
+                &self.source,
+                at,
+                "a pressure or traction needs a facet \"set\"",
+                "add \"set\": the name of a facet set of the body",
+            ));
+        };
+        let traction = match (load.pressure, &load.traction) {
+            (Some(p), _) => {
+                if !p.is_finite() {
+                    return Err(Error::invalid(
+                        &self.source,
+                        at,
+                        "the pressure is not finite",
+                        "give a finite number",
+                    ));
+                }
+                FacetLoad::Pressure(p)
+            }
+            (_, Some(TractionSpec::Vector(t))) => {
+                FacetLoad::Vector(self.load_vector(&t.0, "traction", body_name, at)?)
+            }
+            (_, Some(TractionSpec::Exact(_))) if D == 3 => {
+                return Err(Error::invalid(
+                    &self.source,
+                    at,
+                    "\"exact\" as a traction in 3D is not built yet",
+                    "give the traction as [x, y, z]",
+                ))
+            }
+            (_, Some(TractionSpec::Exact(_))) => FacetLoad::Exact(self.require_exact(at)?),
+            _ => unreachable!("exactly one load kind checked above"),
+        };
+        let body = &self.bodies[bi];
+        let facets = self.find_facet_set(body, set, at)?;
+        let kind = body.mesh.kind;
+        for &f in facets {
+            let nodes = body.mesh.facet_nodes(f);
+            let coords: Vec<[f64; D]> = nodes.iter().map(|&n| body.mesh.nodes[n]).collect();
+            let force = &mut self.external_force;
+            kind.add_facet_load(&coords, &traction, self.thickness, &mut |a, i, v| {
+                force[body.dof(nodes[a], i)] += v
+            });
+        }
+        Ok(())
+    }
+
     fn require_exact(&self, location: &str) -> Result<ExactField> {
         self.exact.clone().ok_or_else(|| {
             Error::invalid(
@@ -1293,146 +1450,6 @@ impl Model {
         Ok(())
     }
 
-    /// The factors of a load path (`None`: proportional), one per load step.
-    fn load_path_factors(
-        &self,
-        case: &Case,
-        path: Option<&[f64]>,
-        at: &str,
-    ) -> Result<Option<Vec<f64>>> {
-        load_path_factors(case, path, &self.source, at)
-    }
-
-    fn apply_loads(&mut self, case: &Case) -> Result<()> {
-        for (k, load) in case.loads.iter().enumerate() {
-            let at = format!("loads[{k}]");
-            let body = self.find_body(&load.body, &at)?.clone();
-            let given = [
-                load.pressure.is_some(),
-                load.traction.is_some(),
-                load.body_force.is_some(),
-                load.force.is_some(),
-            ];
-            if given.iter().filter(|&&g| g).count() != 1 {
-                return Err(Error::invalid(
-                    &self.source,
-                    &at,
-                    "a load needs exactly one of \"pressure\", \"traction\", \"force\" or \"body_force\"",
-                    "split it into one load per kind",
-                ));
-            }
-            let factors = self.load_path_factors(case, load.path.as_deref(), &at)?;
-            let Some(factors) = factors else {
-                self.apply_load(load, &body, &at)?;
-                continue;
-            };
-            // a load on a path is assembled on its own, then added to the total
-            let total = std::mem::replace(&mut self.external_force, vec![0.0; self.dof_count]);
-            let result = self.apply_load(load, &body, &at);
-            let force = std::mem::replace(&mut self.external_force, total);
-            result?;
-            for (f, p) in self.external_force.iter_mut().zip(&force) {
-                *f += p;
-            }
-            self.load_path.push(PathPart {
-                force,
-                dofs: Vec::new(),
-                factors,
-            });
-        }
-        Ok(())
-    }
-
-    /// Assemble one load into `external_force`.
-    fn apply_load(&mut self, load: &crate::io::scene::Load, body: &Body, at: &str) -> Result<()> {
-        let at = at.to_string();
-        {
-            let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-            if let Some(force) = load.force {
-                let Some(set) = &load.set else {
-                    return Err(Error::invalid(
-                        &self.source,
-                        &at,
-                        "a concentrated force needs a node \"set\"",
-                        "add \"set\": the name of a node set of the body (e.g. a \"point\" set)",
-                    ));
-                };
-                if !finite(&force) {
-                    return Err(Error::invalid(
-                        &self.source,
-                        &at,
-                        "the force is not finite",
-                        "give finite numbers",
-                    ));
-                }
-                for &n in self.find_node_set(body, set, &at)? {
-                    self.external_force[body.dof(n, 0)] += force[0];
-                    self.external_force[body.dof(n, 1)] += force[1];
-                }
-                return Ok(());
-            }
-            if let Some(b) = load.body_force {
-                if load.set.is_some() {
-                    return Err(Error::invalid(
-                        &self.source,
-                        &at,
-                        "a body force acts on the whole body and takes no \"set\"",
-                        "remove \"set\"",
-                    ));
-                }
-                if !finite(&b) {
-                    return Err(Error::invalid(
-                        &self.source,
-                        &at,
-                        "the body force is not finite",
-                        "give finite numbers",
-                    ));
-                }
-                add_body_force(body, b, self.thickness, &mut self.external_force);
-                return Ok(());
-            }
-            let Some(set) = &load.set else {
-                return Err(Error::invalid(
-                    &self.source,
-                    &at,
-                    "a pressure or traction needs a facet \"set\"",
-                    "add \"set\": the name of a facet set of the body",
-                ));
-            };
-            let facets = self.find_facet_set(body, set, &at)?.to_vec();
-            let traction = match (load.pressure, load.traction) {
-                (Some(p), _) => {
-                    if !p.is_finite() {
-                        return Err(Error::invalid(
-                            &self.source,
-                            &at,
-                            "the pressure is not finite",
-                            "give a finite number",
-                        ));
-                    }
-                    EdgeTraction::Pressure(p)
-                }
-                (_, Some(TractionSpec::Vector(t))) => {
-                    if !finite(&t) {
-                        return Err(Error::invalid(
-                            &self.source,
-                            &at,
-                            "the traction is not finite",
-                            "give finite numbers",
-                        ));
-                    }
-                    EdgeTraction::Vector(t)
-                }
-                (_, Some(TractionSpec::Exact(_))) => EdgeTraction::Exact(self.require_exact(&at)?),
-                _ => unreachable!("exactly one load kind checked above"),
-            };
-            for f in facets {
-                add_facet_load(body, f, &traction, self.thickness, &mut self.external_force);
-            }
-        }
-        Ok(())
-    }
-
     fn resolve_checks(&mut self, case: &Case) -> Result<()> {
         for (k, check) in case.checks.iter().enumerate() {
             let at = format!("checks[{k}]");
@@ -2431,23 +2448,24 @@ fn sharp_turn_warning(mesh: &Mesh, ends: &[[usize; 2]], loc: &str) -> Option<Str
     ))
 }
 
-/// What acts on a facet.
-enum EdgeTraction {
+/// A load on a facet: a pressure against the outward normal, a traction vector, or the exact
+/// field's traction `sigma_exact . n` (2D).
+#[derive(Clone, Debug)]
+pub enum FacetLoad<const D: usize> {
     Pressure(f64),
-    Vector([f64; 2]),
+    Vector([f64; D]),
     Exact(ExactField),
 }
 
-/// Consistent nodal forces of a distributed load on one facet, added into `force`.
-fn add_facet_load(
-    body: &Body,
-    facet: Facet,
-    traction: &EdgeTraction,
+/// Consistent nodal forces of a distributed load on one edge of kind `kind` with nodes at
+/// `coords` (2D, times `thickness`): `add(a, i, value)` per quadrature point.
+pub(crate) fn add_edge_load(
+    kind: crate::fe::EdgeKind,
+    coords: &[[f64; 2]],
+    load: &FacetLoad<2>,
     thickness: f64,
-    force: &mut [f64],
+    add: &mut dyn FnMut(usize, usize, f64),
 ) {
-    let nodes = body.mesh.facet_nodes(facet);
-    let kind = body.mesh.kind.edge_kind();
     let nn = kind.node_count();
     let mut n = [0.0; 3];
     let mut dn = [0.0; 3];
@@ -2456,7 +2474,7 @@ fn add_facet_load(
         let mut x = [0.0; 2];
         let mut dx = [0.0; 2];
         for a in 0..nn {
-            let p = body.mesh.nodes[nodes[a]];
+            let p = coords[a];
             for i in 0..2 {
                 x[i] += n[a] * p[i];
                 dx[i] += dn[a] * p[i];
@@ -2465,10 +2483,10 @@ fn add_facet_load(
         // n ds = [dy, -dx] ds for a counter-clockwise edge.
         let n_ds = [dx[1], -dx[0]];
         let length = (n_ds[0] * n_ds[0] + n_ds[1] * n_ds[1]).sqrt();
-        let t_ds = match traction {
-            EdgeTraction::Pressure(p) => [-p * n_ds[0], -p * n_ds[1]],
-            EdgeTraction::Vector(t) => [t[0] * length, t[1] * length],
-            EdgeTraction::Exact(f) => {
+        let t_ds = match load {
+            FacetLoad::Pressure(p) => [-p * n_ds[0], -p * n_ds[1]],
+            FacetLoad::Vector(t) => [t[0] * length, t[1] * length],
+            FacetLoad::Exact(f) => {
                 let s = f.stress(x);
                 [
                     s[0] * n_ds[0] + s[2] * n_ds[1],
@@ -2478,25 +2496,33 @@ fn add_facet_load(
         };
         for a in 0..nn {
             for i in 0..2 {
-                force[body.dof(nodes[a], i)] += w * thickness * n[a] * t_ds[i];
+                add(a, i, w * thickness * n[a] * t_ds[i]);
             }
         }
     }
 }
 
-/// Consistent nodal forces of a constant body force over the whole body.
-fn add_body_force(body: &Body, b: [f64; 2], thickness: f64, force: &mut [f64]) {
-    let kind: ElementKind = body.mesh.kind;
-    let rule = kind.error_rule();
+/// Consistent nodal forces of a constant body force over the whole body (2D: times the
+/// thickness), by the cells' load rule.
+fn add_body_force<const D: usize, K: SolidCell<D>>(
+    body: &Body<D, K>,
+    b: [f64; D],
+    thickness: f64,
+    force: &mut [f64],
+) {
+    use crate::fe::PointGeometry;
+    let kind = body.mesh.kind;
+    let rule = kind.load_rule();
     for c in 0..body.mesh.cell_count() {
         let coords = body.mesh.cell_coords(c);
         let cell = body.mesh.cell(c);
         for q in &rule {
             let pv = kind.point_values(&coords, q.xi);
-            let w = q.weight * pv.det_j * thickness;
+            let w = q.weight * pv.jacobian_determinant() * thickness;
+            let n = pv.values();
             for (a, &node) in cell.iter().enumerate() {
-                for i in 0..2 {
-                    force[body.dof(node, i)] += w * pv.n[a] * b[i];
+                for i in 0..D {
+                    force[body.dof(node, i)] += w * n[a] * b[i];
                 }
             }
         }

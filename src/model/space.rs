@@ -13,9 +13,11 @@
 use crate::fe::{ElementKind, QuadPoint, ReferenceCell};
 use crate::fe3d::SolidKind;
 use crate::harness::exact::ExactField;
-use crate::model::Model;
+use crate::model::{FacetLoad, Model};
 use crate::solid::{element_internal_force, element_stiffness, Elasticity, Kinematics};
-use crate::solid3d::{element_internal_force3, element_stiffness3, Elasticity3};
+use crate::solid3d::{
+    element_internal_force3, element_stiffness3, facet_traction_load, Elasticity3,
+};
 use crate::solid_finite::{element_residual_and_tangent, Hyperelastic, Inverted};
 use crate::solid_finite3::element_residual_and_tangent3;
 
@@ -78,6 +80,22 @@ pub trait SolidCell<const D: usize>: ReferenceCell<D> + Send + Sync + 'static {
 
     /// Young's modulus of `material` (scales, messages).
     fn youngs_modulus(material: &Self::Material) -> f64;
+
+    /// The quadrature rule of loads over the cell (body forces): the cell's error rule.
+    fn load_rule(self) -> Vec<QuadPoint<D>>;
+
+    /// The consistent nodal forces `f_a = int_facet N_a t dA` of the facet load `load` on the
+    /// facet of a cell of this kind whose nodes (the facet's own order) are at `coords`
+    /// (times `thickness` in 2D): `add(a, i, value)` for each contribution to component `i`
+    /// of the facet's node `a`. 2D: [`crate::model::add_edge_load`]; 3D:
+    /// [`crate::solid3d::facet_traction_load`] (an exact field is 2D only).
+    fn add_facet_load(
+        self,
+        coords: &[[f64; D]],
+        load: &FacetLoad<D>,
+        thickness: f64,
+        add: &mut dyn FnMut(usize, usize, f64),
+    );
 
     /// The exact field's displacement at `p` for `material` (2D; `None` in 3D, which has no
     /// exact fields).
@@ -174,6 +192,20 @@ impl SolidCell<2> for ElementKind {
     ) -> Option<[f64; 2]> {
         Some(field.displacement(p, material))
     }
+
+    fn load_rule(self) -> Vec<QuadPoint<2>> {
+        self.error_rule()
+    }
+
+    fn add_facet_load(
+        self,
+        coords: &[[f64; 2]],
+        load: &FacetLoad<2>,
+        thickness: f64,
+        add: &mut dyn FnMut(usize, usize, f64),
+    ) {
+        crate::model::add_edge_load(self.edge_kind(), coords, load, thickness, add);
+    }
 }
 
 impl SolidCell<3> for SolidKind {
@@ -233,5 +265,30 @@ impl SolidCell<3> for SolidKind {
 
     fn exact_displacement(_: &ExactField, _: [f64; 3], _: &Elasticity3) -> Option<[f64; 3]> {
         None
+    }
+
+    fn load_rule(self) -> Vec<QuadPoint<3>> {
+        self.error_rule()
+    }
+
+    fn add_facet_load(
+        self,
+        coords: &[[f64; 3]],
+        load: &FacetLoad<3>,
+        _thickness: f64,
+        add: &mut dyn FnMut(usize, usize, f64),
+    ) {
+        let fe = match load {
+            FacetLoad::Pressure(p) => {
+                facet_traction_load(self.facet_kind(), coords, &|_, n| n.map(|v| -p * v))
+            }
+            FacetLoad::Vector(t) => facet_traction_load(self.facet_kind(), coords, &|_, _| *t),
+            FacetLoad::Exact(_) => unreachable!("exact fields are refused in 3D"),
+        };
+        for a in 0..coords.len() {
+            for i in 0..3 {
+                add(a, i, fe[3 * a + i]);
+            }
+        }
     }
 }
