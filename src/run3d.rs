@@ -2,16 +2,18 @@
 //! small-strain elasticity, with contact when the case has pairs, judge the checks, write
 //! `summary.json` and one `.vtu` per body.
 //!
-//! The 3D side of the dimension seam (issue 13): the case format, mesher
-//! ([`crate::mesh::block3`]) and kernels ([`crate::solid3d`]) are 3D; the model
+//! The 3D side of the dimension seam (issue 13): the mesher ([`crate::mesh::block3`]) and
+//! kernels ([`crate::solid3d`]) are 3D; the case format, the Gmsh reader
+//! ([`crate::io::gmsh_read::body_mesh`]), the user sets, supports and loads
+//! ([`crate::model::Model::apply_supports`], [`crate::model::Model::apply_loads`]), the model
 //! ([`crate::model::Model`]`<3, SolidKind>`), the assembly and elastic solve
 //! ([`crate::solver::linear`]), the rigid-mode check ([`crate::model::admit::check_rigid_modes`])
 //! and the active-set contact solve with every enforcement method
 //! ([`crate::solver::active_set`]) are the 2D code paths, generic over the dimension. What is
 //! not built in 3D yet is refused here with the reason (an invalid-case error, exit 2), never
 //! computed wrongly: dynamics, the current contact geometry under small strain, sweeps, exact
-//! solutions, user-defined sets, loads other
-//! than pressure, checks other than `uniform_stress_3d` and `max_penetration`; the 3D
+//! solutions, explicit meshes, checks other than `uniform_stress_3d` and `max_penetration`;
+//! the 3D
 //! discretizations refuse what
 //! they do not treat ([`crate::contact::discretization::Discretize`]).
 //!
@@ -155,7 +157,7 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
         &model.checks,
         &solution,
     ));
-    let mut warnings: Vec<String> = Vec::new();
+    let mut warnings: Vec<String> = model.warnings.clone();
     if let (Some(state), Some(p)) = (&solution.contact, &penetrations) {
         warnings.extend(penetration_warnings(
             &model,
@@ -295,6 +297,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
     crate::model::check_size(case, source)?;
     crate::model::check_solver_settings(case, source)?;
     let mut bodies: Vec<Body3> = Vec::new();
+    let mut set_warnings = Vec::new();
     for (bi, spec) in case.bodies.iter().enumerate() {
         let at = format!("bodies[{bi}] '{}'", spec.name);
         if let Some(problem) = name_problem(&spec.name) {
@@ -313,16 +316,8 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
                 "give every body a unique name",
             ));
         }
-        if !spec.node_sets.is_empty() || !spec.facet_sets.is_empty() {
-            return Err(not_built(
-                source,
-                &at,
-                "user-defined node and facet sets",
-                "use the automatic sets: left/right (x), front/back (y), bottom/top (z), the corners such as bottom_front_left, and all; or a Gmsh mesh whose physical groups are the sets",
-            ));
-        }
         let (material, hyperelastic) = material3(case, &spec.material, source, &at)?;
-        let mesh = match &spec.mesh {
+        let mut mesh = match &spec.mesh {
             MeshSpec::Block3d(block) => block_mesh3(block, source, &at)?,
             MeshSpec::Gmsh(g) => {
                 let (mesh, _) = crate::model::read_gmsh_mesh::<3, SolidKind>(g, source, &at)?;
@@ -332,6 +327,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
             _ => unreachable!("every body was checked to be 3D above"),
         };
         crate::model::check_cells(&mesh, source, &at)?;
+        set_warnings.extend(crate::model::add_user_sets(&mut mesh, spec, source, &at)?);
         bodies.push(Body3 {
             name: spec.name.clone(),
             material_name: spec.material.clone(),
@@ -342,6 +338,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
         });
     }
     let mut model = Model3::with_bodies(&case.name, source, bodies);
+    model.warnings = set_warnings;
     model.description = case.description.clone();
     model.plane = case.analysis.plane;
     model.physics = case.physics.clone();

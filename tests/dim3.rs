@@ -544,3 +544,55 @@ fn body_forces_and_point_forces_reach_the_supports() {
         }
     }
 }
+
+/// User node and facet sets on a 3D body (a point, boxes of three coordinates) carry the
+/// supports and the pressure of the traction patch test: the exact stress, and the lid's set
+/// the same facets as the built-in `top`. A point of two coordinates is refused naming the
+/// form.
+#[test]
+fn user_node_and_facet_sets_of_a_3d_body_carry_supports_and_loads() {
+    let case = |origin: serde_json::Value| {
+        serde_json::json!({
+            "name": "sets-3d",
+            "materials": {"m": {"E": 200.0, "nu": 0.3}},
+            "bodies": [{"name": "block", "material": "m",
+                "mesh": {"block3d": {"element": "Tet10", "x": [0.0, 0.4, 1.0], "y": [0.0, 0.3, 0.8],
+                    "z": [0.0, 0.5, 1.2], "moves": [{"from": [0.4, 0.3, 0.5], "to": [0.45, 0.27, 0.56]}]}},
+                "node_sets": {"origin": {"point": origin},
+                              "x_end": {"box": {"min": [0.9, -0.1, -0.1], "max": [1.1, 0.1, 0.1]}},
+                              "floor": {"box": {"min": [-1, -1, 0], "max": [2, 2, 0]}}},
+                "facet_sets": {"lid": {"box": {"min": [0, 0, 1.2], "max": [1, 0.8, 1.2]}}}}],
+            "supports": [{"body": "block", "set": "floor", "z": 0.0},
+                         {"body": "block", "set": "origin", "x": 0.0, "y": 0.0},
+                         {"body": "block", "set": "x_end", "y": 0.0}],
+            "loads": [{"body": "block", "set": "lid", "pressure": 2.0}],
+            "checks": [{"check": "uniform_stress_3d", "stress": [0, 0, -2, 0, 0, 0], "tol": 1e-10}]
+        })
+    };
+    let parsed =
+        contact_patch::model::parse(&case(serde_json::json!([0, 0, 0])).to_string(), "sets-3d")
+            .unwrap();
+    let o = contact_patch::run3d::run_case3(&parsed, "sets-3d").unwrap_or_else(|e| panic!("{e}"));
+    assert!(o.checks.iter().all(|c| c.passed), "{:?}", o.checks);
+    let mesh = &o.model.bodies[0].mesh;
+    assert_eq!(mesh.facet_sets["lid"], mesh.facet_sets["top"]);
+    assert_eq!(mesh.node_sets["floor"], mesh.node_sets["bottom"]);
+    assert_eq!(
+        mesh.node_sets["x_end"],
+        mesh.node_sets["bottom_front_right"]
+    );
+    assert!(o.warnings.is_empty(), "{:?}", o.warnings);
+    // two coordinates for a 3D body
+    let parsed =
+        contact_patch::model::parse(&case(serde_json::json!([0, 0])).to_string(), "sets-3d")
+            .unwrap();
+    let err = contact_patch::run3d::run_case3(&parsed, "sets-3d")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("bodies[0] 'block'.node_sets.origin"), "{err}");
+    assert!(
+        err.contains("the point has 2 coordinates, but the body is 3D"),
+        "{err}"
+    );
+    assert!(err.contains("[x, y, z]"), "{err}");
+}

@@ -943,9 +943,8 @@ pub struct ExplicitMeshSpec {
 pub enum NodeSetSpec {
     /// Nodes in a closed axis-aligned box.
     Box(BoxSpec),
-    /// The node at a point (within a small tolerance).
-    #[serde(deserialize_with = "point2")]
-    Point([f64; 2]),
+    /// The node at a point `[x, y]` (2D) or `[x, y, z]` (3D), within a small tolerance.
+    Point(Vector),
     /// Node ids.
     Nodes(Vec<usize>),
 }
@@ -966,10 +965,10 @@ pub enum FacetSetSpec {
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BoxSpec {
-    #[serde(deserialize_with = "point2")]
-    pub min: [f64; 2],
-    #[serde(deserialize_with = "point2")]
-    pub max: [f64; 2],
+    /// The lowest corner, `[x, y]` (2D) or `[x, y, z]` (3D).
+    pub min: Vector,
+    /// The highest corner.
+    pub max: Vector,
 }
 
 /// The keyword `"exact"`: take the value from the case's exact solution.
@@ -1041,26 +1040,23 @@ pub struct Support {
     pub path: Option<Vec<f64>>,
 }
 
-/// The components of a load's vector: `[x, y]` for a 2D body, `[x, y, z]` for a 3D one (the
-/// model checks the count against the body's dimension).
+/// A point or a vector of a body: `[x, y]` for a 2D body, `[x, y, z]` for a 3D one (the model
+/// checks the count against the body's dimension).
 #[derive(Clone, Debug, PartialEq, Serialize, JsonSchema)]
 #[serde(transparent)]
-pub struct LoadVector(#[schemars(length(min = 2, max = 3))] pub Vec<f64>);
+pub struct Vector(#[schemars(length(min = 2, max = 3))] pub Vec<f64>);
 
 /// Two or three numbers; any other count is refused naming both forms.
-impl<'de> Deserialize<'de> for LoadVector {
+impl<'de> Deserialize<'de> for Vector {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         struct Components;
         impl<'de> serde::de::Visitor<'de> for Components {
-            type Value = LoadVector;
+            type Value = Vector;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str("a vector [x, y] (2D body) or [x, y, z] (3D body)")
             }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(
-                self,
-                seq: A,
-            ) -> Result<LoadVector, A::Error> {
-                components(seq, &self).map(LoadVector)
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Vector, A::Error> {
+                components(seq, &self).map(Vector)
             }
         }
         d.deserialize_seq(Components)
@@ -1097,7 +1093,7 @@ fn components<'de, A: serde::de::SeqAccess<'de>>(
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[serde(untagged)]
 pub enum TractionSpec {
-    Vector(LoadVector),
+    Vector(Vector),
     Exact(FromExact),
 }
 
@@ -1118,7 +1114,7 @@ impl<'de> Deserialize<'de> for TractionSpec {
                 self,
                 seq: A,
             ) -> Result<TractionSpec, A::Error> {
-                components(seq, &self).map(|v| TractionSpec::Vector(LoadVector(v)))
+                components(seq, &self).map(|v| TractionSpec::Vector(Vector(v)))
             }
             fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<TractionSpec, E> {
                 match v {
@@ -1129,46 +1125,6 @@ impl<'de> Deserialize<'de> for TractionSpec {
         }
         d.deserialize_any(TractionVisitor)
     }
-}
-
-/// `N` numbers from `seq`, or an error naming what `expected` describes and how many numbers
-/// were given (not serde_json's "trailing characters" for one too many).
-fn coordinates<'de, A: serde::de::SeqAccess<'de>, const N: usize>(
-    mut seq: A,
-    expected: &dyn serde::de::Expected,
-) -> Result<[f64; N], A::Error> {
-    let mut out = [0.0; N];
-    let mut given = 0;
-    while let Some(v) = seq.next_element::<f64>()? {
-        if given < N {
-            out[given] = v;
-        }
-        given += 1;
-    }
-    if given != N {
-        return Err(serde::de::Error::invalid_length(given, expected));
-    }
-    Ok(out)
-}
-
-/// A 2D point `[x, y]` of a node or facet set; three numbers (a 3D point) are refused saying
-/// that these sets are 2D.
-fn point2<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
-    struct Point2;
-    impl<'de> serde::de::Visitor<'de> for Point2 {
-        type Value = [f64; 2];
-        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            f.write_str(
-                "a 2D point [x, y] (user-defined node and facet sets are 2D; a 3D body uses its \
-                 automatic sets: left/right (x), front/back (y), bottom/top (z), the corners \
-                 such as bottom_front_left, and all)",
-            )
-        }
-        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<[f64; 2], A::Error> {
-            coordinates(seq, &self)
-        }
-    }
-    d.deserialize_seq(Point2)
 }
 
 /// One load: `pressure` or `traction` on a facet set, a concentrated `force` at every node of a
@@ -1187,11 +1143,11 @@ pub struct Load {
     pub traction: Option<TractionSpec>,
     /// Force per volume, `[b_x, b_y]` (2D) or `[b_x, b_y, b_z]` (3D).
     #[serde(default)]
-    pub body_force: Option<LoadVector>,
+    pub body_force: Option<Vector>,
     /// A concentrated force `[f_x, f_y]` (2D: total, for the case's thickness) or
     /// `[f_x, f_y, f_z]` (3D) at every node of the node set `set`.
     #[serde(default)]
-    pub force: Option<LoadVector>,
+    pub force: Option<Vector>,
     /// The factor of the load at each load step (one per step of `solver.load_steps`; default:
     /// proportional, `k / n` at step `k`): a load path, e.g. a normal load `[1, 1]` and a
     /// tangential one `[0, 1]` (friction is path dependent).

@@ -27,7 +27,7 @@ pub mod stable_step;
 use crate::contact::enforcement::Family;
 use crate::error::{Error, Result};
 use crate::fe::check_geometry;
-use crate::fe::ElementKind;
+use crate::fe::{ElementKind, ReferenceCell};
 use crate::fe3d::SolidKind;
 use crate::harness::exact::ExactField;
 use crate::io::paths::{name_problem, NAME_RULE};
@@ -2191,15 +2191,15 @@ pub(crate) fn check_cells<const D: usize, K: SolidCell<D>>(
 
 /// The nodes of `nodes` that lie outside the box `[lo, hi]` (taken in by the tolerance only),
 /// as a warning naming the set `loc`.
-fn widened_box_warning(
-    mesh: &Mesh,
+fn widened_box_warning<const D: usize, K: ReferenceCell<D>>(
+    mesh: &Mesh<D, K>,
     nodes: impl Iterator<Item = usize>,
-    (lo, hi): ([f64; 2], [f64; 2]),
+    (lo, hi): ([f64; D], [f64; D]),
     loc: &str,
 ) -> Option<String> {
     let outside = |n: &usize| {
         let p = mesh.nodes[*n];
-        (0..2)
+        (0..D)
             .map(|i| (lo[i] - p[i]).max(p[i] - hi[i]))
             .fold(0.0f64, f64::max)
     };
@@ -2210,51 +2210,104 @@ fn widened_box_warning(
     out.sort_unstable_by_key(|x| x.0);
     out.dedup_by_key(|x| x.0);
     let &(n, d) = out.iter().max_by(|a, b| a.1.total_cmp(&b.1))?;
-    let p = mesh.nodes[n];
     Some(format!(
-        "{loc}: {} node(s) lie outside the box [{}, {}] x [{}, {}] and are in the set only by the \
-         tolerance of 1e-9 x the body size ({:.3e}); the farthest is node {n} at ({}, {}), {d:.3e} \
+        "{loc}: {} node(s) lie outside the box {} and are in the set only by the \
+         tolerance of 1e-9 x the body size ({:.3e}); the farthest is node {n} at ({}), {d:.3e} \
          outside. Widen the box to take them in on purpose, or narrow it to leave them out",
         out.len(),
-        lo[0],
-        hi[0],
-        lo[1],
-        hi[1],
+        box_words(lo, hi),
         mesh.tolerance(),
-        p[0],
-        p[1]
+        point_words(mesh.nodes[n]),
     ))
 }
 
+/// `[lo_x, hi_x] x [lo_y, hi_y] (x [lo_z, hi_z])`.
+fn box_words<const D: usize>(lo: [f64; D], hi: [f64; D]) -> String {
+    (0..D)
+        .map(|i| format!("[{}, {}]", lo[i], hi[i]))
+        .collect::<Vec<_>>()
+        .join(" x ")
+}
+
+/// `x, y(, z)`.
+fn point_words<const D: usize>(p: [f64; D]) -> String {
+    p.iter()
+        .map(|x| x.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The `D` coordinates of the point `v` of a set (`what` names it in the message).
+fn set_point<const D: usize>(v: &[f64], what: &str, source: &str, loc: &str) -> Result<[f64; D]> {
+    if v.len() != D {
+        let form = if D == 2 { "[x, y]" } else { "[x, y, z]" };
+        return Err(Error::invalid(
+            source,
+            loc,
+            format!(
+                "the {what} has {} coordinates, but the body is {D}D",
+                v.len()
+            ),
+            format!("give the {what} as {form}"),
+        ));
+    }
+    Ok(std::array::from_fn(|i| v[i]))
+}
+
 /// Add the body's named sets to `mesh`; returns the warnings about them.
-fn add_user_sets(
-    mesh: &mut Mesh,
+pub(crate) fn add_user_sets<const D: usize, K: ReferenceCell<D>>(
+    mesh: &mut Mesh<D, K>,
     spec: &crate::io::scene::BodySpec,
     source: &str,
     at: &str,
 ) -> Result<Vec<String>> {
     let tol = mesh.tolerance();
     let mut warnings = Vec::new();
+    let built_in = if D == 2 {
+        "left, right, bottom, top, the corners and all"
+    } else {
+        "left, right, front, back, bottom, top, the corners and all"
+    };
+    let box_of = |b: &crate::io::scene::BoxSpec, loc: &str| -> Result<([f64; D], [f64; D])> {
+        Ok((
+            set_point::<D>(&b.min.0, "box's min", source, loc)?,
+            set_point::<D>(&b.max.0, "box's max", source, loc)?,
+        ))
+    };
     for (name, set) in &spec.node_sets {
         let loc = format!("{at}.node_sets.{name}");
         if mesh.node_sets.contains_key(name) {
-            return Err(Error::invalid(source, loc, format!("'{name}' is a built-in set name"), "choose another name; the built-in sets are left, right, bottom, top, the corners and all"));
+            return Err(Error::invalid(
+                source,
+                loc,
+                format!("'{name}' is a built-in set name"),
+                format!("choose another name; the built-in sets are {built_in}"),
+            ));
         }
         let nodes = match set {
-            NodeSetSpec::Box(b) => mesh.nodes_in_box(b.min, b.max, tol),
-            NodeSetSpec::Point(p) => match mesh.nearest_node(*p) {
-                Some((n, d)) if d <= tol => vec![n],
-                Some((n, d)) => {
-                    let q = mesh.nodes[n];
-                    return Err(Error::invalid(
-                        source,
-                        loc,
-                        format!("no node at ({}, {}); the nearest is node {n} at ({}, {}), {d:.3e} away", p[0], p[1], q[0], q[1]),
-                        "give the exact coordinates of a node",
-                    ));
+            NodeSetSpec::Box(b) => {
+                let (lo, hi) = box_of(b, &loc)?;
+                mesh.nodes_in_box(lo, hi, tol)
+            }
+            NodeSetSpec::Point(p) => {
+                let p = set_point::<D>(&p.0, "point", source, &loc)?;
+                match mesh.nearest_node(p) {
+                    Some((n, d)) if d <= tol => vec![n],
+                    Some((n, d)) => {
+                        return Err(Error::invalid(
+                            source,
+                            loc,
+                            format!(
+                                "no node at ({}); the nearest is node {n} at ({}), {d:.3e} away",
+                                point_words(p),
+                                point_words(mesh.nodes[n])
+                            ),
+                            "give the exact coordinates of a node",
+                        ));
+                    }
+                    None => Vec::new(),
                 }
-                None => Vec::new(),
-            },
+            }
             NodeSetSpec::Nodes(ids) => {
                 if let Some(&bad) = ids.iter().find(|&&n| n >= mesh.nodes.len()) {
                     return Err(Error::invalid(
@@ -2279,10 +2332,11 @@ fn add_user_sets(
             ));
         }
         if let NodeSetSpec::Box(b) = set {
+            let corners = box_of(b, &loc)?;
             warnings.extend(widened_box_warning(
                 mesh,
                 nodes.iter().copied(),
-                (b.min, b.max),
+                corners,
                 &loc,
             ));
         }
@@ -2295,20 +2349,31 @@ fn add_user_sets(
                 source,
                 loc,
                 format!("'{name}' is a built-in set name"),
-                "choose another name; the built-in facet sets are left, right, bottom and top",
+                if D == 2 {
+                    "choose another name; the built-in facet sets are left, right, bottom and top"
+                } else {
+                    "choose another name; the built-in facet sets are left, right, front, back, bottom and top"
+                },
             ));
         }
         let facets = match set {
-            FacetSetSpec::Box(b) => mesh.facets_in_box(b.min, b.max, tol),
+            FacetSetSpec::Box(b) => {
+                let (lo, hi) = box_of(b, &loc)?;
+                mesh.facets_in_box(lo, hi, tol)
+            }
             FacetSetSpec::Facets(list) => {
                 let mut out = Vec::new();
                 for &[cell, edge] in list {
-                    if cell >= mesh.cell_count() || edge >= mesh.kind.edges().len() {
+                    if cell >= mesh.cell_count() || edge >= mesh.kind.facets().len() {
                         return Err(Error::invalid(
                             source,
                             loc,
                             format!("facet [{cell}, {edge}] does not exist"),
-                            "use [cell, local edge] with valid indices",
+                            if D == 2 {
+                                "use [cell, local edge] with valid indices"
+                            } else {
+                                "use [cell, local face] with valid indices"
+                            },
                         ));
                     }
                     out.push(Facet { cell, edge });
@@ -2325,17 +2390,9 @@ fn add_user_sets(
             ));
         }
         if let FacetSetSpec::Box(b) = set {
-            let edges = mesh.kind.edges();
-            let nodes: Vec<usize> = facets
-                .iter()
-                .flat_map(|f| edges[f.edge].iter().map(|&l| mesh.cell(f.cell)[l]))
-                .collect();
-            warnings.extend(widened_box_warning(
-                mesh,
-                nodes.into_iter(),
-                (b.min, b.max),
-                &loc,
-            ));
+            let corners = box_of(b, &loc)?;
+            let nodes: Vec<usize> = facets.iter().flat_map(|&f| mesh.facet_nodes(f)).collect();
+            warnings.extend(widened_box_warning(mesh, nodes.into_iter(), corners, &loc));
             warnings.extend(separate_pieces_warning(mesh, &facets, &loc));
         }
         mesh.facet_sets.insert(name.clone(), facets);
@@ -2347,12 +2404,17 @@ fn add_user_sets(
 /// connected when they share an end node) has caught facets away from the edge or arc it was
 /// drawn around, e.g. the end of another side that reaches into the box: a warning naming the
 /// set, the number of pieces and each piece's facets and extent. `None` for one piece.
-fn separate_pieces_warning(mesh: &Mesh, facets: &[Facet], loc: &str) -> Option<String> {
-    let ends: Vec<[usize; 2]> = facets
+fn separate_pieces_warning<const D: usize, K: ReferenceCell<D>>(
+    mesh: &Mesh<D, K>,
+    facets: &[Facet],
+    loc: &str,
+) -> Option<String> {
+    // each facet's corners (an edge's two ends in 2D)
+    let ends: Vec<Vec<usize>> = facets
         .iter()
         .map(|&f| {
             let n = mesh.facet_nodes(f);
-            [n[0], n[1]]
+            n[..mesh.kind.facet_corner_count(f.edge)].to_vec()
         })
         .collect();
     // union-find over the facets, joined through shared end nodes
@@ -2378,32 +2440,32 @@ fn separate_pieces_warning(mesh: &Mesh, facets: &[Facet], loc: &str) -> Option<S
             }
         }
     }
-    let mut pieces: std::collections::BTreeMap<usize, (usize, [f64; 2], [f64; 2])> =
+    let mut pieces: std::collections::BTreeMap<usize, (usize, [f64; D], [f64; D])> =
         Default::default();
     for (i, e) in ends.iter().enumerate() {
         let r = root(&mut parent, i);
         let piece = pieces
             .entry(r)
-            .or_insert((0, [f64::INFINITY; 2], [f64::NEG_INFINITY; 2]));
+            .or_insert((0, [f64::INFINITY; D], [f64::NEG_INFINITY; D]));
         piece.0 += 1;
         for &n in e {
-            for k in 0..2 {
+            for k in 0..D {
                 piece.1[k] = piece.1[k].min(mesh.nodes[n][k]);
                 piece.2[k] = piece.2[k].max(mesh.nodes[n][k]);
             }
         }
     }
     if pieces.len() < 2 {
-        return sharp_turn_warning(mesh, &ends, loc);
+        // the turn between consecutive edges (2D)
+        if D != 2 {
+            return None;
+        }
+        let ends: Vec<[usize; 2]> = ends.iter().map(|e| [e[0], e[1]]).collect();
+        return sharp_turn_warning(&mesh.nodes, &ends, loc);
     }
     let listed: Vec<String> = pieces
         .values()
-        .map(|(count, lo, hi)| {
-            format!(
-                "{count} facet(s) in [{}, {}] x [{}, {}]",
-                lo[0], hi[0], lo[1], hi[1]
-            )
-        })
+        .map(|(count, lo, hi)| format!("{count} facet(s) in {}", box_words(*lo, *hi)))
         .collect();
     Some(format!(
         "{loc}: the box takes in {} separate pieces of boundary ({}); a box drawn around one edge \
@@ -2418,9 +2480,13 @@ fn separate_pieces_warning(mesh: &Mesh, facets: &[Facet], loc: &str) -> Option<S
 /// (the angle between the chords of consecutive facets) has caught the end of another side:
 /// a warning naming the set and the corners. `None` if it turns no such corner (an arc meshed
 /// finely turns by a few degrees per facet).
-fn sharp_turn_warning(mesh: &Mesh, ends: &[[usize; 2]], loc: &str) -> Option<String> {
+fn sharp_turn_warning<const D: usize>(
+    nodes: &[[f64; D]],
+    ends: &[[usize; 2]],
+    loc: &str,
+) -> Option<String> {
     let chord = |e: &[usize; 2]| {
-        let (a, b) = (mesh.nodes[e[0]], mesh.nodes[e[1]]);
+        let (a, b) = (nodes[e[0]], nodes[e[1]]);
         [b[0] - a[0], b[1] - a[1]]
     };
     let mut corners = Vec::new();
@@ -2431,7 +2497,7 @@ fn sharp_turn_warning(mesh: &Mesh, ends: &[[usize; 2]], loc: &str) -> Option<Str
             let cos = (u[0] * v[0] + u[1] * v[1]) / (u[0].hypot(u[1]) * v[0].hypot(v[1]));
             let angle = cos.clamp(-1.0, 1.0).acos().to_degrees();
             if angle > 45.0 {
-                let p = mesh.nodes[into[1]];
+                let p = nodes[into[1]];
                 corners.push(format!("{angle:.0} degrees at ({}, {})", p[0], p[1]));
             }
         }
