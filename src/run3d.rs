@@ -12,7 +12,7 @@
 //! ([`crate::solver::active_set`]) are the 2D code paths, generic over the dimension. What is
 //! not built in 3D yet is refused here with the reason (an invalid-case error, exit 2), never
 //! computed wrongly: dynamics, the current contact geometry under small strain, sweeps, exact
-//! solutions, explicit meshes, checks other than `uniform_stress_3d` and `max_penetration`;
+//! solutions, checks other than `uniform_stress_3d` and `max_penetration`;
 //! the 3D
 //! discretizations refuse what
 //! they do not treat ([`crate::contact::discretization::Discretize`]).
@@ -90,13 +90,10 @@ use std::path::Path;
 /// a Gmsh file with tetrahedra or hexahedra (the file named relative to `source`'s folder; a
 /// file that cannot be read is left to the 2D model, which names what is wrong with it).
 pub fn is_3d(case: &Case, source: &str) -> bool {
-    let folder = Path::new(source).parent().unwrap_or(Path::new(""));
     case.bodies.iter().any(|b| match &b.mesh {
         MeshSpec::Block3d(_) => true,
-        MeshSpec::Gmsh(g) => std::fs::read(folder.join(&g.file))
-            .ok()
-            .and_then(|bytes| crate::io::gmsh_read::read_msh(&bytes).ok())
-            .is_some_and(|content| crate::io::gmsh_read::cell_dimension(&content) == 3),
+        MeshSpec::Explicit(e) => e.element.solid().is_some(),
+        MeshSpec::Gmsh(g) => crate::model::gmsh_file_is_3d(g, source),
         _ => false,
     })
 }
@@ -282,16 +279,16 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
             "remove \"exact\"; give the supports numbers and judge with uniform_stress_3d",
         ));
     }
-    if let Some(k) = case
-        .bodies
-        .iter()
-        .position(|b| matches!(b.mesh, MeshSpec::Block(_) | MeshSpec::Explicit(_)))
-    {
+    if let Some(k) = case.bodies.iter().position(|b| match &b.mesh {
+        MeshSpec::Block(_) => true,
+        MeshSpec::Explicit(e) => e.element.plane().is_some(),
+        _ => false,
+    }) {
         return Err(Error::invalid(
             source,
             format!("bodies[{k}] '{}'", case.bodies[k].name),
             "the body is 2D and another body of the case 3D; 2D and 3D bodies do not meet",
-            "give every body a \"block3d\" mesh or a Gmsh mesh of tetrahedra or hexahedra, or run the 2D bodies as a case of their own",
+            "give every body a \"block3d\" mesh, an explicit mesh of 3D cells or a Gmsh mesh of tetrahedra or hexahedra, or run the 2D bodies as a case of their own",
         ));
     }
     crate::model::check_size(case, source)?;
@@ -321,6 +318,15 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
             MeshSpec::Block3d(block) => block_mesh3(block, source, &at)?,
             MeshSpec::Gmsh(g) => {
                 let (mesh, _) = crate::model::read_gmsh_mesh::<3, SolidKind>(g, source, &at)?;
+                crate::model::check_read_size(case, &bodies, &mesh, source, &at)?;
+                mesh
+            }
+            MeshSpec::Explicit(e) => {
+                let kind = e
+                    .element
+                    .solid()
+                    .expect("every body was checked to be 3D above");
+                let mesh = crate::model::explicit_mesh(e, kind, source, &at)?;
                 crate::model::check_read_size(case, &bodies, &mesh, source, &at)?;
                 mesh
             }

@@ -596,3 +596,78 @@ fn user_node_and_facet_sets_of_a_3d_body_carry_supports_and_loads() {
     );
     assert!(err.contains("[x, y, z]"), "{err}");
 }
+
+/// An explicit 3D mesh (two Hex8 cells, nodes `[x, y, z]`, VTK's order) passes the traction
+/// patch test; a node of two coordinates is refused naming the node and the form; the 2D
+/// model (tables, sweeps, exports) refuses an explicit 3D body and a Gmsh file of
+/// tetrahedra, naming the commands that take them.
+#[test]
+fn an_explicit_3d_mesh_runs_and_the_2d_model_refuses_3d_meshes() {
+    let mut nodes = Vec::new();
+    for z in [0.0, 1.2] {
+        for y in [0.0, 0.8] {
+            for x in [0.0, 0.4, 1.0] {
+                nodes.push(serde_json::json!([x, y, z]));
+            }
+        }
+    }
+    // node (i, j, k) = i + 3 j + 6 k; each cell's bottom counter-clockwise, then its top
+    let cell = |i: usize| {
+        let b = [i, i + 1, i + 4, i + 3];
+        let mut c: Vec<usize> = b.to_vec();
+        c.extend(b.iter().map(|n| n + 6));
+        c
+    };
+    let case = |nodes: serde_json::Value| {
+        serde_json::json!({
+            "name": "explicit-3d",
+            "materials": {"m": {"E": 200.0, "nu": 0.3}},
+            "bodies": [{"name": "block", "material": "m",
+                "mesh": {"explicit": {"element": "Hex8", "nodes": nodes, "cells": [cell(0), cell(1)]}}}],
+            "supports": [{"body": "block", "set": "bottom", "z": 0.0},
+                         {"body": "block", "set": "bottom_front_left", "x": 0.0, "y": 0.0},
+                         {"body": "block", "set": "bottom_front_right", "y": 0.0}],
+            "loads": [{"body": "block", "set": "top", "pressure": 2.0}],
+            "checks": [{"check": "uniform_stress_3d", "stress": [0, 0, -2, 0, 0, 0], "tol": 1e-10}]
+        })
+    };
+    let good = case(serde_json::json!(nodes));
+    let parsed = contact_patch::model::parse(&good.to_string(), "explicit-3d").unwrap();
+    assert!(contact_patch::run3d::is_3d(&parsed, "explicit-3d"));
+    let o =
+        contact_patch::run3d::run_case3(&parsed, "explicit-3d").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(o.model.bodies[0].mesh.cell_count(), 2);
+    assert!(o.checks.iter().all(|c| c.passed), "{:?}", o.checks);
+    // the 2D model refuses it, naming the commands that run 3D cases
+    let err = contact_patch::model::Model::build(&parsed, "explicit-3d")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("bodies[0] 'block'.mesh.explicit"), "{err}");
+    assert!(
+        err.contains("3D cases run with `contact-patch run`"),
+        "{err}"
+    );
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let err = contact_patch::model::admit::load(&root.join("cases/gmsh/3d/patch-tet4.json"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("'block'.mesh.gmsh"), "{err}");
+    assert!(
+        err.contains("3D cases run with `contact-patch run`"),
+        "{err}"
+    );
+    // a node of two coordinates
+    let mut short = nodes.clone();
+    short[4] = serde_json::json!([0.4, 0.8]);
+    let parsed =
+        contact_patch::model::parse(&case(serde_json::json!(short)).to_string(), "explicit-3d")
+            .unwrap();
+    let err = contact_patch::run3d::run_case3(&parsed, "explicit-3d")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("mesh.explicit.nodes[4]"), "{err}");
+    assert!(
+        err.contains("the node has 2 coordinates, but Hex8 cells are 3D"),
+        "{err}"
+    );
+}

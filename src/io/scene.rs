@@ -930,12 +930,53 @@ pub struct Move {
     pub to: [f64; 2],
 }
 
+/// A mesh given node by node and cell by cell: 2D cells of `Q4`, `Q9`, `T3` or `T6` with
+/// nodes `[x, y]`, or 3D cells of `Hex8`, `Hex27`, `Tet4` or `Tet10` with nodes `[x, y, z]`
+/// (local node orders as VTK's).
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ExplicitMeshSpec {
-    pub element: ElementKind,
-    pub nodes: Vec<[f64; 2]>,
+    pub element: CellName,
+    pub nodes: Vec<Vector>,
     pub cells: Vec<Vec<usize>>,
+}
+
+/// The element of an explicit mesh, 2D or 3D.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub enum CellName {
+    Q4,
+    Q9,
+    T3,
+    T6,
+    Hex8,
+    Hex27,
+    Tet4,
+    Tet10,
+}
+
+impl CellName {
+    /// The 2D element, if it is one.
+    pub fn plane(self) -> Option<ElementKind> {
+        match self {
+            CellName::Q4 => Some(ElementKind::Q4),
+            CellName::Q9 => Some(ElementKind::Q9),
+            CellName::T3 => Some(ElementKind::T3),
+            CellName::T6 => Some(ElementKind::T6),
+            _ => None,
+        }
+    }
+
+    /// The 3D element, if it is one.
+    pub fn solid(self) -> Option<crate::fe3d::SolidKind> {
+        use crate::fe3d::SolidKind;
+        match self {
+            CellName::Hex8 => Some(SolidKind::Hex8),
+            CellName::Hex27 => Some(SolidKind::Hex27),
+            CellName::Tet4 => Some(SolidKind::Tet4),
+            CellName::Tet10 => Some(SolidKind::Tet10),
+            _ => None,
+        }
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]

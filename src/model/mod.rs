@@ -1766,6 +1766,10 @@ fn validate_enforcement(e: &EnforcementSpec, source: &str, at: &str) -> Result<(
 
 fn build_mesh(spec: &MeshSpec, source: &str, at: &str, notes: &mut Vec<String>) -> Result<Mesh> {
     match spec {
+        MeshSpec::Gmsh(g) if gmsh_file_is_3d(g, source) => Err(three_d_through_the_plane_model(
+            source,
+            format!("{at}.mesh.gmsh"),
+        )),
         MeshSpec::Gmsh(g) => {
             let (mesh, mirrored) = read_gmsh_mesh(g, source, at)?;
             if mirrored > 0 {
@@ -1776,11 +1780,9 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str, notes: &mut Vec<String>) 
             }
             Ok(mesh)
         }
-        MeshSpec::Block3d(_) => Err(Error::invalid(
+        MeshSpec::Block3d(_) => Err(three_d_through_the_plane_model(
             source,
             format!("{at}.mesh.block3d"),
-            "a 3D body in a case that goes through the 2D model: 3D cases run with `contact-patch run`, `check` and `judge`, with 3D bodies only (no 2D bodies beside them); tables, sweeps, studies and exports are 2D for now",
-            "run the case with `contact-patch run CASE` or `contact-patch check CASE`, or give the body a 2D mesh",
         )),
         MeshSpec::Block(b) => {
             let xs = b.x.values();
@@ -1803,58 +1805,120 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str, notes: &mut Vec<String>) 
                 )
             })
         }
-        MeshSpec::Explicit(e) => {
-            let nn = e.element.node_count();
-            for (i, p) in e.nodes.iter().enumerate() {
-                if !(p[0].is_finite() && p[1].is_finite()) {
-                    return Err(Error::invalid(
-                        source,
-                        format!("{at}.mesh.explicit.nodes[{i}]"),
-                        "the coordinates are not finite",
-                        "give finite coordinates",
-                    ));
-                }
-            }
-            let mut conn = Vec::with_capacity(nn * e.cells.len());
-            for (c, cell) in e.cells.iter().enumerate() {
-                if cell.len() != nn {
-                    return Err(Error::invalid(
-                        source,
-                        format!("{at}.mesh.explicit.cells[{c}]"),
-                        format!(
-                            "a {:?} cell needs {nn} nodes, got {}",
-                            e.element,
-                            cell.len()
-                        ),
-                        "list corners counter-clockwise, then mid-side nodes (then the Q9 centre)",
-                    ));
-                }
-                for &n in cell {
-                    if n >= e.nodes.len() {
-                        return Err(Error::invalid(
-                            source,
-                            format!("{at}.mesh.explicit.cells[{c}]"),
-                            format!(
-                                "node {n} does not exist (the mesh has {} nodes, numbered from 0)",
-                                e.nodes.len()
-                            ),
-                            "use node indices below the number of nodes",
-                        ));
-                    }
-                }
-                conn.extend_from_slice(cell);
-            }
-            if e.cells.is_empty() {
+        MeshSpec::Explicit(e) => match e.element.plane() {
+            Some(kind) => explicit_mesh(e, kind, source, at),
+            None => Err(three_d_through_the_plane_model(
+                source,
+                format!("{at}.mesh.explicit"),
+            )),
+        },
+    }
+}
+
+/// The refusal of a 3D body in a case that goes through the 2D model (tables, sweeps,
+/// studies, exports).
+fn three_d_through_the_plane_model(source: &str, at: String) -> Error {
+    Error::invalid(
+        source,
+        at,
+        "a 3D body in a case that goes through the 2D model: 3D cases run with `contact-patch run`, `check` and `judge`, with 3D bodies only (no 2D bodies beside them); tables, sweeps, studies and exports are 2D for now",
+        "run the case with `contact-patch run CASE` or `contact-patch check CASE`, or give the body a 2D mesh",
+    )
+}
+
+/// Whether the Gmsh file of `g` (relative to the case file `source`'s folder) holds 3D cells
+/// (tetrahedra or hexahedra); a file that cannot be read is not (its reader names the
+/// problem).
+pub(crate) fn gmsh_file_is_3d(g: &GmshMeshSpec, source: &str) -> bool {
+    let folder = std::path::Path::new(source)
+        .parent()
+        .unwrap_or(std::path::Path::new(""));
+    std::fs::read(folder.join(&g.file))
+        .ok()
+        .and_then(|bytes| crate::io::gmsh_read::read_msh(&bytes).ok())
+        .is_some_and(|content| crate::io::gmsh_read::cell_dimension(&content) == 3)
+}
+
+/// The mesh of an explicit spec of `kind` cells (2D or 3D): every node with the body's `D`
+/// finite coordinates, every cell with its node count of existing nodes.
+pub(crate) fn explicit_mesh<const D: usize, K: ReferenceCell<D>>(
+    e: &crate::io::scene::ExplicitMeshSpec,
+    kind: K,
+    source: &str,
+    at: &str,
+) -> Result<Mesh<D, K>> {
+    let nn = kind.node_count();
+    let mut nodes = Vec::with_capacity(e.nodes.len());
+    for (i, p) in e.nodes.iter().enumerate() {
+        let place = format!("{at}.mesh.explicit.nodes[{i}]");
+        if p.0.len() != D {
+            return Err(Error::invalid(
+                source,
+                place,
+                format!(
+                    "the node has {} coordinates, but {:?} cells are {D}D",
+                    p.0.len(),
+                    e.element
+                ),
+                if D == 2 {
+                    "give every node as [x, y]"
+                } else {
+                    "give every node as [x, y, z]"
+                },
+            ));
+        }
+        if !p.0.iter().all(|x| x.is_finite()) {
+            return Err(Error::invalid(
+                source,
+                place,
+                "the coordinates are not finite",
+                "give finite coordinates",
+            ));
+        }
+        nodes.push(std::array::from_fn::<f64, D, _>(|k| p.0[k]));
+    }
+    let mut conn = Vec::with_capacity(nn * e.cells.len());
+    for (c, cell) in e.cells.iter().enumerate() {
+        if cell.len() != nn {
+            return Err(Error::invalid(
+                source,
+                format!("{at}.mesh.explicit.cells[{c}]"),
+                format!(
+                    "a {:?} cell needs {nn} nodes, got {}",
+                    e.element,
+                    cell.len()
+                ),
+                if D == 2 {
+                    "list corners counter-clockwise, then mid-side nodes (then the Q9 centre)"
+                } else {
+                    "list the nodes in VTK's order: corners (a hexahedron's bottom face counter-clockwise seen from above, then the top), then mid-edge nodes (then Hex27's face centres and centre)"
+                },
+            ));
+        }
+        for &n in cell {
+            if n >= e.nodes.len() {
                 return Err(Error::invalid(
                     source,
-                    format!("{at}.mesh.explicit.cells"),
-                    "the mesh has no cells",
-                    "add cells",
+                    format!("{at}.mesh.explicit.cells[{c}]"),
+                    format!(
+                        "node {n} does not exist (the mesh has {} nodes, numbered from 0)",
+                        e.nodes.len()
+                    ),
+                    "use node indices below the number of nodes",
                 ));
             }
-            Ok(Mesh::new(e.element, e.nodes.clone(), conn))
         }
+        conn.extend_from_slice(cell);
     }
+    if e.cells.is_empty() {
+        return Err(Error::invalid(
+            source,
+            format!("{at}.mesh.explicit.cells"),
+            "the mesh has no cells",
+            "add cells",
+        ));
+    }
+    Ok(Mesh::new(kind, nodes, conn))
 }
 
 /// The mesh of a body from a Gmsh file, the file named relative to the case file's folder
