@@ -12,7 +12,7 @@
 //! ([`crate::solver::active_set`]) are the 2D code paths, generic over the dimension. What is
 //! not built in 3D yet is refused here with the reason (an invalid-case error, exit 2), never
 //! computed wrongly: dynamics, the current contact geometry under small strain, sweeps, exact
-//! solutions, checks other than `uniform_stress_3d` and `max_penetration`;
+//! solutions, checks other than `uniform_stress_3d`, `reaction` and `max_penetration`;
 //! the 3D
 //! discretizations refuse what
 //! they do not treat ([`crate::contact::discretization::Discretize`]).
@@ -145,6 +145,30 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
                     error,
                     tol: *share,
                     passed: error <= *share,
+                }
+            }
+            Check::Reaction {
+                body,
+                set,
+                component,
+                value,
+                tol,
+            } => {
+                let magnitudes = crate::harness::checks::Magnitudes::of(&model, &solution);
+                let (check, error, tol) = crate::harness::checks::reaction_check(
+                    &model,
+                    &solution,
+                    &magnitudes,
+                    (body, set),
+                    *component,
+                    *value,
+                    *tol,
+                );
+                CheckResult {
+                    check,
+                    error,
+                    tol,
+                    passed: error <= tol,
                 }
             }
             _ => unreachable!("build3 refuses every other check"),
@@ -373,6 +397,18 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
                     ));
                 }
             }
+            Check::Reaction { body, set, tol, .. } => {
+                let b = model.find_body(body, &at)?;
+                model.find_node_set(b, set, &at)?;
+                if !(tol.is_finite() && *tol >= 0.0) {
+                    return Err(Error::invalid(
+                        source,
+                        &at,
+                        format!("tolerance must be a non-negative number, got {tol}"),
+                        "give e.g. \"tol\": 1e-10",
+                    ));
+                }
+            }
             Check::MaxPenetration { pair, share } => {
                 model.resolve_max_penetration(pair.as_deref(), &at)?;
                 if !(share.is_finite() && *share >= 0.0) {
@@ -389,7 +425,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
                     source,
                     &at,
                     "this check",
-                    "use \"uniform_stress_3d\" or \"max_penetration\"",
+                    "use \"uniform_stress_3d\", \"reaction\" or \"max_penetration\"",
                 ))
             }
         }

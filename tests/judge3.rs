@@ -167,3 +167,53 @@ fn edit_array(text: &str, name: &str, edit: impl Fn(&[f64]) -> Vec<f64>) -> Stri
         lines.join("\n")
     )
 }
+
+/// A `reaction` check of a 3D case without contact (the Gmsh patch: the base carries the lid's
+/// load 1.6 in z) is judged from the results' displacements (`K u - f` on this mesh) as the run
+/// judges it; a 2D case that names the component z is refused.
+#[test]
+fn a_3d_reaction_check_is_judged_from_the_results_as_the_run_judges_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = "cases/gmsh/3d/patch-hex8.json";
+    let case = read_3d_case(&root().join(path)).unwrap();
+    let direct = run_case3(&case, &root().join(path).display().to_string()).unwrap();
+    let reaction = direct
+        .checks
+        .iter()
+        .find(|c| c.check.starts_with("reaction Z on block.base"))
+        .unwrap_or_else(|| panic!("{:?}", direct.checks));
+    assert!(reaction.passed, "{reaction:?}");
+    let folder = OutputFolder::new(&tmp.path().join(&direct.model.name)).unwrap();
+    write_run3(&folder, &direct).unwrap();
+    let results = load_results3(&direct.model, folder.path()).unwrap();
+    let j = judge3(&direct.model, &results, 1e-8).unwrap();
+    let judged = j
+        .checks
+        .iter()
+        .find(|c| c.check == reaction.check)
+        .unwrap_or_else(|| panic!("{:?}", j.checks));
+    assert!(judged.passed, "{judged:?}");
+    assert!(
+        (judged.error - reaction.error).abs() < 1e-12,
+        "{judged:?} {reaction:?}"
+    );
+    // a z component in 2D
+    let text = std::fs::read_to_string(root().join("cases/gmsh/patch-q4.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["checks"][2]["component"] = "z".into();
+    let source = root()
+        .join("cases/gmsh/patch-q4.json")
+        .display()
+        .to_string();
+    let err = contact_patch::model::Model::build(
+        &contact_patch::model::parse(&v.to_string(), &source).unwrap(),
+        &source,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("checks[2]"), "{err}");
+    assert!(
+        err.contains("the check names the component z, but the case is 2D"),
+        "{err}"
+    );
+}

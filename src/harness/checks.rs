@@ -50,7 +50,10 @@ pub struct Magnitudes {
 }
 
 impl Magnitudes {
-    pub fn of(model: &Model, solution: &Solution) -> Magnitudes {
+    pub fn of<const D: usize, K: SolidCell<D>>(
+        model: &Model<D, K>,
+        solution: &Solution<D>,
+    ) -> Magnitudes {
         let applied: f64 = model.external_force.iter().map(|f| f.abs()).sum();
         let reactions: f64 = model
             .prescribed
@@ -82,6 +85,32 @@ fn judged(got: f64, value: f64, magnitude: f64, what: &str) -> (f64, String) {
             format!("expected 0, judged relative to {what} {magnitude:.3e}"),
         )
     }
+}
+
+/// The words, error and tolerance of the check `reaction`: the sum of the reactions
+/// `K u - f` in `component` over the nodes of `body.set`, against `value` (relative to it, or
+/// to the applied load when it is 0); 2D and 3D.
+pub fn reaction_check<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+    magnitudes: &Magnitudes,
+    (body, set): (&str, &str),
+    component: crate::io::scene::Component,
+    value: f64,
+    tol: f64,
+) -> (String, f64, f64) {
+    let b = model.body(body).expect("resolved when the model was built");
+    let comp = component.index();
+    let got: f64 = b.mesh.node_sets[set]
+        .iter()
+        .map(|&n| solution.reactions[b.dof(n, comp)])
+        .sum();
+    let (error, expected) = judged(got, value, magnitudes.force, "the applied load");
+    (
+        format!("reaction {component:?} on {body}.{set} = {got:.6e} ({expected})"),
+        error,
+        tol,
+    )
 }
 
 /// NaN-keeping maximum: a NaN error must fail, so it is kept rather than dropped by `max`.
@@ -456,11 +485,7 @@ pub fn evaluate_with(
                     )
                 }
                 Check::Reaction { body, set, component, value, tol } => {
-                    let b = model.body(body).expect("resolved when the model was built");
-                    let comp = component.index();
-                    let got: f64 = b.mesh.node_sets[set].iter().map(|&n| solution.reactions[b.dof(n, comp)]).sum();
-                    let (error, expected) = judged(got, *value, magnitudes.force, "the applied load");
-                    (format!("reaction {component:?} on {body}.{set} = {got:.6e} ({expected})"), error, *tol)
+                    reaction_check(model, solution, &magnitudes, (body, set), *component, *value, *tol)
                 }
                 Check::ContactPressure { pair, tol } => {
                     let exact = model.exact.as_ref().expect("resolved when the model was built");

@@ -448,7 +448,11 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
 
 /// The solution `u` defines: `K u - f` at every dof (reactions at the prescribed ones), and the
 /// largest free-dof residual relative to the largest external force or reaction.
-fn solution_of(model: &Model, u: Vec<f64>, contact_force: Option<&[f64]>) -> Solution {
+pub(crate) fn solution_of<const D: usize, K: crate::model::space::SolidCell<D>>(
+    model: &crate::model::Model<D, K>,
+    u: Vec<f64>,
+    contact_force: Option<&[f64]>,
+) -> crate::solver::linear::Solution<D> {
     let mut r: Vec<f64> = model.external_force.iter().map(|f| -f).collect();
     if let Some(fc) = contact_force {
         for (r, f) in r.iter_mut().zip(fc) {

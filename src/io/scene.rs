@@ -1347,6 +1347,8 @@ pub enum Kinematics {
 pub enum Component {
     X,
     Y,
+    /// 3D bodies only.
+    Z,
 }
 
 impl Component {
@@ -1354,6 +1356,7 @@ impl Component {
         match self {
             Component::X => 0,
             Component::Y => 1,
+            Component::Z => 2,
         }
     }
 }

@@ -1450,6 +1450,19 @@ impl Model {
         Ok(())
     }
 
+    /// A check's component in 2D: `x` or `y`.
+    fn plane_component(&self, component: crate::io::scene::Component, at: &str) -> Result<()> {
+        if component == crate::io::scene::Component::Z {
+            return Err(Error::invalid(
+                &self.source,
+                at,
+                "the check names the component z, but the case is 2D",
+                "use \"x\" or \"y\"",
+            ));
+        }
+        Ok(())
+    }
+
     fn resolve_checks(&mut self, case: &Case) -> Result<()> {
         for (k, check) in case.checks.iter().enumerate() {
             let at = format!("checks[{k}]");
@@ -1485,21 +1498,43 @@ impl Model {
                         "use \"uniform_stress\" with the components [xx, yy, xy]",
                     ));
                 }
-                Check::Reaction { body, set, tol, .. } => {
+                Check::Reaction {
+                    body,
+                    set,
+                    tol,
+                    component,
+                    ..
+                } => {
                     let b = self.find_body(body, &at)?;
                     self.find_node_set(b, set, &at)?;
+                    self.plane_component(*component, &at)?;
                     *tol
                 }
-                Check::Displacement { body, tol, .. } => {
+                Check::Displacement {
+                    body,
+                    tol,
+                    component,
+                    ..
+                } => {
                     self.find_body(body, &at)?;
+                    self.plane_component(*component, &at)?;
                     *tol
                 }
                 Check::MaxPenetration { pair, share } => {
                     self.resolve_max_penetration(pair.as_deref(), &at)?;
                     *share
                 }
-                Check::ContactForce { pair, tol, .. }
-                | Check::MaxContactPressure { pair, tol, .. } => {
+                Check::ContactForce {
+                    pair,
+                    tol,
+                    component,
+                    ..
+                } => {
+                    self.find_pair(pair, &at)?;
+                    self.plane_component(*component, &at)?;
+                    *tol
+                }
+                Check::MaxContactPressure { pair, tol, .. } => {
                     self.find_pair(pair, &at)?;
                     *tol
                 }
