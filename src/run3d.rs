@@ -147,29 +147,9 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
                     passed: error <= *share,
                 }
             }
-            Check::Reaction {
-                body,
-                set,
-                component,
-                value,
-                tol,
-            } => {
-                let magnitudes = crate::harness::checks::Magnitudes::of(&model, &solution);
-                let (check, error, tol) = crate::harness::checks::reaction_check(
-                    &model,
-                    &solution,
-                    &magnitudes,
-                    (body, set),
-                    *component,
-                    *value,
-                    *tol,
-                );
-                CheckResult {
-                    check,
-                    error,
-                    tol,
-                    passed: error <= tol,
-                }
+            reaction @ Check::Reaction { .. } => {
+                crate::harness::checks::reaction_result(&model, &solution, reaction)
+                    .expect("a reaction check")
             }
             _ => unreachable!("build3 refuses every other check"),
         })

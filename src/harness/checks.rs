@@ -113,6 +113,41 @@ pub fn reaction_check<const D: usize, K: SolidCell<D>>(
     )
 }
 
+/// The check `reaction` (`None` for any other check) as a result, judged against the
+/// magnitudes of `solution`: the 3D run and the 3D judge.
+pub fn reaction_result<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+    check: &Check,
+) -> Option<CheckResult> {
+    let Check::Reaction {
+        body,
+        set,
+        component,
+        value,
+        tol,
+    } = check
+    else {
+        return None;
+    };
+    let magnitudes = Magnitudes::of(model, solution);
+    let (check, error, tol) = reaction_check(
+        model,
+        solution,
+        &magnitudes,
+        (body, set),
+        *component,
+        *value,
+        *tol,
+    );
+    Some(CheckResult {
+        check,
+        error,
+        tol,
+        passed: error <= tol,
+    })
+}
+
 /// NaN-keeping maximum: a NaN error must fail, so it is kept rather than dropped by `max`.
 fn worst(a: f64, e: f64) -> f64 {
     if e.is_nan() || e > a {
