@@ -312,3 +312,88 @@ impl<'a> CellLocator<'a> {
         Some((uh, stress_at(body, u, c, xi).0))
     }
 }
+
+/// The reaction of one support set: per component, the sum of the reactions `K u - f` at the
+/// dofs the set's supports prescribe. A dof that several sets prescribe (the same node held in
+/// the same component by two sets) counts once, in the set of the first support of the case
+/// that prescribes it; a later set lists it under `shared`. A node held in x by one set and in
+/// y by another gives each set its own component. A component the set prescribes nowhere (or
+/// only where an earlier set counts it) reads 0; `held` names the components it prescribes.
+#[derive(serde::Serialize)]
+pub struct ReactionSummary {
+    pub body: String,
+    pub set: String,
+    pub x: f64,
+    pub y: f64,
+    /// The z component (3D bodies only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub z: Option<f64>,
+    /// The components the set's supports prescribe (`"x"`, `"y"`, `"z"`).
+    pub held: Vec<&'static str>,
+    /// Dofs the set prescribes whose reaction counts in an earlier set.
+    pub shared: Vec<SharedReaction>,
+}
+
+/// Dofs of a support set whose reaction counts in another (earlier) set.
+#[derive(serde::Serialize)]
+pub struct SharedReaction {
+    pub component: &'static str,
+    /// The set that counts them.
+    pub counted_in: String,
+    pub nodes: usize,
+}
+
+/// The reaction of every support set of `model` (see [`ReactionSummary`]), 2D and 3D.
+pub fn reaction_summaries<const D: usize, K: SolidCell<D>>(
+    model: &crate::model::Model<D, K>,
+    reactions: &[f64],
+) -> Vec<ReactionSummary> {
+    const COMPONENTS: [&str; 3] = ["x", "y", "z"];
+    // the set that counts each dof: the first support prescribing it
+    let mut owner: std::collections::BTreeMap<usize, usize> = std::collections::BTreeMap::new();
+    for &(set, _, dof) in &model.support_dofs {
+        owner.entry(dof).or_insert(set);
+    }
+    model
+        .support_sets
+        .iter()
+        .enumerate()
+        .map(|(i, (bi, set))| {
+            let mut own = [0.0; 3];
+            let mut held = [false; 3];
+            let mut counted = std::collections::BTreeSet::new();
+            let mut shared: std::collections::BTreeMap<(usize, usize), usize> =
+                std::collections::BTreeMap::new();
+            for &(s, comp, dof) in model.support_dofs.iter().filter(|e| e.0 == i) {
+                held[comp] = true;
+                let first = owner[&dof];
+                if first == s {
+                    if counted.insert(dof) {
+                        own[comp] += reactions[dof];
+                    }
+                } else if counted.insert(dof) {
+                    *shared.entry((comp, first)).or_insert(0) += 1;
+                }
+            }
+            ReactionSummary {
+                body: model.bodies[*bi].name.clone(),
+                set: set.clone(),
+                x: own[0],
+                y: own[1],
+                z: (D == 3).then_some(own[2]),
+                held: (0..D).filter(|&c| held[c]).map(|c| COMPONENTS[c]).collect(),
+                shared: shared
+                    .into_iter()
+                    .map(|((comp, first), nodes)| {
+                        let (fb, fs) = &model.support_sets[first];
+                        SharedReaction {
+                            component: COMPONENTS[comp],
+                            counted_in: format!("{}.{fs}", model.bodies[*fb].name),
+                            nodes,
+                        }
+                    })
+                    .collect(),
+            }
+        })
+        .collect()
+}

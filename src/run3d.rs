@@ -57,7 +57,7 @@
 //! under `contact.pairs`), and the check `max_penetration`. Supports are the 2D model's
 //! ([`crate::model::Model::apply_supports`]: one conflict rule, one load path), and
 //! `summary.json` lists each support set's reaction (`reactions`, x, y and z, every prescribed
-//! dof counted in one set: [`crate::io::output::ReactionSummary`]).
+//! dof counted in one set: [`crate::post::ReactionSummary`]).
 //!
 //! The check `uniform_stress_3d` is the 3D uniform-stress check: the largest difference over
 //! the quadrature points of the stiffness rule and the six components, relative to the
@@ -778,7 +778,7 @@ pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
         "dofs": model.dof_count,
         "relative_residual": outcome.solution.relative_residual,
         "timings": outcome.solution.timings,
-        "reactions": crate::io::output::reaction_summaries(model, &outcome.solution.reactions),
+        "reactions": crate::post::reaction_summaries(model, &outcome.solution.reactions),
         "contact": contact_summary(outcome),
         "passed": outcome.passed(),
         "warnings": outcome.warnings,

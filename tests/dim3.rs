@@ -500,8 +500,7 @@ fn traction_vectors_on_every_face_give_a_uniform_stress_with_shear() {
         println!("{element}: {:.2e}", error.error);
         assert!(error.passed, "{element}: {}", error.error);
         // the reactions of the three corners vanish: the tractions balance on their own
-        let summary =
-            contact_patch::io::output::reaction_summaries(&o.model, &o.solution.reactions);
+        let summary = contact_patch::post::reaction_summaries(&o.model, &o.solution.reactions);
         for r in &summary {
             let z = r.z.unwrap();
             assert!(
@@ -530,8 +529,7 @@ fn body_forces_and_point_forces_reach_the_supports() {
     ]);
     for element in ["Hex8", "Tet4", "Hex27", "Tet10"] {
         let o = block_case(element, supports.clone(), loads.clone());
-        let summary =
-            contact_patch::io::output::reaction_summaries(&o.model, &o.solution.reactions);
+        let summary = contact_patch::post::reaction_summaries(&o.model, &o.solution.reactions);
         let r = &summary[0];
         let got = [r.x, r.y, r.z.unwrap()];
         for i in 0..3 {
