@@ -355,14 +355,18 @@ fn judge_refuses_results_it_cannot_use_and_says_how_to_fix_them() {
         "1e-3",
     ]);
     assert!(say(&o).contains("largest distance 1.000e-3"), "{}", say(&o));
-    // binary arrays
+    // numbers as text in an array said to be binary (base64)
     let binary = edited_results(tmp.path(), |t| {
         t.replacen("format=\"ascii\"", "format=\"binary\"", 1)
     });
     let o = run(&["judge", case, binary.to_str().unwrap()]);
     let s = say(&o);
     assert_eq!(o.status.code(), Some(2), "{s}");
-    assert!(s.contains("only ASCII data arrays are read"), "{s}");
+    assert!(
+        s.contains("<Points>: format=\"binary\": not base64")
+            && s.contains("for numbers as text write format=\"ascii\""),
+        "{s}"
+    );
     // a folder without the body's file
     let o = run(&["judge", case, tmp.path().to_str().unwrap()]);
     let s = say(&o);
@@ -629,4 +633,258 @@ fn a_perturbed_contact_pressure_fails_its_check_and_missing_contact_fields_are_n
         s.contains("a 'contact_pressure' or 'contact_force' point field"),
         "{s}"
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Issue 42: the encodings VTK writes, names in any case, the export folder alone, and the force
+// balance of a current-geometry solution.
+
+/// How [`rewrite_vtu`] writes a file's arrays.
+#[derive(Clone, Copy, Debug)]
+struct Encoding {
+    /// `None`: inline base64 (`format="binary"`); `Some(raw)`: `<AppendedData>`, raw or base64.
+    appended: Option<bool>,
+    /// `header_type="UInt64"` (else the default UInt32).
+    header64: bool,
+    /// `compressor="vtkZLibDataCompressor"`, in blocks of 256 bytes (the last one partial or
+    /// full, as VTK writes it).
+    zlib: bool,
+    big_endian: bool,
+}
+
+const ENCODINGS: &[Encoding] = &[
+    Encoding {
+        appended: None,
+        header64: false,
+        zlib: false,
+        big_endian: false,
+    },
+    Encoding {
+        appended: None,
+        header64: true,
+        zlib: false,
+        big_endian: false,
+    },
+    Encoding {
+        appended: None,
+        header64: false,
+        zlib: true,
+        big_endian: false,
+    },
+    Encoding {
+        appended: None,
+        header64: true,
+        zlib: true,
+        big_endian: true,
+    },
+    Encoding {
+        appended: Some(true),
+        header64: false,
+        zlib: false,
+        big_endian: false,
+    },
+    Encoding {
+        appended: Some(true),
+        header64: true,
+        zlib: false,
+        big_endian: false,
+    },
+    Encoding {
+        appended: Some(true),
+        header64: false,
+        zlib: true,
+        big_endian: false,
+    },
+    Encoding {
+        appended: Some(false),
+        header64: true,
+        zlib: true,
+        big_endian: false,
+    },
+];
+
+/// The value of attribute `name` in the start tag `head`.
+fn attribute<'a>(head: &'a str, name: &str) -> Option<&'a str> {
+    let key = format!(" {name}=\"");
+    let start = head.find(&key)? + key.len();
+    Some(&head[start..start + head[start..].find('"')?])
+}
+
+/// The `.vtu` text our tool writes rewritten as VTK writes binary files (a small writer of the
+/// VTK XML format, `vtkXMLWriter`'s layout): every array's numbers as bytes of its `type` in
+/// the chosen byte order, after a header of the array's length (or, compressed, of `[blocks,
+/// block size, last block size, compressed sizes]`), base64-encoded inline or appended; and
+/// every point field's name upper-cased.
+fn rewrite_vtu(text: &str, e: Encoding) -> Vec<u8> {
+    use base64::Engine as _;
+    use std::io::Write as _;
+    let b64 = |b: &[u8]| base64::engine::general_purpose::STANDARD.encode(b);
+    let int = |v: usize| -> Vec<u8> {
+        match (e.header64, e.big_endian) {
+            (true, false) => (v as u64).to_le_bytes().to_vec(),
+            (true, true) => (v as u64).to_be_bytes().to_vec(),
+            (false, false) => (v as u32).to_le_bytes().to_vec(),
+            (false, true) => (v as u32).to_be_bytes().to_vec(),
+        }
+    };
+    let mut out = String::new();
+    let mut appended: Vec<u8> = Vec::new();
+    let mut rest = text;
+    while let Some(i) = rest.find("<DataArray") {
+        out.push_str(&rest[..i]);
+        let gt = i + rest[i..].find('>').unwrap();
+        let close = gt + rest[gt..].find("</DataArray>").unwrap();
+        let head = &rest[i..gt];
+        let words = rest[gt + 1..close].split_ascii_whitespace();
+        let ty = attribute(head, "type").unwrap();
+        let mut data: Vec<u8> = Vec::new();
+        for w in words {
+            let mut b = match ty {
+                "Float64" => w.parse::<f64>().unwrap().to_le_bytes().to_vec(),
+                "Float32" => w.parse::<f32>().unwrap().to_le_bytes().to_vec(),
+                "Int64" => w.parse::<i64>().unwrap().to_le_bytes().to_vec(),
+                "Int32" => w.parse::<i32>().unwrap().to_le_bytes().to_vec(),
+                "UInt32" => w.parse::<u32>().unwrap().to_le_bytes().to_vec(),
+                "UInt8" => vec![w.parse::<u8>().unwrap()],
+                other => panic!("type {other} not written by the tool"),
+            };
+            if e.big_endian {
+                b.reverse();
+            }
+            data.extend(b);
+        }
+        let (header, body) = if e.zlib {
+            const BLOCK: usize = 256;
+            let blocks: Vec<Vec<u8>> = data
+                .chunks(BLOCK)
+                .map(|c| {
+                    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), Default::default());
+                    z.write_all(c).unwrap();
+                    z.finish().unwrap()
+                })
+                .collect();
+            let mut h = int(blocks.len());
+            h.extend(int(BLOCK));
+            h.extend(int(data.len() % BLOCK));
+            for b in &blocks {
+                h.extend(int(b.len()));
+            }
+            (h, blocks.concat())
+        } else {
+            (int(data.len()), data)
+        };
+        let mut head = head.to_string();
+        if let Some(name) = attribute(&head, "Name") {
+            if !["connectivity", "offsets", "types"].contains(&name) {
+                head = head.replace(
+                    &format!("Name=\"{name}\""),
+                    &format!("Name=\"{}\"", name.to_uppercase()),
+                );
+            }
+        }
+        let content = match e.appended {
+            None => {
+                head = head.replace("format=\"ascii\"", "format=\"binary\"");
+                b64(&header) + &b64(&body)
+            }
+            Some(raw) => {
+                head = head.replace(
+                    "format=\"ascii\"",
+                    &format!("format=\"appended\" offset=\"{}\"", appended.len()),
+                );
+                if raw {
+                    appended.extend(&header);
+                    appended.extend(&body);
+                } else {
+                    appended.extend((b64(&header) + &b64(&body)).into_bytes());
+                }
+                String::new()
+            }
+        };
+        out.push_str(&format!("{head}>{content}</DataArray>"));
+        rest = &rest[close + "</DataArray>".len()..];
+    }
+    out.push_str(rest);
+    let root = "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">";
+    assert!(out.contains(root), "the tool's root element changed");
+    let out = out.replace(
+        root,
+        &format!(
+            "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"{}\" header_type=\"{}\"{}>",
+            if e.big_endian { "BigEndian" } else { "LittleEndian" },
+            if e.header64 { "UInt64" } else { "UInt32" },
+            if e.zlib { " compressor=\"vtkZLibDataCompressor\"" } else { "" }
+        ),
+    );
+    let (body, tail) = out.split_at(out.rfind("</VTKFile>").unwrap());
+    let mut bytes = body.as_bytes().to_vec();
+    if let Some(raw) = e.appended {
+        bytes.extend(
+            format!(
+                "<AppendedData encoding=\"{}\">\n   _",
+                if raw { "raw" } else { "base64" }
+            )
+            .bytes(),
+        );
+        bytes.extend(&appended);
+        bytes.extend(b"\n</AppendedData>\n");
+    }
+    bytes.extend(tail.as_bytes());
+    bytes
+}
+
+/// The verdict lines of `judge`'s output (field uses, checks, the count), without the first
+/// line, which names the results' path.
+fn verdict_lines(o: &Output) -> Vec<String> {
+    String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .skip(1)
+        .map(String::from)
+        .collect()
+}
+
+/// `run` of the case `case` into `dir`; the body files it wrote.
+fn run_into(case: &str, dir: &Path) -> Vec<PathBuf> {
+    let o = run(&["run", case, "--out", dir.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", say(&o));
+    let model = contact_patch::model::admit::load(&root().join(case)).unwrap();
+    model
+        .bodies
+        .iter()
+        .map(|b| dir.join(format!("{}.vtu", b.name)))
+        .collect()
+}
+
+#[test]
+fn results_in_every_vtk_encoding_with_upper_case_names_give_the_ascii_verdicts() {
+    let tmp = tempfile::tempdir().unwrap();
+    // one body with a stress field; two bodies with the contact fields
+    for case in [
+        "cases/patch-single/q4-distorted.json",
+        "cases/patch/patch-A-nu0.3.json",
+    ] {
+        let ascii = tmp.path().join("ascii");
+        let files = run_into(case, &ascii);
+        let original = run(&["judge", case, ascii.to_str().unwrap()]);
+        assert_eq!(original.status.code(), Some(0), "{}", say(&original));
+        let expected = verdict_lines(&original);
+        assert!(expected.iter().any(|l| l.contains("pass uniform stress")));
+        for (k, &e) in ENCODINGS.iter().enumerate() {
+            let dir = tmp.path().join(format!("encoding-{k}"));
+            std::fs::create_dir_all(&dir).unwrap();
+            for f in &files {
+                let text = std::fs::read_to_string(f).unwrap();
+                let bytes = rewrite_vtu(&text, e);
+                let seen = String::from_utf8_lossy(&bytes);
+                assert!(!seen.contains("format=\"ascii\""), "{e:?}");
+                assert!(seen.contains("Name=\"DISPLACEMENT\""), "{e:?}");
+                assert!(!seen.contains("Name=\"displacement\""), "{e:?}");
+                std::fs::write(dir.join(f.file_name().unwrap()), bytes).unwrap();
+            }
+            let o = run(&["judge", case, dir.to_str().unwrap()]);
+            assert_eq!(o.status.code(), Some(0), "{case} {e:?}: {}", say(&o));
+            // the same verdicts, errors and measured values, digit for digit
+            assert_eq!(verdict_lines(&o), expected, "{case} {e:?}: {}", say(&o));
+        }
+    }
 }

@@ -93,12 +93,7 @@ fn two_pass(model: &Model, k: usize) -> bool {
 /// node `n` of body `b`).
 pub fn read(model: &Model, results: &Results, matched: &[Vec<usize>]) -> Result<OutsideContact> {
     let file_of = |b: usize| -> &ResultsFile { results.of_body(b) };
-    let all_have = |name: &str| {
-        results
-            .files()
-            .iter()
-            .all(|f| f.grid.fields.contains_key(name))
-    };
+    let all_have = |name: &str| results.files().iter().all(|f| f.has(name));
     let mut out = OutsideContact {
         force_field: all_have(CONTACT_FORCE_FIELD),
         pressure_field: all_have(CONTACT_PRESSURE_FIELD),
@@ -154,11 +149,7 @@ pub fn read(model: &Model, results: &Results, matched: &[Vec<usize>]) -> Result<
             out.pairs.push(this);
             continue;
         }
-        let side_files = |name: &str| {
-            sides
-                .iter()
-                .all(|(b, _, _)| file_of(*b).grid.fields.contains_key(name))
-        };
+        let side_files = |name: &str| sides.iter().all(|(b, _, _)| file_of(*b).has(name));
         let surfaces: Vec<Surface> = sides
             .iter()
             .map(|(b, facets, _)| Surface::new(*b, &model.bodies[*b], facets, model.thickness))

@@ -1,8 +1,10 @@
 //! Another code's results files for `judge` and `table --results`: a `.vtu` with every body, or
 //! a folder with one `<body>.vtu` per body (read by [`crate::io::vtu_read`]), and the point
 //! fields looked up in them by name, with their component counts checked and every value
-//! finite. The names read are the constants below; what each is used for is stated in
-//! [`crate::harness::judge`] and [`crate::harness::outside_contact`].
+//! finite. The names read are the constants below, matched without regard to case
+//! (`DISPLACEMENT` and `Contact_Pressure` are `displacement` and `contact_pressure`; two fields
+//! whose names differ only in case are refused as ambiguous); what each is used for is stated
+//! in [`crate::harness::judge`] and [`crate::harness::outside_contact`].
 
 use crate::error::{Error, Result};
 use crate::io::paths::file_name;
@@ -23,6 +25,43 @@ pub const CONTACT_STATUS_FIELD: &str = "contact_status";
 pub struct ResultsFile {
     pub shown: String,
     pub grid: PointGrid,
+}
+
+impl ResultsFile {
+    /// The point field named `name` without regard to case, with the name the file gives it;
+    /// `None` when absent, an error when two fields match.
+    pub(crate) fn lookup(&self, name: &str) -> Result<Option<(&str, &PointField)>> {
+        if let Some((k, f)) = self.grid.fields.get_key_value(name) {
+            return Ok(Some((k, f)));
+        }
+        let mut found = self
+            .grid
+            .fields
+            .iter()
+            .filter(|(k, _)| k.eq_ignore_ascii_case(name));
+        let first = found.next();
+        if let Some((other, _)) = found.next() {
+            return Err(Error::invalid(
+                &self.shown,
+                format!("point field '{name}'"),
+                format!(
+                    "the fields '{}' and '{other}' both match (names are read without regard \
+                     to case)",
+                    first.expect("a first match").0
+                ),
+                "give the field one name only",
+            ));
+        }
+        Ok(first.map(|(k, f)| (k.as_str(), f)))
+    }
+
+    /// Whether the file has a point field named `name` (without regard to case).
+    pub(crate) fn has(&self, name: &str) -> bool {
+        self.grid
+            .fields
+            .keys()
+            .any(|k| k.eq_ignore_ascii_case(name))
+    }
 }
 
 /// Another code's results: one file for every body, or one file per body.
@@ -91,13 +130,14 @@ pub fn load_results_of<'a>(bodies: impl Iterator<Item = &'a str>, path: &Path) -
     }
 }
 
-/// A named point field with at least `min_components` components, or `None` when absent.
+/// A named point field (matched without regard to case, [`ResultsFile::lookup`]) with at
+/// least `min_components` components, or `None` when absent.
 pub(crate) fn field<'a>(
     file: &'a ResultsFile,
     name: &str,
     min_components: usize,
 ) -> Result<Option<&'a PointField>> {
-    let Some(f) = file.grid.fields.get(name) else {
+    let Some((name, f)) = file.lookup(name)? else {
         return Ok(None);
     };
     if f.components < min_components {
