@@ -888,3 +888,95 @@ fn results_in_every_vtk_encoding_with_upper_case_names_give_the_ascii_verdicts()
         }
     }
 }
+
+/// `cases/patch/patch-A-nu0.3.json` with the contact geometry in the current configuration:
+/// the punch slides over the foundation by the lateral strain, and the pair's moments balance
+/// about the deformed positions `X + u`.
+fn current_geometry_patch(tmp: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(root().join("cases/patch/patch-A-nu0.3.json")).unwrap();
+    let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
+    case["name"] = "patch-A-current".into();
+    case["physics"] = serde_json::json!({"contact_geometry": "current"});
+    let path = tmp.join("patch-A-current.json");
+    std::fs::write(&path, case.to_string()).unwrap();
+    path
+}
+
+#[test]
+fn force_balance_of_a_current_geometry_run_agrees_between_run_and_judge() {
+    let tmp = tempfile::tempdir().unwrap();
+    let case = current_geometry_patch(tmp.path());
+    let direct = run_case(&case, &mut |_| {}).unwrap();
+    let folder = OutputFolder::new(&tmp.path().join("run")).unwrap();
+    write_run(&folder, &direct).unwrap();
+    let results = load_results(&direct.model, folder.path()).unwrap();
+    let j = judge(&direct.model, &results, DEFAULT_MATCH_SHARE).unwrap();
+    assert!(
+        j.not_judged.is_empty(),
+        "{:?}",
+        j.not_judged.iter().map(|n| &n.why).collect::<Vec<_>>()
+    );
+    let balance = |checks: &[contact_patch::harness::checks::CheckResult]| {
+        checks
+            .iter()
+            .find(|c| c.check.starts_with("force balance"))
+            .cloned()
+            .unwrap()
+    };
+    let (d, o) = (balance(&direct.checks), balance(&j.checks));
+    println!(
+        "run: {} ({:e})\njudge: {} ({:e})",
+        d.check, d.error, o.check, o.error
+    );
+    assert!(d.passed && o.passed, "{d:?}\n{o:?}");
+    assert!((o.error - d.error).abs() <= 1e-12, "{d:?}\n{o:?}");
+    // every other check too: the pressure from areas and normals at X + u
+    for d in &direct.checks {
+        let o = j
+            .checks
+            .iter()
+            .find(|c| {
+                c.check.split(" = ").next() == d.check.split(" = ").next()
+                    || c.check.starts_with(d.check.split(" (").next().unwrap())
+            })
+            .unwrap_or_else(|| panic!("{} not judged", d.check));
+        assert_eq!(
+            o.passed, d.passed,
+            "{}: {:e} vs {:e}",
+            d.check, o.error, d.error
+        );
+        assert!(
+            (o.error - d.error).abs() <= 1e-12 * d.error.abs().max(1e-3),
+            "{}: {:e} vs {:e}",
+            d.check,
+            o.error,
+            d.error
+        );
+    }
+    // the same results judged by the case with reference geometry (the export's): the moments
+    // about X do not balance; the message names that term and the configuration they balance in
+    let reference = root().join("cases/patch/patch-A-nu0.3.json");
+    let o = run(&[
+        "judge",
+        reference.to_str().unwrap(),
+        folder.path().to_str().unwrap(),
+    ]);
+    let s = say(&o);
+    assert_eq!(o.status.code(), Some(1), "{s}");
+    let line = s
+        .lines()
+        .find(|l| {
+            let l = l.trim_start();
+            l.starts_with("FAIL force balance") || l.starts_with("pass force balance")
+        })
+        .unwrap_or_else(|| panic!("{s}"));
+    println!("{line}");
+    assert!(line.trim_start().starts_with("FAIL"), "{line}");
+    assert!(
+        line.contains("largest: the net moment / L of pair 'interface'")
+            && line.contains(
+                "with the moments about the deformed positions X + u the results balance"
+            ),
+        "{line}"
+    );
+}

@@ -141,7 +141,7 @@ fn owner(model: &Model, d: usize) -> (usize, usize, usize) {
 }
 
 /// `body` moved to `X + u` (or as it is, borrowed, without `u`).
-fn placed<'a>(body: &'a Body, u: Option<&[f64]>) -> std::borrow::Cow<'a, Body> {
+pub(crate) fn placed<'a>(body: &'a Body, u: Option<&[f64]>) -> std::borrow::Cow<'a, Body> {
     let Some(u) = u else {
         return std::borrow::Cow::Borrowed(body);
     };

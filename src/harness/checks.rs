@@ -252,6 +252,16 @@ pub fn balance_scale(model: &Model, solution: &Solution) -> f64 {
 /// [`force_balance`] of the given nodal forces; `solution.reactions` must already hold
 /// `K u - f - f_contact` (the out-of-balance force at the free dofs).
 pub fn force_balance_of(model: &Model, solution: &Solution, forces: &[PairForces]) -> f64 {
+    force_balance_terms(model, solution, forces).0
+}
+
+/// [`force_balance_of`] and the words naming its largest term: the out-of-balance force, or a
+/// pair's net force x or y, or its net moment / L (a NaN term is the largest).
+pub fn force_balance_terms(
+    model: &Model,
+    solution: &Solution,
+    forces: &[PairForces],
+) -> (f64, String) {
     let size = model.size();
     let load = balance_scale(model, solution).max(f64::MIN_POSITIVE);
     let out_of_balance: f64 = model
@@ -262,24 +272,28 @@ pub fn force_balance_of(model: &Model, solution: &Solution, forces: &[PairForces
         .map(|(_, r)| r.abs())
         .sum();
     let mut error = out_of_balance / load;
+    let mut largest = "the out-of-balance force sum |K u - f - f_c| over the free dofs".to_string();
     for pf in forces {
         if !matches!(model.contact[pf.pair].master, MasterSide::Body { .. })
             || pf.force_scale == 0.0
         {
             continue;
         }
-        let net = [
-            pf.on_slave[0] + pf.on_master[0],
-            pf.on_slave[1] + pf.on_master[1],
+        let name = &model.contact[pf.pair].name;
+        let terms = [
+            (pf.on_slave[0] + pf.on_master[0], "net force x"),
+            (pf.on_slave[1] + pf.on_master[1], "net force y"),
+            (pf.net_moment / size, "net moment / L"),
         ];
-        let e = net[0]
-            .abs()
-            .max(net[1].abs())
-            .max(pf.net_moment.abs() / size)
-            / load;
-        error = worst(error, e);
+        for (value, what) in terms {
+            let e = value.abs() / load;
+            if e > error || e.is_nan() && !error.is_nan() {
+                error = e;
+                largest = format!("the {what} of pair '{name}'");
+            }
+        }
     }
-    error
+    (error, largest)
 }
 
 /// Penetration above this share of the contact element size makes a run warn.
@@ -581,9 +595,11 @@ pub fn evaluate_with(
                     let found = warnings(model, solution).iter().any(|w| w.contains(contains.as_str()));
                     (format!("the run warns {contains:?}"), if found { 0.0 } else { f64::INFINITY }, 0.0)
                 }
-                Check::ForceBalance { tol } => (
+                Check::ForceBalance { tol } => {
+                    let (error, largest) = if has_forces { force_balance_terms(model, solution, forces) } else { (f64::INFINITY, "no contact forces".to_string()) };
+                    (
                     format!(
-                        "force balance: net force and net moment / L (L = {:.3e}) of each pair between bodies and the out-of-balance force, relative to {}",
+                        "force balance: net force and net moment / L (L = {:.3e}) of each pair between bodies and the out-of-balance force, relative to {}; largest: {largest}",
                         model.size(),
                         if balance_scale(model, solution) != magnitudes.force {
                             format!("the magnitude of the stiffness terms {:.3e} (the applied load {:.3e} is round-off of it)", solution.force_scale, magnitudes.force)
@@ -591,9 +607,10 @@ pub fn evaluate_with(
                             format!("the applied load {:.3e}", magnitudes.force)
                         }
                     ),
-                    if has_forces { force_balance_of(model, solution, forces) } else { f64::INFINITY },
+                    error,
                     *tol,
-                ),
+                    )
+                }
                 Check::Displacement { body, point, component, value, tol } => {
                     let b = model.body(body).expect("resolved when the model was built");
                     let (n, _) = b.mesh.nearest_node(*point).expect("a body has nodes");

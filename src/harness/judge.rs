@@ -18,8 +18,16 @@
 //! * the contact checks (`contact_pressure`, `contact_force`, `max_contact_pressure`,
 //!   `max_penetration`, `force_balance`): from the results' point fields `contact_force`,
 //!   `contact_pressure` (compression positive) and `contact_gap` on the pairs' surfaces, as
-//!   [`crate::harness::outside_contact`] states; a check whose field is missing is listed as not
-//!   judged, naming the field. With contact forces `f_c`, `K u - f - f_c` is the residual.
+//!   [`crate::harness::outside_contact`] states (in the configuration the case's contact
+//!   geometry names, as our run); a check whose field is missing is listed as not judged, naming
+//!   the field. With contact forces `f_c`, `f_int(u) - f - f_c` is the residual (the run's
+//!   [`crate::solver::linear::residual`]). A failed `force_balance` names its largest term and
+//!   says when the results balance with the moments in the other configuration.
+//!
+//! The field names are matched without regard to case
+//! ([`crate::harness::outside_results`]), and the `.vtu` may be in any encoding VTK writes
+//! ([`crate::io::vtu_read`]). The case may be given as the folder `contact-patch export`
+//! wrote, which carries it ([`crate::io::export::exported_case`]).
 //!
 //! `table --results DIR` makes one table cell per swept case from the results in `DIR`
 //! ([`outside_cells`]), judged as the sweep judges an exact method: the stress criterion
@@ -31,7 +39,8 @@
 use crate::contact::forces::PairForces;
 use crate::error::{Error, Result};
 use crate::harness::checks::{
-    evaluate_with, force_balance_of, pressure_error_of, CheckResult, Magnitudes,
+    evaluate_with, force_balance_of, force_balance_terms, pressure_error_of, CheckResult,
+    Magnitudes,
 };
 use crate::harness::outside_contact::{self, OutsideContact, Source};
 use crate::harness::outside_results::field;
@@ -40,10 +49,10 @@ pub use crate::harness::outside_results::{
     CONTACT_PRESSURE_FIELD, CONTACT_STATUS_FIELD, DISPLACEMENT_FIELD, STRESS_FIELD,
 };
 use crate::io::paths::file_name;
-use crate::io::scene::Check;
+use crate::io::scene::{Check, ContactGeometry};
 use crate::io::vtu_read::PointGrid;
 use crate::model::Model;
-use crate::solver::linear::{for_each_element_stiffness, Solution, Timings};
+use crate::solver::linear::{Solution, Timings};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -291,7 +300,7 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
     let contact = if model.contact.is_empty() {
         OutsideContact::default()
     } else {
-        outside_contact::read(model, results, &matched)?
+        outside_contact::read(model, results, &matched, &u)?
     };
     let solution = solution_of(model, u, contact.nodal_force.as_deref());
     let mut checks = Vec::new();
@@ -318,6 +327,11 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
                     .into_iter()
                     .map(|mut c| {
                         c.check += &format!(" [from the results' '{from}']");
+                        if let (false, Check::ForceBalance { tol }, CONTACT_FORCE_FIELD) =
+                            (c.passed, check, from)
+                        {
+                            c.check += &balance_elsewhere(model, &solution, &forces, *tol);
+                        }
                         c
                     }),
             ),
@@ -446,29 +460,73 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
     })
 }
 
-/// The solution `u` defines: `K u - f` at every dof (reactions at the prescribed ones), and the
-/// largest free-dof residual relative to the largest external force or reaction.
+/// Where the force balance of the results fails in the configuration of the case: whether it
+/// holds with the moments taken in the other one (`X + u` for a reference-geometry case, `X` for
+/// a current-geometry one), in words to append to the check (empty when it does not hold there
+/// either). A code that evaluates contact in the deformed geometry balances its moments about
+/// `X + u`, which a small-sliding case judged about `X` does not credit.
+fn balance_elsewhere(
+    model: &Model,
+    solution: &Solution,
+    forces: &[PairForces],
+    tol: f64,
+) -> String {
+    let current = model.physics.contact_geometry == ContactGeometry::Current;
+    let moved: Vec<PairForces> = forces
+        .iter()
+        .map(|pf| {
+            let mut pf = pf.clone();
+            pf.net_moment = pf
+                .nodes
+                .iter()
+                .map(|t| {
+                    let body = &model.bodies[t.body];
+                    let x = body.mesh.nodes[t.node];
+                    let p = if current {
+                        x
+                    } else {
+                        [
+                            x[0] + solution.u[body.dof(t.node, 0)],
+                            x[1] + solution.u[body.dof(t.node, 1)],
+                        ]
+                    };
+                    p[0] * t.force[1] - p[1] * t.force[0]
+                })
+                .sum();
+            pf
+        })
+        .collect();
+    let (error, _) = force_balance_terms(model, solution, &moved);
+    if error > tol || error.is_nan() {
+        return String::new();
+    }
+    let (other, geometry) = if current {
+        ("reference positions X", "current")
+    } else {
+        ("deformed positions X + u", "reference")
+    };
+    format!(
+        "; with the moments about the {other} the results balance (error {error:.3e}): their \
+         contact forces act in the other configuration than the case's \
+         physics.contact_geometry \"{geometry}\""
+    )
+}
+
+/// The solution `u` defines: `f_int(u) - f - f_c` at every dof (reactions at the prescribed
+/// ones; `f_int = K u` under small strain, the finite-strain internal force under finite
+/// kinematics, by the run's own [`crate::solver::linear::residual`]), and the largest free-dof
+/// residual relative to the largest external force or reaction.
 pub(crate) fn solution_of<const D: usize, K: crate::model::space::SolidCell<D>>(
     model: &crate::model::Model<D, K>,
     u: Vec<f64>,
     contact_force: Option<&[f64]>,
 ) -> crate::solver::linear::Solution<D> {
-    let mut r: Vec<f64> = model.external_force.iter().map(|f| -f).collect();
+    let mut r = crate::solver::linear::residual(model, &u);
     if let Some(fc) = contact_force {
         for (r, f) in r.iter_mut().zip(fc) {
             *r -= f;
         }
     }
-    for_each_element_stiffness(model, |dofs, ke| {
-        let n = dofs.len();
-        for i in 0..n {
-            let mut s = 0.0;
-            for j in 0..n {
-                s += ke[i * n + j] * u[dofs[j]];
-            }
-            r[dofs[i]] += s;
-        }
-    });
     let free = |d: &usize| model.prescribed[*d].is_none();
     let dofs = 0..model.dof_count;
     let largest_free = dofs

@@ -30,13 +30,18 @@
 //! else `-p A n` for frictionless pairs, where the forces are normal), `max_penetration` the
 //! gaps. `force_balance`'s out-of-balance force is `sum |K u - f - f_c|` over the free dofs with
 //! our `K` and `f` and the results' nodal contact forces `f_c`. A check whose field is missing
-//! is not judged and says which field it needs. Contact geometry in the current configuration
-//! is not judged (our rows then use `X + u` at their last geometry update, which a results file
-//! does not state). A node on the surfaces of two pairs carries one field value, the sum of
-//! both pairs' forces; such pairs' checks are not judged.
+//! is not judged and says which field it needs. A node on the surfaces of two pairs carries one
+//! field value, the sum of both pairs' forces; such pairs' checks are not judged.
+//!
+//! **Configuration.** The surfaces (normals `n_a`, areas `A_a`) and the points `x_a` of the
+//! moments are those of the configuration the case's contact geometry names, the rule of our
+//! own run ([`crate::contact::forces::pair_forces`]): the reference positions `X_a` for
+//! `contact_geometry: "reference"`, the deformed ones `X_a + u_a` (`u` the results'
+//! displacement) for `"current"`, where our rows are evaluated at `X + u` and a code that
+//! evaluates contact in the deformed geometry balances its moments.
 
 use crate::contact::discretization::geometry::Surface;
-use crate::contact::forces::{element_sizes, NodalTraction, PairForces, Penetration};
+use crate::contact::forces::{element_sizes, placed, NodalTraction, PairForces, Penetration};
 use crate::error::Result;
 use crate::harness::outside_results::{
     field, Results, ResultsFile, CONTACT_FORCE_FIELD, CONTACT_GAP_FIELD, CONTACT_PRESSURE_FIELD,
@@ -90,8 +95,15 @@ fn two_pass(model: &Model, k: usize) -> bool {
 }
 
 /// Read the contact fields of `results` at the matched points (`matched[b][n]`: the point of
-/// node `n` of body `b`).
-pub fn read(model: &Model, results: &Results, matched: &[Vec<usize>]) -> Result<OutsideContact> {
+/// node `n` of body `b`), `u` the results' displacement at every dof (module notes,
+/// **Configuration**).
+pub fn read(
+    model: &Model,
+    results: &Results,
+    matched: &[Vec<usize>],
+    u: &[f64],
+) -> Result<OutsideContact> {
+    let config = (model.physics.contact_geometry == ContactGeometry::Current).then_some(u);
     let file_of = |b: usize| -> &ResultsFile { results.of_body(b) };
     let all_have = |name: &str| results.files().iter().all(|f| f.has(name));
     let mut out = OutsideContact {
@@ -131,13 +143,7 @@ pub fn read(model: &Model, results: &Results, matched: &[Vec<usize>]) -> Result<
         let shared = owners.iter().find(|((b, _), pairs)| {
             pairs.len() > 1 && pairs.contains(&k) && sides.iter().any(|s| s.0 == *b)
         });
-        if model.physics.contact_geometry != ContactGeometry::Reference {
-            this.refused = Some(
-                "the case takes contact geometry in the current configuration, whose normals \
-                 and areas at the rows' last geometry update a results file does not state"
-                    .into(),
-            );
-        } else if let Some(((b, n), _)) = shared {
+        if let Some(((b, n), _)) = shared {
             this.refused = Some(format!(
                 "node {n} of body '{}' lies on the surfaces of several pairs, and its field \
                  value is their sum",
@@ -152,7 +158,14 @@ pub fn read(model: &Model, results: &Results, matched: &[Vec<usize>]) -> Result<
         let side_files = |name: &str| sides.iter().all(|(b, _, _)| file_of(*b).has(name));
         let surfaces: Vec<Surface> = sides
             .iter()
-            .map(|(b, facets, _)| Surface::new(*b, &model.bodies[*b], facets, model.thickness))
+            .map(|(b, facets, _)| {
+                Surface::new(
+                    *b,
+                    &placed(&model.bodies[*b], config),
+                    facets,
+                    model.thickness,
+                )
+            })
             .collect();
         let carries: Vec<bool> = sides.iter().map(|s| s.2).collect();
         let has_force = side_files(CONTACT_FORCE_FIELD);
@@ -187,7 +200,13 @@ pub fn read(model: &Model, results: &Results, matched: &[Vec<usize>]) -> Result<
                             p,
                         )
                     };
-                    let x = body.mesh.nodes[n];
+                    let x = match config {
+                        Some(u) => [
+                            body.mesh.nodes[n][0] + u[body.dof(n, 0)],
+                            body.mesh.nodes[n][1] + u[body.dof(n, 1)],
+                        ],
+                        None => body.mesh.nodes[n],
+                    };
                     let target = if s == 0 {
                         &mut on_slave
                     } else {
