@@ -362,10 +362,10 @@ enum Command {
     },
     /// Judge another code's results for a case with the case's checks (see `export`).
     #[command(
-        after_help = "Example:\n  contact-patch judge cases/patch-single/q4-distorted.json results/q4-distorted.vtu\n  contact-patch judge cases/patch/patch-A-nu0.3.json results/patch-A-nu0.3/ --junit judge.xml\n\nRESULTS is a .vtu file with the point field 'displacement' (optional: 'stress'), or a folder\nwith one <body name>.vtu per body. Each node is matched to the result point within\n--match-tol times the model size. Checks that need the solve's contact forces are listed as\nnot judged. Exit codes: 0 every judged check passes, 1 one fails, 2 bad input."
+        after_help = "Example:\n  contact-patch judge cases/patch-single/q4-distorted.json results/q4-distorted.vtu\n  contact-patch judge cases/patch/patch-A-nu0.3.json results/patch-A-nu0.3/ --junit judge.xml\n  contact-patch judge export/patch-A-nu0.3 results/patch-A-nu0.3/\n\nCASE is a case file, or the folder `export` wrote for it (or the <case>.json in it), which\ncarries the case. RESULTS is a .vtu file (ASCII, base64 binary, appended raw or base64,\nzlib-compressed) with the point field 'displacement' (optional: 'stress'; names read without\nregard to case), or a folder with one <body name>.vtu per body. Each node is matched to the result point within\n--match-tol times the model size. Checks that need the solve's contact forces are listed as\nnot judged. Exit codes: 0 every judged check passes, 1 one fails, 2 bad input."
     )]
     Judge {
-        /// The case file (JSON).
+        /// The case file (JSON), or a folder `export` wrote (or the <case>.json sidecar in it).
         case: PathBuf,
         /// The results: a .vtu file, or a folder with <body name>.vtu per body.
         results: PathBuf,
@@ -813,10 +813,22 @@ fn judge(case: &Path, results: &Path, match_tol: f64, junit_path: Option<&Path>)
         Ok(f) => f,
         Err(code) => return code,
     };
-    if let Some(case3) = contact_patch::run3d::read_3d_case(case) {
-        return judge3(case, &case3, results, match_tol, junit_out);
-    }
-    let judged = contact_patch::model::admit::load(case).and_then(|model| {
+    // an export folder or its sidecar carries the case (contact_patch::io::export)
+    let model = match contact_patch::io::export::exported_case(case) {
+        Ok(Some((sidecar, exported))) => {
+            let source = sidecar.display().to_string();
+            contact_patch::model::Model::build(&exported, &source)
+                .and_then(contact_patch::model::admit::admit)
+        }
+        Ok(None) => {
+            if let Some(case3) = contact_patch::run3d::read_3d_case(case) {
+                return judge3(case, &case3, results, match_tol, junit_out);
+            }
+            contact_patch::model::admit::load(case)
+        }
+        Err(e) => Err(e),
+    };
+    let judged = model.and_then(|model| {
         let found = judge::load_results(&model, results)?;
         let j = judge::judge(&model, &found, match_tol)?;
         Ok((model, j))

@@ -889,6 +889,66 @@ fn results_in_every_vtk_encoding_with_upper_case_names_give_the_ascii_verdicts()
     }
 }
 
+#[test]
+fn judge_takes_the_export_folder_alone() {
+    let tmp = tempfile::tempdir().unwrap();
+    let export = tmp.path().join("export");
+    // a case of block meshes with contact, and one meshed from a Gmsh file (written into the
+    // sidecar as an explicit mesh with its physical groups as node and facet sets)
+    for (case, name) in [
+        ("cases/patch/patch-A-nu0.3.json", "patch-A-nu0.3"),
+        ("cases/gmsh/patch-q4.json", "patch-q4"),
+    ] {
+        let o = run(&["export", case, "--out", export.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(0), "{}", say(&o));
+        let results = tmp.path().join(format!("results-{name}"));
+        run_into(case, &results);
+        let direct = run(&["judge", case, results.to_str().unwrap()]);
+        assert_eq!(direct.status.code(), Some(0), "{}", say(&direct));
+        // from a folder where the case file the sidecar records does not exist: the export
+        // folder, and its sidecar, are enough
+        let folder = export.join(name);
+        let sidecar = folder.join(format!("{name}.json"));
+        let elsewhere = tempfile::tempdir().unwrap();
+        for given in [&folder, &sidecar] {
+            let o = Command::new(BIN)
+                .current_dir(elsewhere.path())
+                .args(["judge", given.to_str().unwrap(), results.to_str().unwrap()])
+                .output()
+                .unwrap();
+            assert_eq!(o.status.code(), Some(0), "{}", say(&o));
+            assert_eq!(verdict_lines(&o), verdict_lines(&direct), "{}", say(&o));
+        }
+        let value: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&sidecar).unwrap()).unwrap();
+        if name == "patch-q4" {
+            assert!(
+                value["problem"]["bodies"][0]["mesh"]
+                    .get("explicit")
+                    .is_some(),
+                "{}",
+                value["problem"]["bodies"][0]
+            );
+        }
+        // a sidecar without the case says how to get one
+        let mut old = value.clone();
+        old.as_object_mut().unwrap().remove("problem");
+        let old_file = tmp.path().join(format!("old-{name}.json"));
+        std::fs::write(&old_file, old.to_string()).unwrap();
+        let o = run(&[
+            "judge",
+            old_file.to_str().unwrap(),
+            results.to_str().unwrap(),
+        ]);
+        let s = say(&o);
+        assert_eq!(o.status.code(), Some(2), "{s}");
+        assert!(
+            s.contains("holds no 'problem'") && s.contains("export the case again"),
+            "{s}"
+        );
+    }
+}
+
 /// `cases/patch/patch-A-nu0.3.json` with the contact geometry in the current configuration:
 /// the punch slides over the foundation by the lateral strain, and the pair's moments balance
 /// about the deformed positions `X + u`.

@@ -13,13 +13,18 @@
 //!   a closed form (`sigma = const`, `u = [e_xx x + g/2 y, g/2 x + e_yy y]` with `e = D^-1
 //!   sigma`, or Timoshenko & Goodier's cantilever, see `src/harness/exact.rs`), and the same
 //!   data resolved on the mesh: every prescribed dof with its value and every nonzero
-//!   consistent nodal load (`f_a = int N_a t ds`), by body, node number and Gmsh node tag.
+//!   consistent nodal load (`f_a = int N_a t ds`), by body, node number and Gmsh node tag;
+//!   and under `problem` the case itself as a case file states it, so that the folder alone is
+//!   enough to judge results (`contact-patch judge <folder or sidecar> RESULTS`, read back by
+//!   [`exported_case`]): a body meshed from a Gmsh file becomes an `explicit` mesh with its
+//!   nodes and cells as built (the same numbering) and its node and facet sets as lists; every
+//!   other body is as written.
 
 use crate::error::{Error, Result};
 use crate::harness::exact::ExactField;
 use crate::io::gmsh;
 use crate::io::paths::{file_name, OutputFolder, ReportFolder};
-use crate::io::scene::{Case, Plane};
+use crate::io::scene::{Case, MeshSpec, Plane};
 use crate::model::admit::admit;
 use crate::model::{parse, Model};
 use serde_json::{json, Value};
@@ -74,8 +79,125 @@ fn exact_description(model: &Model) -> Value {
     }
 }
 
-/// The sidecar JSON of a case.
-pub fn sidecar(case: &Case, model: &Model, case_file: &Path) -> Value {
+/// The case as data that builds the same model without any other file (module notes): the
+/// case serialized, each body meshed from a Gmsh file replaced by its explicit mesh and sets.
+fn self_sufficient(case: &Case, model: &Model, source: &str) -> Result<Value> {
+    let mut scene = serde_json::to_value(case).expect("a case serializes");
+    for (spec, body) in case.bodies.iter().zip(&model.bodies) {
+        if !matches!(spec.mesh, MeshSpec::Gmsh(_)) {
+            continue;
+        }
+        let mesh = &body.mesh;
+        let cells: Vec<&[usize]> = (0..mesh.cell_count()).map(|c| mesh.cell(c)).collect();
+        // the sets an explicit mesh of the same nodes and cells has by itself
+        let built_in =
+            crate::mesh::Mesh::new(mesh.kind, mesh.nodes.clone(), mesh.connectivity.clone());
+        let mut node_sets = serde_json::Map::new();
+        for (name, nodes) in &mesh.node_sets {
+            match built_in.node_sets.get(name) {
+                Some(same) if same == nodes => {}
+                Some(_) => return Err(clash(source, &body.name, "node", name)),
+                None => {
+                    node_sets.insert(name.clone(), json!({ "nodes": nodes }));
+                }
+            }
+        }
+        let mut facet_sets = serde_json::Map::new();
+        for (name, facets) in &mesh.facet_sets {
+            match built_in.facet_sets.get(name) {
+                Some(same) if same == facets => {}
+                Some(_) => return Err(clash(source, &body.name, "facet", name)),
+                None => {
+                    let list: Vec<[usize; 2]> = facets.iter().map(|f| [f.cell, f.edge]).collect();
+                    facet_sets.insert(name.clone(), json!({ "facets": list }));
+                }
+            }
+        }
+        let at = scene["bodies"]
+            .as_array_mut()
+            .expect("bodies serialize as a list")
+            .iter_mut()
+            .find(|b| b["name"] == body.name.as_str())
+            .expect("every body is in the case");
+        at["mesh"] =
+            json!({"explicit": {"element": mesh.kind, "nodes": mesh.nodes, "cells": cells}});
+        at["node_sets"] = Value::Object(node_sets);
+        at["facet_sets"] = Value::Object(facet_sets);
+    }
+    Ok(scene)
+}
+
+/// The refusal of a Gmsh set whose name is that of a built-in set with other members.
+fn clash(source: &str, body: &str, kind: &str, name: &str) -> Error {
+    Error::invalid(
+        source,
+        format!("body '{body}', {kind} set '{name}'"),
+        format!(
+            "the Gmsh file's {kind} set '{name}' differs from the built-in set of that name, \
+             which an explicit mesh of the same nodes would have"
+        ),
+        "rename the physical group in the .msh file (the built-in sets are the sides, corners \
+         and 'all')",
+    )
+}
+
+/// The case of an export at `path` (its folder, or the sidecar `<case>.json` in it) and the
+/// sidecar's path, or `None` when `path` is not an export (a case file).
+pub fn exported_case(path: &Path) -> Result<Option<(std::path::PathBuf, Case)>> {
+    let sidecar = if path.is_dir() {
+        let name = path.file_name().map(|n| n.to_string_lossy().to_string());
+        let file = name.map(|n| path.join(format!("{n}.json")));
+        match file.filter(|f| f.is_file()) {
+            Some(f) => f,
+            None => {
+                return Err(Error::invalid(
+                    path.display(),
+                    "export folder",
+                    "no sidecar <folder name>.json in the folder",
+                    "give the folder `contact-patch export` wrote for the case (<out>/<case \
+                     name>/), its <case name>.json, or the case file",
+                ))
+            }
+        }
+    } else {
+        path.to_path_buf()
+    };
+    let source = sidecar.display().to_string();
+    let Ok(text) = fs::read_to_string(&sidecar) else {
+        return Ok(None);
+    };
+    let Ok(value) = serde_json::from_str::<Value>(&text) else {
+        return Ok(None);
+    };
+    let is_export = value
+        .get("format")
+        .and_then(Value::as_str)
+        .is_some_and(|f| f.starts_with("contact-patch export"));
+    if !is_export {
+        return Ok(None);
+    }
+    let Some(problem) = value.get("problem") else {
+        return Err(Error::invalid(
+            &source,
+            "problem",
+            format!(
+                "the sidecar ({}) holds no 'problem': it was written before the export carried \
+                 the case",
+                value["format"]
+            ),
+            format!(
+                "export the case again (contact-patch export CASE --out DIR), or judge with the \
+                 case file it names: {}",
+                value["case_file"]
+            ),
+        ));
+    };
+    let case = parse(&problem.to_string(), &format!("{source} (problem)"))?;
+    Ok(Some((sidecar, case)))
+}
+
+/// The sidecar JSON of a case, or why the case cannot be stated without its files.
+pub fn sidecar(case: &Case, model: &Model, case_file: &Path) -> Result<Value> {
     let scene = serde_json::to_value(case).expect("a case serializes");
     let pick = |key: &str| scene.get(key).cloned().unwrap_or(Value::Null);
     let mut offset = 0usize;
@@ -138,7 +260,8 @@ pub fn sidecar(case: &Case, model: &Model, case_file: &Path) -> Value {
         }
         offset += mesh.nodes.len();
     }
-    json!({
+    let problem = self_sufficient(case, model, &case_file.display().to_string())?;
+    Ok(json!({
         "format": SIDECAR_FORMAT,
         "case": model.name,
         "description": model.description,
@@ -167,11 +290,12 @@ pub fn sidecar(case: &Case, model: &Model, case_file: &Path) -> Value {
             "consistent_nodal_forces": forces,
         },
         "results": {
-            "judge": format!("contact-patch judge {} RESULTS", case_file.display()),
+            "judge": "contact-patch judge EXPORT_FOLDER RESULTS (this folder, or this file; or the case file named by case_file)",
             "expected": "a .vtu with point data 'displacement' (2 or 3 components) at the mesh's nodes, optionally 'stress' (xx, yy, xy, or a 2x2 / 3x3 tensor) and the contact fields below; or a folder with <body>.vtu per body when bodies touch",
             "fields": judged_fields(),
         },
-    })
+        "problem": problem,
+    }))
 }
 
 /// The point fields `judge` reads, with their components, meaning and use
@@ -251,7 +375,7 @@ pub fn export_case(case_file: &Path, out: &ReportFolder) -> Result<(OutputFolder
         (msh_name, gmsh::msh(&meshes)),
         (
             json_name,
-            serde_json::to_string_pretty(&sidecar(&case, &model, case_file))
+            serde_json::to_string_pretty(&sidecar(&case, &model, case_file)?)
                 .expect("the sidecar serializes")
                 + "\n",
         ),
