@@ -44,8 +44,10 @@
 //!   an open point is not in contact and has no slip (none reported, as for a frictionless
 //!   pair).
 //!
-//! A node without a row of its own (the master surface of a one-pass pair) is `unmeasured`:
-//! it has a force and a pressure but no gap, status or slip.
+//! A node without a row of its own (the master surface of a one-pass pair, or a slave node
+//! past the master's free end, whose finite-kinematics row to a master vertex carries no force:
+//! `Constraint::past_free_end`) is `unmeasured`: it has a force and a pressure but no gap,
+//! status or slip.
 //!
 //! Per pair the totals: the forces on both sides (from [`super::forces`]), the normal force
 //! the pair transmits, `sum_a -f_a . n_a` over the first-pass slave side, the closed area (the
@@ -211,7 +213,9 @@ fn one_pair(model: &Model, state: &ContactState, u: &[f64], forces: &PairForces)
     let pair = &model.contact[k];
     let mut findings: BTreeMap<(usize, usize), RowFindings> = BTreeMap::new();
     for (i, r) in state.rows.iter().enumerate() {
-        if r.pair != k {
+        // a row past the master's free end that carries no force is no measurement: the node
+        // has no master facet under it ([`Constraint::past_free_end`])
+        if r.pair != k || (r.past_free_end && !state.active[i]) {
             continue;
         }
         let found = findings.entry((r.slave_body, r.slave_node)).or_default();

@@ -1067,6 +1067,7 @@ fn weighted_row(
         segment: None,
         nodal_normal: None,
         hessian: None,
+        past_free_end: false,
     }
 }
 
