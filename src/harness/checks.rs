@@ -275,7 +275,7 @@ pub fn force_balance_of(model: &Model, solution: &Solution, forces: &[PairForces
         let e = net[0]
             .abs()
             .max(net[1].abs())
-            .max(pf.net_moment.abs() / size)
+            .max(crate::contact::forces::length(&pf.net_moment) / size)
             / load;
         error = worst(error, e);
     }

@@ -253,7 +253,7 @@ pub fn read(model: &Model, results: &Results, matched: &[Vec<usize>]) -> Result<
                 pair: k,
                 on_slave,
                 on_master,
-                net_moment,
+                net_moment: [0.0, 0.0, net_moment],
                 force_scale,
                 nodes,
                 penetration,

@@ -193,6 +193,15 @@ impl Rows<'_> {
 /// The contact rows of a pair in the dimension of the model's cells: the one place where the
 /// discretizations of 2D ([`constraints`]) and 3D meet the dimension-free solver.
 pub trait Discretize<const D: usize>: crate::model::space::SolidCell<D> {
+    /// The cells' contact facets: edges in 2D, faces in 3D.
+    type Facet: geometry::FacetShape<D>;
+
+    /// The kind of this cell's facets.
+    fn facet_shape(self) -> Self::Facet;
+
+    /// The VTK cell type of this cell's facets (the contact surfaces' `.vtu` files).
+    fn facet_vtk_type(self) -> u8;
+
     /// The rows of `pair` in the reference configuration of `model`, or why the pair's
     /// discretization does not apply.
     fn pair_rows(
@@ -211,6 +220,19 @@ pub trait Discretize<const D: usize>: crate::model::space::SolidCell<D> {
 }
 
 impl Discretize<2> for crate::fe::ElementKind {
+    type Facet = crate::fe::EdgeKind;
+
+    fn facet_shape(self) -> crate::fe::EdgeKind {
+        self.edge_kind()
+    }
+
+    fn facet_vtk_type(self) -> u8 {
+        match self.edge_kind() {
+            crate::fe::EdgeKind::Line2 => 3,
+            crate::fe::EdgeKind::Line3 => 21,
+        }
+    }
+
     fn pair_rows(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>, String> {
         constraints(model, pair)
     }
@@ -221,6 +243,16 @@ impl Discretize<2> for crate::fe::ElementKind {
 }
 
 impl Discretize<3> for crate::fe3d::SolidKind {
+    type Facet = crate::fe::ElementKind;
+
+    fn facet_shape(self) -> crate::fe::ElementKind {
+        self.facet_kind()
+    }
+
+    fn facet_vtk_type(self) -> u8 {
+        self.facet_kind().vtk_cell_type()
+    }
+
     fn pair_rows(
         model: &crate::model::Model3,
         pair: &ContactPair,
