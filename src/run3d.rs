@@ -57,7 +57,12 @@
 //! under `contact.pairs`), and the check `max_penetration`. Supports are the 2D model's
 //! ([`crate::model::Model::apply_supports`]: one conflict rule, one load path), and
 //! `summary.json` lists each support set's reaction (`reactions`, x, y and z, every prescribed
-//! dof counted in one set: [`crate::post::ReactionSummary`]).
+//! dof counted in one set: [`crate::post::ReactionSummary`]). Contact output is the 2D one,
+//! from the same functions generic over the dimension: per pair the summary of
+//! [`crate::io::output::PairSummary`] (forces, normal force, closed area, largest pressure,
+//! point counts), the `<pair>.contact.csv`, `.json` and `.vtu` files of
+//! [`crate::io::contact_output`] (pressure, shear, gap, status, slip and forces per point,
+//! [`crate::contact::results`]) and the contact fields of the body `.vtu` files.
 //!
 //! The check `uniform_stress_3d` is the 3D uniform-stress check: the largest difference over
 //! the quadrature points of the stiffness rule and the six components, relative to the
@@ -66,14 +71,15 @@
 //! kinematics), the mean over the cells
 //! around each node of the stress at the cell's natural centre.
 
-use crate::contact::discretization::geometry::Surface3;
-use crate::contact::forces::{element_sizes, pair_penetration, Penetration};
-use crate::contact::state::ContactState;
+use crate::contact::forces::{pair_forces, Penetration};
+use crate::contact::results::{pair_results, PairResults};
 use crate::error::{Error, Result};
 use crate::fe::displacement_gradient_at;
 use crate::fe::ReferenceCell;
 use crate::fe3d::SolidKind;
 use crate::harness::checks::{max_penetration_check, penetration_warnings, CheckResult};
+use crate::io::contact_output::{body_point_arrays, write_pair_files};
+use crate::io::output::pair_summaries;
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
 use crate::io::scene::{
     Case, Check, ContactGeometry, DiscretizationSpec, Interaction, Kinematics, MaterialModel,
@@ -122,10 +128,12 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
     crate::post::check_finite_nodal_stresses(&model, &solution.u, nodal_stress)?;
     solution.timings.mesh = meshed;
     solution.timings.total = start.elapsed().as_secs_f64();
-    let penetrations = solution
-        .contact
-        .as_ref()
-        .map(|state| penetrations3(&model, state));
+    let penetrations: Option<Vec<Penetration<3>>> = solution.contact.as_ref().map(|state| {
+        pair_forces(&model, state)
+            .into_iter()
+            .map(|f| f.penetration)
+            .collect()
+    });
     let mut checks: Vec<CheckResult> = case
         .checks
         .iter()
@@ -661,48 +669,10 @@ fn nodal_stress(body: &Body3, u: &[f64]) -> Vec<[f64; 6]> {
         .collect()
 }
 
-/// The largest penetration of every contact pair of `model` in the contact solution `state`
-/// ([`crate::contact::forces::pair_penetration`], as in 2D): relative to the longest facet at
-/// the slave node, the facets and positions taken where the rows were linearized (the
-/// reference configuration, or `X + u` in the current geometry).
-fn penetrations3(model: &Model3, state: &ContactState<3>) -> Vec<Penetration<3>> {
-    let config = state.configuration.as_deref();
-    let position = |b: usize, n: usize| {
-        let body = &model.bodies[b];
-        let p = body.mesh.nodes[n];
-        match config {
-            Some(u) => std::array::from_fn(|i| p[i] + u[body.dof(n, i)]),
-            None => p,
-        }
-    };
-    (0..model.contact.len())
-        .map(|k| {
-            let pair = &model.contact[k];
-            let mut sides = vec![(pair.slave.0, &pair.slave.1)];
-            if let MasterSide::Body { body, facets } = &pair.master {
-                sides.push((*body, facets));
-            }
-            let surfaces: Vec<Surface3> = sides
-                .iter()
-                .map(|&(b, facets)| {
-                    let mesh = &model.bodies[b].mesh;
-                    let nodes: Vec<Vec<usize>> =
-                        facets.iter().map(|&f| mesh.facet_nodes(f)).collect();
-                    let coords = nodes
-                        .iter()
-                        .map(|f| f.iter().map(|&n| position(b, n)).collect())
-                        .collect();
-                    Surface3::from_facets(b, mesh.kind.facet_kind(), nodes, coords, 1.0)
-                })
-                .collect();
-            let sizes: Vec<_> = surfaces.iter().map(element_sizes).collect();
-            pair_penetration(state, k, &surfaces, &sizes, position)
-        })
-        .collect()
-}
-
-/// The contact part of the summary: how the solve ended and the rows' totals.
-fn contact_summary(outcome: &Outcome3) -> Option<serde_json::Value> {
+/// The contact part of the summary: how the solve ended, the rows' totals and each pair's
+/// summary (the 2D one: [`crate::io::output::PairSummary`]) from its forces and per-point
+/// `results`.
+fn contact_summary(outcome: &Outcome3, results: &[PairResults<3>]) -> Option<serde_json::Value> {
     let state = outcome.solution.contact.as_ref()?;
     let active = state.active.iter().filter(|&&a| a).count();
     let mut force = [0.0; 3];
@@ -711,27 +681,11 @@ fn contact_summary(outcome: &Outcome3) -> Option<serde_json::Value> {
             force[i] += f * r.normal[i];
         }
     }
-    let penetrations = penetrations3(&outcome.model, state);
-    let pairs: Vec<serde_json::Value> = penetrations
-        .iter()
-        .enumerate()
-        .map(|(k, p)| {
-            let mut pair = serde_json::json!({
-                "name": outcome.model.contact[k].name,
-                "max_penetration": p.depth,
-                "max_penetration_share": p.share_of_element,
-            });
-            if let Some((b, node, point)) = p.at {
-                pair["max_penetration_at"] = serde_json::json!({
-                    "body": outcome.model.bodies[b].name,
-                    "node": node,
-                    "point": point,
-                });
-            }
-            pair
-        })
-        .collect();
-    let most = |get: fn(&Penetration<3>) -> f64| penetrations.iter().map(get).fold(0.0, f64::max);
+    let forces = pair_forces(&outcome.model, state);
+    let penetrations: Vec<&Penetration<3>> = forces.iter().map(|f| &f.penetration).collect();
+    let pairs = pair_summaries(&outcome.model, state, &forces, results);
+    let most =
+        |get: fn(&Penetration<3>) -> f64| penetrations.iter().map(|p| get(p)).fold(0.0, f64::max);
     let mut summary = serde_json::json!({
         "termination": format!("{:?}", state.termination),
         "iterations": state.iterations,
@@ -755,6 +709,12 @@ fn contact_summary(outcome: &Outcome3) -> Option<serde_json::Value> {
 pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
     let model = &outcome.model;
     let u = &outcome.solution.u;
+    let results: Vec<PairResults<3>> = outcome
+        .solution
+        .contact
+        .as_ref()
+        .map(|state| pair_results(model, state, u))
+        .unwrap_or_default();
     let bodies: Vec<serde_json::Value> = model
         .bodies
         .iter()
@@ -779,7 +739,7 @@ pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
         "relative_residual": outcome.solution.relative_residual,
         "timings": outcome.solution.timings,
         "reactions": crate::post::reaction_summaries(model, &outcome.solution.reactions),
-        "contact": contact_summary(outcome),
+        "contact": contact_summary(outcome, &results),
         "passed": outcome.passed(),
         "warnings": outcome.warnings,
         "checks": outcome.checks.iter().map(|c| serde_json::json!({
@@ -798,7 +758,7 @@ pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
     folder.write(|tmp| {
         let text = serde_json::to_string_pretty(&summary).expect("the summary serializes");
         crate::io::paths::write_new_file(&tmp.join("summary.json"), &(text + "\n"))?;
-        for body in &model.bodies {
+        for (k, body) in model.bodies.iter().enumerate() {
             let mesh = &body.mesh;
             let stress: Vec<f64> = nodal_stress(body, u).into_iter().flatten().collect();
             let displacement: Vec<f64> = (0..mesh.nodes.len())
@@ -808,16 +768,13 @@ pub fn write_run3(folder: &OutputFolder, outcome: &Outcome3) -> Result<()> {
                 .map(|c| (mesh.kind.vtk_cell_type(), mesh.cell(c).to_vec()))
                 .collect();
             let path = tmp.join(file_name("body name", &body.name, ".vtu")?);
-            write_grid(
-                &path,
-                &mesh.nodes,
-                &cells,
-                &[
-                    PointArray::float("displacement", 3, displacement),
-                    PointArray::float("stress", 6, stress),
-                ],
-            )?;
+            let mut arrays = vec![
+                PointArray::float("displacement", 3, displacement),
+                PointArray::float("stress", 6, stress),
+            ];
+            arrays.extend(body_point_arrays(model, k, &results));
+            write_grid(&path, &mesh.nodes, &cells, &arrays)?;
         }
-        Ok(())
+        write_pair_files(tmp, model, &results)
     })
 }

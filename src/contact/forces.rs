@@ -65,33 +65,35 @@
 //! configuration.
 
 use super::discretization::geometry::{NodeData, Surface};
+use super::discretization::Discretize;
 use super::state::ContactState;
-use crate::model::{Body, MasterSide, Model};
+use crate::model::{MasterSide, Model};
 use std::collections::BTreeMap;
 
-/// The contact traction at one node of a contact surface.
+/// The contact traction at one node of a contact surface (`D` components).
 #[derive(Clone, Debug)]
-pub struct NodalTraction {
+pub struct NodalTraction<const D: usize = 2> {
     pub body: usize,
     pub node: usize,
     /// Position (in the configuration of the rows).
-    pub point: [f64; 2],
-    /// Tributary area `t int N_a ds`.
+    pub point: [f64; D],
+    /// Tributary area `t int N_a ds` (`int N_a dA` in 3D).
     pub area: f64,
     /// The part of it that the pair's rows at the node cover, `C_a` (module notes; 0 at a node
     /// without rows).
     pub covered_area: f64,
     /// Outward unit normal of the surface at the node.
-    pub normal: [f64; 2],
+    pub normal: [f64; D],
     /// Nodal contact force `f_a`.
-    pub force: [f64; 2],
-    /// The recovered traction `-p_a n_a + tau_a t_a` (module notes).
-    pub traction: [f64; 2],
+    pub force: [f64; D],
+    /// The recovered traction `-p_a n_a + tau_a` (module notes).
+    pub traction: [f64; D],
     /// The recovered pressure `p_a` (compression positive; `-f_a . n_a / A_a` where the node's
     /// tributary is wholly covered).
     pub pressure: f64,
-    /// The recovered shear traction `tau_a` along `t_a = (-n_y, n_x)` (`f_a . t_a / A_a` where
-    /// the node's tributary is wholly covered).
+    /// The recovered shear traction: in 2D `tau_a` along `t_a = (-n_y, n_x)` (signed;
+    /// `f_a . t_a / A_a` where the node's tributary is wholly covered), in 3D the magnitude of
+    /// the tangential traction vector `tau_a` (module notes).
     pub shear: f64,
     /// Whether a row of the pair has this node as its slave node.
     pub carries_rows: bool,
@@ -110,21 +112,22 @@ pub struct Penetration<const D: usize = 2> {
 
 /// What one pair transmits.
 #[derive(Clone, Debug)]
-pub struct PairForces {
+pub struct PairForces<const D: usize = 2> {
     pub pair: usize,
     /// Net force on the pair's (first-pass) slave body, and on its master (body or rigid).
-    pub on_slave: [f64; 2],
-    pub on_master: [f64; 2],
+    pub on_slave: [f64; D],
+    pub on_master: [f64; D],
     /// Net moment (about the origin, in the configuration of the rows) of the forces on both
-    /// sides, and the sum of `|f_a|` over all nodes (its scale).
-    pub net_moment: f64,
+    /// sides, `[M_x, M_y, M_z]` (in 2D only `M_z`), and the sum of `|f_a|` over all nodes (its
+    /// scale).
+    pub net_moment: [f64; 3],
     pub force_scale: f64,
     /// Tractions at the nodes of both surfaces (the master's only for a body master).
-    pub nodes: Vec<NodalTraction>,
-    pub penetration: Penetration,
+    pub nodes: Vec<NodalTraction<D>>,
+    pub penetration: Penetration<D>,
 }
 
-impl PairForces {
+impl<const D: usize> PairForces<D> {
     /// Largest contact pressure over the nodes that carry rows (both sides for two passes).
     pub fn max_pressure(&self) -> f64 {
         self.nodes
@@ -134,23 +137,29 @@ impl PairForces {
     }
 }
 
-/// The body owning global dof `d`, and the local node and component.
-fn owner(model: &Model, d: usize) -> (usize, usize, usize) {
-    let r = model.dof_owner(d).expect("a body owns every dof");
-    (r.body, r.node, r.component)
+/// The length of `a` (`hypot` component by component: in 2D `|f|` as `f_x.hypot(f_y)`, and
+/// `|M_z|` exactly for a 2D moment).
+pub fn length(a: &[f64]) -> f64 {
+    a.iter().fold(0.0, |l: f64, &c| l.hypot(c))
 }
 
-/// `body` moved to `X + u` (or as it is, borrowed, without `u`).
-pub(crate) fn placed<'a>(body: &'a Body, u: Option<&[f64]>) -> std::borrow::Cow<'a, Body> {
-    let Some(u) = u else {
-        return std::borrow::Cow::Borrowed(body);
-    };
-    let mut b = body.clone();
-    for (n, p) in b.mesh.nodes.iter_mut().enumerate() {
-        p[0] += u[body.dof(n, 0)];
-        p[1] += u[body.dof(n, 1)];
+/// `a` in three components (`[a_x, a_y, 0]` in 2D).
+fn in_3d<const D: usize>(a: [f64; D]) -> [f64; 3] {
+    std::array::from_fn(|i| if i < D { a[i] } else { 0.0 })
+}
+
+/// The directions `d_k` whose nodal force components `f_a . d_k` are recovered as the shear
+/// (module notes): in 2D the tangent `t = (-n_y, n_x)` (a signed shear); in 3D the axes
+/// projected onto the tangent plane, `e_k - n_k n`, whose components make the tangential
+/// traction vector.
+fn shear_directions<const D: usize>(n: [f64; D]) -> Vec<[f64; D]> {
+    if D == 2 {
+        vec![std::array::from_fn(|i| if i == 0 { -n[1] } else { n[0] })]
+    } else {
+        (0..D)
+            .map(|k| std::array::from_fn(|i| f64::from(u8::from(i == k)) - n[k] * n[i]))
+            .collect()
     }
-    std::borrow::Cow::Owned(b)
 }
 
 /// Longest facet at each node of `surface`: the largest distance between two nodes of a
@@ -173,31 +182,43 @@ pub(crate) fn element_sizes<const D: usize, K>(surface: &Surface<D, K>) -> BTree
     h
 }
 
-/// Forces, pressures and penetrations of every pair of `model` in the contact solution `state`.
-pub fn pair_forces(model: &Model, state: &ContactState) -> Vec<PairForces> {
+/// Forces, pressures and penetrations of every pair of `model` in the contact solution `state`,
+/// in either dimension.
+pub fn pair_forces<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
+    state: &ContactState<D>,
+) -> Vec<PairForces<D>> {
     let config = state.configuration.as_deref();
     (0..model.contact.len())
         .map(|k| one_pair(model, state, k, config))
         .collect()
 }
 
-fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]>) -> PairForces {
+fn one_pair<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
+    state: &ContactState<D>,
+    k: usize,
+    config: Option<&[f64]>,
+) -> PairForces<D> {
     let pair = &model.contact[k];
-    // The surfaces of both sides, in the configuration of the rows.
+    // The surfaces of both sides, in the configuration of the rows (the out-of-plane thickness
+    // weighs the 2D tributaries).
     let mut sides = vec![(pair.slave.0, &pair.slave.1)];
     if let MasterSide::Body { body, facets } = &pair.master {
         sides.push((*body, facets));
     }
-    let surfaces: Vec<Surface> = sides
+    let thickness = if D == 2 { model.thickness } else { 1.0 };
+    let surfaces: Vec<Surface<D, K::Facet>> = sides
         .iter()
-        .map(|&(b, facets)| {
-            let body = placed(&model.bodies[b], config);
-            Surface::new(b, &body, facets, model.thickness)
-        })
+        .map(|&(b, facets)| Surface::of_body(b, &model.bodies[b], facets, thickness, config))
         .collect();
+    let owner = |d: usize| {
+        let r = model.dof_owner(d).expect("a body owns every dof");
+        (r.body, r.node, r.component)
+    };
 
     // f^k, per (body, node).
-    let mut nodal: BTreeMap<(usize, usize), [f64; 2]> = BTreeMap::new();
+    let mut nodal: BTreeMap<(usize, usize), [f64; D]> = BTreeMap::new();
     let mut slave_nodes = std::collections::BTreeSet::new();
     for (i, (r, &lambda)) in state.rows.iter().zip(&state.forces).enumerate() {
         if r.pair != k {
@@ -205,43 +226,47 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
         }
         slave_nodes.insert((r.slave_body, r.slave_node));
         for (&d, &c) in r.dofs.iter().zip(&r.coeffs) {
-            let (b, n, comp) = owner(model, d);
-            nodal.entry((b, n)).or_insert([0.0; 2])[comp] += c * lambda;
+            let (b, n, comp) = owner(d);
+            nodal.entry((b, n)).or_insert([0.0; D])[comp] += c * lambda;
         }
         // a frictional row's tangential force acts along its slip gradient
         if let Some(Some(f)) = state.friction.get(i) {
             for (t, &lambda_t) in r.tangents.iter().zip(&f.force) {
                 for (&d, &c) in t.dofs.iter().zip(&t.coeffs) {
-                    let (b, n, comp) = owner(model, d);
-                    nodal.entry((b, n)).or_insert([0.0; 2])[comp] += c * lambda_t;
+                    let (b, n, comp) = owner(d);
+                    nodal.entry((b, n)).or_insert([0.0; D])[comp] += c * lambda_t;
                 }
             }
         }
     }
-    let position = |b: usize, n: usize| {
+    let position = |b: usize, n: usize| -> [f64; D] {
         let body = &model.bodies[b];
         let p = body.mesh.nodes[n];
         match config {
-            Some(u) => [p[0] + u[body.dof(n, 0)], p[1] + u[body.dof(n, 1)]],
+            Some(u) => std::array::from_fn(|i| p[i] + u[body.dof(n, i)]),
             None => p,
         }
     };
-    let (mut on_slave, mut on_master) = ([0.0; 2], [0.0; 2]);
-    let (mut net_moment, mut force_scale) = (0.0, 0.0);
+    let (mut on_slave, mut on_master) = ([0.0; D], [0.0; D]);
+    let (mut net_moment, mut force_scale) = ([0.0; 3], 0.0);
     for (&(b, n), f) in &nodal {
         let target = if b == pair.slave.0 {
             &mut on_slave
         } else {
             &mut on_master
         };
-        target[0] += f[0];
-        target[1] += f[1];
-        let p = position(b, n);
-        net_moment += p[0] * f[1] - p[1] * f[0];
-        force_scale += f[0].hypot(f[1]);
+        for i in 0..D {
+            target[i] += f[i];
+        }
+        let (p, f3) = (in_3d(position(b, n)), in_3d(*f));
+        for i in 0..3 {
+            let (j, l) = ((i + 1) % 3, (i + 2) % 3);
+            net_moment[i] += p[j] * f3[l] - p[l] * f3[j];
+        }
+        force_scale += length(f);
     }
     if let MasterSide::Rigid(_) = pair.master {
-        on_master = [-on_slave[0], -on_slave[1]];
+        on_master = on_slave.map(|f| -f);
     }
 
     // the covered tributaries of the rows, per surface (pass 1: the slave surface, pass 2: the
@@ -260,22 +285,35 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
             *e = e.max(w);
         }
     }
+    let dot = |a: [f64; D], b: [f64; D]| (0..D).map(|i| a[i] * b[i]).sum::<f64>();
     let mut nodes = Vec::new();
     for (s, cover) in surfaces.iter().zip(&cover) {
-        let force = |n: usize| nodal.get(&(s.body, n)).copied().unwrap_or([0.0; 2]);
-        let component = |along: &dyn Fn(&NodeData) -> [f64; 2]| -> BTreeMap<usize, f64> {
+        let force = |n: usize| nodal.get(&(s.body, n)).copied().unwrap_or([0.0; D]);
+        let component = |along: &dyn Fn(&NodeData<D>) -> [f64; D]| -> BTreeMap<usize, f64> {
             s.nodes
                 .iter()
-                .map(|(&n, data)| {
-                    let (f, d) = (force(n), along(data));
-                    (n, f[0] * d[0] + f[1] * d[1])
-                })
+                .map(|(&n, data)| (n, dot(force(n), along(data))))
                 .collect()
         };
-        let pressure = recovered(s, cover, &component(&|d| [-d.normal[0], -d.normal[1]]));
-        let shear = recovered(s, cover, &component(&|d| [-d.normal[1], d.normal[0]]));
+        let pressure = recovered(s, cover, &component(&|d| d.normal.map(|c| -c)));
+        let shear: Vec<BTreeMap<usize, f64>> = (0..if D == 2 { 1 } else { D })
+            .map(|k| recovered(s, cover, &component(&|d| shear_directions(d.normal)[k])))
+            .collect();
         for (&n, data) in &s.nodes {
-            let (nn, p, tau) = (data.normal, pressure[&n], shear[&n]);
+            let (nn, p) = (data.normal, pressure[&n]);
+            // the tangential traction `sum_k v_k d_k`: `tau t` in 2D, the recovered vector
+            // projected onto the node's tangent plane in 3D
+            let mut tangential = [0.0; D];
+            for (v, d) in shear.iter().zip(shear_directions(nn)) {
+                for i in 0..D {
+                    tangential[i] += v[&n] * d[i];
+                }
+            }
+            let tau = if D == 2 {
+                shear[0][&n]
+            } else {
+                dot(tangential, tangential).sqrt()
+            };
             // the whole tributary where it is covered to round-off
             let covered_area = cover.get(&n).map_or(0.0, |c| c.values().sum());
             let covered_area = if (covered_area - data.area).abs() <= 1e-14 * data.area {
@@ -291,7 +329,7 @@ fn one_pair(model: &Model, state: &ContactState, k: usize, config: Option<&[f64]
                 covered_area,
                 normal: nn,
                 force: force(n),
-                traction: [-p * nn[0] - tau * nn[1], -p * nn[1] + tau * nn[0]],
+                traction: std::array::from_fn(|i| -p * nn[i] + tangential[i]),
                 pressure: p,
                 shear: tau,
                 carries_rows: slave_nodes.contains(&(s.body, n)),

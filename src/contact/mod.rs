@@ -106,6 +106,13 @@ pub struct Constraint<const D: usize = 2> {
     /// gap, computed with the row (`contact::discretization::mortar_linearization`); `None`
     /// elsewhere (small strain builds none).
     pub hessian: Option<GapHessian>,
+    /// Finite kinematics, 2D node-to-surface: the row holds a slave node that is past the
+    /// master surface's free end (beyond the end's extension, no master facet under it) against
+    /// the nearest vertex two master facets share, for Newton's iterates only. Its gap is the
+    /// distance to that vertex, positive, so it carries no force at a converged state; the
+    /// node is reported `unmeasured` (its gap is not a gap to the master under it: there is
+    /// none). `false` for every other row.
+    pub past_free_end: bool,
 }
 
 /// Where a row acts, in any dimension: its dofs, the slave dof it may be solved for and the

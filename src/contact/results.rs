@@ -44,8 +44,10 @@
 //!   an open point is not in contact and has no slip (none reported, as for a frictionless
 //!   pair).
 //!
-//! A node without a row of its own (the master surface of a one-pass pair) is `unmeasured`:
-//! it has a force and a pressure but no gap, status or slip.
+//! A node without a row of its own (the master surface of a one-pass pair, or a slave node
+//! past the master's free end, whose finite-kinematics row to a master vertex carries no force:
+//! `Constraint::past_free_end`) is `unmeasured`: it has a force and a pressure but no gap,
+//! status or slip.
 //!
 //! Per pair the totals: the forces on both sides (from [`super::forces`]), the normal force
 //! the pair transmits, `sum_a -f_a . n_a` over the first-pass slave side, the closed area (the
@@ -61,13 +63,18 @@
 //! Positions are reference coordinates (the rows' configuration may be `X + u`: see
 //! [`super::forces`]); the displacement at each node is given beside them.
 
-use super::forces::{pair_forces, PairForces};
+use super::discretization::Discretize;
+use super::forces::{length, pair_forces, PairForces};
 use super::friction::Status as FrictionStatus;
 use super::state::ContactState;
-use crate::fe::EdgeKind;
 use crate::model::{MasterSide, Model};
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 use std::collections::BTreeMap;
+
+/// A point or vector of `D` components, serialized as a list.
+fn components<S: Serializer, const D: usize>(v: &[f64; D], s: S) -> Result<S::Ok, S::Error> {
+    v.as_slice().serialize(s)
+}
 
 /// What the rows say about a contact point.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
@@ -116,33 +123,39 @@ pub enum Side {
     Master,
 }
 
-/// The results at one node of a contact surface.
+/// The results at one node of a contact surface (`D` components).
 #[derive(Clone, Debug, Serialize)]
-pub struct ContactPoint {
+pub struct ContactPoint<const D: usize = 2> {
     pub side: Side,
     /// Body name and local node number.
     pub body: String,
     pub node: usize,
     /// Reference position and displacement.
-    pub x: [f64; 2],
-    pub u: [f64; 2],
+    #[serde(serialize_with = "components")]
+    pub x: [f64; D],
+    #[serde(serialize_with = "components")]
+    pub u: [f64; D],
     /// Outward unit normal of the surface and tributary area `A_a`.
-    pub normal: [f64; 2],
+    #[serde(serialize_with = "components")]
+    pub normal: [f64; D],
     pub area: f64,
     /// Nodal contact force `f_a`.
-    pub force: [f64; 2],
+    #[serde(serialize_with = "components")]
+    pub force: [f64; D],
     /// The covered part `C_a` of the tributary area (module notes).
     pub covered_area: f64,
     /// The recovered pressure `p_a` (`-f_a . n_a / A_a` where the tributary is wholly covered).
     pub pressure: f64,
-    /// The recovered shear traction `tau_a` along `t_a = (-n_y, n_x)` (`f_a . t_a / A_a` where
-    /// the tributary is wholly covered).
+    /// The recovered shear traction: in 2D `tau_a` along `t_a = (-n_y, n_x)` (`f_a . t_a / A_a`
+    /// where the tributary is wholly covered), in 3D the magnitude of the tangential traction
+    /// ([`super::forces`]).
     pub shear: f64,
     /// The gap of the node's rows (`None`: unmeasured).
     pub gap: Option<f64>,
     pub status: PointStatus,
     /// Coulomb pairs, at points in contact (stick or slip): slip measure `g_t` and plastic
-    /// slip `g_t^p` (`None` elsewhere: frictionless pairs, open and unmeasured points).
+    /// slip `g_t^p` (`None` elsewhere: frictionless pairs, open and unmeasured points); in 2D
+    /// signed along `t_a`, in 3D their lengths in the tangent plane.
     pub slip: Option<f64>,
     pub plastic_slip: Option<f64>,
 }
@@ -151,7 +164,8 @@ pub struct ContactPoint {
 #[derive(Clone, Debug)]
 pub struct SurfaceCells {
     pub side: Side,
-    pub kind: EdgeKind,
+    /// The VTK cell type of its facets (edges in 2D, faces in 3D).
+    pub vtk_type: u8,
     /// Each facet's points (indices into [`PairResults::points`]), in edge order
     /// `[start, end(, mid)]`.
     pub facets: Vec<Vec<usize>>,
@@ -159,10 +173,12 @@ pub struct SurfaceCells {
 
 /// The totals of one pair.
 #[derive(Clone, Debug, Serialize)]
-pub struct PairTotals {
+pub struct PairTotals<const D: usize = 2> {
     /// Net force on the slave body and on the master (body or rigid surface).
-    pub force_on_slave: [f64; 2],
-    pub force_on_master: [f64; 2],
+    #[serde(serialize_with = "components")]
+    pub force_on_slave: [f64; D],
+    #[serde(serialize_with = "components")]
+    pub force_on_master: [f64; D],
     /// `sum_a -f_a . n_a` over the slave side: the normal force the pair transmits.
     pub normal_force: f64,
     /// Sum of the covered tributary areas `C_a` of the slave side's closed (closed, stick,
@@ -181,16 +197,21 @@ pub struct PairTotals {
 
 /// Everything a pair's result files hold.
 #[derive(Clone, Debug)]
-pub struct PairResults {
+pub struct PairResults<const D: usize = 2> {
     pub pair: usize,
     pub name: String,
-    pub points: Vec<ContactPoint>,
+    pub points: Vec<ContactPoint<D>>,
     pub surfaces: Vec<SurfaceCells>,
-    pub totals: PairTotals,
+    pub totals: PairTotals<D>,
 }
 
-/// The per-point results of every pair of `model` in the contact solution `state` at `u`.
-pub fn pair_results(model: &Model, state: &ContactState, u: &[f64]) -> Vec<PairResults> {
+/// The per-point results of every pair of `model` in the contact solution `state` at `u`, in
+/// either dimension.
+pub fn pair_results<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
+    state: &ContactState<D>,
+    u: &[f64],
+) -> Vec<PairResults<D>> {
     pair_forces(model, state)
         .iter()
         .map(|f| one_pair(model, state, u, f))
@@ -199,33 +220,49 @@ pub fn pair_results(model: &Model, state: &ContactState, u: &[f64]) -> Vec<PairR
 
 /// What the rows of one slave node found.
 #[derive(Default)]
-struct RowFindings {
+struct RowFindings<const D: usize> {
     frictionless_gap: Option<f64>,
-    jump: Option<([f64; 2], [f64; 2])>,
+    jump: Option<([f64; D], [f64; D])>,
     carries_force: bool,
     friction: Option<(FrictionStatus, f64, f64)>,
 }
 
-fn one_pair(model: &Model, state: &ContactState, u: &[f64], forces: &PairForces) -> PairResults {
+fn one_pair<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
+    state: &ContactState<D>,
+    u: &[f64],
+    forces: &PairForces<D>,
+) -> PairResults<D> {
     let k = forces.pair;
     let pair = &model.contact[k];
-    let mut findings: BTreeMap<(usize, usize), RowFindings> = BTreeMap::new();
+    let mut findings: BTreeMap<(usize, usize), RowFindings<D>> = BTreeMap::new();
     for (i, r) in state.rows.iter().enumerate() {
-        if r.pair != k {
+        // a row past the master's free end that carries no force is no measurement: the node
+        // has no master facet under it ([`Constraint::past_free_end`])
+        if r.pair != k || (r.past_free_end && !state.active[i]) {
             continue;
         }
         let found = findings.entry((r.slave_body, r.slave_node)).or_default();
         let g = state.gaps[i];
         if r.bilateral {
-            let e = found.jump.get_or_insert(([0.0; 2], r.slave_normal));
-            e.0[0] += g * r.normal[0];
-            e.0[1] += g * r.normal[1];
+            let e = found.jump.get_or_insert(([0.0; D], r.slave_normal));
+            for c in 0..D {
+                e.0[c] += g * r.normal[c];
+            }
         } else {
             found.frictionless_gap = Some(found.frictionless_gap.map_or(g, |m: f64| m.min(g)));
         }
         found.carries_force |= state.active[i];
         if let Some(Some(fp)) = state.friction.get(i) {
-            found.friction = Some((fp.status, fp.slip[0], fp.plastic_slip[0]));
+            // in 2D the one tangent's signed slip, in 3D the slip's length in the plane
+            let along = |v: &[f64]| {
+                if fp.tangents == 1 {
+                    v[0]
+                } else {
+                    length(&v[..fp.tangents])
+                }
+            };
+            found.friction = Some((fp.status, along(&fp.slip), along(&fp.plastic_slip)));
         }
     }
 
@@ -252,7 +289,7 @@ fn one_pair(model: &Model, state: &ContactState, u: &[f64], forces: &PairForces)
                 Some(f) => {
                     let gap = match (f.frictionless_gap, f.jump) {
                         (Some(g), _) => Some(g),
-                        (None, Some((d, ns))) => Some(-(d[0] * ns[0] + d[1] * ns[1])),
+                        (None, Some((d, ns))) => Some(-(0..D).map(|c| d[c] * ns[c]).sum::<f64>()),
                         (None, None) => None,
                     };
                     let status = match (f.friction, f.carries_force) {
@@ -277,7 +314,7 @@ fn one_pair(model: &Model, state: &ContactState, u: &[f64], forces: &PairForces)
                 body: body.name.clone(),
                 node: n.node,
                 x: body.mesh.nodes[n.node],
-                u: [u[body.dof(n.node, 0)], u[body.dof(n.node, 1)]],
+                u: std::array::from_fn(|c| u[body.dof(n.node, c)]),
                 normal: nn,
                 area: n.area,
                 force,
@@ -303,7 +340,7 @@ fn one_pair(model: &Model, state: &ContactState, u: &[f64], forces: &PairForces)
             .collect();
         surfaces.push(SurfaceCells {
             side,
-            kind: body.mesh.kind.edge_kind(),
+            vtk_type: body.mesh.kind.facet_vtk_type(),
             facets,
         });
     }
@@ -315,12 +352,13 @@ fn one_pair(model: &Model, state: &ContactState, u: &[f64], forces: &PairForces)
         force_on_master: forces.on_master,
         normal_force: slave_side
             .clone()
-            .map(|p| -(p.force[0] * p.normal[0] + p.force[1] * p.normal[1]))
+            .map(|p| -(0..D).map(|c| p.force[c] * p.normal[c]).sum::<f64>())
             .sum(),
         closed_area: slave_side
             .filter(|p| p.status > PointStatus::Open)
             .map(|p| p.covered_area)
-            .sum(),
+            .sum::<f64>()
+            + 0.0,
         max_pressure: points
             .iter()
             .filter(|p| p.status != PointStatus::Unmeasured)

@@ -283,7 +283,10 @@ pub fn force_balance_terms(
         let terms = [
             (pf.on_slave[0] + pf.on_master[0], "net force x"),
             (pf.on_slave[1] + pf.on_master[1], "net force y"),
-            (pf.net_moment / size, "net moment / L"),
+            (
+                crate::contact::forces::length(&pf.net_moment) / size,
+                "net moment / L",
+            ),
         ];
         for (value, what) in terms {
             let e = value.abs() / load;

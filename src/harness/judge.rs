@@ -476,7 +476,7 @@ fn balance_elsewhere(
         .iter()
         .map(|pf| {
             let mut pf = pf.clone();
-            pf.net_moment = pf
+            let moment: f64 = pf
                 .nodes
                 .iter()
                 .map(|t| {
@@ -493,6 +493,7 @@ fn balance_elsewhere(
                     p[0] * t.force[1] - p[1] * t.force[0]
                 })
                 .sum();
+            pf.net_moment = [0.0, 0.0, moment];
             pf
         })
         .collect();

@@ -41,7 +41,7 @@
 //! evaluates contact in the deformed geometry balances its moments.
 
 use crate::contact::discretization::geometry::Surface;
-use crate::contact::forces::{element_sizes, placed, NodalTraction, PairForces, Penetration};
+use crate::contact::forces::{element_sizes, NodalTraction, PairForces, Penetration};
 use crate::error::Result;
 use crate::harness::outside_results::{
     field, Results, ResultsFile, CONTACT_FORCE_FIELD, CONTACT_GAP_FIELD, CONTACT_PRESSURE_FIELD,
@@ -159,12 +159,7 @@ pub fn read(
         let surfaces: Vec<Surface> = sides
             .iter()
             .map(|(b, facets, _)| {
-                Surface::new(
-                    *b,
-                    &placed(&model.bodies[*b], config),
-                    facets,
-                    model.thickness,
-                )
+                Surface::of_body(*b, &model.bodies[*b], facets, model.thickness, config)
             })
             .collect();
         let carries: Vec<bool> = sides.iter().map(|s| s.2).collect();
@@ -263,7 +258,7 @@ pub fn read(
                 pair: k,
                 on_slave,
                 on_master,
-                net_moment,
+                net_moment: [0.0, 0.0, net_moment],
                 force_scale,
                 nodes,
                 penetration,

@@ -2,8 +2,12 @@
 //! and contact point data in the body `.vtu` files (the quantities of
 //! [`crate::contact::results`]).
 //!
+//! The same files in 2D and 3D, from one writer generic over the dimension: vectors have the
+//! body's components (`x, y` or `x, y, z` in the CSV), and in 3D `shear` and `slip` are lengths
+//! in the tangent plane where in 2D they are signed along `t = (-n_y, n_x)`.
+//!
 //! * `<pair>.contact.vtu`: the pair's surfaces (slave, and the master body's) as Line2/Line3
-//!   cells at reference positions, with point data `displacement`, `normal`, `area`,
+//!   cells in 2D, Quad4/Quad9/Tri3/Tri6 cells in 3D, at reference positions, with point data `displacement`, `normal`, `area`,
 //!   `contact_force`, `contact_pressure`, `contact_shear`, `contact_gap`, `contact_status`
 //!   (0 unmeasured, 1 open, 2 closed, 3 stick, 4 slip), `contact_slip`, `side` (0 slave,
 //!   1 master) and `node` (the body's local node number). VTK readers take no NaN in ASCII
@@ -19,16 +23,41 @@
 
 use crate::contact::results::{ContactPoint, PairResults, PointStatus, Side};
 use crate::error::Result;
-use crate::fe::EdgeKind;
 use crate::io::paths::file_name;
 use crate::io::scene::RigidSurface;
 use crate::io::vtu::{number, write_grid, PointArray};
+use crate::model::space::SolidCell;
 use crate::model::{MasterSide, Model};
 use serde::Serialize;
 use std::path::Path;
 
-/// The columns of a pair's CSV file.
-pub const CSV_HEADER: &str = "side,body,node,x,y,u_x,u_y,normal_x,normal_y,area,force_x,force_y,pressure,shear,gap,status,slip,plastic_slip";
+/// The columns of a pair's CSV file in `D` dimensions (2D: `side,body,node,x,y,u_x,u_y,
+/// normal_x,normal_y,area,force_x,force_y,pressure,shear,gap,status,slip,plastic_slip`; 3D adds
+/// the z components).
+pub fn csv_header<const D: usize>() -> String {
+    let axes = &["x", "y", "z"][..D];
+    let vector = |name: &str| -> Vec<String> {
+        axes.iter()
+            .map(|a| {
+                if name.is_empty() {
+                    a.to_string()
+                } else {
+                    format!("{name}_{a}")
+                }
+            })
+            .collect()
+    };
+    let mut columns: Vec<String> = ["side", "body", "node"].map(String::from).to_vec();
+    columns.extend(vector(""));
+    columns.extend(vector("u"));
+    columns.extend(vector("normal"));
+    columns.push("area".into());
+    columns.extend(vector("force"));
+    for c in ["pressure", "shear", "gap", "status", "slip", "plastic_slip"] {
+        columns.push(c.into());
+    }
+    columns.join(",")
+}
 
 /// The file names of pair `name`'s results (contact `.vtu`, CSV, JSON).
 pub fn pair_file_names(name: &str) -> Result<[String; 3]> {
@@ -40,7 +69,11 @@ pub fn pair_file_names(name: &str) -> Result<[String; 3]> {
 }
 
 /// Write the three files of every pair into `dir`.
-pub fn write_pair_files(dir: &Path, model: &Model, results: &[PairResults]) -> Result<()> {
+pub fn write_pair_files<const D: usize, K: SolidCell<D>>(
+    dir: &Path,
+    model: &Model<D, K>,
+    results: &[PairResults<D>],
+) -> Result<()> {
     for r in results {
         let [vtu, csv, json] = pair_file_names(&r.name)?;
         write_surface_vtu(&dir.join(vtu), r)?;
@@ -61,29 +94,23 @@ fn side_code(s: Side) -> i32 {
     }
 }
 
-fn write_surface_vtu(path: &Path, r: &PairResults) -> Result<()> {
+/// `v` with three components (`z = 0` in 2D), as VTK wants its vectors.
+fn in_3d<const D: usize>(v: [f64; D]) -> [f64; 3] {
+    std::array::from_fn(|i| if i < D { v[i] } else { 0.0 })
+}
+
+fn write_surface_vtu<const D: usize>(path: &Path, r: &PairResults<D>) -> Result<()> {
     let p = &r.points;
-    let points: Vec<[f64; 2]> = p.iter().map(|q| q.x).collect();
+    let points: Vec<[f64; D]> = p.iter().map(|q| q.x).collect();
     let cells: Vec<(u8, Vec<usize>)> = r
         .surfaces
         .iter()
-        .flat_map(|s| {
-            let kind = match s.kind {
-                EdgeKind::Line2 => 3u8,
-                EdgeKind::Line3 => 21u8,
-            };
-            s.facets.iter().map(move |f| (kind, f.clone()))
-        })
+        .flat_map(|s| s.facets.iter().map(move |f| (s.vtk_type, f.clone())))
         .collect();
-    let vec3 = |f: fn(&ContactPoint) -> [f64; 2]| {
-        p.iter()
-            .flat_map(|q| {
-                let v = f(q);
-                [v[0], v[1], 0.0]
-            })
-            .collect::<Vec<f64>>()
+    let vec3 = |f: fn(&ContactPoint<D>) -> [f64; D]| {
+        p.iter().flat_map(|q| in_3d(f(q))).collect::<Vec<f64>>()
     };
-    let scalar = |f: fn(&ContactPoint) -> f64| p.iter().map(f).collect::<Vec<f64>>();
+    let scalar = |f: fn(&ContactPoint<D>) -> f64| p.iter().map(f).collect::<Vec<f64>>();
     let arrays = vec![
         PointArray::float("displacement", 3, vec3(|q| q.u)),
         PointArray::float("normal", 3, vec3(|q| q.normal)),
@@ -108,36 +135,30 @@ fn write_surface_vtu(path: &Path, r: &PairResults) -> Result<()> {
     write_grid(path, &points, &cells, &arrays)
 }
 
-/// The CSV text of one pair (header [`CSV_HEADER`], one line per point).
-pub fn csv_text(r: &PairResults) -> String {
+/// The CSV text of one pair (header [`csv_header`], one line per point).
+pub fn csv_text<const D: usize>(r: &PairResults<D>) -> String {
     let opt = |v: Option<f64>| v.map(number).unwrap_or_default();
-    let mut s = String::from(CSV_HEADER);
+    let mut s = csv_header::<D>();
     s.push('\n');
     for q in &r.points {
         let side = match q.side {
             Side::Slave => "slave",
             Side::Master => "master",
         };
-        let fields = [
-            side.to_string(),
-            q.body.clone(),
-            q.node.to_string(),
-            number(q.x[0]),
-            number(q.x[1]),
-            number(q.u[0]),
-            number(q.u[1]),
-            number(q.normal[0]),
-            number(q.normal[1]),
-            number(q.area),
-            number(q.force[0]),
-            number(q.force[1]),
+        let mut fields = vec![side.to_string(), q.body.clone(), q.node.to_string()];
+        for v in [q.x, q.u, q.normal] {
+            fields.extend(v.map(number));
+        }
+        fields.push(number(q.area));
+        fields.extend(q.force.map(number));
+        fields.extend([
             number(q.pressure),
             number(q.shear),
             opt(q.gap),
             q.status.word().to_string(),
             opt(q.slip),
             opt(q.plastic_slip),
-        ];
+        ]);
         s += &fields.join(",");
         s.push('\n');
     }
@@ -145,16 +166,20 @@ pub fn csv_text(r: &PairResults) -> String {
 }
 
 #[derive(Serialize)]
-struct PairFile<'a> {
+struct PairFile<'a, const D: usize> {
     pair: &'a str,
     slave: &'a str,
-    /// The master body's name, or `rigid line` / `rigid circle`.
+    /// The master body's name, or `rigid line` / `rigid circle` / `rigid plane` / `rigid
+    /// sphere`.
     master: String,
-    totals: &'a crate::contact::results::PairTotals,
-    points: &'a [ContactPoint],
+    totals: &'a crate::contact::results::PairTotals<D>,
+    points: &'a [ContactPoint<D>],
 }
 
-fn json_value<'a>(model: &'a Model, r: &'a PairResults) -> PairFile<'a> {
+fn json_value<'a, const D: usize, K: SolidCell<D>>(
+    model: &'a Model<D, K>,
+    r: &'a PairResults<D>,
+) -> PairFile<'a, D> {
     let pair = &model.contact[r.pair];
     PairFile {
         pair: &r.name,
@@ -172,7 +197,11 @@ fn json_value<'a>(model: &'a Model, r: &'a PairResults) -> PairFile<'a> {
 }
 
 /// The contact point data of body `body` (empty when the model has no contact pair).
-pub fn body_point_arrays(model: &Model, body: usize, results: &[PairResults]) -> Vec<PointArray> {
+pub fn body_point_arrays<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    body: usize,
+    results: &[PairResults<D>],
+) -> Vec<PointArray> {
     if model.contact.is_empty() {
         return Vec::new();
     }
@@ -188,8 +217,9 @@ pub fn body_point_arrays(model: &Model, body: usize, results: &[PairResults]) ->
             continue;
         }
         let k = q.node;
-        force[3 * k] += q.force[0];
-        force[3 * k + 1] += q.force[1];
+        for (c, f) in q.force.iter().enumerate() {
+            force[3 * k + c] += f;
+        }
         pressure[k] += q.pressure;
         if let Some(g) = q.gap {
             gap[k] = Some(gap[k].map_or(g, |m: f64| m.min(g)));

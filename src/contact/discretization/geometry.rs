@@ -283,16 +283,7 @@ pub fn ray_point(kind: EdgeKind, coords: &[[f64; 2]], p: [f64; 2], nu: [f64; 2])
 impl Surface {
     /// The surface of facet set `facets` of `body` (index `body_index`), thickness `t`.
     pub fn new(body_index: usize, body: &Body, facets: &[Facet], thickness: f64) -> Surface {
-        let kind = body.mesh.kind.edge_kind();
-        let (nodes, coords) = facets
-            .iter()
-            .map(|&f| {
-                let nodes = body.mesh.facet_nodes(f);
-                let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| body.mesh.nodes[n]).collect();
-                (nodes, coords)
-            })
-            .unzip();
-        Surface::from_facets(body_index, kind, nodes, coords, thickness)
+        Surface::of_body(body_index, body, facets, thickness, None)
     }
 }
 
@@ -310,6 +301,45 @@ impl Surface3 {
             })
             .unzip();
         Surface::from_facets(body_index, kind, nodes, coords, 1.0)
+    }
+}
+
+impl<const D: usize, F: FacetShape<D>> Surface<D, F> {
+    /// The surface of facet set `facets` of `body` (index `body_index`) in any dimension, its
+    /// nodes at `X + u` when the displacement `u` is given (the configuration of contact rows
+    /// in the current geometry), its weights times `thickness` (1 in 3D).
+    pub fn of_body<K: super::Discretize<D, Facet = F>>(
+        body_index: usize,
+        body: &Body<D, K>,
+        facets: &[Facet],
+        thickness: f64,
+        u: Option<&[f64]>,
+    ) -> Self {
+        let mesh = &body.mesh;
+        let (nodes, coords) = facets
+            .iter()
+            .map(|&f| {
+                let nodes = mesh.facet_nodes(f);
+                let coords: Vec<[f64; D]> = nodes
+                    .iter()
+                    .map(|&n| {
+                        let x = mesh.nodes[n];
+                        match u {
+                            Some(u) => std::array::from_fn(|i| x[i] + u[body.dof(n, i)]),
+                            None => x,
+                        }
+                    })
+                    .collect();
+                (nodes, coords)
+            })
+            .unzip();
+        Surface::from_facets(
+            body_index,
+            mesh.kind.facet_shape(),
+            nodes,
+            coords,
+            thickness,
+        )
     }
 }
 

@@ -21,7 +21,9 @@
 //!   point is the free end) has no facet under it and gets no row: it is reported as
 //!   `unmeasured` (contact in the reference configuration) or named in a warning (a tie).
 //!   Under finite kinematics a contact node there is still held against the nearest shared
-//!   vertex (see `node_to_surface`).
+//!   vertex while Newton iterates (see `node_to_surface`); that row's gap is the distance to
+//!   the vertex, so it carries no force at a converged state, and the node is reported as
+//!   `unmeasured` too ([`crate::contact::Constraint::past_free_end`]).
 //! * **Two-pass**: the rows of the pass with the roles swapped are appended (pass 2).
 //! * **Rigid masters**: a line `g = n . (x_s - p)` or a circle `g = |x_s - c| - R` with
 //!   `n = (x_s - c)/|x_s - c|`; only slave dofs appear. Node-to-surface takes one pass (a
@@ -191,6 +193,15 @@ impl Rows<'_> {
 /// The contact rows of a pair in the dimension of the model's cells: the one place where the
 /// discretizations of 2D ([`constraints`]) and 3D meet the dimension-free solver.
 pub trait Discretize<const D: usize>: crate::model::space::SolidCell<D> {
+    /// The cells' contact facets: edges in 2D, faces in 3D.
+    type Facet: geometry::FacetShape<D>;
+
+    /// The kind of this cell's facets.
+    fn facet_shape(self) -> Self::Facet;
+
+    /// The VTK cell type of this cell's facets (the contact surfaces' `.vtu` files).
+    fn facet_vtk_type(self) -> u8;
+
     /// The rows of `pair` in the reference configuration of `model`, or why the pair's
     /// discretization does not apply.
     fn pair_rows(
@@ -209,6 +220,19 @@ pub trait Discretize<const D: usize>: crate::model::space::SolidCell<D> {
 }
 
 impl Discretize<2> for crate::fe::ElementKind {
+    type Facet = crate::fe::EdgeKind;
+
+    fn facet_shape(self) -> crate::fe::EdgeKind {
+        self.edge_kind()
+    }
+
+    fn facet_vtk_type(self) -> u8 {
+        match self.edge_kind() {
+            crate::fe::EdgeKind::Line2 => 3,
+            crate::fe::EdgeKind::Line3 => 21,
+        }
+    }
+
     fn pair_rows(model: &Model, pair: &ContactPair) -> Result<Vec<Constraint>, String> {
         constraints(model, pair)
     }
@@ -219,6 +243,16 @@ impl Discretize<2> for crate::fe::ElementKind {
 }
 
 impl Discretize<3> for crate::fe3d::SolidKind {
+    type Facet = crate::fe::ElementKind;
+
+    fn facet_shape(self) -> crate::fe::ElementKind {
+        self.facet_kind()
+    }
+
+    fn facet_vtk_type(self) -> u8 {
+        self.facet_kind().vtk_cell_type()
+    }
+
     fn pair_rows(
         model: &crate::model::Model3,
         pair: &ContactPair,
@@ -373,6 +407,7 @@ pub(crate) fn weighted_row(
         segment: None,
         nodal_normal: None,
         hessian: None,
+        past_free_end: false,
     }
 }
 
@@ -680,7 +715,9 @@ fn node_to_surface(
         // the master; defect W02's contact half). It is reported as unmeasured. Under finite
         // kinematics (rows at the iterate `X + u`) the vertex row stays: without it the
         // finite patch test D (Q9, punch slave, Lagrange) converged to a state 0.73 off the
-        // exact stress, the punch's end node having lost its row at an iterate past the end
+        // exact stress, the punch's end node having lost its row at an iterate past the end.
+        // Its gap is the distance to the vertex (positive: it carries no force at a converged
+        // state), so the row is marked `past_free_end` and its node reported as unmeasured
         let past_free_end = || {
             candidates
                 .iter()
@@ -699,7 +736,8 @@ fn node_to_surface(
                 .min_by(|a, b| a.0.total_cmp(&b.0))
                 .is_some_and(|(_, at_free_end)| at_free_end)
         };
-        if !rows.tied && !linearize && past_free_end() {
+        let past_the_end = !rows.tied && past_free_end();
+        if past_the_end && !linearize {
             continue;
         }
         let vertex = candidates
@@ -730,6 +768,9 @@ fn node_to_surface(
             };
             let g0 = nu[0] * d[0] + nu[1] * d[1];
             rows.node(slave, s, nu, g0, Some((master, &[v], &[1.0])), pass);
+            if let Some(row) = rows.out.last_mut() {
+                row.past_free_end = past_the_end;
+            }
             if linearize {
                 attach_segment(rows, slave, s, master, &[v], MasterPoint::Vertex { side });
             }

@@ -295,6 +295,10 @@ pub struct MortarIntegrals3 {
     pub multiplier_mass: MortarMatrix3,
     /// Every non-empty clip polygon.
     pub cells: Vec<IntegrationCell>,
+    /// The covered tributary of each slave node facet by facet, `(facet, int N_a dA)` over the
+    /// clip polygons of each slave facet (what [`crate::contact::Constraint::cover`] holds for
+    /// a mortar row: the whole tributary where a facet is wholly covered).
+    pub cover: BTreeMap<usize, Vec<(usize, f64)>>,
 }
 
 /// The auxiliary plane of a slave facet: origin and orthonormal in-plane axes (`t_1 x t_2`
@@ -753,6 +757,7 @@ pub fn mortar_integrals3_with_points(
     let mut m: MortarMatrix3 = BTreeMap::new();
     let mut multiplier_mass: MortarMatrix3 = BTreeMap::new();
     let mut cells = Vec::new();
+    let mut cover: BTreeMap<usize, Vec<(usize, f64)>> = BTreeMap::new();
     for (f, xs) in slave.coords.iter().enumerate() {
         let (origin, normal) = centre_and_normal(ks, xs)
             .map_err(|why| format!("slave facet {f} (nodes {:?}): {why}", slave.facets[f]))?;
@@ -781,6 +786,7 @@ pub fn mortar_integrals3_with_points(
         let [lo, hi] = bounding_box(xs);
         let mut d_local = [[0.0; MAX_NODES]; MAX_NODES];
         let mut mass_local = [[0.0; MAX_NODES]; MAX_NODES];
+        let mut cover_local = [0.0; MAX_NODES];
         let mut m_local: Vec<(usize, [[f64; MAX_NODES]; MAX_NODES])> = Vec::new();
         // the cube about the slave box's centre holds the box; keep the boxes that meet it
         let centre: [f64; 3] = std::array::from_fn(|i| 0.5 * (lo[i] + hi[i]));
@@ -835,6 +841,7 @@ pub fn mortar_integrals3_with_points(
                             let basis = multiplier_basis(ks, xi_s);
                             let phi = multiplier_values(ns, &basis, phi_of.as_ref());
                             for j in 0..ns {
+                                cover_local[j] += w * n_s[j];
                                 for k in 0..ns {
                                     d_local[j][k] += w * phi[j] * n_s[k];
                                     mass_local[j][k] += w * phi[j] * phi[k];
@@ -862,6 +869,7 @@ pub fn mortar_integrals3_with_points(
         }
         let ids = &slave.facets[f];
         for j in 0..ns {
+            cover.entry(ids[j]).or_default().push((f, cover_local[j]));
             let dj = d.entry(ids[j]).or_default();
             for k in 0..ns {
                 *dj.entry(ids[k]).or_default() += d_local[j][k];
@@ -883,6 +891,7 @@ pub fn mortar_integrals3_with_points(
         m,
         multiplier_mass,
         cells,
+        cover,
     })
 }
 
@@ -1017,6 +1026,7 @@ pub fn mortar_rows3(
             row.point = slave_x[&j];
             row.bilateral = numbering.tied;
             row.mass = mass.clone();
+            row.cover = integrals.cover.get(&j).cloned().unwrap_or_default();
             rows.push(row);
         }
     }
@@ -1061,12 +1071,13 @@ fn weighted_row(
         pair: numbering.pair,
         bilateral: false,
         mass: Vec::new(),
-        // the covered share of 3D mortar facets is not computed (no 3D nodal pressure)
+        // set by the caller from the mortar integrals (`MortarIntegrals3::cover`)
         cover: Vec::new(),
         tangents: Vec::new(),
         segment: None,
         nodal_normal: None,
         hessian: None,
+        past_free_end: false,
     }
 }
 

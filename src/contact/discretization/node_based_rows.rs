@@ -236,6 +236,7 @@ pub fn node_row<const D: usize, K>(
         segment: None,
         nodal_normal: None,
         hessian: None,
+        past_free_end: false,
     }
 }
 
