@@ -77,7 +77,7 @@ use crate::error::{Error, Result};
 use crate::fe::displacement_gradient_at;
 use crate::fe::ReferenceCell;
 use crate::fe3d::SolidKind;
-use crate::harness::checks::{max_penetration_check, penetration_warnings, CheckResult};
+use crate::harness::checks::{penetration_warnings, CheckResult};
 use crate::io::contact_output::{body_point_arrays, write_pair_files};
 use crate::io::output::pair_summaries;
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
@@ -128,12 +128,10 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
     crate::post::check_finite_nodal_stresses(&model, &solution.u, nodal_stress)?;
     solution.timings.mesh = meshed;
     solution.timings.total = start.elapsed().as_secs_f64();
-    let penetrations: Option<Vec<Penetration<3>>> = solution.contact.as_ref().map(|state| {
-        pair_forces(&model, state)
-            .into_iter()
-            .map(|f| f.penetration)
-            .collect()
-    });
+    let forces = solution
+        .contact
+        .as_ref()
+        .map(|state| pair_forces(&model, state));
     let mut checks: Vec<CheckResult> = case
         .checks
         .iter()
@@ -141,25 +139,31 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
             Check::UniformStress3d { stress, tol } => {
                 uniform_stress_check3(&model, &solution.u, stress, *tol)
             }
-            Check::MaxPenetration { pair, share } => {
-                let shares = penetrations.as_ref().map(|p| {
-                    p.iter()
-                        .enumerate()
-                        .map(|(k, p)| (model.contact[k].name.as_str(), p.share_of_element))
-                });
-                let (check, error) = max_penetration_check(pair.as_deref(), shares);
+            Check::ContactForce { .. }
+            | Check::MaxContactPressure { .. }
+            | Check::MaxPenetration { .. }
+            | Check::ForceBalance { .. } => {
+                let magnitudes = crate::harness::checks::Magnitudes::of(&model, &solution);
+                let (check, error, tol) = crate::harness::checks::contact_force_check(
+                    &model,
+                    &solution,
+                    forces.as_deref(),
+                    &magnitudes,
+                    check,
+                )
+                .expect("a contact force check");
                 CheckResult {
                     check,
                     error,
-                    tol: *share,
-                    passed: error <= *share,
+                    tol,
+                    passed: error <= tol,
                 }
             }
             reaction @ Check::Reaction { .. } => {
                 crate::harness::checks::reaction_result(&model, &solution, reaction)
                     .expect("a reaction check")
             }
-            _ => unreachable!("build3 refuses every other check"),
+            _ => unreachable!("Model::resolve_checks refuses in 3D every check matched above"),
         })
         .collect();
     checks.extend(crate::harness::checks::unconverged(
@@ -167,11 +171,11 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
         &solution,
     ));
     let mut warnings: Vec<String> = model.warnings.clone();
-    if let (Some(state), Some(p)) = (&solution.contact, &penetrations) {
+    if let (Some(state), Some(f)) = (&solution.contact, &forces) {
         warnings.extend(penetration_warnings(
             &model,
             state,
-            p.iter().cloned().enumerate(),
+            f.iter().map(|f| (f.pair, f.penetration.clone())),
         ));
     }
     warnings.extend(crate::harness::stability::friction_cannot_hold(
@@ -372,53 +376,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
     if finite {
         check_finite3(&model, case)?;
     }
-    for (k, check) in case.checks.iter().enumerate() {
-        let at = format!("checks[{k}]");
-        match check {
-            Check::UniformStress3d { stress, tol } => {
-                if !(stress.iter().all(|v| v.is_finite()) && tol.is_finite() && *tol > 0.0) {
-                    return Err(Error::invalid(
-                        source,
-                        &at,
-                        "the stress and the tolerance must be finite, the tolerance positive",
-                        "give six finite components [xx, yy, zz, yz, xz, xy] and e.g. \"tol\": 1e-10",
-                    ));
-                }
-            }
-            Check::Reaction { body, set, tol, .. } => {
-                let b = model.find_body(body, &at)?;
-                model.find_node_set(b, set, &at)?;
-                if !(tol.is_finite() && *tol >= 0.0) {
-                    return Err(Error::invalid(
-                        source,
-                        &at,
-                        format!("tolerance must be a non-negative number, got {tol}"),
-                        "give e.g. \"tol\": 1e-10",
-                    ));
-                }
-            }
-            Check::MaxPenetration { pair, share } => {
-                model.resolve_max_penetration(pair.as_deref(), &at)?;
-                if !(share.is_finite() && *share >= 0.0) {
-                    return Err(Error::invalid(
-                        source,
-                        &at,
-                        format!("tolerance must be a non-negative number, got {share}"),
-                        "give the largest penetration relative to the element size, e.g. 0.01",
-                    ));
-                }
-            }
-            _ => {
-                return Err(not_built(
-                    source,
-                    &at,
-                    "this check",
-                    "use \"uniform_stress_3d\", \"reaction\" or \"max_penetration\"",
-                ))
-            }
-        }
-    }
-    model.checks = case.checks.clone();
+    model.resolve_checks(case)?;
     Ok(model)
 }
 

@@ -229,7 +229,11 @@ pub fn pressure_error_of(
 /// [`pair_forces`]). A pair that carries nothing is skipped. (Until issue 16 the pairs' terms
 /// were relative to the sum of the nodal |contact forces| and the residual to the largest nodal
 /// force, scales that depend on the mesh rather than on the load the user applied.)
-pub fn force_balance(model: &Model, solution: &Solution, forces: &[PairForces]) -> f64 {
+pub fn force_balance<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+    forces: &[PairForces<D>],
+) -> f64 {
     if solution.contact.is_none() {
         return f64::INFINITY;
     }
@@ -240,7 +244,10 @@ pub fn force_balance(model: &Model, solution: &Solution, forces: &[PairForces]) 
 /// `F` is below `sqrt(eps)` of the stiffness terms' magnitude [`Solution::force_scale`] (a
 /// motion without load, such as a rigid lift, whose reactions are round-off of those terms),
 /// that magnitude, the scale of the solve's round-off.
-pub fn balance_scale(model: &Model, solution: &Solution) -> f64 {
+pub fn balance_scale<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+) -> f64 {
     let load = Magnitudes::of(model, solution).force;
     if load < f64::EPSILON.sqrt() * solution.force_scale {
         solution.force_scale
@@ -251,16 +258,20 @@ pub fn balance_scale(model: &Model, solution: &Solution) -> f64 {
 
 /// [`force_balance`] of the given nodal forces; `solution.reactions` must already hold
 /// `K u - f - f_contact` (the out-of-balance force at the free dofs).
-pub fn force_balance_of(model: &Model, solution: &Solution, forces: &[PairForces]) -> f64 {
+pub fn force_balance_of<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+    forces: &[PairForces<D>],
+) -> f64 {
     force_balance_terms(model, solution, forces).0
 }
 
 /// [`force_balance_of`] and the words naming its largest term: the out-of-balance force, or a
-/// pair's net force x or y, or its net moment / L (a NaN term is the largest).
-pub fn force_balance_terms(
-    model: &Model,
-    solution: &Solution,
-    forces: &[PairForces],
+/// pair's net force x, y (or z), or its net moment / L (a NaN term is the largest); 2D and 3D.
+pub fn force_balance_terms<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+    forces: &[PairForces<D>],
 ) -> (f64, String) {
     let size = model.size();
     let load = balance_scale(model, solution).max(f64::MIN_POSITIVE);
@@ -280,15 +291,17 @@ pub fn force_balance_terms(
             continue;
         }
         let name = &model.contact[pf.pair].name;
-        let terms = [
-            (pf.on_slave[0] + pf.on_master[0], "net force x"),
-            (pf.on_slave[1] + pf.on_master[1], "net force y"),
+        let net_force = (0..D).map(|i| {
             (
-                crate::contact::forces::length(&pf.net_moment) / size,
-                "net moment / L",
-            ),
-        ];
-        for (value, what) in terms {
+                pf.on_slave[i] + pf.on_master[i],
+                format!("net force {}", ["x", "y", "z"][i]),
+            )
+        });
+        let moment = (
+            crate::contact::forces::length(&pf.net_moment) / size,
+            "net moment / L".to_string(),
+        );
+        for (value, what) in net_force.chain([moment]) {
             let e = value.abs() / load;
             if e > error || e.is_nan() && !error.is_nan() {
                 error = e;
@@ -444,7 +457,11 @@ pub fn max_penetration_check<'a>(
     )
 }
 
-fn pair_of<'a>(forces: &'a [PairForces], model: &Model, name: &str) -> Option<&'a PairForces> {
+fn pair_of<'a, const D: usize, K: SolidCell<D>>(
+    forces: &'a [PairForces<D>],
+    model: &Model<D, K>,
+    name: &str,
+) -> Option<&'a PairForces<D>> {
     let k = model.contact.iter().position(|p| p.name == name)?;
     forces.iter().find(|f| f.pair == k)
 }
@@ -483,6 +500,85 @@ pub fn unconverged<const D: usize>(
                 passed: false,
             }),
         })
+}
+
+/// The checks of the pairs' contact forces, 2D and 3D: `contact_force` (the pair's total force
+/// on its slave body, one component), `max_contact_pressure`, `max_penetration` and
+/// `force_balance`, each as words, error and tolerance, from `forces` (our solve's, or another
+/// code's read by [`crate::harness::outside_contact`]; `None`: no contact forces, the check
+/// fails). `None` for any other check.
+pub fn contact_force_check<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+    contact_forces: Option<&[PairForces<D>]>,
+    magnitudes: &Magnitudes,
+    check: &Check,
+) -> Option<(String, f64, f64)> {
+    let has_forces = contact_forces.is_some();
+    let forces: &[PairForces<D>] = contact_forces.unwrap_or(&[]);
+    Some(match check {
+        Check::ContactForce {
+            pair,
+            component,
+            value,
+            tol,
+        } => {
+            let got = pair_of(forces, model, pair)
+                .map(|f| f.on_slave[component.index()])
+                .unwrap_or(f64::NAN);
+            let (error, expected) = judged(got, *value, magnitudes.force, "the applied load");
+            (
+                format!("total contact force {component:?} of '{pair}' on its slave body = {got:.6e} ({expected})"),
+                error,
+                *tol,
+            )
+        }
+        Check::MaxContactPressure { pair, value, tol } => {
+            let got = pair_of(forces, model, pair)
+                .map(|f| f.max_pressure())
+                .unwrap_or(f64::NAN);
+            let (error, expected) = judged(got, *value, magnitudes.stress, "the load's stress");
+            (
+                format!("max contact pressure of '{pair}' = {got:.6e} ({expected})"),
+                error,
+                *tol,
+            )
+        }
+        Check::MaxPenetration { pair, share } => {
+            let shares = forces.iter().map(|f| {
+                (
+                    model.contact[f.pair].name.as_str(),
+                    f.penetration.share_of_element,
+                )
+            });
+            let (words, got) = max_penetration_check(pair.as_deref(), has_forces.then_some(shares));
+            (words, got, *share)
+        }
+        Check::ForceBalance { tol } => {
+            let (error, largest) = if has_forces {
+                force_balance_terms(model, solution, forces)
+            } else {
+                (f64::INFINITY, "no contact forces".to_string())
+            };
+            let against = if balance_scale(model, solution) != magnitudes.force {
+                format!(
+                    "the magnitude of the stiffness terms {:.3e} (the applied load {:.3e} is round-off of it)",
+                    solution.force_scale, magnitudes.force
+                )
+            } else {
+                format!("the applied load {:.3e}", magnitudes.force)
+            };
+            (
+                format!(
+                    "force balance: net force and net moment / L (L = {:.3e}) of each pair between bodies and the out-of-balance force, relative to {against}; largest: {largest}",
+                    model.size()
+                ),
+                error,
+                *tol,
+            )
+        }
+        _ => return None,
+    })
 }
 
 /// [`evaluate`] with the contact forces given: those of our solve (`solution.contact`), or,
@@ -545,20 +641,8 @@ pub fn evaluate_with(
                     let error = if has_forces { pressure_error_of(model, solution, forces, exact, Some(k), None) } else { f64::INFINITY };
                     (format!("contact pressure of '{pair}' against the exact stress"), error, *tol)
                 }
-                Check::ContactForce { pair, component, value, tol } => {
-                    let got = pair_of(forces, model, pair).map(|f| f.on_slave[component.index()]).unwrap_or(f64::NAN);
-                    let (error, expected) = judged(got, *value, magnitudes.force, "the applied load");
-                    (format!("total contact force {component:?} of '{pair}' on its slave body = {got:.6e} ({expected})"), error, *tol)
-                }
-                Check::MaxContactPressure { pair, value, tol } => {
-                    let got = pair_of(forces, model, pair).map(|f| f.max_pressure()).unwrap_or(f64::NAN);
-                    let (error, expected) = judged(got, *value, magnitudes.stress, "the load's stress");
-                    (format!("max contact pressure of '{pair}' = {got:.6e} ({expected})"), error, *tol)
-                }
-                Check::MaxPenetration { pair, share } => {
-                    let shares = forces.iter().map(|f| (model.contact[f.pair].name.as_str(), f.penetration.share_of_element));
-                    let (words, got) = max_penetration_check(pair.as_deref(), has_forces.then_some(shares));
-                    (words, got, *share)
+                Check::ContactForce { .. } | Check::MaxContactPressure { .. } | Check::MaxPenetration { .. } => {
+                    contact_force_check(model, solution, contact_forces, &magnitudes, check).expect("a contact force check")
                 }
                 Check::TerminatesWith { reason, contains } => {
                     let (got, text) = match solution.contact.as_ref().map(|c| &c.termination) {
@@ -598,21 +682,8 @@ pub fn evaluate_with(
                     let found = warnings(model, solution).iter().any(|w| w.contains(contains.as_str()));
                     (format!("the run warns {contains:?}"), if found { 0.0 } else { f64::INFINITY }, 0.0)
                 }
-                Check::ForceBalance { tol } => {
-                    let (error, largest) = if has_forces { force_balance_terms(model, solution, forces) } else { (f64::INFINITY, "no contact forces".to_string()) };
-                    (
-                    format!(
-                        "force balance: net force and net moment / L (L = {:.3e}) of each pair between bodies and the out-of-balance force, relative to {}; largest: {largest}",
-                        model.size(),
-                        if balance_scale(model, solution) != magnitudes.force {
-                            format!("the magnitude of the stiffness terms {:.3e} (the applied load {:.3e} is round-off of it)", solution.force_scale, magnitudes.force)
-                        } else {
-                            format!("the applied load {:.3e}", magnitudes.force)
-                        }
-                    ),
-                    error,
-                    *tol,
-                    )
+                Check::ForceBalance { .. } => {
+                    contact_force_check(model, solution, contact_forces, &magnitudes, check).expect("a contact force check")
                 }
                 Check::Displacement { body, point, component, value, tol } => {
                     let b = model.body(body).expect("resolved when the model was built");

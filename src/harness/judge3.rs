@@ -226,10 +226,13 @@ pub fn judge3(model: &Model3, results: &Results, match_share: f64) -> Result<Jud
             Check::UniformStress3d { stress, tol } => {
                 checks.push(uniform_stress_check3(model, &u, stress, *tol))
             }
-            Check::MaxPenetration { .. } => not_judged.push(NotJudged {
+            Check::MaxPenetration { .. }
+            | Check::ContactForce { .. }
+            | Check::MaxContactPressure { .. }
+            | Check::ForceBalance { .. } => not_judged.push(NotJudged {
                 check: serde_json::to_string(check).expect("checks serialize"),
-                why: "the penetration of a 3D pair is judged from our contact rows only (a \
-                      run of the case), not from another code's results"
+                why: "the contact forces and penetrations of a 3D pair are judged from our \
+                      contact rows only (a run of the case), not from another code's results"
                     .to_string(),
             }),
             Check::Reaction { .. } if model.contact.is_empty() => {
@@ -245,9 +248,7 @@ pub fn judge3(model: &Model3, results: &Results, match_share: f64) -> Result<Jud
                       results, which a 3D judgement does not read"
                     .to_string(),
             }),
-            _ => unreachable!(
-                "build3 refuses every check but uniform_stress_3d, reaction and max_penetration"
-            ),
+            _ => unreachable!("Model::resolve_checks refuses in 3D every check matched above"),
         }
     }
     // the results' own stress field

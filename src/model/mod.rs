@@ -1132,6 +1132,179 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
         }
         Ok(())
     }
+
+    /// A check's component: in 2D `x` or `y`, in 3D any.
+    fn plane_component(&self, component: crate::io::scene::Component, at: &str) -> Result<()> {
+        if D == 2 && component == crate::io::scene::Component::Z {
+            return Err(Error::invalid(
+                &self.source,
+                at,
+                "the check names the component z, but the case is 2D",
+                "use \"x\" or \"y\"",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The case's checks, validated against the model (names, tolerances, the dimension) into
+    /// [`Model::checks`]: one set of rules for 2D and 3D. A 3D case takes `uniform_stress_3d`,
+    /// `reaction`, `max_penetration`, `contact_force`, `max_contact_pressure` and
+    /// `force_balance`; the others are refused by name (not judged in 3D yet).
+    pub(crate) fn resolve_checks(&mut self, case: &Case) -> Result<()> {
+        for (k, check) in case.checks.iter().enumerate() {
+            let at = format!("checks[{k}]");
+            let judged_in_3d = matches!(
+                check,
+                Check::UniformStress3d { .. }
+                    | Check::Reaction { .. }
+                    | Check::MaxPenetration { .. }
+                    | Check::ContactForce { .. }
+                    | Check::MaxContactPressure { .. }
+                    | Check::ForceBalance { .. }
+            );
+            if D == 3 && !judged_in_3d {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    "this check is not judged in 3D (a 3D run judges uniform_stress_3d, reaction, max_penetration, contact_force, max_contact_pressure and force_balance)",
+                    "use one of those, or run the case in 2D",
+                ));
+            }
+            let tol = match check {
+                Check::UniformStress {
+                    body,
+                    tol,
+                    per_condition,
+                    ..
+                } => {
+                    if let Some(b) = body {
+                        self.find_body(b, &at)?;
+                    }
+                    if per_condition.is_some_and(|c| !(c.is_finite() && c >= 0.0)) {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            format!("per_condition must be a non-negative number, got {per_condition:?}"),
+                            "give e.g. 10 (the tolerance becomes max(tol, 10 eps times the condition estimate))",
+                        ));
+                    }
+                    *tol
+                }
+                Check::ExactDisplacement { tol } => {
+                    self.require_exact(&at)?;
+                    *tol
+                }
+                Check::UniformStress3d { stress, tol } => {
+                    if D == 2 {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "uniform_stress_3d is a check of 3D cases, and this case's bodies are 2D",
+                            "use \"uniform_stress\" with the components [xx, yy, xy]",
+                        ));
+                    }
+                    if !stress.iter().all(|v| v.is_finite()) {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "the stress must be finite",
+                            "give six finite components [xx, yy, zz, yz, xz, xy]",
+                        ));
+                    }
+                    *tol
+                }
+                Check::Reaction {
+                    body,
+                    set,
+                    tol,
+                    component,
+                    ..
+                } => {
+                    let b = self.find_body(body, &at)?;
+                    self.find_node_set(b, set, &at)?;
+                    self.plane_component(*component, &at)?;
+                    *tol
+                }
+                Check::Displacement {
+                    body,
+                    tol,
+                    component,
+                    ..
+                } => {
+                    self.find_body(body, &at)?;
+                    self.plane_component(*component, &at)?;
+                    *tol
+                }
+                Check::MaxPenetration { pair, share } => {
+                    self.resolve_max_penetration(pair.as_deref(), &at)?;
+                    *share
+                }
+                Check::ContactForce {
+                    pair,
+                    tol,
+                    component,
+                    ..
+                } => {
+                    self.find_pair(pair, &at)?;
+                    self.plane_component(*component, &at)?;
+                    *tol
+                }
+                Check::MaxContactPressure { pair, tol, .. } => {
+                    self.find_pair(pair, &at)?;
+                    *tol
+                }
+                Check::ContactPressure { pair, tol } => {
+                    self.find_pair(pair, &at)?;
+                    self.require_exact(&at)?;
+                    *tol
+                }
+                Check::TerminatesWith { .. } | Check::StatusChanges { .. } => {
+                    if self.contact.is_empty() {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "terminates_with and status_changes judge the contact solve, but the case has no contact",
+                            "remove the check or add a contact pair",
+                        ));
+                    }
+                    0.0
+                }
+                Check::Warns { .. } => 0.0,
+                Check::Equilibrium { tol, per_condition } => {
+                    if per_condition.is_some_and(|c| !(c.is_finite() && c >= 0.0)) {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            format!("per_condition must be a non-negative number, got {per_condition:?}"),
+                            "give e.g. 10 (the tolerance becomes 10 eps times the condition estimate)",
+                        ));
+                    }
+                    *tol
+                }
+                Check::ForceBalance { tol } => {
+                    if self.contact.is_empty() {
+                        return Err(Error::invalid(
+                            &self.source,
+                            &at,
+                            "force_balance checks contact forces, but the case has no contact",
+                            "remove the check or add a contact pair",
+                        ));
+                    }
+                    *tol
+                }
+            };
+            if !(tol.is_finite() && tol >= 0.0) {
+                return Err(Error::invalid(
+                    &self.source,
+                    &at,
+                    format!("tolerance must be a non-negative number, got {tol}"),
+                    "give e.g. 1e-10",
+                ));
+            }
+            self.checks.push(check.clone());
+        }
+        Ok(())
+    }
 }
 
 impl Model {
@@ -1446,147 +1619,6 @@ impl Model {
                 format!("\"{}\" means nothing here: {why}", variation.name()),
                 "remove \"slave_normal_variation\", or use \"normal\": \"slave\" with \"physics\": {\"kinematics\": \"finite\"} between deformable bodies",
             ));
-        }
-        Ok(())
-    }
-
-    /// A check's component in 2D: `x` or `y`.
-    fn plane_component(&self, component: crate::io::scene::Component, at: &str) -> Result<()> {
-        if component == crate::io::scene::Component::Z {
-            return Err(Error::invalid(
-                &self.source,
-                at,
-                "the check names the component z, but the case is 2D",
-                "use \"x\" or \"y\"",
-            ));
-        }
-        Ok(())
-    }
-
-    fn resolve_checks(&mut self, case: &Case) -> Result<()> {
-        for (k, check) in case.checks.iter().enumerate() {
-            let at = format!("checks[{k}]");
-            let tol = match check {
-                Check::UniformStress {
-                    body,
-                    tol,
-                    per_condition,
-                    ..
-                } => {
-                    if let Some(b) = body {
-                        self.find_body(b, &at)?;
-                    }
-                    if per_condition.is_some_and(|c| !(c.is_finite() && c >= 0.0)) {
-                        return Err(Error::invalid(
-                            &self.source,
-                            &at,
-                            format!("per_condition must be a non-negative number, got {per_condition:?}"),
-                            "give e.g. 10 (the tolerance becomes max(tol, 10 eps times the condition estimate))",
-                        ));
-                    }
-                    *tol
-                }
-                Check::ExactDisplacement { tol } => {
-                    self.require_exact(&at)?;
-                    *tol
-                }
-                Check::UniformStress3d { .. } => {
-                    return Err(Error::invalid(
-                        &self.source,
-                        &at,
-                        "uniform_stress_3d is a check of 3D cases, and this case's bodies are 2D",
-                        "use \"uniform_stress\" with the components [xx, yy, xy]",
-                    ));
-                }
-                Check::Reaction {
-                    body,
-                    set,
-                    tol,
-                    component,
-                    ..
-                } => {
-                    let b = self.find_body(body, &at)?;
-                    self.find_node_set(b, set, &at)?;
-                    self.plane_component(*component, &at)?;
-                    *tol
-                }
-                Check::Displacement {
-                    body,
-                    tol,
-                    component,
-                    ..
-                } => {
-                    self.find_body(body, &at)?;
-                    self.plane_component(*component, &at)?;
-                    *tol
-                }
-                Check::MaxPenetration { pair, share } => {
-                    self.resolve_max_penetration(pair.as_deref(), &at)?;
-                    *share
-                }
-                Check::ContactForce {
-                    pair,
-                    tol,
-                    component,
-                    ..
-                } => {
-                    self.find_pair(pair, &at)?;
-                    self.plane_component(*component, &at)?;
-                    *tol
-                }
-                Check::MaxContactPressure { pair, tol, .. } => {
-                    self.find_pair(pair, &at)?;
-                    *tol
-                }
-                Check::ContactPressure { pair, tol } => {
-                    self.find_pair(pair, &at)?;
-                    self.require_exact(&at)?;
-                    *tol
-                }
-                Check::TerminatesWith { .. } | Check::StatusChanges { .. } => {
-                    if self.contact.is_empty() {
-                        return Err(Error::invalid(
-                            &self.source,
-                            &at,
-                            "terminates_with and status_changes judge the contact solve, but the case has no contact",
-                            "remove the check or add a contact pair",
-                        ));
-                    }
-                    0.0
-                }
-                Check::Warns { .. } => 0.0,
-                Check::Equilibrium { tol, per_condition } => {
-                    if per_condition.is_some_and(|c| !(c.is_finite() && c >= 0.0)) {
-                        return Err(Error::invalid(
-                            &self.source,
-                            &at,
-                            format!("per_condition must be a non-negative number, got {per_condition:?}"),
-                            "give e.g. 10 (the tolerance becomes 10 eps times the condition estimate)",
-                        ));
-                    }
-                    *tol
-                }
-                Check::ForceBalance { tol } => {
-                    if self.contact.is_empty() {
-                        return Err(Error::invalid(
-                            &self.source,
-                            &at,
-                            "force_balance checks contact forces, but the case has no contact",
-                            "remove the check or add a contact pair",
-                        ));
-                    }
-                    *tol
-                }
-            };
-            if !(tol.is_finite() && tol >= 0.0) {
-                return Err(Error::invalid(
-                    &self.source,
-                    &at,
-                    format!("tolerance must be a non-negative number, got {tol}"),
-                    "give e.g. 1e-10",
-                ));
-            }
-            self.checks.push(check.clone());
         }
         Ok(())
     }
