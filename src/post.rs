@@ -14,13 +14,18 @@
 //! * Relative L2 displacement error: `sqrt(int |u_h - u|^2 dA / int |u|^2 dA)`, with a Gauss rule
 //!   richer than the stiffness rule (see `fe::ElementKind::error_rule`).
 
+use crate::contact::forces::PairForces;
+use crate::contact::results::PairResults;
+use crate::contact::state::ContactState;
 use crate::fe::displacement_gradient_at;
 use crate::fe::ReferenceCell;
 use crate::harness::exact::ExactField;
+use crate::io::contact_output::pair_file_names;
 use crate::model::space::SolidCell;
 use crate::model::{Body, Model};
 use crate::solid::{strain_at, MAX_DOFS};
 use crate::solid_finite::jacobian;
+use serde::Serialize;
 
 /// Element displacements of cell `c` of `body`.
 pub fn cell_displacements(body: &Body, u: &[f64], c: usize, out: &mut Vec<f64>) {
@@ -394,6 +399,96 @@ pub fn reaction_summaries<const D: usize, K: SolidCell<D>>(
                     })
                     .collect(),
             }
+        })
+        .collect()
+}
+
+/// A point or vector of `D` components, serialized as a list.
+fn components<S: serde::Serializer, const D: usize>(v: &[f64; D], s: S) -> Result<S::Ok, S::Error> {
+    v.as_slice().serialize(s)
+}
+
+/// What one contact pair transmits (`D` components: the same summary in 2D and 3D).
+#[derive(Serialize)]
+pub struct PairSummary<const D: usize = 2> {
+    pub name: String,
+    /// Net force on the slave body and on the master (body or rigid surface), `[x, y(, z)]`.
+    #[serde(serialize_with = "components")]
+    pub force_on_slave: [f64; D],
+    #[serde(serialize_with = "components")]
+    pub force_on_master: [f64; D],
+    pub max_pressure: f64,
+    pub max_penetration: f64,
+    pub max_penetration_share: f64,
+    /// Body, node and position of the slave node with the largest share.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_penetration_at: Option<PointRef<D>>,
+    /// Coulomb pairs: total tangential force, stick/slip/open counts, dissipation.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<crate::contact::friction::FrictionSummary>,
+    /// The normal force the pair transmits (`sum_a -f_a . n_a` over the slave surface), the
+    /// covered tributary area of its closed points, and the points of each status (both
+    /// surfaces; see [`crate::contact::results`]).
+    pub normal_force: f64,
+    pub closed_area: f64,
+    pub point_status: PointStatusCounts,
+    /// The pair's per-point files in this folder: contact `.vtu`, `.csv`, `.json`.
+    pub files: [String; 3],
+}
+
+/// How many points of a pair's surfaces have each status.
+#[derive(Serialize)]
+pub struct PointStatusCounts {
+    pub unmeasured: usize,
+    pub open: usize,
+    pub closed: usize,
+    pub stick: usize,
+    pub slip: usize,
+}
+
+/// A node named for a user: body name, node number, position.
+#[derive(Serialize)]
+pub struct PointRef<const D: usize = 2> {
+    pub body: String,
+    pub node: usize,
+    #[serde(serialize_with = "components")]
+    pub point: [f64; D],
+}
+
+/// The summary of every pair of `model` (in either dimension) from its forces and per-point
+/// results in the contact solution `state`.
+pub fn pair_summaries<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    state: &ContactState<D>,
+    forces: &[PairForces<D>],
+    results: &[PairResults<D>],
+) -> Vec<PairSummary<D>> {
+    forces
+        .iter()
+        .zip(results)
+        .map(|(f, r)| PairSummary {
+            name: model.contact[f.pair].name.clone(),
+            force_on_slave: f.on_slave,
+            force_on_master: f.on_master,
+            max_pressure: f.max_pressure(),
+            max_penetration: f.penetration.depth,
+            max_penetration_share: f.penetration.share_of_element,
+            max_penetration_at: f.penetration.at.map(|(b, node, point)| PointRef {
+                body: model.bodies[b].name.clone(),
+                node,
+                point,
+            }),
+            friction: crate::contact::friction::pair_summary(state, f.pair),
+            normal_force: r.totals.normal_force,
+            closed_area: r.totals.closed_area,
+            point_status: PointStatusCounts {
+                unmeasured: r.totals.unmeasured,
+                open: r.totals.open,
+                closed: r.totals.closed,
+                stick: r.totals.stick,
+                slip: r.totals.slip,
+            },
+            files: pair_file_names(&r.name).unwrap_or_default(),
         })
         .collect()
 }

@@ -59,7 +59,7 @@
 //! `summary.json` lists each support set's reaction (`reactions`, x, y and z, every prescribed
 //! dof counted in one set: [`crate::post::ReactionSummary`]). Contact output is the 2D one,
 //! from the same functions generic over the dimension: per pair the summary of
-//! [`crate::io::output::PairSummary`] (forces, normal force, closed area, largest pressure,
+//! [`crate::post::PairSummary`] (forces, normal force, closed area, largest pressure,
 //! point counts), the `<pair>.contact.csv`, `.json` and `.vtu` files of
 //! [`crate::io::contact_output`] (pressure, shear, gap, status, slip and forces per point,
 //! [`crate::contact::results`]) and the contact fields of the body `.vtu` files.
@@ -79,7 +79,6 @@ use crate::fe::ReferenceCell;
 use crate::fe3d::SolidKind;
 use crate::harness::checks::{penetration_warnings, CheckResult};
 use crate::io::contact_output::{body_point_arrays, write_pair_files};
-use crate::io::output::pair_summaries;
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
 use crate::io::scene::{
     Case, Check, ContactGeometry, DiscretizationSpec, Interaction, Kinematics, MaterialModel,
@@ -88,6 +87,7 @@ use crate::io::scene::{
 use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
 use crate::model::{Body3, MasterSide, Model3};
+use crate::post::pair_summaries;
 use crate::solid3d::{strain_at3, Elasticity3};
 use crate::solid_finite::Hyperelastic;
 use std::path::Path;
@@ -628,7 +628,7 @@ fn nodal_stress(body: &Body3, u: &[f64]) -> Vec<[f64; 6]> {
 }
 
 /// The contact part of the summary: how the solve ended, the rows' totals and each pair's
-/// summary (the 2D one: [`crate::io::output::PairSummary`]) from its forces and per-point
+/// summary (the 2D one: [`crate::post::PairSummary`]) from its forces and per-point
 /// `results`.
 fn contact_summary(outcome: &Outcome3, results: &[PairResults<3>]) -> Option<serde_json::Value> {
     let state = outcome.solution.contact.as_ref()?;
