@@ -403,19 +403,14 @@ pub fn reaction_summaries<const D: usize, K: SolidCell<D>>(
         .collect()
 }
 
-/// A point or vector of `D` components, serialized as a list.
-fn components<S: serde::Serializer, const D: usize>(v: &[f64; D], s: S) -> Result<S::Ok, S::Error> {
-    v.as_slice().serialize(s)
-}
-
 /// What one contact pair transmits (`D` components: the same summary in 2D and 3D).
 #[derive(Serialize)]
 pub struct PairSummary<const D: usize = 2> {
     pub name: String,
     /// Net force on the slave body and on the master (body or rigid surface), `[x, y(, z)]`.
-    #[serde(serialize_with = "components")]
+    #[serde(serialize_with = "crate::contact::results::components")]
     pub force_on_slave: [f64; D],
-    #[serde(serialize_with = "components")]
+    #[serde(serialize_with = "crate::contact::results::components")]
     pub force_on_master: [f64; D],
     pub max_pressure: f64,
     pub max_penetration: f64,
@@ -451,7 +446,7 @@ pub struct PointStatusCounts {
 pub struct PointRef<const D: usize = 2> {
     pub body: String,
     pub node: usize,
-    #[serde(serialize_with = "components")]
+    #[serde(serialize_with = "crate::contact::results::components")]
     pub point: [f64; D],
 }
 

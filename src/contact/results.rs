@@ -71,8 +71,12 @@ use crate::model::{MasterSide, Model};
 use serde::{Serialize, Serializer};
 use std::collections::BTreeMap;
 
-/// A point or vector of `D` components, serialized as a list.
-fn components<S: Serializer, const D: usize>(v: &[f64; D], s: S) -> Result<S::Ok, S::Error> {
+/// A point or vector of `D` components, serialized as a list (the contact results and
+/// [`crate::post::PairSummary`]).
+pub(crate) fn components<S: Serializer, const D: usize>(
+    v: &[f64; D],
+    s: S,
+) -> Result<S::Ok, S::Error> {
     v.as_slice().serialize(s)
 }
 
