@@ -1125,17 +1125,21 @@ fn table(
     let mut suites = Vec::new();
     for w in &written {
         let part = &w.cells;
-        if w.catalogue == Catalogue::Patch {
+        if w.catalogue == Catalogue::Patch && contact_patch::harness::report::has_seed_cells(part) {
             println!("{}", contact_patch::harness::report::seed_summary(part));
         }
         suites.push(junit::TestSuite {
             name: w.catalogue.name().to_string(),
-            seconds: part.iter().map(|c| c.time_ms / 1e3).sum(),
+            seconds: part.iter().filter_map(|c| c.time_ms).sum::<f64>() / 1e3,
             cases: part.iter().map(junit::cell_case).collect(),
         });
         print_catalogue(&folder, w);
     }
-    println!("{} cells in {seconds:.2}s", cells.len());
+    println!(
+        "{} cells {} {seconds:.2}s",
+        cells.len(),
+        if outside.is_some() { "judged in" } else { "in" }
+    );
     if !errors.is_empty() {
         suites.push(junit::TestSuite {
             name: "cases that could not run".into(),

@@ -252,11 +252,23 @@ fn exported_gmsh_file_reads_back_with_mshio() {
             .lines()
             .skip(1)
             .collect();
+        // every physical name is unique (readers such as meshio key the groups by name alone)
+        let mut unique: Vec<&str> = names.iter().map(|l| l.split_once('"').unwrap().1).collect();
+        unique.sort();
+        let all = unique.len();
+        unique.dedup();
+        assert_eq!(
+            unique.len(),
+            all,
+            "{case}: a physical name used twice: {names:?}"
+        );
         for b in &model.bodies {
             for (set, nodes) in b.mesh.node_sets.iter().filter(|(s, _)| *s != "all") {
                 let line = names
                     .iter()
-                    .find(|l| l.starts_with("0 ") && l.ends_with(&format!("\"{}/{set}\"", b.name)))
+                    .find(|l| {
+                        l.starts_with("0 ") && l.ends_with(&format!("\"{}/{set}/nodes\"", b.name))
+                    })
                     .unwrap_or_else(|| panic!("{case}: no group for {}/{set}", b.name));
                 let tag: i32 = line.split(' ').nth(1).unwrap().parse().unwrap();
                 let in_group = ents
@@ -346,6 +358,11 @@ fn judge_refuses_results_it_cannot_use_and_says_how_to_fix_them() {
         "{s}"
     );
     assert!(s.contains("--match-tol"), "{s}");
+    // a node merely off its point gets the general hint, which names the reference coordinates
+    assert!(
+        !s.contains("deformed positions") && s.contains("(not X + u)"),
+        "{s}"
+    );
     // ... which a looser matching distance accepts
     let o = run(&[
         "judge",
@@ -355,6 +372,42 @@ fn judge_refuses_results_it_cannot_use_and_says_how_to_fix_them() {
         "1e-3",
     ]);
     assert!(say(&o).contains("largest distance 1.000e-3"), "{}", say(&o));
+    // the points written at the deformed positions X + u (issue 42, item 7): the hint says so
+    let points_tag =
+        "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    let deformed = edited_results(tmp.path(), |t| {
+        let rows = |text: &str| -> Vec<Vec<f64>> {
+            text.trim()
+                .lines()
+                .map(|l| l.split(' ').map(|w| w.parse().unwrap()).collect())
+                .collect()
+        };
+        let (_, rest) = t.split_once("Name=\"displacement\"").unwrap();
+        let u = rows(
+            rest.split_once('>')
+                .unwrap()
+                .1
+                .split_once("</DataArray>")
+                .unwrap()
+                .0,
+        );
+        let (head, rest) = t.split_once(points_tag).unwrap();
+        let (points, tail) = rest.split_once("</DataArray>").unwrap();
+        let moved: Vec<String> = rows(points)
+            .iter()
+            .zip(&u)
+            .map(|(p, u)| format!("{} {} {}", p[0] + u[0], p[1] + u[1], p[2]))
+            .collect();
+        format!("{head}{points_tag}{}\n</DataArray>{tail}", moved.join("\n"))
+    });
+    let o = run(&["judge", case, deformed.to_str().unwrap()]);
+    let s = say(&o);
+    assert_eq!(o.status.code(), Some(2), "{s}");
+    assert!(
+        s.contains("the results' points are the deformed positions X + u")
+            && s.contains("reference coordinates X"),
+        "{s}"
+    );
     // numbers as text in an array said to be binary (base64)
     let binary = edited_results(tmp.path(), |t| {
         t.replacen("format=\"ascii\"", "format=\"binary\"", 1)
@@ -488,6 +541,41 @@ fn table_of_outside_results_matches_the_direct_cells_of_the_same_method() {
     }
     // the seed's verdicts: mesh A passes, mesh C one-pass fails
     assert_eq!(verdicts, ["pass", "fail"]);
+    // the report states only what was measured: no seed row of `?` judged "NO", no two-pass
+    // claim "confirmed" from an empty table, no kappa, no times of 0.00 (issue 42, item 3)
+    let report = std::fs::read_to_string(out.join("patch-table.md")).unwrap();
+    for unmeasured in [
+        "matches the seed",
+        "confirmed",
+        "kappa = ",
+        " 0.00 |",
+        "| ? |",
+    ] {
+        assert!(
+            !report.contains(unmeasured),
+            "the outside table claims {unmeasured:?}:\n{report}"
+        );
+    }
+    for stated in [
+        "No cell of this table uses the seed's method",
+        "No two-pass cell of meshes B or C is in this table",
+        "no cell was solved here",
+        "2 cells judged in",
+    ] {
+        assert!(report.contains(stated), "no {stated:?}:\n{report}");
+    }
+    let rows: Vec<&str> = report
+        .lines()
+        .filter(|l| l.contains("| stand-in |"))
+        .collect();
+    assert_eq!(rows.len(), 2, "{report}");
+    for row in rows {
+        // `... | iterations | time ms | note |`: the time is the third field from the end
+        let fields: Vec<&str> = row.split('|').collect();
+        let time = fields[fields.len() - 3].trim();
+        assert_eq!(time, "-", "a time where nothing was timed: {row}");
+    }
+    assert!(!say(&o).contains("Taylor 2004 (seed)"), "{}", say(&o));
     // a missing results folder is refused before any work
     let o = run(&[
         "table",
@@ -1038,5 +1126,190 @@ fn force_balance_of_a_current_geometry_run_agrees_between_run_and_judge() {
                 "with the moments about the deformed positions X + u the results balance"
             ),
         "{line}"
+    );
+}
+
+#[test]
+fn the_sidecars_facet_lists_run_counter_clockwise_with_the_body_on_the_left() {
+    // issue 42, item 7: the sidecar documents its facet layout; the layout holds on the
+    // rectangles of the patch test (one step to the left of a facet's midpoint is inside its
+    // body, one step to the right outside)
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("export");
+    let case = "cases/patch/patch-B-nu0.3.json";
+    let o = run(&["export", case, "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", say(&o));
+    let model = contact_patch::model::admit::load(&root().join(case)).unwrap();
+    let sidecar: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join(&model.name).join(format!("{}.json", model.name)))
+            .unwrap(),
+    )
+    .unwrap();
+    let layout = sidecar["mesh"]["facet_sets"].as_str().unwrap();
+    assert!(layout.contains("counter-clockwise") && layout.contains("[start, end]"));
+    assert!(sidecar["mesh"]["gmsh_format"]
+        .as_str()
+        .unwrap()
+        .contains("'<body>/<node set>/nodes'"));
+    let mut checked = 0;
+    for (b, body) in model.bodies.iter().enumerate() {
+        let [lo, hi] = body.mesh.bounding_box();
+        let inside = |p: [f64; 2]| (0..2).all(|i| p[i] > lo[i] && p[i] < hi[i]);
+        let json = &sidecar["bodies"][b];
+        assert_eq!(json["name"], body.name.as_str());
+        for (set, value) in json["facet_sets"].as_object().unwrap() {
+            assert_eq!(value["physical_group"], format!("{}/{set}", body.name));
+            for facet in value["facets"].as_array().unwrap() {
+                let nodes: Vec<usize> = facet
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|n| n.as_u64().unwrap() as usize)
+                    .collect();
+                let (a, e) = (body.mesh.nodes[nodes[0]], body.mesh.nodes[nodes[1]]);
+                let t = [e[0] - a[0], e[1] - a[1]];
+                let mid = [(a[0] + e[0]) / 2.0, (a[1] + e[1]) / 2.0];
+                let step = 1e-3;
+                let left = [mid[0] - step * t[1], mid[1] + step * t[0]];
+                let right = [mid[0] + step * t[1], mid[1] - step * t[0]];
+                assert!(
+                    inside(left) && !inside(right),
+                    "{}/{set}: facet {nodes:?} from {a:?} to {e:?}",
+                    body.name
+                );
+                checked += 1;
+            }
+        }
+        for (set, value) in json["node_sets"].as_object().unwrap() {
+            if set != "all" {
+                assert_eq!(
+                    value["physical_group"],
+                    format!("{}/{set}/nodes", body.name)
+                );
+            }
+        }
+    }
+    assert!(checked > 10, "{checked} facets checked");
+}
+
+#[test]
+fn an_outside_penalty_code_is_credited_with_its_kappa_series_and_a_cell_can_say_n_a() {
+    // issue 42, item 6: our own penalty runs of patch C (node-to-surface, one pass, punch
+    // slave) at kappa 1e4 and 1e7 stand in for another code's kappa series; the outside cell
+    // must read the trend and errors of the direct sweep's penalty cell
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    let case_c = "cases/patch/patch-C-nu0.3.json";
+    let text = std::fs::read_to_string(root().join(case_c)).unwrap();
+    let name = "patch-C-nu0.3";
+    for kappa in [1e4, 1e7] {
+        let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
+        case["contact"][0]["enforcement"] = serde_json::json!({"kind": "penalty", "kappa": kappa});
+        let path = tmp.path().join(format!("penalty-{kappa:e}.json"));
+        std::fs::write(&path, case.to_string()).unwrap();
+        let direct = run_case(&path, &mut |_| {}).unwrap();
+        let folder =
+            OutputFolder::new(&results.join(name).join(format!("kappa-{kappa:e}"))).unwrap();
+        write_run(&folder, &direct).unwrap();
+    }
+    // a code without 3-node contact facets says so for patch E
+    let case_e = "cases/patch/patch-E-nu0.3.json";
+    let na = results.join("patch-E-nu0.3");
+    std::fs::create_dir_all(&na).unwrap();
+    std::fs::write(na.join("not-applicable.txt"), "no 3-node contact facets\n").unwrap();
+    let out = tmp.path().join("tables");
+    let table = |cases: &[&str], out: &Path| {
+        let mut args = vec!["table"];
+        args.extend(cases);
+        args.extend([
+            "--results",
+            results.to_str().unwrap(),
+            "--code",
+            "their-penalty",
+        ]);
+        args.extend(["--out", out.to_str().unwrap()]);
+        run(&args)
+    };
+    let o = table(&[case_c, case_e], &out);
+    assert_eq!(o.status.code(), Some(0), "{}", say(&o));
+    let cells: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("patch-table.json")).unwrap())
+            .unwrap();
+    let cells = cells.as_array().unwrap();
+    assert_eq!(cells.len(), 2);
+    let direct = contact_patch::harness::run_sweep(&root().join(case_c), &mut |_| {}).unwrap();
+    let same = direct
+        .iter()
+        .find(|c| {
+            c.discretization == "node_to_surface"
+                && c.passes == Some(1)
+                && c.slave.as_deref() == Some("punch")
+                && c.enforcement == "penalty"
+        })
+        .unwrap();
+    assert_eq!(
+        same.kappa,
+        Some(1e4),
+        "the sweep's penalty cell is at kappa 1e4"
+    );
+    let series = &cells[0];
+    assert_eq!(series["kappa"], 1e4);
+    assert_eq!(
+        series["penalty_trend"],
+        same.penalty_trend.as_deref().unwrap()
+    );
+    for (key, want) in [
+        ("stress_error", same.stress_error.unwrap()),
+        ("stress_error_stiff", same.stress_error_stiff.unwrap()),
+    ] {
+        let got = series[key].as_f64().unwrap();
+        assert!(
+            (got - want).abs() <= 1e-9 * want.max(1e-3),
+            "{key}: {got:e} vs {want:e}"
+        );
+    }
+    assert_eq!(series["verdict"], same.verdict.as_str());
+    let note = series["note"].as_str().unwrap();
+    assert!(
+        note.contains("kappa series") && note.contains("as kappa grows 1e3x"),
+        "{note}"
+    );
+    let na_cell = &cells[1];
+    assert_eq!(na_cell["verdict"], "n/a");
+    assert_eq!(
+        na_cell["note"],
+        "n/a (their-penalty): no 3-node contact facets"
+    );
+    let report = std::fs::read_to_string(out.join("patch-table.md")).unwrap();
+    assert!(report.contains("Another code's kappa series"), "{report}");
+    // refusals: an empty reason, a series of one kappa, a series too narrow, a bad folder name
+    let refused = |setup: &dyn Fn(), says: &str| {
+        setup();
+        let o = table(&[case_c, case_e], &tmp.path().join("refused"));
+        assert_eq!(o.status.code(), Some(2), "{}", say(&o));
+        assert!(say(&o).contains(says), "no {says:?}: {}", say(&o));
+    };
+    refused(
+        &|| std::fs::write(na.join("not-applicable.txt"), " \n").unwrap(),
+        "the file is empty",
+    );
+    std::fs::write(na.join("not-applicable.txt"), "no 3-node contact facets").unwrap();
+    let series_dir = results.join(name);
+    let stiff = series_dir.join("kappa-1e7");
+    let moved = series_dir.join("kappa-5e4");
+    refused(
+        &|| std::fs::rename(&stiff, &moved).unwrap(),
+        "a factor 5.000; the trend needs at least 100",
+    );
+    std::fs::rename(&moved, &stiff).unwrap();
+    let kept = tmp.path().join("kept");
+    refused(
+        &|| std::fs::rename(&stiff, &kept).unwrap(),
+        "a kappa series of one kappa",
+    );
+    std::fs::rename(&kept, &stiff).unwrap();
+    refused(
+        &|| std::fs::create_dir(series_dir.join("kappa-big")).unwrap(),
+        "'big' is not a positive number",
     );
 }

@@ -282,7 +282,7 @@ pub fn grid_markdown(cells: &[super::Cell], with_time: bool) -> String {
                 .unwrap_or("-".into()),
         );
         if with_time {
-            s += &format!(" {:.2} |", c.time_ms);
+            s += &format!(" {} |", super::time_text(c.time_ms));
         }
         s += &format!(" {} |\n", c.note.replace('|', "/"));
     }

@@ -195,6 +195,39 @@ fn stress_of(v: &[f64]) -> std::result::Result<[f64; 3], String> {
     }
 }
 
+/// How to fix a node without a result point. When some result point minus its displacement
+/// lands on the node, the results were written at the deformed positions `X + u` (a common
+/// default of codes that solve in the current configuration), and the hint says so.
+pub(crate) fn unmatched_node_hint(
+    grid: &crate::io::vtu_read::PointGrid,
+    displacement: &crate::io::vtu_read::PointField,
+    x: &[f64],
+    delta: f64,
+    mesh: &str,
+) -> String {
+    let deformed = grid.points.iter().enumerate().any(|(k, p)| {
+        let u = displacement.at(k);
+        let distance2: f64 = x
+            .iter()
+            .enumerate()
+            .map(|(i, xi)| (p[i] - u.get(i).copied().unwrap_or(0.0) - xi).powi(2))
+            .sum();
+        distance2.sqrt() <= delta
+    });
+    if deformed {
+        format!(
+            "the results' points are the deformed positions X + u (a point minus its displacement \
+             lands on this node): write the points at the reference coordinates X of {mesh}'s \
+             nodes (the undeformed configuration) and the displacement as point data"
+        )
+    } else {
+        format!(
+            "solve on {mesh} and write the results at the reference coordinates X of its nodes \
+             (not X + u); or raise --match-tol (a share of the model size)"
+        )
+    }
+}
+
 /// Judge `results` with the checks of `model`; nodes are matched within
 /// `match_share * model.size()`.
 pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judgement> {
@@ -269,8 +302,13 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
                     &file.shown,
                     format!("node {n} of body '{}' at ({}, {})", body.name, x[0], x[1]),
                     format!("no result point within {delta:.3e} of the node; {nearest}"),
-                    "solve on the exported mesh (contact-patch export) and write results at \
-                     its nodes; or raise --match-tol (a share of the model size)",
+                    unmatched_node_hint(
+                        &file.grid,
+                        displacement,
+                        &x,
+                        delta,
+                        "the exported mesh (contact-patch export)",
+                    ),
                 ));
             };
             let value = displacement.at(k);
@@ -573,9 +611,228 @@ pub fn results_in(dir: &Path, name: &str) -> Result<Option<std::path::PathBuf>> 
     })
 }
 
+/// The file by which another code says it cannot solve a case: `DIR/<case>/not-applicable.txt`,
+/// its text the reason (e.g. "no 3-node contact facets"); the cell is `n/a` with that reason.
+pub const NOT_APPLICABLE_FILE: &str = "not-applicable.txt";
+
+/// The folders of a penalty code's kappa series: `DIR/<case>/kappa-<value>/`, each a results
+/// set of the case at that penalty parameter (`<case>.vtu`, or one `<body>.vtu` per body).
+pub const KAPPA_FOLDER_PREFIX: &str = "kappa-";
+
+/// The longest reason [`NOT_APPLICABLE_FILE`] may give, in bytes.
+const LONGEST_REASON: u64 = 2000;
+
+/// The smallest ratio of the largest to the smallest kappa of a series: the trend rule
+/// (the error falls by at least a tenth of the ratio) says nothing over a narrower span.
+pub const SMALLEST_KAPPA_SPAN: f64 = 100.0;
+
+/// What one results set of a swept case measured (see [`outside_cells`]).
+struct Measured {
+    stress_error: f64,
+    pressure_error: Option<f64>,
+    /// The load error and the force balance, from the results' contact forces.
+    forces: Option<(f64, f64)>,
+    judged_on: Vec<&'static str>,
+    missing: Vec<&'static str>,
+}
+
+impl Measured {
+    /// The note's words: what was judged, and what the results lack.
+    fn words(&self) -> String {
+        let missing = if self.missing.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; not in the results: {} (fields '{CONTACT_PRESSURE_FIELD}', '{CONTACT_FORCE_FIELD}')",
+                self.missing.join(", ")
+            )
+        };
+        format!("judged on {}{missing}", self.judged_on.join(", "))
+    }
+}
+
+/// Judge the results at `path` of the swept case `model` as the sweep judges an exact method.
+fn measure_outside(
+    model: &Model,
+    sweep: &crate::io::scene::SweepSpec,
+    path: &Path,
+    match_share: f64,
+) -> Result<Measured> {
+    let results = load_results(model, path)?;
+    let judged = judge(model, &results, match_share)?;
+    let mut measured = Measured {
+        stress_error: crate::harness::stress_error(model, &judged.solution.u, sweep.pressure),
+        pressure_error: None,
+        forces: None,
+        judged_on: vec!["the stress of its displacement"],
+        missing: Vec::new(),
+    };
+    let pairs = &judged.contact.pairs;
+    let pressures: Option<Vec<PairForces>> = pairs
+        .iter()
+        .map(|p| p.pressures().map(|(f, _)| f.clone()))
+        .collect();
+    match (pressures, model.exact.as_ref()) {
+        (Some(p), Some(exact)) if !pairs.is_empty() => {
+            measured.pressure_error = Some(pressure_error_of(
+                model,
+                &judged.solution,
+                &p,
+                exact,
+                None,
+                Some(sweep.pressure.abs()),
+            ));
+            measured.judged_on.push("the contact pressure");
+        }
+        _ => measured.missing.push("pressure"),
+    }
+    let forces: Option<Vec<PairForces>> = pairs
+        .iter()
+        .map(|p| p.forces().map(|(f, _)| f.clone()))
+        .collect();
+    match forces {
+        Some(f) if !pairs.is_empty() => {
+            let first_pass: std::collections::HashSet<(usize, usize, usize)> = f
+                .iter()
+                .flat_map(|pf| {
+                    let slave = model.contact[pf.pair].slave.0;
+                    pf.nodes
+                        .iter()
+                        .filter(move |n| n.carries_rows && n.body == slave)
+                        .map(move |n| (pf.pair, n.body, n.node))
+                })
+                .collect();
+            let load = crate::harness::load_error(model, &f, sweep.pressure, &|k, b, n| {
+                first_pass.contains(&(k, b, n))
+            });
+            let balance = force_balance_of(model, &judged.solution, &f);
+            measured.forces = Some((load, balance));
+            measured
+                .judged_on
+                .push("the total contact force and the force balance");
+        }
+        _ => measured.missing.push("contact forces"),
+    }
+    Ok(measured)
+}
+
+/// The reason in `DIR/<case>/not-applicable.txt`, when the outside code gave one.
+fn not_applicable_reason(folder: &Path) -> Result<Option<String>> {
+    let file = folder.join(NOT_APPLICABLE_FILE);
+    if !file.is_file() {
+        return Ok(None);
+    }
+    let shown = file.display().to_string();
+    let size = std::fs::metadata(&file)
+        .map_err(|e| Error::io(&shown, "reading its size", e))?
+        .len();
+    if size > LONGEST_REASON {
+        return Err(Error::invalid(
+            &shown,
+            "the reason",
+            format!("{size} bytes; a reason is at most {LONGEST_REASON}"),
+            "say in a sentence why the code cannot solve the case",
+        ));
+    }
+    let text = std::fs::read(&file).map_err(|e| Error::io(&shown, "reading", e))?;
+    let text = String::from_utf8(text).map_err(|_| {
+        Error::invalid(
+            &shown,
+            "the reason",
+            "not UTF-8 text",
+            "write the reason as plain text",
+        )
+    })?;
+    let reason = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    if reason.is_empty() {
+        return Err(Error::invalid(
+            &shown,
+            "the reason",
+            "the file is empty",
+            "say why the code cannot solve the case, e.g. \"no 3-node contact facets\"",
+        ));
+    }
+    Ok(Some(reason))
+}
+
+/// The kappa series in `DIR/<case>/`: `(kappa, results path)` sorted by kappa; empty when the
+/// folder holds no `kappa-*` folder.
+fn kappa_series(folder: &Path, case: &str) -> Result<Vec<(f64, std::path::PathBuf)>> {
+    let shown = folder.display().to_string();
+    let entries = std::fs::read_dir(folder).map_err(|e| Error::io(&shown, "listing", e))?;
+    let mut series = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::io(&shown, "listing", e))?;
+        let name = entry.file_name().to_string_lossy().to_string();
+        let Some(value) = name.strip_prefix(KAPPA_FOLDER_PREFIX) else {
+            continue;
+        };
+        let path = entry.path();
+        if !path.is_dir() {
+            continue;
+        }
+        let kappa: f64 = value
+            .parse()
+            .ok()
+            .filter(|k: &f64| k.is_finite() && *k > 0.0)
+            .ok_or_else(|| {
+                Error::invalid(
+                    &shown,
+                    format!("folder '{name}'"),
+                    format!("'{value}' is not a positive number"),
+                    "name each folder of a kappa series kappa-<value>, e.g. kappa-1e6",
+                )
+            })?;
+        let file = path.join(file_name("case name", case, ".vtu")?);
+        series.push((kappa, if file.is_file() { file } else { path }));
+    }
+    series.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if series.len() == 1 {
+        return Err(Error::invalid(
+            &shown,
+            format!("folder '{}'", series[0].1.display()),
+            "a kappa series of one kappa: the trend of the error needs two or more",
+            format!(
+                "add the same case solved at a kappa {SMALLEST_KAPPA_SPAN:e} times larger (or \
+                 more), or put the results directly in {shown}/"
+            ),
+        ));
+    }
+    if let (Some(first), Some(last)) = (series.first(), series.last()) {
+        if series.len() > 1 && last.0 < SMALLEST_KAPPA_SPAN * first.0 {
+            return Err(Error::invalid(
+                &shown,
+                "the kappa series",
+                format!(
+                    "kappa spans {:e} to {:e}, a factor {:.3}; the trend needs at least {SMALLEST_KAPPA_SPAN}",
+                    first.0,
+                    last.0,
+                    last.0 / first.0
+                ),
+                "add a kappa at least 100 times the smallest",
+            ));
+        }
+        if let Some(w) = series.windows(2).find(|w| w[0].0 == w[1].0) {
+            return Err(Error::invalid(
+                &shown,
+                "the kappa series",
+                format!("two folders give kappa {:e}", w[0].0),
+                "give each kappa once",
+            ));
+        }
+    }
+    Ok(series)
+}
+
 /// One table cell for the swept case at `case_file` from another code's results in `dir`
 /// (see [`results_in`]), named `code` in the enforcement column; no cell for a case without
-/// a sweep. A case without results is an `n/a` cell that says so.
+/// a sweep. A case without results is an `n/a` cell that says so; so is one whose folder
+/// `DIR/<case>/` holds [`NOT_APPLICABLE_FILE`], with the code's reason. A penalty code hands
+/// in a kappa series as folders `DIR/<case>/kappa-<value>/` (two or more, spanning at least
+/// [`SMALLEST_KAPPA_SPAN`]): the cell is judged as our penalty cells are, on the trend of its
+/// stress error from the smallest to the largest kappa (`round-off` at both, `1/kappa` when it
+/// falls by at least a tenth of the kappa ratio, else `no fall`), with the contact forces of the
+/// largest kappa.
 pub fn outside_cells(
     case_file: &Path,
     dir: &Path,
@@ -598,6 +855,29 @@ pub fn outside_cells(
             sweep.tol,
         )
     };
+    let folder = dir.join(file_name("case name", &model.name, "")?);
+    let file = dir.join(file_name("case name", &model.name, ".vtu")?);
+    if folder.is_dir() {
+        if let Some(reason) = not_applicable_reason(&folder)? {
+            if file.is_file() {
+                return Err(Error::invalid(
+                    folder.display(),
+                    NOT_APPLICABLE_FILE,
+                    format!(
+                        "says the code cannot solve the case, yet {} holds its results",
+                        file.display()
+                    ),
+                    "remove one of the two",
+                ));
+            }
+            cell.note = format!("n/a ({code}): {reason}");
+            return Ok(vec![cell]);
+        }
+        let series = kappa_series(&folder, &model.name)?;
+        if !series.is_empty() {
+            return kappa_series_cell(cell, &model, &sweep, &series, match_share);
+        }
+    }
     let Some(path) = results_in(dir, &model.name)? else {
         cell.note = format!(
             "no results: neither {0}/{1}.vtu nor {0}/{1}/ exists",
@@ -606,74 +886,68 @@ pub fn outside_cells(
         );
         return Ok(vec![cell]);
     };
-    let results = load_results(&model, &path)?;
-    let judged = judge(&model, &results, match_share)?;
-    let e = crate::harness::stress_error(&model, &judged.solution.u, sweep.pressure);
-    cell.stress_error = Some(e);
-    let mut pass = e <= sweep.tol;
-    let mut judged_on = vec!["the stress of its displacement"];
-    let mut missing = Vec::new();
-    let pairs = &judged.contact.pairs;
-    let pressures: Option<Vec<PairForces>> = pairs
-        .iter()
-        .map(|p| p.pressures().map(|(f, _)| f.clone()))
-        .collect();
-    match (pressures, model.exact.as_ref()) {
-        (Some(p), Some(exact)) if !pairs.is_empty() => {
-            let error = pressure_error_of(
-                &model,
-                &judged.solution,
-                &p,
-                exact,
-                None,
-                Some(sweep.pressure.abs()),
-            );
-            cell.pressure_error = Some(error);
-            pass &= error <= sweep.tol;
-            judged_on.push("the contact pressure");
-        }
-        _ => missing.push("pressure"),
-    }
-    let forces: Option<Vec<PairForces>> = pairs
-        .iter()
-        .map(|p| p.forces().map(|(f, _)| f.clone()))
-        .collect();
-    match forces {
-        Some(f) if !pairs.is_empty() => {
-            let first_pass: std::collections::HashSet<(usize, usize, usize)> = f
-                .iter()
-                .flat_map(|pf| {
-                    let slave = model.contact[pf.pair].slave.0;
-                    pf.nodes
-                        .iter()
-                        .filter(move |n| n.carries_rows && n.body == slave)
-                        .map(move |n| (pf.pair, n.body, n.node))
-                })
-                .collect();
-            let load = crate::harness::load_error(&model, &f, sweep.pressure, &|k, b, n| {
-                first_pass.contains(&(k, b, n))
-            });
-            let balance = force_balance_of(&model, &judged.solution, &f);
-            cell.load_error = Some(load);
-            cell.force_balance = Some(balance);
-            pass &= load <= sweep.tol && balance <= crate::harness::balance_tol(&model);
-            judged_on.push("the total contact force and the force balance");
-        }
-        _ => missing.push("contact forces"),
+    let measured = measure_outside(&model, &sweep, &path, match_share)?;
+    cell.stress_error = Some(measured.stress_error);
+    cell.pressure_error = measured.pressure_error;
+    let mut pass = measured.stress_error <= sweep.tol
+        && measured.pressure_error.is_none_or(|e| e <= sweep.tol);
+    if let Some((load, balance)) = measured.forces {
+        cell.load_error = Some(load);
+        cell.force_balance = Some(balance);
+        pass &= load <= sweep.tol && balance <= crate::harness::balance_tol(&model);
     }
     cell.verdict = if pass { "pass" } else { "fail" }.into();
-    let missing = if missing.is_empty() {
-        String::new()
+    cell.note = format!("{}: {}", path.display(), measured.words());
+    Ok(vec![cell])
+}
+
+/// The cell of a penalty code's kappa series (see [`outside_cells`]).
+fn kappa_series_cell(
+    mut cell: crate::harness::Cell,
+    model: &Model,
+    sweep: &crate::io::scene::SweepSpec,
+    series: &[(f64, std::path::PathBuf)],
+    match_share: f64,
+) -> Result<Vec<crate::harness::Cell>> {
+    let mut errors = Vec::with_capacity(series.len());
+    let mut stiffest = None;
+    for (kappa, path) in series {
+        let measured = measure_outside(model, sweep, path, match_share)?;
+        errors.push((*kappa, measured.stress_error));
+        stiffest = Some(measured);
+    }
+    let stiffest = stiffest.expect("a series of two or more");
+    let (k1, e1) = errors[0];
+    let (k2, e2) = errors[errors.len() - 1];
+    let ratio = k2 / k1;
+    let trend = if e1 <= sweep.tol && e2 <= sweep.tol {
+        "round-off"
+    } else if e2 * ratio / 10.0 <= e1 {
+        "1/kappa"
     } else {
-        format!(
-            "; not in the results: {} (fields '{CONTACT_PRESSURE_FIELD}', '{CONTACT_FORCE_FIELD}')",
-            missing.join(", ")
-        )
+        "no fall"
     };
+    cell.kappa = Some(k1);
+    cell.stress_error = Some(e1);
+    cell.stress_error_stiff = Some(e2);
+    cell.penalty_trend = Some(trend.into());
+    cell.pressure_error = stiffest.pressure_error;
+    let mut pass = trend != "no fall";
+    if let Some((load, balance)) = stiffest.forces {
+        cell.load_error = Some(load);
+        cell.force_balance = Some(balance);
+        pass &= load <= sweep.tol && balance <= crate::harness::balance_tol(model);
+    }
+    cell.verdict = if pass { "pass" } else { "fail" }.into();
+    let listed: Vec<String> = errors
+        .iter()
+        .map(|(k, e)| format!("{k:e}: {e:.3e}"))
+        .collect();
     cell.note = format!(
-        "{}: judged on {}{missing}",
-        path.display(),
-        judged_on.join(", ")
+        "kappa series (kappa: stress error) {}: {trend} as kappa grows {ratio:e}x (the \
+         'at 1000 kappa' column holds the largest kappa's); at the largest kappa {}",
+        listed.join(", "),
+        stiffest.words()
     );
     Ok(vec![cell])
 }

@@ -187,8 +187,13 @@ pub fn judge3(model: &Model3, results: &Results, match_share: f64) -> Result<Jud
                     &file.shown,
                     at(),
                     format!("no result point within {delta:.3e} of the node; {nearest}"),
-                    "solve on the mesh our tool wrote (<body>.vtu of `contact-patch run`) and \
-                     write results at its nodes; or raise --match-tol (a share of the model size)",
+                    crate::harness::judge::unmatched_node_hint(
+                        &file.grid,
+                        displacement,
+                        &x,
+                        delta,
+                        "the mesh our tool wrote (<body>.vtu of `contact-patch run`)",
+                    ),
                 ));
             };
             let value = displacement.at(k);

@@ -245,7 +245,7 @@ pub fn cell_case(c: &Cell) -> TestCase {
     TestCase {
         classname: format!("{}.{}", c.catalogue.name(), c.case),
         name: cell_name(c),
-        seconds: c.time_ms / 1e3,
+        seconds: c.time_ms.unwrap_or(0.0) / 1e3,
         verdict,
     }
 }

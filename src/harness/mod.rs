@@ -118,7 +118,9 @@ pub struct Cell {
     /// a consistent one (standard mortar): the largest stress difference from the penalty
     /// method at the same kappa, over `p` (zero for a lumped mass, where the two coincide).
     pub vs_penalty: Option<f64>,
-    pub time_ms: f64,
+    /// Wall-clock time of the cell's solves; `None` when nothing was solved here (an `n/a`
+    /// cell, or another code's results judged by `table --results`).
+    pub time_ms: Option<f64>,
     pub note: String,
     /// The frictional patch test's own measures (catalogue `friction`, see [`friction`]).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -158,7 +160,7 @@ impl Cell {
             termination: None,
             linear_solver: None,
             vs_penalty: None,
-            time_ms: 0.0,
+            time_ms: None,
             note: String::new(),
             friction: None,
             tol,
@@ -437,7 +439,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
             }
             let start = Instant::now();
             let solved = solve_static(&model, &mut |_| {});
-            cell.time_ms = start.elapsed().as_secs_f64() * 1e3;
+            cell.time_ms = Some(start.elapsed().as_secs_f64() * 1e3);
             let mut frictional = None;
             let m = match solved {
                 Ok(s) => {
@@ -454,7 +456,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                             Ok(p) => stress_difference(&model, &s, &p, sweep.pressure),
                             Err(_) => f64::NAN,
                         });
-                        cell.time_ms += start.elapsed().as_secs_f64() * 1e3;
+                        *cell.time_ms.get_or_insert(0.0) += start.elapsed().as_secs_f64() * 1e3;
                     }
                     if let Some(expect) = sweep.expect {
                         let state = s.contact.as_ref().expect("a contact solve");
@@ -544,7 +546,7 @@ pub fn run_sweep(path: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Cell
                 stiff.contact[0].enforcement = method(e).scaled(sweep.penalty_factor);
                 let start = Instant::now();
                 let s2 = solve_static(&stiff, &mut |_| {});
-                cell.time_ms += start.elapsed().as_secs_f64() * 1e3;
+                *cell.time_ms.get_or_insert(0.0) += start.elapsed().as_secs_f64() * 1e3;
                 let e2 = match s2 {
                     Ok(s) => {
                         let m2 = measure(&stiff, &s, sweep.pressure);
@@ -688,6 +690,13 @@ pub const SEED_ROW: [(&str, &str); 7] = [
     ("E", "f"),
 ];
 
+/// A cell's time for the tables: milliseconds to two decimals, `-` when nothing was timed.
+pub fn time_text(time_ms: Option<f64>) -> String {
+    time_ms
+        .map(|t| format!("{t:.2}"))
+        .unwrap_or_else(|| "-".into())
+}
+
 /// The full grid as a Markdown table; `with_time` adds the time column (not in snapshots).
 pub fn grid_markdown(cells: &[Cell], with_time: bool) -> String {
     let mut s = String::from("| mesh | nu | discretization | passes | slave | enforcement | verdict | stress error | at 1000 kappa | trend | pressure error | load error | rank def. | stability | iterations |");
@@ -722,7 +731,7 @@ pub fn grid_markdown(cells: &[Cell], with_time: bool) -> String {
                 .unwrap_or("-".into()),
         );
         if with_time {
-            s += &format!(" {:.2} |", c.time_ms);
+            s += &format!(" {} |", time_text(c.time_ms));
         }
         s += &format!(" {} |\n", c.note.replace('|', "/"));
     }

@@ -213,7 +213,7 @@ pub fn sidecar(case: &Case, model: &Model, case_file: &Path) -> Result<Value> {
                 let group = if set == gmsh::ALL_NODES_SET {
                     format!("{} (the body's physical surface)", body.name)
                 } else {
-                    gmsh::group_name(&body.name, set)
+                    gmsh::node_group_name(&body.name, set)
                 };
                 (
                     set.clone(),
@@ -273,8 +273,10 @@ pub fn sidecar(case: &Case, model: &Model, case_file: &Path) -> Result<Value> {
         },
         "mesh": {
             "gmsh": format!("{}.msh", model.name),
-            "gmsh_format": "MSH 4.1 ASCII; physical surface per body, physical curve '<body>/<facet set>' per facet set, physical point group '<body>/<node set>' per node set",
+            "gmsh_format": "MSH 4.1 ASCII; physical surface per body, physical curve '<body>/<facet set>' per facet set, physical point group '<body>/<node set>/nodes' per node set (every physical name distinct)",
             "node_order": "element node orders as Gmsh and VTK: corners counter-clockwise, then edge midpoints (edge 0-1 first), then the centre",
+            "node_sets": "bodies[].node_sets.<set>.nodes: the set's nodes as node numbers of that body (0-based; Gmsh tag = node_tag_offset + n + 1)",
+            "facet_sets": "bodies[].facet_sets.<set>.facets: one list per facet, its node numbers of that body (0-based) in the order [start, end] for 2-node facets and [start, end, midpoint] for 3-node ones; start to end runs counter-clockwise around the body, so the body lies to the left and the outward normal is the tangent turned clockwise",
         },
         "materials": pick("materials"),
         "bodies": bodies,

@@ -14,10 +14,12 @@
 //! * facet set `s` of body `b`: a curve entity of its own in the physical curve (dim 1) named
 //!   `b/s`, holding the set's facets as elements 1 (2-node line) or 8 (3-node line: ends, then
 //!   midpoint);
-//! * node set `s` of body `b`: the physical point group (dim 0) named `b/s`; each node in a
-//!   node set is a point entity (one element 15, a 1-node point) carrying the groups of every
+//! * node set `s` of body `b`: the physical point group (dim 0) named `b/s/nodes`; each node in
+//!   a node set is a point entity (one element 15, a 1-node point) carrying the groups of every
 //!   set that holds it. The automatic set `all` is the body's surface group and is not
-//!   repeated.
+//!   repeated. The suffix keeps every physical name unique: a facet set and the node set of its
+//!   nodes usually share a name, and readers that key groups by name alone (meshio) would keep
+//!   only one of two groups named alike.
 
 use crate::fe::ElementKind;
 use crate::mesh::Mesh;
@@ -27,9 +29,15 @@ use std::fmt::Write as _;
 /// The set every body has that equals its surface group (not written as a point group).
 pub const ALL_NODES_SET: &str = "all";
 
-/// The name of the physical group of set `set` of body `body`.
+/// The name of the physical group (dim 1) of facet set `set` of body `body`.
 pub fn group_name(body: &str, set: &str) -> String {
     format!("{body}/{set}")
+}
+
+/// The name of the physical group (dim 0) of node set `set` of body `body`: distinct from the
+/// facet set of the same name.
+pub fn node_group_name(body: &str, set: &str) -> String {
+    format!("{body}/{set}/nodes")
 }
 
 /// Gmsh element type of a cell kind, and of its facets.
@@ -86,7 +94,7 @@ pub fn msh(bodies: &[(&str, &Mesh)]) -> String {
             if set == ALL_NODES_SET {
                 continue;
             }
-            let tag = group(0, group_name(name, set), &mut groups);
+            let tag = group(0, node_group_name(name, set), &mut groups);
             for &n in nodes {
                 of_node.entry(n).or_default().push(tag);
             }
@@ -244,7 +252,7 @@ mod tests {
         // per body: the surface, 2 point groups, 1 curve group
         assert!(
             text.contains(
-                "$PhysicalNames\n8\n2 1 \"a\"\n0 1 \"a/base\"\n0 2 \"a/corner\"\n1 1 \"a/base\"\n"
+                "$PhysicalNames\n8\n2 1 \"a\"\n0 1 \"a/base/nodes\"\n0 2 \"a/corner/nodes\"\n1 1 \"a/base\"\n"
             ),
             "{text}"
         );
