@@ -46,12 +46,20 @@ its test inputs) from our sidecar. What maps to what:
   `--contact penalty`: `PenaltyContactFrictionless` (mortar, penalty `--kappa`, pressure per
   unit gap; default: the case's sweep kappa, else the pair's own).
 
+`--supports-from-exact` writes a diagnostic variant of a uniform-stress case: each prescribed
+displacement takes the exact field's value at its node. The patch tests hold the punch's x at
+one top corner, so their exact solution slides the punch against the foundation by 4 eps_xx;
+a code that evaluates contact in the deformed configuration (Kratos moves its mesh) sees that
+slide. The variant removes it without changing the stress, so the same judge tells whether a
+failure comes from the slide.
+
 Exit 0 on success, 3 when Kratos cannot take the case (the reason on stderr, one line starting
 with "n/a:"), 2 on bad input.
 """
 
 import argparse
 import json
+import math
 import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -102,7 +110,56 @@ def kappa_of(sidecar, pair, given):
     raise NotApplicable(f"pair {pair['name']!r}: no penalty kappa in the case; give --kappa")
 
 
-def convert(export_dir, out_dir, contact, kappa=None):
+def rigid_line_body(rigid, owner, slave_body, slave_facets, bodies, nodes, elements, fixed_nodes):
+    """Mesh a rigid line (point p, normal n pointing to the slave side) as a strip of Q4 cells
+    behind it, every node held: Kratos' mortar needs a meshed master. The strip's surface nodes
+    are the slave nodes projected onto the line (so its edges are as fine as the slave's where
+    the slave is fine), plus one edge beyond each end; the strip is one cell deep. Its nodes
+    and elements get ids after the bodies'; returns its surface edges, ordered so that the
+    strip lies on their right (outward normal towards the slave), its Properties id and its
+    nodes. The strip is not one of the case's bodies: no results are written for it."""
+    (px, py), (nx, ny) = rigid["point"], rigid["normal"]
+    length = math.hypot(nx, ny)
+    nx, ny = nx / length, ny / length
+    tx, ty = ny, -nx  # the tangent: (t, n) is a right-handed pair
+    used = sorted({n for f in slave_facets for n in f})
+    s = sorted({round((slave_body["points"][n][0] - px) * tx + (slave_body["points"][n][1] - py) * ty,
+                      12) for n in used})
+    h = min(b - a for a, b in zip(s, s[1:])) if len(s) > 1 else 1.0
+    s = [s[0] - (s[1] - s[0] if len(s) > 1 else h)] + s + [s[-1] + (s[-1] - s[-2] if len(s) > 1 else h)]
+    depth = max(s[-1] - s[0], h) / 10.0
+    first = max(i for i, _ in nodes) + 1
+    top = list(range(first, first + len(s)))
+    bottom = list(range(first + len(s), first + 2 * len(s)))
+    for ids, d in ((top, 0.0), (bottom, depth)):
+        for i, si in zip(ids, s):
+            nodes.append((i, (px + si * tx - d * nx, py + si * ty - d * ny)))
+    fixed_nodes.extend(top + bottom)
+    prop = max(b["property"] for b in bodies.values()) + 1
+    eid = max(i for rows in elements.values() for i, *_ in rows)
+    rows = elements.setdefault("SmallDisplacementElement2D4N", [])
+    # with t = (n_y, -n_x) the cell (bottom_i, bottom_i+1, top_i+1, top_i) runs counter-clockwise
+    # when (t, n) is a right-handed pair: t x n = n_y^2 + n_x^2 > 0, always
+    for k in range(len(s) - 1):
+        eid += 1
+        rows.append((eid, prop, [bottom[k], bottom[k + 1], top[k + 1], top[k]], owner))
+    return [(top[k + 1], top[k]) for k in range(len(s) - 1)], prop, top + bottom
+
+
+def exact_displacement(sidecar, body, node, component):
+    """The closed form's displacement of a uniform-stress case at one node (the sidecar's
+    `exact.closed_form`: u_x = eps_xx x + gamma_xy / 2 y, u_y = gamma_xy / 2 x + eps_yy y)."""
+    exact = sidecar.get("exact") or {}
+    if exact.get("kind") != "uniform_stress":
+        raise NotApplicable("--supports-from-exact needs a uniform-stress case")
+    e = exact["strain_by_body"][body["name"]]
+    x, y = body["points"][node]
+    if component == "x":
+        return e["eps_xx"] * x + 0.5 * e["gamma_xy"] * y
+    return 0.5 * e["gamma_xy"] * x + e["eps_yy"] * y
+
+
+def convert(export_dir, out_dir, contact, kappa=None, supports_from_exact=False):
     export_dir, out_dir = Path(export_dir), Path(out_dir)
     case = export_dir.name
     sidecar = json.loads((export_dir / f"{case}.json").read_text())
@@ -129,6 +186,7 @@ def convert(export_dir, out_dir, contact, kappa=None):
             elements.setdefault(name, []).append((eid, prop, [ids[n] for n in conn], body["name"]))
             body_cells.append((vtk_type, [ids[n] for n in conn]))
         bodies[body["name"]] = {
+            "name": body["name"],
             "property": prop,
             "offset": offset,
             "nodes": ids,
@@ -141,6 +199,8 @@ def convert(export_dir, out_dir, contact, kappa=None):
 
     # --- contact pairs: 2-node edges on each side ---------------------------------------------
     conditions = []  # (id, nodes) of LineCondition2D2N
+    fixed_nodes = []  # nodes of meshed rigid obstacles, held at zero displacement
+    obstacles = []  # the meshed rigid obstacles as Kratos bodies
     pair_parts = []  # (pair name, tied, slave cond ids, master cond ids, kappa)
     cid = 0
     for pair in sidecar.get("contact") or []:
@@ -155,10 +215,30 @@ def convert(export_dir, out_dir, contact, kappa=None):
         sides = []
         for side in ("slave", "master"):
             spec = pair[side]
-            if "rigid" in spec:
-                raise NotApplicable(
-                    f"pair {pair['name']!r}: a rigid {side} ({spec['rigid'].get('kind')}); Kratos' "
-                    "mortar contact pairs two meshed surfaces (mesh the obstacle as a body)")
+            if spec.get("rigid"):
+                if side == "slave" or spec["rigid"].get("kind") != "line" or tied:
+                    raise NotApplicable(
+                        f"pair {pair['name']!r}: a rigid {side} ({spec['rigid'].get('kind')}); "
+                        "Kratos' mortar contact pairs two meshed surfaces, and only a rigid line "
+                        "is meshed here (as a held strip)")
+                slave_spec = pair["slave"]
+                slave_body = bodies[slave_spec["body"]]
+                slave_facets = slave_body["facet_sets"][slave_spec["set"]]["facets"]
+                edges, prop, strip_nodes = rigid_line_body(
+                    spec["rigid"], f"{pair['name']}_rigid", slave_body, slave_facets, bodies, nodes,
+                    elements, fixed_nodes)
+                eid = max(i for rows in elements.values() for i, *_ in rows)
+                # the strip: a body of Kratos' model only, of the slave's material (held)
+                obstacles.append({"name": f"{pair['name']}_rigid", "property": prop,
+                                  "nodes": strip_nodes, "E": slave_body["E"],
+                                  "nu": slave_body["nu"]})
+                ids = []
+                for a, b in edges:
+                    cid += 1
+                    conditions.append((cid, slave_body["property"], [a, b]))
+                    ids.append(cid)
+                sides.append(ids)
+                continue
             body = bodies[spec["body"]]
             facets = body["facet_sets"][spec["set"]]["facets"]
             ids = []
@@ -179,9 +259,12 @@ def convert(export_dir, out_dir, contact, kappa=None):
         raise NotApplicable("more than 10 pairs (Kratos' contact processes take keys 0-9)")
 
     # --- supports and loads, as resolved by our tool ------------------------------------------
-    fixed = {"x": [], "y": []}
+    fixed = {"x": [(n, 0.0) for n in fixed_nodes], "y": [(n, 0.0) for n in fixed_nodes]}
     for p in sidecar["resolved"]["prescribed_displacements"]:
-        fixed[p["component"]].append((p["gmsh_node_tag"], float(p["value"])))
+        value = float(p["value"])
+        if supports_from_exact:
+            value = exact_displacement(sidecar, bodies[p["body"]], p["node"], p["component"])
+        fixed[p["component"]].append((p["gmsh_node_tag"], value))
     loads = {}
     for f in sidecar["resolved"]["consistent_nodal_forces"]:
         v = loads.setdefault(f["gmsh_node_tag"], [0.0, 0.0])
@@ -192,7 +275,7 @@ def convert(export_dir, out_dir, contact, kappa=None):
     m = [f"// {case}: written by crosscheck/kratos_convert.py from {export_dir.name}/{case}.json",
          "Begin ModelPartData", "End ModelPartData", "",
          "Begin Properties 0", "End Properties"]
-    for b in bodies.values():
+    for b in list(bodies.values()) + obstacles:
         # declared here for the elements; their values come from materials.json (Kratos warns
         # that it overwrites them)
         m += [f"Begin Properties {b['property']}", "End Properties"]
@@ -234,6 +317,9 @@ def convert(export_dir, out_dir, contact, kappa=None):
     for bname, b in bodies.items():
         eids = [i for rows in elements.values() for i, _, _, owner in rows if owner == bname]
         sub_model_part(bname, b["nodes"], eids)
+    for ob in obstacles:
+        eids = [i for rows in elements.values() for i, _, _, owner in rows if owner == ob["name"]]
+        sub_model_part(ob["name"], ob["nodes"], eids)
     if loads:
         sub_model_part("point_loads", sorted(loads), (), [load_ids[t] for t in sorted(loads)])
     cond_nodes = {i: conn for i, _, conn in conditions}
@@ -253,7 +339,8 @@ def convert(export_dir, out_dir, contact, kappa=None):
             "constitutive_law": {"name": law[plane]},
             "Variables": {"YOUNG_MODULUS": b["E"], "POISSON_RATIO": b["nu"],
                           "THICKNESS": thickness, "DENSITY": 1.0},
-            "Tables": {}}} for bname, b in bodies.items()]}
+            "Tables": {}}} for bname, b in list(bodies.items())
+                          + [(ob["name"], ob) for ob in obstacles]]}
     (out_dir / "materials.json").write_text(json.dumps(materials, indent=2) + "\n")
 
     # --- ProjectParameters.json ---------------------------------------------------------------
@@ -331,9 +418,14 @@ def main(argv=None):
     ap.add_argument("out", help="folder for the Kratos input")
     ap.add_argument("--contact", choices=["alm", "penalty"], default="alm")
     ap.add_argument("--kappa", type=float, help="penalty (pressure per unit gap)")
+    ap.add_argument("--supports-from-exact", action="store_true",
+                    help="a diagnostic variant: every prescribed displacement takes the value of "
+                         "the case's exact field at its node (uniform-stress cases), e.g. the "
+                         "patch tests' punch held where the exact solution puts it, so that the "
+                         "bodies do not slide against each other")
     a = ap.parse_args(argv)
     try:
-        mortar = convert(a.export, a.out, a.contact, a.kappa)
+        mortar = convert(a.export, a.out, a.contact, a.kappa, a.supports_from_exact)
     except NotApplicable as e:
         print(f"n/a: {e}", file=sys.stderr)
         return 3
