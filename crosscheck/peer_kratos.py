@@ -403,19 +403,32 @@ def reason(k):
     if ns and "judge" in ns:
         nt = ns["judge"]
         nf = [c for c in nt["checks"] if c.lower().startswith("fail")]
-        parts.append(f"without the slide (punch held at the exact u_x, same judge): "
-                     f"{nt['summary']}" + ("" if not nf else ": " + "; ".join(
-                         short(f[5:]) for f in nf)))
+        if nt["verdict"] == "pass":
+            parts.insert(0, "**the slide**: without it (punch held at the exact u_x) the same "
+                            f"judge passes ({nt['summary']})")
+        else:
+            parts.append("without the slide (punch held at the exact u_x) the same judge still "
+                         f"fails ({nt['summary']}): " + "; ".join(short(f[5:]) for f in nf))
     return ". ".join(parts)
+
+
+def slide_counts(rows, method):
+    """(solved patch cells, passing, failing that pass without the slide) for one method."""
+    solved = [r["kratos"][method] for r in rows
+              if r["catalogue"] == "patch" and "judge" in r["kratos"][method]]
+    passing = [k for k in solved if k.get("table", {}).get("verdict") == "pass"]
+    by_slide = [k for k in solved if k not in passing
+                and k.get("without_slide", {}).get("judge", {}).get("verdict") == "pass"]
+    return len(solved), len(passing), len(by_slide)
 
 
 def short(check):
     """A judge line without its bracketed source: the check and its error."""
-    head = check.split(" [from")[0].split(" of each pair")[0]
-    if "(error" in head:
-        return head
-    err = check[check.rfind("(error"):] if "(error" in check else ""
-    return f"{head[:90]} {err}".strip()
+    text = check
+    if " [from" in text:
+        start = text.index(" [from")
+        text = text[:start] + text[text.index("]", start) + 1:]
+    return text.replace(" of each pair between bodies and the out-of-balance force", "")
 
 
 def markdown(r):
@@ -450,7 +463,19 @@ def markdown(r):
             L.append(f"| {row['case']} | {our('tie')} (mortar Lagrange tie) | "
                      f"{kratos_cell(kk['alm'])} (mesh tying) | - | "
                      f"{kratos_cell(kk['penalty'])} | n/a |")
-    L += ["", f"DOLFINx: {dolfinx}.", "", "### Why Kratos' cells are not a pass", ""]
+    L += ["", f"DOLFINx: {dolfinx}.", "", "### Why Kratos' cells are not a pass", "",
+          "The patch cases hold the punch's x at its top-left corner only, so their exact "
+          "solution slides the punch against the foundation by 4 eps_xx at the interface (0 at "
+          "nu = 0; 0.0156 at nu = 0.3). Our tool takes the contact geometry in the reference "
+          "configuration (small sliding); Kratos moves its mesh and takes it in the current one. "
+          "Each solved patch case is therefore solved again with every prescribed displacement "
+          "at the exact field's value (`kratos_convert.py --supports-from-exact`: no slide, the "
+          "same stress) and judged by the same case:", ""]
+    for method, code in METHODS.items():
+        n, ok, slide = slide_counts(rows, method)
+        L.append(f"- {code}: {ok} of {n} solved patch cells pass; {slide} of the {n - ok} "
+                 "failing ones pass without the slide.")
+    L.append("")
     why = {}  # the same reason for several cells is said once
     for row in rows:
         for method, k in row["kratos"].items():
