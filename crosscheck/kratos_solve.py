@@ -25,7 +25,7 @@ these cases needs it.
 
 and KRATOS_DIR/solve.json: wall times (import, solve) and Kratos' Newton iterations. Exit 0
 when Kratos' solve returned converged, 1 when it ran but did not converge (the results are still
-written and judged), 2 when it failed.
+written and judged), 2 when Kratos failed (raised an error), 4 when this script broke.
 """
 
 import json
@@ -190,6 +190,9 @@ def main(argv):
         model = KM.Model()
         analysis = Analysis(model, parameters)
         analysis.Run()
+    except RuntimeError as e:  # Kratos' own failure (reading, solving): a result, exit 2
+        print(f"kratos_solve: Kratos failed: {e}".splitlines()[0][:500], file=sys.stderr)
+        return 2
     finally:
         os.chdir(cwd)
     t_solve = time.perf_counter() - t
@@ -219,6 +222,7 @@ def main(argv):
 if __name__ == "__main__":
     try:
         sys.exit(main(sys.argv))
-    except Exception as e:  # Kratos raises RuntimeError on a failed solve
-        print(f"kratos_solve: {type(e).__name__}: {e}", file=sys.stderr)
-        sys.exit(2)
+    except Exception:  # a broken script (not Kratos failing): exit 4, never taken as a result
+        import traceback
+        traceback.print_exc()
+        sys.exit(4)

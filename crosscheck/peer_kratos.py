@@ -121,8 +121,9 @@ def solve_kratos(kpy, export, case, method, rundir, variant="", extra=()):
     if rc == 3:
         reason = next((ln[4:].strip() for ln in out.splitlines() if ln.startswith("n/a:")), out)
         return {"status": "n/a", "reason": reason}
+    # exit 0 converged, 1 not converged, 2 Kratos failed: results; 4 (or other) a broken script
     rc, wall, out = run(pinned([kpy, HERE / "kratos_solve.py", kdir, rdir]), log=kdir / "solve.log",
-                        env=ONE_THREAD, ok=None)
+                        env=ONE_THREAD, ok=(0, 1, 2))
     entry = {"status": {0: "converged", 1: "not converged"}.get(rc, "failed"),
              "process_seconds": wall}
     solve_json = kdir / "solve.json"
