@@ -546,12 +546,13 @@ def markdown(r):
         wall = "-" if e.get("wall_seconds") is None else f"{e['wall_seconds']:.2f} s" + (
             f" ({e['solve_seconds']:.2f} s solve)" if e.get("solve_seconds") else "")
         if e.get("peak") is None:
-            L.append(f"| {name} | {newton} | - | - | - | - | - | {e.get('reason') or 'fail'} | - "
-                     f"| {wall} |")
+            why = (e.get("reason") or "fail").replace("|", "\\|")
+            L.append(f"| {name} | {newton} | - | - | - | - | - | {why} | - | {wall} |")
             continue
         j = e.get("judge")
         jtxt = "-" if j is None else f"{j['verdict']}: {j['summary']}" + "".join(
             f"; {short(c[5:])}" for c in j["checks"] if c.lower().startswith("fail"))
+        jtxt = jtxt.replace("|", "\\|")  # a table cell: |K u - f - f_c| has bars
         pf = "-" if e.get("peak_of_forces") is None else f"{e['peak_of_forces']:.4f}"
         L.append(f"| {name} | {newton} | {e['peak']:.4f} | {e['peak_error']:.2%} | {pf} | "
                  f"{e['half_width']:.4f} | {e['half_width_error']:.4f} | {e['verdict']} | {jtxt} "
