@@ -12,7 +12,13 @@
 # 4. solves the same cases on the meshes our tool wrote with DOLFINx and scikit-fem;
 # 5. judges DOLFINx's own .vtu output of each case with `contact-patch judge` (the case's
 #    checks applied to an outside code's results, JUnit in the run folder);
-# 6. writes reports/crosscheck.md and reports/crosscheck.json; exits 1 when any verdict fails.
+# 6. without CASE arguments, the peer code: Kratos Multiphysics (.venv-kratos, pinned in
+#    crosscheck/requirements-kratos.txt; "SKIPPED:" when it cannot be installed) solves the
+#    contact and tied patch tests and Hertz's cylinder, judged by our tool
+#    (crosscheck/peer_kratos.py -> reports/peer-codes.md and .json; XCHECK_SKIP_PEER=1 skips);
+# 7. writes reports/crosscheck.md and reports/crosscheck.json; exits 1 when any verdict fails
+#    (or when the peer step broke: our tool crashed or a script failed; Kratos failing a cell
+#    is a result in reports/peer-codes.md, not a failure of the run).
 #
 # Default cases: cases/patch-single, cases/convergence (single-body elasticity),
 # crosscheck/cases (cross-check-only elasticity cases), crosscheck/cases/contact (penalty
@@ -133,6 +139,53 @@ for c in "${CASES[@]}"; do
     echo "$rc" > "$OUT/$name/judge-dolfinx.rc"
 done
 
-# --- 6. the verdicts ------------------------------------------------------------------------------
+# --- 6. the peer code: Kratos on the patch, tied and Hertz cases ---------------------------------
+# Only in the default run (no CASE arguments), unless XCHECK_SKIP_PEER=1. Its own environment,
+# .venv-kratos (crosscheck/requirements-kratos.txt, the same Python 3.12); when it cannot be
+# installed, one "SKIPPED:" line and the rest of the cross-check goes on. Kratos failing a cell
+# is recorded in reports/peer-codes.md; our tool crashing or a broken script fails the run.
+PEER_RC=0
+if [ "$#" -eq 0 ] && [ -z "${XCHECK_SKIP_PEER:-}" ]; then
+    PEER_START=$SECONDS
+    KVENV="$ROOT/.venv-kratos"
+    KREQ="$ROOT/crosscheck/requirements-kratos.txt"
+    KSTAMP="$KVENV/.xcheck-requirements.sha256"
+    KWANT="$(sha256sum "$KREQ" | cut -d' ' -f1)"
+    kratos_ready=1
+    if [ ! -x "$KVENV/bin/python" ] || ! is312 "$KVENV/bin/python"; then
+        echo "crosscheck: creating $KVENV with $PY312"
+        rm -rf "$KVENV"
+        "$PY312" -m venv "$KVENV" || kratos_ready=0
+    fi
+    if [ "$kratos_ready" = 1 ] && [ "$(cat "$KSTAMP" 2>/dev/null || true)" != "$KWANT" ]; then
+        echo "crosscheck: installing crosscheck/requirements-kratos.txt"
+        if "$KVENV/bin/python" -m pip install --disable-pip-version-check -q -r "$KREQ" \
+                > "$OUT/kratos-install.log" 2>&1; then
+            echo "$KWANT" > "$KSTAMP"
+        else
+            kratos_ready=0
+        fi
+    fi
+    if [ "$kratos_ready" = 1 ] && ! "$KVENV/bin/python" -c \
+            'import KratosMultiphysics.ContactStructuralMechanicsApplication' > /dev/null 2>&1; then
+        kratos_ready=0
+    fi
+    if [ "$kratos_ready" = 1 ]; then
+        "$KVENV/bin/python" crosscheck/peer_kratos.py "$TOOL" "$KVENV/bin/python" "$OUT/peer" \
+            reports > "$OUT/peer.log" 2>&1 || PEER_RC=$?
+        if [ "$PEER_RC" -ne 0 ]; then
+            echo "crosscheck: the peer-code check broke (exit $PEER_RC):" >&2
+            tail -n 40 "$OUT/peer.log" >&2
+        fi
+        echo "crosscheck: peer code Kratos took $((SECONDS - PEER_START)) s (reports/peer-codes.md)"
+    else
+        echo "SKIPPED: crosscheck: Kratos (crosscheck/requirements-kratos.txt) could not be installed or imported in $KVENV; reports/peer-codes.md not regenerated (see $OUT/kratos-install.log)"
+    fi
+fi
+
+# --- 7. the verdicts ------------------------------------------------------------------------------
 echo "$SECONDS" > "$OUT/elapsed"
-"$PY" crosscheck/report.py "$OUT" reports/crosscheck.md reports/crosscheck.json "${CASES[@]}"
+rc=0
+"$PY" crosscheck/report.py "$OUT" reports/crosscheck.md reports/crosscheck.json "${CASES[@]}" || rc=$?
+[ "$PEER_RC" -eq 0 ] || exit 1
+exit "$rc"
