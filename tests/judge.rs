@@ -1037,15 +1037,24 @@ fn judge_takes_the_export_folder_alone() {
     }
 }
 
-/// `cases/patch/patch-A-nu0.3.json` with the contact geometry in the current configuration:
-/// the punch slides over the foundation by the lateral strain, and the pair's moments balance
-/// about the deformed positions `X + u`.
-fn current_geometry_patch(tmp: &Path) -> PathBuf {
+/// `cases/patch/patch-A-nu0.3.json` with the punch's top-left corner held at `x = 0` (the
+/// catalogue's support before issue 42: the exact solution then slides the punch over the
+/// foundation by `4 eps_xx`), its contact geometry `geometry` (`reference` or `current`); with
+/// `current` the pair's moments balance about the deformed positions `X + u`.
+fn sliding_patch(tmp: &Path, geometry: &str) -> PathBuf {
     let text = std::fs::read_to_string(root().join("cases/patch/patch-A-nu0.3.json")).unwrap();
     let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
-    case["name"] = "patch-A-current".into();
-    case["physics"] = serde_json::json!({"contact_geometry": "current"});
-    let path = tmp.join("patch-A-current.json");
+    case["name"] = format!("patch-A-sliding-{geometry}").into();
+    case["physics"] = serde_json::json!({"contact_geometry": geometry});
+    let corner = case["supports"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .find(|s| s["body"] == "punch" && s["set"] == "top_left")
+        .unwrap();
+    assert_eq!(corner["x"], "exact", "the catalogue's punch corner");
+    corner["x"] = 0.0.into();
+    let path = tmp.join(format!("patch-A-sliding-{geometry}.json"));
     std::fs::write(&path, case.to_string()).unwrap();
     path
 }
@@ -1053,7 +1062,7 @@ fn current_geometry_patch(tmp: &Path) -> PathBuf {
 #[test]
 fn force_balance_of_a_current_geometry_run_agrees_between_run_and_judge() {
     let tmp = tempfile::tempdir().unwrap();
-    let case = current_geometry_patch(tmp.path());
+    let case = sliding_patch(tmp.path(), "current");
     let direct = run_case(&case, &mut |_| {}).unwrap();
     let folder = OutputFolder::new(&tmp.path().join("run")).unwrap();
     write_run(&folder, &direct).unwrap();
@@ -1103,7 +1112,7 @@ fn force_balance_of_a_current_geometry_run_agrees_between_run_and_judge() {
     }
     // the same results judged by the case with reference geometry (the export's): the moments
     // about X do not balance; the message names that term and the configuration they balance in
-    let reference = root().join("cases/patch/patch-A-nu0.3.json");
+    let reference = sliding_patch(tmp.path(), "reference");
     let o = run(&[
         "judge",
         reference.to_str().unwrap(),
@@ -1312,4 +1321,42 @@ fn an_outside_penalty_code_is_credited_with_its_kappa_series_and_a_cell_can_say_
         &|| std::fs::create_dir(series_dir.join("kappa-big")).unwrap(),
         "'big' is not a positive number",
     );
+}
+
+#[test]
+fn the_patch_catalogue_does_not_slide_so_current_geometry_contact_passes_it_too() {
+    // issue 42, item 1: the exported patch cases were small-sliding tests (the punch held at
+    // x = 0 slides by 4 eps_xx), failed by O(p/E) by codes that take contact in the deformed
+    // geometry; the catalogue now holds the punch's corner at the exact u_x. Mortar with
+    // Lagrange multipliers and current contact geometry passes meshes A-C; the old support fails.
+    let tmp = tempfile::tempdir().unwrap();
+    for mesh in ["A", "B", "C"] {
+        let text =
+            std::fs::read_to_string(root().join(format!("cases/patch/patch-{mesh}-nu0.3.json")))
+                .unwrap();
+        let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
+        case["physics"] = serde_json::json!({"contact_geometry": "current"});
+        case["contact"][0]["discretization"] =
+            serde_json::json!({"kind": "mortar", "multiplier": "standard"});
+        let stress_error = |case: &serde_json::Value, name: &str| {
+            let path = tmp.path().join(format!("{name}.json"));
+            std::fs::write(&path, case.to_string()).unwrap();
+            let run = run_case(&path, &mut |_| {}).unwrap();
+            let check = run
+                .checks
+                .iter()
+                .find(|c| c.check.starts_with("uniform stress"))
+                .unwrap()
+                .clone();
+            check.error
+        };
+        let slip_free = stress_error(&case, &format!("{mesh}-current"));
+        assert!(slip_free <= 1e-10, "mesh {mesh}: {slip_free:e}");
+        case["supports"][2]["x"] = 0.0.into();
+        let sliding = stress_error(&case, &format!("{mesh}-current-sliding"));
+        assert!(
+            sliding > 1e-4,
+            "mesh {mesh}: the slide is seen: {sliding:e}"
+        );
+    }
 }

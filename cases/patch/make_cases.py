@@ -46,7 +46,9 @@ def case(mesh, nu):
         "name": name,
         "description": f"Contact patch test, mesh {mesh} ({character}), nu = {nu}: punch on foundation under "
         f"uniform pressure {P}; exact solution sigma_yy = -{P} everywhere. The pair as written is node-to-surface "
-        "one-pass (punch slave) with Lagrange multipliers; `contact-patch table` runs the sweep.",
+        "one-pass (punch slave) with Lagrange multipliers; `contact-patch table` runs the sweep. The punch's "
+        "top-left corner is held at the exact u_x, so the exact solution does not slide at the interface "
+        "and a code that takes contact in the current geometry solves the same problem.",
         "analysis": {"plane": "strain", "thickness": 1.0},
         "materials": {"m": {"E": 1000.0, "nu": nu}},
         "bodies": [
@@ -65,7 +67,7 @@ def case(mesh, nu):
         "supports": [
             {"body": "foundation", "set": "bottom", "y": 0.0},
             {"body": "foundation", "set": "bottom_left", "x": 0.0},
-            {"body": "punch", "set": "top_left", "x": 0.0},
+            {"body": "punch", "set": "top_left", "x": "exact"},
         ],
         "loads": [
             {"body": "punch", "set": "top", "pressure": P},
