@@ -105,6 +105,10 @@ enum Command {
             requires = "results"
         )]
         code: String,
+        /// With --results: the area the results' contact_pressure is per: `case` (the case's
+        /// contact geometry, the default) or `deformed` (X + u, whatever the case says).
+        #[arg(long, value_name = "AREA", default_value = "case", value_parser = contact_patch::harness::judge::PressureArea::parse, requires = "results")]
+        pressure_area: contact_patch::harness::judge::PressureArea,
         /// Run only shard K of N (every N-th case, from the K-th) and write
         /// table.shard-K-of-N.json into --out; `contact-patch merge` combines the parts.
         #[arg(long, value_name = "K/N", conflicts_with_all = ["baseline", "junit"])]
@@ -372,6 +376,10 @@ enum Command {
         /// Node-matching distance, as a share of the model size.
         #[arg(long, value_name = "SHARE", default_value_t = contact_patch::harness::judge::DEFAULT_MATCH_SHARE)]
         match_tol: f64,
+        /// The area the results' contact_pressure is per: `case` (the case's contact
+        /// geometry, the default) or `deformed` (X + u, whatever the case says).
+        #[arg(long, value_name = "AREA", default_value = "case", value_parser = contact_patch::harness::judge::PressureArea::parse)]
+        pressure_area: contact_patch::harness::judge::PressureArea,
         /// Also write JUnit XML to this file (one test case per check; its folder must exist).
         #[arg(long, value_name = "FILE")]
         junit: Option<PathBuf>,
@@ -388,8 +396,9 @@ fn main() -> ExitCode {
             case,
             results,
             match_tol,
+            pressure_area,
             junit,
-        } => judge(&case, &results, match_tol, junit.as_deref()),
+        } => judge(&case, &results, match_tol, pressure_area, junit.as_deref()),
         Command::Table {
             paths,
             out,
@@ -398,6 +407,7 @@ fn main() -> ExitCode {
             baseline_factor,
             results,
             code,
+            pressure_area,
             shard,
         } => table(
             &paths,
@@ -405,7 +415,9 @@ fn main() -> ExitCode {
             junit.as_deref(),
             &baseline,
             baseline_factor,
-            results.as_deref().map(|dir| (dir, code.as_str())),
+            results
+                .as_deref()
+                .map(|dir| (dir, code.as_str(), pressure_area)),
             shard,
         ),
         Command::Study { study, out, shard } => run_study(&study, &out, shard),
@@ -807,7 +819,13 @@ fn export(paths: &[PathBuf], out: &Path) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-fn judge(case: &Path, results: &Path, match_tol: f64, junit_path: Option<&Path>) -> ExitCode {
+fn judge(
+    case: &Path,
+    results: &Path,
+    match_tol: f64,
+    pressure_area: contact_patch::harness::judge::PressureArea,
+    junit_path: Option<&Path>,
+) -> ExitCode {
     use contact_patch::harness::judge;
     let junit_out = match junit_file(junit_path) {
         Ok(f) => f,
@@ -822,6 +840,14 @@ fn judge(case: &Path, results: &Path, match_tol: f64, junit_path: Option<&Path>)
         }
         Ok(None) => {
             if let Some(case3) = contact_patch::run3d::read_3d_case(case) {
+                if pressure_area != judge::PressureArea::Case {
+                    eprintln!(
+                        "error: --pressure-area {pressure_area:?}: a 3D case's judge reads no \
+                         contact fields (only 'displacement' and 'stress')\n  hint: leave out \
+                         --pressure-area for 3D cases"
+                    );
+                    return ExitCode::from(2);
+                }
                 return judge3(case, &case3, results, match_tol, junit_out);
             }
             contact_patch::model::admit::load(case)
@@ -830,7 +856,14 @@ fn judge(case: &Path, results: &Path, match_tol: f64, junit_path: Option<&Path>)
     };
     let judged = model.and_then(|model| {
         let found = judge::load_results(&model, results)?;
-        let j = judge::judge(&model, &found, match_tol)?;
+        let j = judge::judge_with(
+            &model,
+            &found,
+            judge::ReadOptions {
+                match_share: match_tol,
+                pressure_area,
+            },
+        )?;
         Ok((model, j))
     });
     let (model, j) = match judged {
@@ -984,7 +1017,7 @@ fn table(
     junit_path: Option<&Path>,
     baseline_paths: &[PathBuf],
     baseline_factor: f64,
-    outside: Option<(&Path, &str)>,
+    outside: Option<(&Path, &str, contact_patch::harness::judge::PressureArea)>,
     shard: Option<contact_patch::harness::shard::Shard>,
 ) -> ExitCode {
     let paths = if paths.is_empty() {
@@ -1011,7 +1044,7 @@ fn table(
         eprintln!("error: --baseline-factor {baseline_factor}: must be a number above 1\n  hint: it is how many times an error may grow before it is a regression, e.g. --baseline-factor 10");
         return ExitCode::from(2);
     }
-    if let Some((dir, _)) = outside {
+    if let Some((dir, _, _)) = outside {
         if !dir.is_dir() {
             eprintln!("error: --results {}: no such folder\n  hint: give the folder that holds <case name>.vtu (or <case name>/<body>.vtu) for each case", dir.display());
             return ExitCode::from(2);
@@ -1047,11 +1080,14 @@ fn table(
             }
         };
         match guarded(case, || match outside {
-            Some((dir, code)) => contact_patch::harness::judge::outside_cells(
+            Some((dir, code, pressure_area)) => contact_patch::harness::judge::outside_cells(
                 case,
                 dir,
                 code,
-                contact_patch::harness::judge::DEFAULT_MATCH_SHARE,
+                contact_patch::harness::judge::ReadOptions {
+                    pressure_area,
+                    ..Default::default()
+                },
             ),
             None => contact_patch::harness::run_sweep(case, &mut progress),
         }) {

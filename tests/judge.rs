@@ -1360,3 +1360,105 @@ fn the_patch_catalogue_does_not_slide_so_current_geometry_contact_passes_it_too(
         );
     }
 }
+
+#[test]
+fn a_pressure_per_deformed_area_is_judged_with_pressure_area_deformed() {
+    // issue 42, item 5: a code that reports its pressure per unit deformed area. Our run of
+    // patch A with current contact geometry writes exactly that (p A(X + u) = the nodal force);
+    // the catalogue case takes contact in the reference geometry, where the pressure is
+    // per reference area: read as it is, it is off by A(X)/A(X + u) - 1 ~ eps_xx; with
+    // --pressure-area deformed it is turned into the case's and passes.
+    let tmp = tempfile::tempdir().unwrap();
+    let case = "cases/patch/patch-A-nu0.3.json";
+    let text = std::fs::read_to_string(root().join(case)).unwrap();
+    let mut current: serde_json::Value = serde_json::from_str(&text).unwrap();
+    current["physics"] = serde_json::json!({"contact_geometry": "current"});
+    let current_file = tmp.path().join("patch-A-current.json");
+    std::fs::write(&current_file, current.to_string()).unwrap();
+    let run_dir = tmp.path().join("run");
+    // our own run fails its contact_pressure check by the same ratio (its pressure is per
+    // deformed area); its results are written all the same
+    let o = run(&[
+        "run",
+        current_file.to_str().unwrap(),
+        "--out",
+        run_dir.to_str().unwrap(),
+    ]);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{}", say(&o));
+    let files = [run_dir.join("foundation.vtu"), run_dir.join("punch.vtu")];
+    // the pressure alone: the forces come from -p A n
+    let results = tmp.path().join("results");
+    std::fs::create_dir(&results).unwrap();
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        std::fs::write(
+            results.join(f.file_name().unwrap()),
+            drop_array(&text, "contact_force"),
+        )
+        .unwrap();
+    }
+    let pressure_line = |o: &Output| -> (String, f64) {
+        let s = say(o);
+        let line = s
+            .lines()
+            .map(str::trim_start)
+            .find(|l| l.contains("contact pressure of 'interface'"))
+            .unwrap_or_else(|| panic!("{s}"))
+            .to_string();
+        let error: f64 = line
+            .split("(error ")
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        (line, error)
+    };
+    let as_is = run(&["judge", case, results.to_str().unwrap()]);
+    let (line, error) = pressure_line(&as_is);
+    assert!(line.starts_with("FAIL") && error > 1e-4, "{line}");
+    let deformed = run(&[
+        "judge",
+        case,
+        results.to_str().unwrap(),
+        "--pressure-area",
+        "deformed",
+    ]);
+    let (line, error) = pressure_line(&deformed);
+    assert!(line.starts_with("pass") && error <= 1e-10, "{line}");
+    // the same for the table of an outside code
+    let out = tmp.path().join("tables");
+    let dir = tmp.path().join("table-results");
+    std::fs::create_dir(&dir).unwrap();
+    std::fs::rename(&results, dir.join("patch-A-nu0.3")).unwrap();
+    for (area, passes) in [("case", false), ("deformed", true)] {
+        let o = run(&[
+            "table",
+            case,
+            "--results",
+            dir.to_str().unwrap(),
+            "--pressure-area",
+            area,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", say(&o));
+        let cells: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("patch-table.json")).unwrap())
+                .unwrap();
+        let e = cells[0]["pressure_error"].as_f64().unwrap();
+        assert_eq!(e <= 1e-10, passes, "--pressure-area {area}: {e:e}");
+    }
+    // a word it does not know is refused
+    let o = run(&[
+        "judge",
+        case,
+        dir.to_str().unwrap(),
+        "--pressure-area",
+        "spatial",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", say(&o));
+    assert!(say(&o).contains("give 'case'"), "{}", say(&o));
+}

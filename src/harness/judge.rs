@@ -42,6 +42,7 @@ use crate::harness::checks::{
     evaluate_with, force_balance_of, force_balance_terms, pressure_error_of, CheckResult,
     Magnitudes,
 };
+pub use crate::harness::outside_contact::PressureArea;
 use crate::harness::outside_contact::{self, OutsideContact, Source};
 use crate::harness::outside_results::field;
 pub use crate::harness::outside_results::{
@@ -228,9 +229,42 @@ pub(crate) fn unmatched_node_hint(
     }
 }
 
+/// How another code's results are read: the node-matching distance (a share of the model
+/// size) and the area its `contact_pressure` is per.
+#[derive(Clone, Copy, Debug)]
+pub struct ReadOptions {
+    pub match_share: f64,
+    pub pressure_area: PressureArea,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            match_share: DEFAULT_MATCH_SHARE,
+            pressure_area: PressureArea::Case,
+        }
+    }
+}
+
 /// Judge `results` with the checks of `model`; nodes are matched within
-/// `match_share * model.size()`.
+/// `match_share * model.size()`, the pressure read per area of the case's configuration.
 pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judgement> {
+    judge_with(
+        model,
+        results,
+        ReadOptions {
+            match_share,
+            ..ReadOptions::default()
+        },
+    )
+}
+
+/// [`judge`] with the results read as `options` says.
+pub fn judge_with(model: &Model, results: &Results, options: ReadOptions) -> Result<Judgement> {
+    let ReadOptions {
+        match_share,
+        pressure_area,
+    } = options;
     if !(match_share.is_finite() && match_share > 0.0 && match_share < 1.0) {
         return Err(Error::invalid(
             &model.source,
@@ -338,7 +372,7 @@ pub fn judge(model: &Model, results: &Results, match_share: f64) -> Result<Judge
     let contact = if model.contact.is_empty() {
         OutsideContact::default()
     } else {
-        outside_contact::read(model, results, &matched, &u)?
+        outside_contact::read(model, results, &matched, &u, pressure_area)?
     };
     let solution = solution_of(model, u, contact.nodal_force.as_deref());
     let mut checks = Vec::new();
@@ -656,10 +690,10 @@ fn measure_outside(
     model: &Model,
     sweep: &crate::io::scene::SweepSpec,
     path: &Path,
-    match_share: f64,
+    options: ReadOptions,
 ) -> Result<Measured> {
     let results = load_results(model, path)?;
-    let judged = judge(model, &results, match_share)?;
+    let judged = judge_with(model, &results, options)?;
     let mut measured = Measured {
         stress_error: crate::harness::stress_error(model, &judged.solution.u, sweep.pressure),
         pressure_error: None,
@@ -837,7 +871,7 @@ pub fn outside_cells(
     case_file: &Path,
     dir: &Path,
     code: &str,
-    match_share: f64,
+    options: ReadOptions,
 ) -> Result<Vec<crate::harness::Cell>> {
     let model = crate::model::admit::load(case_file)?;
     let Some(sweep) = model.sweep.clone() else {
@@ -875,7 +909,7 @@ pub fn outside_cells(
         }
         let series = kappa_series(&folder, &model.name)?;
         if !series.is_empty() {
-            return kappa_series_cell(cell, &model, &sweep, &series, match_share);
+            return kappa_series_cell(cell, &model, &sweep, &series, options);
         }
     }
     let Some(path) = results_in(dir, &model.name)? else {
@@ -886,7 +920,7 @@ pub fn outside_cells(
         );
         return Ok(vec![cell]);
     };
-    let measured = measure_outside(&model, &sweep, &path, match_share)?;
+    let measured = measure_outside(&model, &sweep, &path, options)?;
     cell.stress_error = Some(measured.stress_error);
     cell.pressure_error = measured.pressure_error;
     let mut pass = measured.stress_error <= sweep.tol
@@ -907,12 +941,12 @@ fn kappa_series_cell(
     model: &Model,
     sweep: &crate::io::scene::SweepSpec,
     series: &[(f64, std::path::PathBuf)],
-    match_share: f64,
+    options: ReadOptions,
 ) -> Result<Vec<crate::harness::Cell>> {
     let mut errors = Vec::with_capacity(series.len());
     let mut stiffest = None;
     for (kappa, path) in series {
-        let measured = measure_outside(model, sweep, path, match_share)?;
+        let measured = measure_outside(model, sweep, path, options)?;
         errors.push((*kappa, measured.stress_error));
         stiffest = Some(measured);
     }

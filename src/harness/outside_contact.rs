@@ -39,6 +39,13 @@
 //! `contact_geometry: "reference"`, the deformed ones `X_a + u_a` (`u` the results'
 //! displacement) for `"current"`, where our rows are evaluated at `X + u` and a code that
 //! evaluates contact in the deformed geometry balances its moments.
+//!
+//! **The pressure's area.** `contact_pressure` is read per unit area of that same
+//! configuration ([`PressureArea::Case`], the default). A code that reports its pressure per
+//! unit deformed area whatever the case says ([`PressureArea::Deformed`], `--pressure-area
+//! deformed`) has it turned into the case's: the force is `f_a = -p_a A_a(X + u) n_a(X + u)`,
+//! and the pressure judged `p_a A_a(X + u) / A_a`, with `A_a` and `n_a` of the case's
+//! configuration. For a case with `contact_geometry: "current"` the two are the same.
 
 use crate::contact::discretization::geometry::Surface;
 use crate::contact::forces::{element_sizes, NodalTraction, PairForces, Penetration};
@@ -50,6 +57,30 @@ use crate::harness::outside_results::{
 use crate::io::scene::{Check, ContactGeometry, DiscretizationSpec, Interaction};
 use crate::model::{MasterSide, Model};
 use std::collections::{BTreeMap, BTreeSet};
+
+/// The area another code's `contact_pressure` is per (module notes, **The pressure's area**).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PressureArea {
+    /// Per unit area of the configuration the case's contact geometry names.
+    #[default]
+    Case,
+    /// Per unit area of the deformed configuration `X + u`.
+    Deformed,
+}
+
+impl PressureArea {
+    /// The option's words: `case` or `deformed`.
+    pub fn parse(text: &str) -> std::result::Result<PressureArea, String> {
+        match text {
+            "case" => Ok(PressureArea::Case),
+            "deformed" => Ok(PressureArea::Deformed),
+            other => Err(format!(
+                "'{other}': give 'case' (per area of the case's contact geometry, the default) \
+                 or 'deformed' (per deformed area, at X + u)"
+            )),
+        }
+    }
+}
 
 /// What the results give for one pair.
 #[derive(Clone, Debug, Default)]
@@ -102,8 +133,12 @@ pub fn read(
     results: &Results,
     matched: &[Vec<usize>],
     u: &[f64],
+    pressure_area: PressureArea,
 ) -> Result<OutsideContact> {
     let config = (model.physics.contact_geometry == ContactGeometry::Current).then_some(u);
+    // the configuration the results' pressure is per, where it differs from the case's
+    let pressure_config =
+        (pressure_area == PressureArea::Deformed && config.is_none()).then_some(u);
     let file_of = |b: usize| -> &ResultsFile { results.of_body(b) };
     let all_have = |name: &str| results.files().iter().all(|f| f.has(name));
     let mut out = OutsideContact {
@@ -162,6 +197,14 @@ pub fn read(
                 Surface::of_body(*b, &model.bodies[*b], facets, model.thickness, config)
             })
             .collect();
+        let pressure_surfaces: Option<Vec<Surface>> = pressure_config.map(|u| {
+            sides
+                .iter()
+                .map(|(b, facets, _)| {
+                    Surface::of_body(*b, &model.bodies[*b], facets, model.thickness, Some(u))
+                })
+                .collect()
+        });
         let carries: Vec<bool> = sides.iter().map(|s| s.2).collect();
         let has_force = side_files(CONTACT_FORCE_FIELD);
         let has_pressure = side_files(CONTACT_PRESSURE_FIELD);
@@ -187,12 +230,14 @@ pub fn read(
                         )
                     } else {
                         let p = pressure_values.expect("checked above").at(point)[0];
+                        // the area and normal the pressure is per (module notes)
+                        let per = pressure_surfaces
+                            .as_ref()
+                            .and_then(|d| d[s].nodes.get(&n))
+                            .unwrap_or(data);
                         (
-                            [
-                                -p * data.area * data.normal[0],
-                                -p * data.area * data.normal[1],
-                            ],
-                            p,
+                            [-p * per.area * per.normal[0], -p * per.area * per.normal[1]],
+                            p * per.area / data.area,
                         )
                     };
                     let x = match config {
