@@ -153,7 +153,7 @@ def solve_kratos(kpy, export, case, method, rundir, extra=(), sub="", root="resu
         entry.update({"solve_seconds": s["solve_seconds"], "import_seconds": s["import_seconds"],
                       "newton_iterations": s["newton_iterations"],
                       "mortar_type": s["mortar_type"]})
-    if rc == 1:
+    if rc in (1, 2):
         entry["newton"] = newton_history(out)
     if rc >= 2:
         entry["reason"] = "Kratos' solve failed: " + out.strip().splitlines()[-1][:300]
@@ -467,6 +467,8 @@ def kratos_cell(k):
     """Kratos' cell as `table --results` judged it: the verdict with its errors (a penalty
     series: the stress error at the smallest and the largest kappa, and the trend), or n/a."""
     t = k.get("table")
+    if k["status"] == "failed":
+        return "fail (Kratos failed)"
     if t is None or t.get("verdict") is None:
         return "n/a" if k["status"] == "n/a" else f"fail ({k['status']})"
     if t["verdict"] == "n/a":
@@ -484,7 +486,15 @@ def reason(k):
     t = k.get("table") or {}
     if t.get("verdict") == "pass":
         return ""
-    if t.get("verdict") == "n/a" or k["status"] == "n/a":
+    if k["status"] == "failed" and "series" in k:
+        return "; ".join(
+            f"kappa {kappa}: {e['status']}" + (
+                f" ({e['reason']})" if e.get("reason") else "") + (
+                ", Kratos' Newton, displacement ratio per iteration: " + ", ".join(
+                    f"{x:.1e}" for x in e["newton"][:6]) + f", ..., last {e['newton'][-1]:.1e} "
+                f"after {len(e['newton'])} iterations" if e.get("newton") else "")
+            for kappa, e in k["series"].items())
+    if (t.get("verdict") == "n/a" or k["status"] == "n/a") and k["status"] != "failed":
         return t.get("note") or k.get("reason", "n/a")
     parts = []
     if k["status"] == "failed":
@@ -567,6 +577,14 @@ def markdown(r):
         for cat in ("patch", "tied"):
             n, ok, na = verdict_counts(rows, method, cat)
             L.append(f"- {code}, {cat}: {ok} of {n} judged cells pass; {na} n/a.")
+    unconverged = [f"{row['case']} {METHODS[m]}" for row in rows for m, k in row["kratos"].items()
+                   if k.get("table", {}).get("verdict") == "pass"
+                   and (k["status"] == "not converged" or any(
+                       e["status"] == "not converged" for e in k.get("series", {}).values()))]
+    if unconverged:
+        L += ["", "Kratos' Newton reported no convergence (its relative displacement criterion "
+              "1e-13 not reached in 100 iterations) on cells the judge passes: "
+              + ", ".join(unconverged) + "."]
     L += ["", "The patch cases hold the punch's top-left corner at the exact u_x, so their exact "
           "solution does not slide at the interface: a code that takes the contact geometry in "
           "the current configuration (Kratos moves its mesh) solves the same problem as one "
