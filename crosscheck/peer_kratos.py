@@ -527,7 +527,7 @@ def scan_words(scan):
 def verdict_counts(rows, method, catalogue):
     """(cells Kratos solved, passing, n/a) of one catalogue for one method, from the tables."""
     ks = [r["kratos"][method] for r in rows if r["catalogue"] == catalogue]
-    v = [k.get("table", {}).get("verdict") for k in ks]
+    v = ["fail" if k["status"] == "failed" else k.get("table", {}).get("verdict") for k in ks]
     return sum(x in ("pass", "fail") for x in v), v.count("pass"), v.count("n/a")
 
 
@@ -576,7 +576,7 @@ def markdown(r):
     for method, code in METHODS.items():
         for cat in ("patch", "tied"):
             n, ok, na = verdict_counts(rows, method, cat)
-            L.append(f"- {code}, {cat}: {ok} of {n} judged cells pass; {na} n/a.")
+            L.append(f"- {code}, {cat}: {ok} of {n} cells Kratos took pass; {na} n/a.")
     unconverged = [f"{row['case']} {METHODS[m]}" for row in rows for m, k in row["kratos"].items()
                    if k.get("table", {}).get("verdict") == "pass"
                    and (k["status"] == "not converged" or any(
