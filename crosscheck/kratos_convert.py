@@ -37,7 +37,8 @@ its test inputs) from our sidecar. What maps to what:
   `<pair>_slave`, `<pair>_master` and `<pair>` (both): the contact process searches `<pair>`
   and takes `<pair>_slave` as the slave side (`assume_master_slave`). Kratos' 2D mortar
   conditions exist for 2-node edges only, so a pair on Q9/T6 facets (3-node edges) is refused
-  with exit code 3 and that reason (the cross-check records the cell as n/a);
+  with exit code 3 and that reason (the cross-check writes it to the results' `<case>/
+  not-applicable.txt`, so that `contact-patch table --results` shows the cell as n/a with it);
 * a tied pair (`"interaction": "tied"`) -> Kratos' mortar mesh tying (`MeshTyingProcess`,
   `mortar_type: ComponentsMeshTying`, Lagrange multipliers); with `--contact penalty` it is
   refused (exit 3): Kratos' penalty contact is frictionless or frictional, it has no tie;
@@ -45,13 +46,6 @@ its test inputs) from our sidecar. What maps to what:
   penalty of the augmentation from the stiffness unless `--kappa` is given);
   `--contact penalty`: `PenaltyContactFrictionless` (mortar, penalty `--kappa`, pressure per
   unit gap; default: the case's sweep kappa, else the pair's own).
-
-`--supports-from-exact` writes a diagnostic variant of a uniform-stress case: each prescribed
-displacement takes the exact field's value at its node. The patch tests hold the punch's x at
-one top corner, so their exact solution slides the punch against the foundation by 4 eps_xx;
-a code that evaluates contact in the deformed configuration (Kratos moves its mesh) sees that
-slide. The variant removes it without changing the stress, so the same judge tells whether a
-failure comes from the slide.
 
 Exit 0 on success, 3 when Kratos cannot take the case (the reason on stderr, one line starting
 with "n/a:"), 2 on bad input.
@@ -146,20 +140,7 @@ def rigid_line_body(rigid, owner, slave_body, slave_facets, bodies, nodes, eleme
     return [(top[k + 1], top[k]) for k in range(len(s) - 1)], prop, top + bottom
 
 
-def exact_displacement(sidecar, body, node, component):
-    """The closed form's displacement of a uniform-stress case at one node (the sidecar's
-    `exact.closed_form`: u_x = eps_xx x + gamma_xy / 2 y, u_y = gamma_xy / 2 x + eps_yy y)."""
-    exact = sidecar.get("exact") or {}
-    if exact.get("kind") != "uniform_stress":
-        raise NotApplicable("--supports-from-exact needs a uniform-stress case")
-    e = exact["strain_by_body"][body["name"]]
-    x, y = body["points"][node]
-    if component == "x":
-        return e["eps_xx"] * x + 0.5 * e["gamma_xy"] * y
-    return 0.5 * e["gamma_xy"] * x + e["eps_yy"] * y
-
-
-def convert(export_dir, out_dir, contact, kappa=None, supports_from_exact=False):
+def convert(export_dir, out_dir, contact, kappa=None):
     export_dir, out_dir = Path(export_dir), Path(out_dir)
     case = export_dir.name
     sidecar = json.loads((export_dir / f"{case}.json").read_text())
@@ -261,10 +242,7 @@ def convert(export_dir, out_dir, contact, kappa=None, supports_from_exact=False)
     # --- supports and loads, as resolved by our tool ------------------------------------------
     fixed = {"x": [(n, 0.0) for n in fixed_nodes], "y": [(n, 0.0) for n in fixed_nodes]}
     for p in sidecar["resolved"]["prescribed_displacements"]:
-        value = float(p["value"])
-        if supports_from_exact:
-            value = exact_displacement(sidecar, bodies[p["body"]], p["node"], p["component"])
-        fixed[p["component"]].append((p["gmsh_node_tag"], value))
+        fixed[p["component"]].append((p["gmsh_node_tag"], float(p["value"])))
     loads = {}
     for f in sidecar["resolved"]["consistent_nodal_forces"]:
         v = loads.setdefault(f["gmsh_node_tag"], [0.0, 0.0])
@@ -424,14 +402,9 @@ def main(argv=None):
     ap.add_argument("out", help="folder for the Kratos input")
     ap.add_argument("--contact", choices=["alm", "penalty"], default="alm")
     ap.add_argument("--kappa", type=float, help="penalty (pressure per unit gap)")
-    ap.add_argument("--supports-from-exact", action="store_true",
-                    help="a diagnostic variant: every prescribed displacement takes the value of "
-                         "the case's exact field at its node (uniform-stress cases), e.g. the "
-                         "patch tests' punch held where the exact solution puts it, so that the "
-                         "bodies do not slide against each other")
     a = ap.parse_args(argv)
     try:
-        mortar = convert(a.export, a.out, a.contact, a.kappa, a.supports_from_exact)
+        mortar = convert(a.export, a.out, a.contact, a.kappa)
     except NotApplicable as e:
         print(f"n/a: {e}", file=sys.stderr)
         return 3

@@ -11,13 +11,17 @@ TOOL is our built `contact-patch`, KRATOS_PYTHON the interpreter of the Kratos e
 measured here, in this run:
 
 1. `contact-patch export` of every case (RUN_DIR/export/<case>/);
-2. per case and Kratos method (alm, penalty): kratos_convert.py (exit 3 = Kratos cannot take
-   the case: the cell is n/a with that reason), kratos_solve.py under one thread (taskset -c 0,
+2. per case and Kratos method: kratos_convert.py (exit 3 = Kratos cannot take the case: its
+   reason goes to RUN_DIR/results/<method>/<case>/not-applicable.txt, so that `table --results`
+   makes the cell n/a with it), kratos_solve.py under one thread (taskset -c 0,
    OMP_NUM_THREADS=1), `contact-patch judge RUN_DIR/export/<case>/ RESULTS` (verdict lines and
-   exit code kept in RUN_DIR);
-3. the patch cases again with --supports-from-exact (the punch held where the exact solution
-   puts it: no slide between the bodies), judged by the same case: a failure that disappears
-   there is the slide's;
+   exit code kept in RUN_DIR). ALM: one solve, RESULTS = results/alm/<case>/. Penalty: a kappa
+   series, one solve per kappa of PENALTY_KAPPAS, RESULTS = results/penalty/<case>/kappa-<k>/,
+   which `table --results` judges as our own penalty cells (the trend of the stress error as
+   kappa grows, the contact forces at the largest kappa);
+3. for each penalty cell the table fails, and for KAPPA_SCAN_REFERENCE, a wider scan
+   (KAPPA_SCAN: the stress error, the out-of-balance force and Kratos' Newton iterations per
+   kappa), to say what was measured about the failure and why the series stops where it does;
 4. `contact-patch table cases/patch cases/tied --results ... --code kratos-alm` (and
    kratos-penalty), and our own `contact-patch table cases/patch cases/tied` on one thread; the
    peer table puts our mortar cells (augmented Lagrangian per iteration, penalty; for ties the
@@ -56,6 +60,14 @@ HERTZ_PEAK = 0.03  # as crosscheck/report.py: peak within 3 % of p0
 # hertz-cylinder is a Lagrange case: Kratos' penalty gets the kappa of the cross-check's penalty
 # Hertz cases at the same E (crosscheck/cases/contact/cylinder-penalty-*.json)
 HERTZ_KAPPA = 1e5
+# Kratos' penalty series: two kappas 100x apart (the smallest span `table --results` takes). The
+# largest is the sweep's kappa (1e4): above it the out-of-balance force of Kratos' results grows
+# with kappa past the force-balance tolerance 1e-12 (the scan of KAPPA_SCAN_REFERENCE in the
+# report measures it), so a series up to the sweep's 1e7 would fail on round-off, not on the
+# method.
+PENALTY_KAPPAS = ("1e2", "1e4")
+KAPPA_SCAN = ("1e2", "1e3", "1e4", "1e5", "1e6", "1e7", "1e8")
+KAPPA_SCAN_REFERENCE = "patch-A-nu0.3"
 ONE_THREAD = {"OMP_NUM_THREADS": "1", "RAYON_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
               "MKL_NUM_THREADS": "1"}
 
@@ -117,18 +129,16 @@ def read_point_field(vtu, name):
     return pts, None
 
 
-def solve_kratos(kpy, export, case, method, rundir, variant="", extra=()):
-    """Convert, solve and judge one case with one Kratos method; a dict for the report."""
-    tag = f"{method}{variant}"
-    kdir = rundir / "kratos" / tag / case
-    rdir = rundir / "results" / tag / case
+def solve_kratos(kpy, export, case, method, rundir, extra=(), sub="", root="results"):
+    """Convert and solve one case with one Kratos method into RUN_DIR/<root>/<method>/<case>/
+    (or its subfolder `sub`, e.g. kappa-1e4); a dict for the report, with "results" the folder.
+    When Kratos cannot take the case: status n/a and the converter's reason."""
+    kdir = rundir / "kratos" / root / method / case / sub
+    rdir = rundir / root / method / case / sub
     for d in (kdir, rdir):
         shutil.rmtree(d, ignore_errors=True)
-    conv = [kpy, HERE / "kratos_convert.py", export / case, kdir, "--contact", method]
-    if variant:
-        conv.append("--supports-from-exact")
-    conv.extend(extra)
-    rc, _, out = run(conv, ok=(0, 3))
+    rc, _, out = run([kpy, HERE / "kratos_convert.py", export / case, kdir, "--contact", method,
+                      *extra], ok=(0, 3))
     if rc == 3:
         reason = next((ln[4:].strip() for ln in out.splitlines() if ln.startswith("n/a:")), out)
         return {"status": "n/a", "reason": reason}
@@ -143,7 +153,7 @@ def solve_kratos(kpy, export, case, method, rundir, variant="", extra=()):
         entry.update({"solve_seconds": s["solve_seconds"], "import_seconds": s["import_seconds"],
                       "newton_iterations": s["newton_iterations"],
                       "mortar_type": s["mortar_type"]})
-    if rc == 1:
+    if rc in (1, 2):
         entry["newton"] = newton_history(out)
     if rc >= 2:
         entry["reason"] = "Kratos' solve failed: " + out.strip().splitlines()[-1][:300]
@@ -161,6 +171,66 @@ def newton_history(log):
             except ValueError:
                 pass
     return ratios
+
+
+def not_applicable(rundir, method, case, reason):
+    """RUN_DIR/results/<method>/<case>/not-applicable.txt with the converter's reason: the
+    file by which `table --results` makes the cell n/a with the outside code's reason."""
+    folder = rundir / "results" / method / case
+    shutil.rmtree(folder, ignore_errors=True)
+    folder.mkdir(parents=True)
+    (folder / "not-applicable.txt").write_text(reason + "\n")
+
+
+def solve_one(tool, kpy, export, case, method, rundir):
+    """One Kratos solve of a case (ALM, or mesh tying for tied cases), judged."""
+    k = solve_kratos(kpy, export, case, method, rundir)
+    if k["status"] == "n/a":
+        not_applicable(rundir, method, case, k["reason"])
+    elif k["status"] in ("converged", "not converged"):
+        k["judge"] = judge(tool, export, case, rundir / "results" / method / case, rundir,
+                           method)
+    return k
+
+
+def solve_series(tool, kpy, export, case, method, rundir, kappas=PENALTY_KAPPAS,
+                 root="results"):
+    """Kratos' penalty at each kappa of `kappas`, into RUN_DIR/<root>/<method>/<case>/kappa-<k>/
+    (the kappa series `table --results` judges), each judged; n/a for the case when the
+    converter refuses it."""
+    series = {}
+    for kappa in kappas:
+        k = solve_kratos(kpy, export, case, method, rundir, extra=("--kappa", kappa),
+                         sub=f"kappa-{kappa}", root=root)
+        if k["status"] == "n/a":
+            if root == "results":
+                not_applicable(rundir, method, case, k["reason"])
+            return k
+        if k["status"] in ("converged", "not converged"):
+            k["judge"] = judge(tool, export, case,
+                               rundir / root / method / case / f"kappa-{kappa}", rundir,
+                               f"{root}-{method}-kappa-{kappa}")
+        series[kappa] = k
+    states = {k["status"] for k in series.values()}
+    if "failed" in states and root == "results":
+        # a kappa without results: no series for the table (its cell reads "no results"); the
+        # report gives Kratos' failure
+        shutil.rmtree(rundir / root / method / case, ignore_errors=True)
+    status = "converged" if states == {"converged"} else (
+        "failed" if "failed" in states else "not converged")
+    return {"status": status, "series": series,
+            "process_seconds": sum(k.get("process_seconds", 0.0) for k in series.values()),
+            "solve_seconds": sum(k.get("solve_seconds", 0.0) for k in series.values())}
+
+
+def check_error(k, start):
+    """The error of the judge line of `k` that begins with `start` (e.g. "uniform stress",
+    "force balance"), or None."""
+    for line in k.get("judge", {}).get("checks", []):
+        text = line.split(" ", 1)[1]
+        if text.startswith(start) and "(error " in text:
+            return float(text.rsplit("(error ", 1)[1].split(",")[0])
+    return None
 
 
 def judge(tool, export, case, rdir, rundir, tag):
@@ -253,6 +323,8 @@ def main(argv):
     rundir.mkdir(parents=True, exist_ok=True)
     (rundir / "judge").mkdir(exist_ok=True)
     export = rundir / "export"
+    for stale in ("results", "kratos", "scan"):  # a kind of results another run left
+        shutil.rmtree(rundir / stale, ignore_errors=True)
     t_start = time.perf_counter()
 
     # 1. the export ----------------------------------------------------------------------------
@@ -272,18 +344,8 @@ def main(argv):
         catalogue = "patch" if case.startswith("patch") else "tied"
         row = {"case": case, "catalogue": catalogue, "kratos": {}, "ours": {}}
         for method in METHODS:
-            k = solve_kratos(kpy, export, case, method, rundir)
-            if k["status"] in ("converged", "not converged"):
-                k["judge"] = judge(tool, export, case, rundir / "results" / method / case,
-                                   rundir, method)
-                if catalogue == "patch":
-                    v = solve_kratos(kpy, export, case, method, rundir, "-noslide")
-                    if v["status"] in ("converged", "not converged"):
-                        v["judge"] = judge(tool, export, case,
-                                           rundir / "results" / f"{method}-noslide" / case,
-                                           rundir, f"{method}-noslide")
-                    k["without_slide"] = v
-            row["kratos"][method] = k
+            row["kratos"][method] = (solve_series if method == "penalty" else solve_one)(
+                tool, kpy, export, case, method, rundir)
         cells = ours_patch if catalogue == "patch" else ours_tied
         for kind in (("alm", "penalty") if catalogue == "patch" else ("tie",)):
             c = ours_cell(cells, case, kind)
@@ -292,9 +354,8 @@ def main(argv):
                                             "stress_error", "pressure_error", "load_error",
                                             "force_balance", "time_ms", "note")}
         rows.append(row)
-        print(f"peer: {case}: " + ", ".join(
-            f"{m} {r.get('judge', {}).get('verdict', r['status'])}"
-            for m, r in row["kratos"].items()), flush=True)
+        print(f"peer: {case}: " + ", ".join(f"{m} {r['status']}"
+                                            for m, r in row["kratos"].items()), flush=True)
 
     # 4. the tables of Kratos' results --------------------------------------------------------------
     tables = {}
@@ -313,8 +374,26 @@ def main(argv):
             c = tables.get(method, {}).get(row["case"])
             if c is not None:
                 row["kratos"][method]["table"] = {
-                    key: c.get(key) for key in ("verdict", "stress_error", "pressure_error",
-                                                "load_error", "force_balance", "note")}
+                    key: c.get(key) for key in ("verdict", "kappa", "stress_error",
+                                                "stress_error_stiff", "penalty_trend",
+                                                "pressure_error", "load_error",
+                                                "force_balance", "note")}
+
+    # 3b. the penalty's kappa scan: the failing penalty cells and the reference ----------------
+    for row in rows:
+        k = row["kratos"]["penalty"]
+        failing = k.get("table", {}).get("verdict") == "fail"
+        if row["catalogue"] == "patch" and (failing or row["case"] == KAPPA_SCAN_REFERENCE):
+            scan = solve_series(tool, kpy, export, row["case"], "penalty", rundir,
+                                kappas=KAPPA_SCAN, root="scan")
+            k["scan"] = [{"kappa": float(kappa), "status": e["status"],
+                          "newton_iterations": e.get("newton_iterations"),
+                          "stress_error": check_error(e, "uniform stress"),
+                          "pressure_error": check_error(e, "contact pressure"),
+                          "force_balance": check_error(e, "force balance")}
+                         for kappa, e in scan.get("series", {}).items()]
+            print(f"peer: {row['case']}: penalty scan " + ", ".join(
+                f"{e['kappa']:.0e}: {fmt(e['stress_error'])}" for e in k["scan"]), flush=True)
 
     # 5. Hertz ---------------------------------------------------------------------------------
     h = hertz_closed_form(export)
@@ -385,55 +464,71 @@ def fmt(x):
 
 
 def kratos_cell(k):
-    """Kratos' cell: the table's verdict with its errors, or n/a with the reason."""
-    if k["status"] == "n/a":
+    """Kratos' cell as `table --results` judged it: the verdict with its errors (a penalty
+    series: the stress error at the smallest and the largest kappa, and the trend), or n/a."""
+    t = k.get("table")
+    if k["status"] == "failed":
+        return "fail (Kratos failed)"
+    if t is None or t.get("verdict") is None:
+        return "n/a" if k["status"] == "n/a" else f"fail ({k['status']})"
+    if t["verdict"] == "n/a":
         return "n/a"
-    if "judge" not in k:
-        return f"fail ({k['status']})"
-    t = k.get("table", {})
-    v = t.get("verdict", k["judge"]["verdict"])
-    return f"{v} (stress {fmt(t.get('stress_error'))}, p {fmt(t.get('pressure_error'))})"
+    if t.get("penalty_trend"):
+        return (f"{t['verdict']} (stress {fmt(t['stress_error'])} -> "
+                f"{fmt(t['stress_error_stiff'])}: {t['penalty_trend']}, p {fmt(t['pressure_error'])})")
+    return f"{t['verdict']} (stress {fmt(t['stress_error'])}, p {fmt(t['pressure_error'])})"
 
 
 def reason(k):
-    """Why Kratos' cell is not a pass: n/a's reason, or the measured property."""
-    if k["status"] == "n/a":
-        return k["reason"]
-    if k["status"] == "failed":
-        return k.get("reason", "Kratos' solve failed")
-    t = k.get("table", {})
+    """Why Kratos' cell is not a pass: the n/a reason as `table --results` recorded it, or what
+    was measured (the table's note, the judge's failing checks, Kratos' Newton, the kappa
+    scan)."""
+    t = k.get("table") or {}
     if t.get("verdict") == "pass":
         return ""
+    if k["status"] == "failed" and "series" in k:
+        return "; ".join(
+            f"kappa {kappa}: {e['status']}" + (
+                f" ({e['reason']})" if e.get("reason") else "") + (
+                ", Kratos' Newton, displacement ratio per iteration: " + ", ".join(
+                    f"{x:.1e}" for x in e["newton"][:6]) + f", ..., last {e['newton'][-1]:.1e} "
+                f"after {len(e['newton'])} iterations" if e.get("newton") else "")
+            for kappa, e in k["series"].items())
+    if (t.get("verdict") == "n/a" or k["status"] == "n/a") and k["status"] != "failed":
+        return t.get("note") or k.get("reason", "n/a")
     parts = []
+    if k["status"] == "failed":
+        parts.append(k.get("reason", "Kratos' solve failed"))
     if k["status"] == "not converged":
         parts.append("Kratos' Newton did not converge")
     if k.get("newton"):
         parts.append("Kratos' Newton, displacement ratio per iteration: " + ", ".join(
             f"{x:.1e}" for x in k["newton"][:8]) + (" ..." if len(k["newton"]) > 8 else ""))
-    fails = [c for c in k["judge"]["checks"] if c.lower().startswith("fail")]
-    if fails:
-        parts.append("judge: " + "; ".join(short(f[5:]) for f in fails))
-    ns = k.get("without_slide")
-    if ns and "judge" in ns:
-        nt = ns["judge"]
-        nf = [c for c in nt["checks"] if c.lower().startswith("fail")]
-        if nt["verdict"] == "pass":
-            parts.insert(0, "**the slide**: without it (punch held at the exact u_x) the same "
-                            f"judge passes ({nt['summary']})")
-        else:
-            parts.append("without the slide (punch held at the exact u_x) the same judge still "
-                         f"fails ({nt['summary']}): " + "; ".join(short(f[5:]) for f in nf))
+    if t.get("note"):
+        parts.append("table: " + t["note"])
+    checks = [c for e in ([k] + list(k.get("series", {}).values()))
+              for c in e.get("judge", {}).get("checks", []) if c.lower().startswith("fail")]
+    if checks and "series" not in k:
+        parts.append("judge: " + "; ".join(short(c[5:]) for c in checks))
+    if k.get("scan"):
+        parts.append("kappa scan: " + scan_words(k["scan"]))
     return ". ".join(parts)
 
 
-def slide_counts(rows, method):
-    """(solved patch cells, passing, failing that pass without the slide) for one method."""
-    solved = [r["kratos"][method] for r in rows
-              if r["catalogue"] == "patch" and "judge" in r["kratos"][method]]
-    passing = [k for k in solved if k.get("table", {}).get("verdict") == "pass"]
-    by_slide = [k for k in solved if k not in passing
-                and k.get("without_slide", {}).get("judge", {}).get("verdict") == "pass"]
-    return len(solved), len(passing), len(by_slide)
+def scan_words(scan):
+    """The kappa scan, one entry per kappa: stress error, out-of-balance, Newton iterations."""
+    return "; ".join(
+        f"{e['kappa']:.0e}: stress {fmt(e['stress_error'])}, balance {fmt(e['force_balance'])}, "
+        + (f"{e['newton_iterations']} Newton iterations" if e["status"] == "converged"
+           else f"{e['status']} after {e.get('newton_iterations')} Newton iterations")
+        for e in scan)
+
+
+def verdict_counts(rows, method, catalogue):
+    """(cells Kratos solved, passing, n/a) of one catalogue for one method, from the tables."""
+    ks = [r["kratos"][method] for r in rows if r["catalogue"] == catalogue]
+    v = ["fail" if k["status"] == "failed" else k.get("table", {}).get("verdict") for k in ks]
+    return sum(x in ("pass", "fail") for x in v), v.count("pass"), v.count("n/a")
 
 
 def short(check):
@@ -477,19 +572,34 @@ def markdown(r):
             L.append(f"| {row['case']} | {our('tie')} (mortar Lagrange tie) | "
                      f"{kratos_cell(kk['alm'])} (mesh tying) | - | "
                      f"{kratos_cell(kk['penalty'])} | n/a |")
-    L += ["", f"DOLFINx: {dolfinx}.", "", "### Why Kratos' cells are not a pass", "",
-          "The patch cases hold the punch's x at its top-left corner only, so their exact "
-          "solution slides the punch against the foundation by 4 eps_xx at the interface (0 at "
-          "nu = 0; 0.0156 at nu = 0.3). Our tool takes the contact geometry in the reference "
-          "configuration (small sliding); Kratos moves its mesh and takes it in the current one. "
-          "Each solved patch case is therefore solved again with every prescribed displacement "
-          "at the exact field's value (`kratos_convert.py --supports-from-exact`: no slide, the "
-          "same stress) and judged by the same case:", ""]
+    L += ["", f"DOLFINx: {dolfinx}.", "", "### Counts", ""]
     for method, code in METHODS.items():
-        n, ok, slide = slide_counts(rows, method)
-        L.append(f"- {code}: {ok} of {n} solved patch cells pass; {slide} of the {n - ok} "
-                 "failing ones pass without the slide.")
-    L.append("")
+        for cat in ("patch", "tied"):
+            n, ok, na = verdict_counts(rows, method, cat)
+            L.append(f"- {code}, {cat}: {ok} of {n} cells Kratos took pass; {na} n/a.")
+    unconverged = [f"{row['case']} {METHODS[m]}" for row in rows for m, k in row["kratos"].items()
+                   if k.get("table", {}).get("verdict") == "pass"
+                   and (k["status"] == "not converged" or any(
+                       e["status"] == "not converged" for e in k.get("series", {}).values()))]
+    if unconverged:
+        L += ["", "Kratos' Newton reported no convergence (its relative displacement criterion "
+              "1e-13 not reached in 100 iterations) on cells the judge passes: "
+              + ", ".join(unconverged) + "."]
+    L += ["", "The patch cases hold the punch's top-left corner at the exact u_x, so their exact "
+          "solution does not slide at the interface: a code that takes the contact geometry in "
+          "the current configuration (Kratos moves its mesh) solves the same problem as one "
+          "that takes it in the reference configuration (ours).", "",
+          "Kratos' penalty is handed to `table --results` as a kappa series (folders "
+          f"`<case>/kappa-{PENALTY_KAPPAS[0]}/` ... `kappa-{PENALTY_KAPPAS[-1]}/`) and judged as "
+          "our penalty cells are: the trend of the stress error from the smallest to the largest "
+          "kappa (round-off at both, 1/kappa when it falls by at least a tenth of the kappa "
+          "ratio, else no fall), the total contact force and the force balance at the largest "
+          f"kappa. The series stops at {PENALTY_KAPPAS[-1]}: the scan of "
+          f"{KAPPA_SCAN_REFERENCE} below gives the out-of-balance force of Kratos' results per "
+          "kappa against the balance tolerance 1e-12. Our penalty cells are at the sweep's kappa "
+          "(1e4) and 1000 times it. Cells Kratos cannot take have the converter's reason in "
+          "`<case>/not-applicable.txt`; the reasons below are the table's notes.", "",
+          "### Why Kratos' cells are not a pass", ""]
     why = {}  # the same reason for several cells is said once
     for row in rows:
         for method, k in row["kratos"].items():
@@ -501,11 +611,11 @@ def markdown(r):
         L.append(f"- **{', '.join(cells)}**: {text}")
     if not why:
         L.append("- every Kratos cell passes")
-    L += ["", "Our penalty cells are judged as `contact-patch table` judges our penalty: at the "
-          "sweep's kappa, with the penalty's trend as kappa grows (each cell's note, e.g. "
-          "\"kappa = 1e4: stress error round-off as kappa grows 1000x\"); Kratos' penalty cells "
-          "at the one kappa it ran (1e4, the sweep's), as `table --results` judges an outside "
-          "code."]
+    ref = next((r for r in rows if r["case"] == KAPPA_SCAN_REFERENCE), None)
+    if ref and ref["kratos"]["penalty"].get("scan"):
+        L += ["", f"Kratos' penalty on {KAPPA_SCAN_REFERENCE} (the scan's reference) per kappa: "
+              + scan_words(ref["kratos"]["penalty"]["scan"]) + "."]
+    L.append("")
     # wall times
     L += ["", "### Wall times (one core each)", "",
           f"Ours: the whole patch and tied tables (every cell of both catalogues) in "
@@ -526,6 +636,9 @@ def markdown(r):
         def t_k(k):
             if "process_seconds" not in k:
                 return "n/a"
+            if "series" in k:
+                return (f"{k['process_seconds']:.2f} s ({k['solve_seconds']:.3f} s), "
+                        f"{len(k['series'])} kappas")
             s = k.get("solve_seconds")
             return f"{k['process_seconds']:.2f} s ({s:.3f} s)" if s is not None else \
                 f"{k['process_seconds']:.2f} s"

@@ -107,6 +107,11 @@ pub const KNOWN_REPORTS: &[KnownReport] = &[
         title: "Cross-check against DOLFINx and scikit-fem",
         command: "bash crosscheck/run.sh",
     },
+    KnownReport {
+        stem: "peer-codes",
+        title: "Peer codes: Kratos Multiphysics on the contact catalogue",
+        command: "bash crosscheck/run.sh",
+    },
 ];
 
 /// The page's file name in the reports folder.
