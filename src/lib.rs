@@ -42,6 +42,7 @@
 //! geometry, load steps and geometric stiffness run only when the case's `physics` and `solver`
 //! sections ask for them.
 
+pub mod capability;
 pub mod contact;
 pub mod error;
 pub mod fe;
