@@ -688,16 +688,13 @@ pub const SEED_ROW: [(&str, &str); 7] = [
     ("E", "f"),
 ];
 
-/// The full grid as a Markdown table; `with_time` adds the time column (not in snapshots).
-pub fn grid_markdown(cells: &[Cell], with_time: bool) -> String {
+/// The full grid as a Markdown table: verdicts and errors, no wall times (those go to
+/// `<catalogue>-table.times.csv`, [`crate::harness::report::times_csv`]).
+pub fn grid_markdown(cells: &[Cell]) -> String {
     let mut s = String::from("| mesh | nu | discretization | passes | slave | enforcement | verdict | stress error | at 1000 kappa | trend | pressure error | load error | rank def. | stability | iterations |");
-    s += if with_time {
-        " time ms | note |\n"
-    } else {
-        " note |\n"
-    };
+    s += " note |\n";
     s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
-    s += if with_time { "---|---|\n" } else { "---|\n" };
+    s += "---|\n";
     for c in cells {
         s += &format!(
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
@@ -721,9 +718,6 @@ pub fn grid_markdown(cells: &[Cell], with_time: bool) -> String {
                 .map(|r| r.to_string())
                 .unwrap_or("-".into()),
         );
-        if with_time {
-            s += &format!(" {:.2} |", c.time_ms);
-        }
         s += &format!(" {} |\n", c.note.replace('|', "/"));
     }
     s

@@ -141,7 +141,7 @@ fn perturbed_lagrange_note(cells: &[Cell]) -> String {
 }
 
 /// The whole report.
-pub fn patch_report(cells: &[Cell], seconds: f64) -> String {
+pub fn patch_report(cells: &[Cell]) -> String {
     let mut s = String::from(
         "# The contact patch test: meshes A-E across discretizations and enforcement methods\n\n",
     );
@@ -167,11 +167,12 @@ pub fn patch_report(cells: &[Cell], seconds: f64) -> String {
     s += &format!("Penalty-type methods run at kappa = {} and at 1000 kappa; `trend` says whether the stress error is round-off at both,\n", k_list.join(", "));
     s += "falls like 1/kappa, or does not fall. `load error` compares the total contact force with the exact load. `rank def.` is the number of\n";
     s += "dependent active constraints; `stability` is `unstable` when a multiplier system (Lagrange, elimination) is singular.\n";
-    s += "`iterations` counts linear solves of the active-set loop; times are wall-clock per cell on the machine that ran the table.\n";
+    s += "`iterations` counts linear solves of the active-set loop. Wall times per cell are in `patch-table.times.csv`, out of this\n";
+    s += "file so that a rerun changes it only where a result changes.\n";
     s += &perturbed_lagrange_note(cells);
     s += "\n";
-    s += &grid_markdown(cells, true);
-    s += &format!("\n{} cells in {seconds:.2} s.\n", cells.len());
+    s += &grid_markdown(cells);
+    s += &format!("\n{} cells.\n", cells.len());
     s
 }
 
@@ -225,12 +226,13 @@ pub fn tied_report(cells: &[Cell]) -> String {
         s += &note;
         s += "\n";
     }
-    s += &grid_markdown(cells, true);
+    s += &grid_markdown(cells);
+    s += "\nWall times per cell: `tied-table.times.csv`.\n";
     s
 }
 
 /// The frictional patch tests (`reports/friction-table.md`).
-pub fn friction_report(cells: &[Cell], seconds: f64) -> String {
+pub fn friction_report(cells: &[Cell]) -> String {
     let mut s = String::from(
         "# The frictional contact patch test: meshes A-E across discretizations and enforcement methods\n\n",
     );
@@ -248,7 +250,36 @@ pub fn friction_report(cells: &[Cell], seconds: f64) -> String {
     s += "## Summary: the enforcement methods that pass, per discretization\n\n";
     s += &crate::harness::friction::summary_markdown(cells);
     s += "\n## The full grid\n\n";
-    s += &crate::harness::friction::grid_markdown(cells, true);
-    s += &format!("\n{} cells in {seconds:.2} s.\n", cells.len());
+    s += &crate::harness::friction::grid_markdown(cells);
+    s += &format!(
+        "\n{} cells. Wall times per cell: `friction-table.times.csv`.\n",
+        cells.len()
+    );
+    s
+}
+
+/// The wall times of one catalogue's cells, `<catalogue>-table.times.csv`: a comment line with
+/// the whole run's time (`seconds`, every catalogue of it), then one row per cell in the
+/// table's order, keyed as the baseline matches cells. Kept out of the verdict tables so that a
+/// rerun changes those only where a result changes.
+pub fn times_csv(cells: &[Cell], seconds: f64) -> String {
+    let mut s = format!(
+        "# wall times of the cells of one `contact-patch table` run, which took {seconds:.2} s in all\n"
+    );
+    s += "case,mesh,nu,status,discretization,passes,slave,enforcement,time_ms\n";
+    for c in cells {
+        s += &format!(
+            "{},{},{},{},{},{},{},{},{:.2}\n",
+            c.case,
+            c.mesh,
+            c.nu,
+            c.friction.as_ref().map(|f| f.expect.as_str()).unwrap_or(""),
+            c.discretization,
+            c.passes.map(|p| p.to_string()).unwrap_or_default(),
+            c.slave.as_deref().unwrap_or(""),
+            c.enforcement,
+            c.time_ms
+        );
+    }
     s
 }
