@@ -37,11 +37,14 @@
 //!   ([`harness::layer`]).
 //! * [`io::output`]: `summary.json` and `.vtu` files, written through [`io::paths`] (the one
 //!   owner of every path written); [`run`]: one case from file to results, as the command runs it.
+//! * [`capability`]: what a case may ask for, asked of the checks `run` makes before its first
+//!   solve (the README's generated capability matrix).
 //!
 //! Physics is opt-in: a scene without contact pairs builds no contact row, and current contact
 //! geometry, load steps and geometric stiffness run only when the case's `physics` and `solver`
 //! sections ask for them.
 
+pub mod capability;
 pub mod contact;
 pub mod error;
 pub mod fe;

@@ -10,7 +10,7 @@
 //!   beta = 0;
 //! * under refinement L1 -> L2 -> L3 (h = 0.08, 0.04, 0.02): the L2 errors of the shear traction
 //!   and of the pressure over the contact zone, and of the pressure over 0.8 a, fall at every
-//!   step (L4 is left to the report: see README, Cattaneo-Mindlin);
+//!   step (L4 is left to the report: see docs/verification.md, Cattaneo-Mindlin);
 //! * the command writes the table, the JSON and the plot, and refuses a frictionless pair.
 
 use std::path::{Path, PathBuf};

@@ -176,11 +176,7 @@ fn friction_table() {
     settings.bind(|| {
         insta::assert_snapshot!(
             "friction_table",
-            format!(
-                "{}\n{}",
-                summary_markdown(&cells),
-                grid_markdown(&cells, false)
-            )
+            format!("{}\n{}", summary_markdown(&cells), grid_markdown(&cells))
         );
     });
 }

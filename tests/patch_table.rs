@@ -102,7 +102,7 @@ fn patch_table() {
     settings.bind(|| {
         insta::assert_snapshot!(
             "patch_table",
-            format!("{summary}\n{}", grid_markdown(&cells, false))
+            format!("{summary}\n{}", grid_markdown(&cells))
         );
     });
 }
@@ -129,5 +129,5 @@ fn tied_table() {
     let mut settings = insta::Settings::clone_current();
     settings.set_snapshot_path("../snapshots");
     settings.set_prepend_module_to_snapshot(false);
-    settings.bind(|| insta::assert_snapshot!("tied_table", grid_markdown(&cells, false)));
+    settings.bind(|| insta::assert_snapshot!("tied_table", grid_markdown(&cells)));
 }

@@ -241,18 +241,14 @@ pub fn summary_markdown(cells: &[super::Cell]) -> String {
     s
 }
 
-/// The full friction grid as a Markdown table; `with_time` adds the time column (not in
-/// snapshots).
-pub fn grid_markdown(cells: &[super::Cell], with_time: bool) -> String {
+/// The full friction grid as a Markdown table: verdicts and errors, no wall times (those go to
+/// `<catalogue>-table.times.csv`, [`crate::harness::report::times_csv`]).
+pub fn grid_markdown(cells: &[super::Cell]) -> String {
     use super::rounded;
     let mut s = String::from("| mesh | status | discretization | passes | slave | enforcement | verdict | statuses | stress error | at 1000 kappa | trend | pressure error | tangential error | load error | cone ratio | min dissipation | iterations |");
-    s += if with_time {
-        " time ms | note |\n"
-    } else {
-        " note |\n"
-    };
+    s += " note |\n";
     s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
-    s += if with_time { "---|---|\n" } else { "---|\n" };
+    s += "---|\n";
     for c in cells {
         let f = c.friction.as_ref();
         s += &format!(
@@ -281,9 +277,6 @@ pub fn grid_markdown(cells: &[super::Cell], with_time: bool) -> String {
                 .map(|r| r.to_string())
                 .unwrap_or("-".into()),
         );
-        if with_time {
-            s += &format!(" {} |", super::time_text(c.time_ms));
-        }
         s += &format!(" {} |\n", c.note.replace('|', "/"));
     }
     s

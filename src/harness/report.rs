@@ -203,7 +203,7 @@ fn perturbed_lagrange_note(cells: &[Cell]) -> String {
 }
 
 /// The whole report.
-pub fn patch_report(cells: &[Cell], seconds: f64) -> String {
+pub fn patch_report(cells: &[Cell]) -> String {
     let mut s = String::from(
         "# The contact patch test: meshes A-E across discretizations and enforcement methods\n\n",
     );
@@ -240,35 +240,36 @@ pub fn patch_report(cells: &[Cell], seconds: f64) -> String {
     }
     s += "`load error` compares the total contact force with the exact load. `rank def.` is the number of\n";
     s += "dependent active constraints; `stability` is `unstable` when a multiplier system (Lagrange, elimination) is singular.\n";
-    s += "`iterations` counts linear solves of the active-set loop; ";
-    s += &times_sentence(cells);
+    s += "`iterations` counts linear solves of the active-set loop. ";
+    s += &times_sentence(cells, "patch-table.times.csv");
     s += &perturbed_lagrange_note(cells);
     s += "\n";
-    s += &grid_markdown(cells, true);
-    s += &closing_count(cells, seconds);
+    s += &grid_markdown(cells);
+    s += &closing_count(cells);
     s
 }
 
-/// What the time column holds: the cells' own solves, or nothing when no cell was solved here
-/// (another code's results judged by `table --results`).
-fn times_sentence(cells: &[Cell]) -> String {
+/// Where the cells' wall times are, or that none was solved here (another code's results
+/// judged by `table --results`): the sentence after the grid's legend.
+fn times_sentence(cells: &[Cell], file: &str) -> String {
     if cells.iter().any(|c| c.time_ms.is_some()) {
-        "times are wall-clock per cell on the machine that ran the table (`-`: nothing solved).\n"
-            .into()
+        format!(
+            "Wall times per cell are in `{file}` (`-`: nothing solved), out of this file so that a \
+             rerun changes it only where a result changes.\n"
+        )
     } else {
-        "no cell was solved here (`-` in the time column): the results are another code's, judged, not timed.\n".into()
+        "No cell was solved here: the results are another code's, judged, not timed.\n".into()
     }
 }
 
-/// The table's last line: how many cells, and how long making them took (solving, or judging
-/// another code's results).
-fn closing_count(cells: &[Cell], seconds: f64) -> String {
+/// The table's last line: how many cells, solved or judged.
+fn closing_count(cells: &[Cell]) -> String {
     let verb = if cells.iter().any(|c| c.time_ms.is_some()) {
-        "cells in"
+        "cells"
     } else {
-        "cells judged in"
+        "cells judged"
     };
-    format!("\n{} {verb} {seconds:.2} s.\n", cells.len())
+    format!("\n{} {verb}.\n", cells.len())
 }
 
 /// The tied-interface patch tests: every constant stress state across non-matching interfaces.
@@ -287,7 +288,9 @@ pub fn tied_report(cells: &[Cell]) -> String {
     s += "## Summary (Lagrange multipliers)\n\n";
     if !cells.iter().any(|c| c.enforcement == "lagrange") {
         s += "No cell of this table uses Lagrange multipliers: no summary.\n\n## The full grid\n\n";
-        s += &grid_markdown(cells, true);
+        s += &grid_markdown(cells);
+        s += "\n";
+        s += &times_sentence(cells, "tied-table.times.csv");
         return s;
     }
     s += "| mesh and stress | node-to-surface (upper slave) | node-to-surface (lower slave) | mortar | dual mortar |\n|---|---|---|---|---|\n";
@@ -327,12 +330,14 @@ pub fn tied_report(cells: &[Cell]) -> String {
         s += &note;
         s += "\n";
     }
-    s += &grid_markdown(cells, true);
+    s += &grid_markdown(cells);
+    s += "\n";
+    s += &times_sentence(cells, "tied-table.times.csv");
     s
 }
 
 /// The frictional patch tests (`reports/friction-table.md`).
-pub fn friction_report(cells: &[Cell], seconds: f64) -> String {
+pub fn friction_report(cells: &[Cell]) -> String {
     let mut s = String::from(
         "# The frictional contact patch test: meshes A-E across discretizations and enforcement methods\n\n",
     );
@@ -350,7 +355,34 @@ pub fn friction_report(cells: &[Cell], seconds: f64) -> String {
     s += "## Summary: the enforcement methods that pass, per discretization\n\n";
     s += &crate::harness::friction::summary_markdown(cells);
     s += "\n## The full grid\n\n";
-    s += &crate::harness::friction::grid_markdown(cells, true);
-    s += &closing_count(cells, seconds);
+    s += &crate::harness::friction::grid_markdown(cells);
+    s += &closing_count(cells);
+    s += &times_sentence(cells, "friction-table.times.csv");
+    s
+}
+
+/// The wall times of one catalogue's cells, `<catalogue>-table.times.csv`: a comment line with
+/// the whole run's time (`seconds`, every catalogue of it), then one row per cell in the
+/// table's order, keyed as the baseline matches cells. Kept out of the verdict tables so that a
+/// rerun changes those only where a result changes.
+pub fn times_csv(cells: &[Cell], seconds: f64) -> String {
+    let mut s = format!(
+        "# wall times of the cells of one `contact-patch table` run, which took {seconds:.2} s in all\n"
+    );
+    s += "case,mesh,nu,status,discretization,passes,slave,enforcement,time_ms\n";
+    for c in cells {
+        s += &format!(
+            "{},{},{},{},{},{},{},{},{}\n",
+            c.case,
+            c.mesh,
+            c.nu,
+            c.friction.as_ref().map(|f| f.expect.as_str()).unwrap_or(""),
+            c.discretization,
+            c.passes.map(|p| p.to_string()).unwrap_or_default(),
+            c.slave.as_deref().unwrap_or(""),
+            c.enforcement,
+            crate::harness::time_text(c.time_ms)
+        );
+    }
     s
 }

@@ -361,8 +361,8 @@ pub struct Written {
     pub cells: Vec<Cell>,
 }
 
-/// Write `<catalogue>-table.md` and `.json` for every catalogue among `cells` (what `table`
-/// writes; `seconds` is the run's time, shown in the patch and friction tables).
+/// Write `<catalogue>-table.md`, `.json` and `.times.csv` for every catalogue among `cells`
+/// (what `table` writes; `seconds` is the run's time, written with the cells' times).
 pub fn write_tables(folder: &ReportFolder, cells: &[Cell], seconds: f64) -> Result<Vec<Written>> {
     let mut catalogues: Vec<Catalogue> = cells.iter().map(|c| c.catalogue).collect();
     catalogues.sort();
@@ -376,9 +376,13 @@ pub fn write_tables(folder: &ReportFolder, cells: &[Cell], seconds: f64) -> Resu
             .collect();
         let report = match catalogue {
             Catalogue::Tied => crate::harness::report::tied_report(&part),
-            Catalogue::Patch => crate::harness::report::patch_report(&part, seconds),
-            Catalogue::Friction => crate::harness::report::friction_report(&part, seconds),
+            Catalogue::Patch => crate::harness::report::patch_report(&part),
+            Catalogue::Friction => crate::harness::report::friction_report(&part),
         };
+        folder.write_file(
+            &format!("{}-table.times.csv", catalogue.name()),
+            &crate::harness::report::times_csv(&part, seconds),
+        )?;
         let json = serde_json::to_string_pretty(&part).expect("cells serialize") + "\n";
         let (md, js) = (
             format!("{}-table.md", catalogue.name()),
