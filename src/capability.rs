@@ -9,8 +9,8 @@
 //! solves call on their rows). A combination is asked on a small scene ([`Scene`]: a punch
 //! pressed onto a foundation of the same footprint on matching grids, or onto a rigid line or
 //! plane), so a refusal names a rule of the tool, not a property of a mesh. "yes" means such a
-//! case is accepted and solved; whether its answer passes the patch test is what the tables
-//! (`contact-patch table`, `patch-3d`, `finite-patch`) judge.
+//! case passes every check before the solve; whether the solve converges and passes the patch
+//! test is what the tables (`contact-patch table`, `patch-3d`, `finite-patch`) judge.
 //!
 //! [`matrix_markdown`] writes the two tables of the README: discretizations x enforcement
 //! methods (frictionless, small strain, static; each dimension), and dimension x kinematics x
@@ -433,7 +433,7 @@ pub fn matrix_markdown() -> String {
             }
         }
     }
-    out.push_str("\nn2n node-to-node, n2s node-to-surface (one pass; n2s-2 two passes), mortar and dual: segment-based mortar with standard or dual multipliers; rigid: against a rigid line, circle, plane or sphere. The reasons, as the tool gives them:\n\n");
+    out.push_str("\nn2n node-to-node, n2s node-to-surface (one pass; n2s-2 two passes), mortar and dual: segment-based mortar with standard or dual multipliers; rigid: against the scene's rigid master, a line in 2D and a plane in 3D. The reasons, as the tool gives them:\n\n");
     out.push_str(&reasons.markdown());
     out
 }
