@@ -463,6 +463,21 @@ fn one_file_for_two_bodies_is_refused_where_their_displacements_differ() {
     );
 }
 
+/// The direct sweep's cell of `case` with node-to-surface, one pass, the punch slave, and the
+/// enforcement method `enforcement`.
+fn direct_cell(case: &str, enforcement: &str) -> contact_patch::harness::Cell {
+    contact_patch::harness::run_sweep(&root().join(case), &mut |_| {})
+        .unwrap()
+        .into_iter()
+        .find(|c| {
+            c.discretization == "node_to_surface"
+                && c.passes == Some(1)
+                && c.slave.as_deref() == Some("punch")
+                && c.enforcement == enforcement
+        })
+        .unwrap()
+}
+
 #[test]
 fn table_of_outside_results_matches_the_direct_cells_of_the_same_method() {
     // our own runs of the cases as written (node-to-surface, one pass, slave punch, Lagrange)
@@ -496,16 +511,7 @@ fn table_of_outside_results_matches_the_direct_cells_of_the_same_method() {
     for (case, cell) in cases.iter().zip(cells) {
         assert_eq!(cell["enforcement"], "stand-in");
         assert_eq!(cell["discretization"], "outside");
-        let direct = contact_patch::harness::run_sweep(&root().join(case), &mut |_| {}).unwrap();
-        let same = direct
-            .iter()
-            .find(|c| {
-                c.discretization == "node_to_surface"
-                    && c.passes == Some(1)
-                    && c.slave.as_deref() == Some("punch")
-                    && c.enforcement == "lagrange"
-            })
-            .unwrap();
+        let same = direct_cell(case, "lagrange");
         let got = cell["stress_error"].as_f64().unwrap();
         let want = same.stress_error.unwrap();
         assert!(
@@ -1242,16 +1248,7 @@ fn an_outside_penalty_code_is_credited_with_its_kappa_series_and_a_cell_can_say_
             .unwrap();
     let cells = cells.as_array().unwrap();
     assert_eq!(cells.len(), 2);
-    let direct = contact_patch::harness::run_sweep(&root().join(case_c), &mut |_| {}).unwrap();
-    let same = direct
-        .iter()
-        .find(|c| {
-            c.discretization == "node_to_surface"
-                && c.passes == Some(1)
-                && c.slave.as_deref() == Some("punch")
-                && c.enforcement == "penalty"
-        })
-        .unwrap();
+    let same = direct_cell(case_c, "penalty");
     assert_eq!(
         same.kappa,
         Some(1e4),

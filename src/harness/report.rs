@@ -99,36 +99,29 @@ fn two_pass_claims(cells: &[Cell]) -> String {
         count(&mut al, al_cell, &|c| c.verdict == "fail");
         count(&mut pt, pt_cell, &|c| c.verdict == "fail");
         count(&mut lm, lm_cell, &|c| c.rank_deficiency.unwrap_or(0) > 0);
-        let shown = |c: Option<&Cell>, x: Option<String>| match c {
-            Some(_) => x.unwrap_or_else(|| "-".into()),
-            None => "-".into(),
-        };
+        let dash = |x: Option<String>| x.unwrap_or_else(|| "-".into());
         s += &format!(
             "| {mesh} | {nu} | {} ({}, {}) | {} ({}) | {} ({}) | {}, {} |\n",
             v(pen),
-            shown(pen, pen.and_then(|c| c.penalty_trend.clone())),
-            shown(
-                pen,
+            dash(pen.and_then(|c| c.penalty_trend.clone())),
+            dash(
                 pen.and_then(|c| c.max_penetration)
                     .map(|p| format!("{p:.1e}"))
             ),
             v(al_cell),
-            shown(
-                al_cell,
+            dash(
                 al_cell
                     .and_then(|c| c.newton_iterations)
                     .map(|n| n.to_string())
             ),
             v(pt_cell),
-            shown(
-                pt_cell,
+            dash(
                 pt_cell
                     .and_then(|c| c.newton_iterations)
                     .map(|n| n.to_string())
             ),
             v(lm_cell),
-            shown(
-                lm_cell,
+            dash(
                 lm_cell
                     .and_then(|c| c.rank_deficiency)
                     .map(|r| r.to_string())
