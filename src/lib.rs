@@ -57,7 +57,6 @@ pub mod post;
 pub mod run;
 pub mod run3d;
 pub mod solid;
-pub mod solid3d;
 pub mod solid_finite;
 pub mod solid_finite3;
 pub mod solver;

@@ -3,7 +3,7 @@
 //! `summary.json` and one `.vtu` per body.
 //!
 //! The 3D side of the dimension seam (issue 13): the mesher ([`crate::mesh::block3`]) and
-//! kernels ([`crate::solid3d`]) are 3D; the case format, the Gmsh reader
+//! kernels ([`crate::solid`]) are 3D; the case format, the Gmsh reader
 //! ([`crate::io::gmsh_read::body_mesh`]), the user sets, supports and loads
 //! ([`crate::model::Model::apply_supports`], [`crate::model::Model::apply_loads`]), the model
 //! ([`crate::model::Model`]`<3, SolidKind>`), the assembly and elastic solve
@@ -88,7 +88,7 @@ use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
 use crate::model::{Body3, MasterSide, Model3};
 use crate::post::pair_summaries;
-use crate::solid3d::{strain_at3, Elasticity3};
+use crate::solid::{strain_at, Elasticity};
 use crate::solid_finite::Hyperelastic;
 use std::path::Path;
 
@@ -233,7 +233,7 @@ fn stress_at(body: &Body3, coords: &[[f64; 3]], u_e: &[f64], xi: [f64; 3]) -> ([
             (x, law.cauchy3(&h))
         }
         None => {
-            let (eps, x) = strain_at3(kind, coords, u_e, xi);
+            let (eps, x) = strain_at(kind, coords, u_e, xi);
             (x, body.material.stress(eps))
         }
     }
@@ -543,7 +543,7 @@ fn material3(
     name: &str,
     source: &str,
     at: &str,
-) -> Result<(Elasticity3, Option<Hyperelastic>)> {
+) -> Result<(Elasticity<3>, Option<Hyperelastic>)> {
     let Some(mat) = case.materials.get(name) else {
         let known: Vec<&String> = case.materials.keys().collect();
         return Err(Error::invalid(
@@ -599,7 +599,7 @@ fn material3(
         }
         _ => None,
     };
-    Ok((Elasticity3::new(mat.youngs_modulus, mat.nu), hyperelastic))
+    Ok((Elasticity::solid(mat.youngs_modulus, mat.nu), hyperelastic))
 }
 
 /// The nodal stress of `body`: the mean over the cells around each node of the stress at the

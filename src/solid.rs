@@ -1,100 +1,185 @@
-//! Small-strain isotropic linear elasticity in 2D: element residual and tangent, stiffness,
-//! stress.
+//! Small-strain isotropic linear elasticity in `D = 2` (plane strain, plane stress, with a
+//! thickness) and `D = 3`, written once for both: constitutive matrix, element stiffness,
+//! internal force and strain; the 2D element mass; consistent loads on solid cells.
 //!
-//! Voigt notation with engineering shear: `eps = [eps_xx, eps_yy, gamma_xy]`,
-//! `sigma = [sigma_xx, sigma_yy, sigma_xy] = D eps`, with
-//! plane strain `D = [[l+2m, l, 0], [l, l+2m, 0], [0, 0, m]]` (Lame l, m) and
-//! plane stress `D = E/(1-nu^2) [[1, nu, 0], [nu, 1, 0], [0, 0, (1-nu)/2]]`.
-//! Out-of-plane stress: `sigma_zz = nu (sigma_xx + sigma_yy)` in plane strain, zero in plane
-//! stress.
+//! **Voigt notation** ([`Voigt`]) with engineering shears: the strain of the displacement
+//! gradient `H = du/dx` is `eps_p = H_ii` for a normal component `p = (i, i)` and
+//! `eps_p = H_ij + H_ji` for a shear `p = (i, j)`, in the order
+//! `[xx, yy, xy]` (2D) and `[xx, yy, zz, yz, xz, xy]` (3D); `sigma = D eps` in the same order.
+//! With Lamé's `lambda = E nu / ((1 + nu)(1 - 2 nu))`, `mu = E / (2 (1 + nu))`:
+//!
+//! * 3D: `D = lambda m m^T + mu diag(2, 2, 2, 1, 1, 1)`, `m = [1, 1, 1, 0, 0, 0]` (e.g.
+//!   Hughes, *The Finite Element Method*, 2000, section 2.7);
+//! * plane strain: the in-plane block of the 3D `D`,
+//!   `D = [[l+2m, l, 0], [l, l+2m, 0], [0, 0, m]]`, with the out-of-plane stress
+//!   `sigma_zz = nu (sigma_xx + sigma_yy)`;
+//! * plane stress: `D = E/(1-nu^2) [[1, nu, 0], [nu, 1, 0], [0, 0, (1-nu)/2]]`, `sigma_zz = 0`.
 //!
 //! **Residual and tangent.** An element contributes, at its current displacements `u_e`, the
 //! internal force and its derivative
-//! `f_int(u_e) = int B^T sigma(u_e) t dA` and `K_T = d f_int / d u_e`,
-//! with `B_a = [[N_a,x, 0], [0, N_a,y], [N_a,y, N_a,x]]` and each integral evaluated with the
-//! element's stiffness rule (see `fe`): `sum_q w_q det J t (...)` at the quadrature points.
-//! The strain comes from the displacement gradient `H = du/dx = sum_a u_a (grad N_a)^T` as
-//! `eps = [H_xx, H_yy, H_xy + H_yx]`. Equilibrium is `f_int(u) = f_ext` (+ contact forces).
+//! `f_int(u_e) = int B^T sigma(u_e) t dV` and `K_T = d f_int / d u_e = int B^T D B t dV`
+//! (`t` the thickness in 2D, 1 in 3D), each integral evaluated with the element's stiffness
+//! rule ([`crate::fe`], [`crate::fe3d`]): `sum_q w_q det J t (...)` at the quadrature points.
+//! `B_a` is the `V x D` operator `eps = sum_a B_a u_a` (`V = D (D + 1) / 2`): for a normal
+//! component `p = (i, i)` its row is `N_a,i` in column `i`; for a shear `p = (i, j)` it is
+//! `N_a,j` in column `i` and `N_a,i` in column `j`, e.g. in 2D
+//! `B_a = [[N_a,x, 0], [0, N_a,y], [N_a,y, N_a,x]]`. Equilibrium is `f_int(u) = f_ext`
+//! (+ contact forces). With small strain `sigma = D eps` is linear in `u_e`, so
+//! `f_int = K_e u_e`; the kernel still integrates `f_int` from the stresses (with the strain
+//! from `H`), the form that finite strain keeps. Finite deformation (`physics.kinematics:
+//! "finite"`) has its own kernels, [`crate::solid_finite`], with a hyperelastic law in place of
+//! [`Elasticity`].
 //!
-//! **Mass.** For dynamics ([`crate::solver::dynamics`]) an element also gives its consistent
+//! **Implementation.** `K_e` is accumulated in `D x D` node blocks
+//! `K_ab += w B_a^T (D B_b)` with `B`'s zeros skipped (each entry of `D B_b` and of
+//! `B_a^T (D B_b)` a sum over the Voigt components where `B` is not zero, in ascending order),
+//! every block computed (the lower ones too) and written straight into the caller's row-major
+//! slice; no heap allocation. The order of operations is that of the 2D array kernel these
+//! replaced, so that `K_e` is the same to the last bit: the assembly reads the upper triangle in
+//! global numbering, which takes local `(a, b)` or `(b, a)` blocks depending on the mesh, and
+//! mirroring the upper local blocks instead changes the iteration counts of round-off sensitive
+//! cells of the patch table. The material's `D` is stored as a `6 x 6` matrix whose leading
+//! `V x V` block is used. Global vectors and matrices (assembly, factorization) stay in
+//! `solve`/`sparse` (faer).
+//!
+//! **Mass** (2D, for dynamics, [`crate::solver::dynamics`]). An element gives its consistent
 //! mass `M_e = int rho N^T N t dA` ([`element_mass`], both components alike, with a rule exact
 //! for `N_a N_b` on straight-sided elements) and its lumped mass by the HRZ scaling of the
 //! consistent diagonal (Hinton, Rock & Zienkiewicz, Earthquake Eng. Struct. Dyn. 4 (1976)
 //! 245-249): `m_a = M_aa m / sum_b M_bb`, `m` the element's mass, positive for every element
 //! (row sums are zero or negative at the corners of T6 and Q9 would be wrong for T6).
 //!
-//! **Kinematics seam.** [`Kinematics`] says how strain follows from displacement. With small
-//! strain (this module; finite deformation has its own kernels in [`crate::solid_finite`],
-//! assembled by [`crate::solver::finite_assembly`]) `sigma = D eps` is linear in `u_e`, so
-//! `f_int = K_e u_e` and `K_T = K_e = int B^T D B t dA`, the element stiffness; the kernel still
-//! integrates `f_int` from the stresses, which is the form that finite strain keeps (there `B`
-//! depends on `F = I + H` and `K_T` gains a geometric part). The kernels therefore take the
-//! element's reference coordinates *and* its displacements.
-//!
-//! **Implementation.** Element-level algebra is on fixed-size nalgebra types, sized per element
-//! kind at compile time (`N` nodes, `2 N` dofs): `D` a `Matrix3`, the nodes a `2 x N` matrix,
-//! the gradients `dN_a/dx` an `N x 2` matrix, `B_a` a `Matrix3x2`, and `K_e` accumulated in
-//! 2x2 node blocks `K_ab += w B_a^T (D B_b)` straight into its destination (a row-major view
-//! of the caller's slice, or the leading block of an [`ElementMatrix`]), with `B`'s zeros
-//! skipped; no heap allocation. `K_e` is bit-for-bit the one of the array loops it replaced
-//! (see `add_material_tangent`). Global vectors and matrices (assembly, factorization) stay in
-//! `solve`/`sparse` (faer).
+//! **Consistent loads** on solid cells (3D; 2D edge loads are [`crate::model`]'s): a body force
+//! `b(x)` gives `f_a = int N_a b dV` ([`body_force_load`]); a traction `t(x)` on a facet gives
+//! `f_a = int N_a t dA` with `dA = |x_s x x_t| ds dt` on the facet's 2D reference element
+//! ([`facet_traction_load`]); both with rich rules (the cell's error rule; Gauss 5x5 or
+//! Radon's 7-point rule on facets).
 
-use crate::fe::{ElementKind, QuadPoint, ReferenceCell, MAX_NODES};
-use crate::io::scene::Plane;
-use nalgebra::{
-    Const, Matrix, Matrix2, Matrix3, Matrix3x2, MatrixViewMut, SMatrix, SVector, StorageMut,
-    Vector3, U1,
+use crate::fe::{
+    field_gradient, gauss_square, triangle_rule, ElementKind, PointGeometry, QuadPoint,
+    ReferenceCell, MAX_NODES,
 };
+use crate::io::scene::Plane;
+use nalgebra::{SMatrix, SVector, Vector3};
 
-/// Largest number of element dofs.
+/// Largest number of element dofs in 2D.
 pub const MAX_DOFS: usize = 2 * MAX_NODES;
 
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub struct Elasticity {
-    pub youngs_modulus: f64,
-    pub nu: f64,
-    pub plane: Plane,
-    /// The constitutive matrix `D` (`sigma = D eps`, Voigt notation above).
-    pub d: Matrix3<f64>,
+/// A constitutive matrix in Voigt notation: the leading `V x V` block (`V` =
+/// [`Voigt::SIZE`]) is the material's, the rest zero.
+pub type VoigtMatrix = SMatrix<f64, 6, 6>;
+
+/// Voigt notation in `D` dimensions (module docs): the tensor index pairs of the components.
+pub struct Voigt<const D: usize>;
+
+impl<const D: usize> Voigt<D> {
+    /// The number of components, `D (D + 1) / 2`.
+    pub const SIZE: usize = D * (D + 1) / 2;
+
+    /// The index pairs `(i, j)`, `i <= j`, of the components: normal ones first, then the
+    /// shears.
+    pub const PAIRS: &'static [(usize, usize)] = match D {
+        2 => &[(0, 0), (1, 1), (0, 1)],
+        3 => &[(0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1)],
+        _ => panic!("solids are 2D or 3D"),
+    };
+
+    /// The strain `eps_p = H_ii` (normal) or `H_ij + H_ji` (shear) of the displacement
+    /// gradient `H` (`H_ij = du_i/dx_j`); `V` must be [`Voigt::SIZE`].
+    pub fn strain<const V: usize>(h: &SMatrix<f64, D, D>) -> [f64; V] {
+        const { assert!(V == D * (D + 1) / 2) };
+        std::array::from_fn(|p| {
+            let (i, j) = Self::PAIRS[p];
+            if i == j {
+                h[(i, i)]
+            } else {
+                h[(i, j)] + h[(j, i)]
+            }
+        })
+    }
+
+    /// The components `p` (ascending) where column `c` of `B_a` is not zero, with the
+    /// gradient component `k` that is there: `B_a[p][c] = N_a,k`.
+    #[inline(always)]
+    fn column_terms(c: usize) -> impl Iterator<Item = (usize, usize)> + Clone {
+        Self::PAIRS
+            .iter()
+            .enumerate()
+            .filter_map(move |(p, &(i, j))| match () {
+                _ if i == c => Some((p, j)),
+                _ if j == c => Some((p, i)),
+                _ => None,
+            })
+    }
+
+    /// The isotropic `D` of Lamé's `lambda`, `mu`: `lambda + 2 mu` on the normal diagonal,
+    /// `lambda` off it, `mu` on the shear diagonal (plane strain in 2D).
+    pub fn isotropic(lambda: f64, mu: f64) -> VoigtMatrix {
+        let mut d = VoigtMatrix::zeros();
+        for (p, &(i, j)) in Self::PAIRS.iter().enumerate() {
+            for (q, &(k, l)) in Self::PAIRS.iter().enumerate() {
+                d[(p, q)] = match (i == j, k == l) {
+                    (true, true) if p == q => lambda + 2.0 * mu,
+                    (true, true) => lambda,
+                    (false, false) if p == q => mu,
+                    _ => 0.0,
+                };
+            }
+        }
+        d
+    }
 }
 
-impl Elasticity {
+/// An isotropic linear elastic material in `D` dimensions (plane strain or plane stress in
+/// 2D).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Elasticity<const D: usize = 2> {
+    pub youngs_modulus: f64,
+    pub nu: f64,
+    /// The 2D reduction; `None` in 3D.
+    plane: Option<Plane>,
+    /// The constitutive matrix `D` (`sigma = D eps`, Voigt order of [`Voigt`]).
+    pub d: VoigtMatrix,
+}
+
+/// Lamé's `(lambda, mu)` of Young's modulus `E` and Poisson's ratio `nu`.
+pub fn lame(youngs_modulus: f64, nu: f64) -> (f64, f64) {
+    (
+        youngs_modulus * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+        youngs_modulus / (2.0 * (1.0 + nu)),
+    )
+}
+
+impl Elasticity<2> {
+    /// The 2D material of a plane-strain or plane-stress section.
     pub fn new(youngs_modulus: f64, nu: f64, plane: Plane) -> Self {
-        let e = youngs_modulus;
         let d = match plane {
             Plane::Strain => {
-                let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
-                let mu = e / (2.0 * (1.0 + nu));
-                #[rustfmt::skip]
-                let d = Matrix3::new(
-                    lambda + 2.0 * mu, lambda, 0.0,
-                    lambda, lambda + 2.0 * mu, 0.0,
-                    0.0, 0.0, mu,
-                );
-                d
+                let (lambda, mu) = lame(youngs_modulus, nu);
+                Voigt::<2>::isotropic(lambda, mu)
             }
             Plane::Stress => {
-                let c = e / (1.0 - nu * nu);
-                #[rustfmt::skip]
-                let d = Matrix3::new(
-                    c, c * nu, 0.0,
-                    c * nu, c, 0.0,
-                    0.0, 0.0, c * 0.5 * (1.0 - nu),
-                );
+                let c = youngs_modulus / (1.0 - nu * nu);
+                let mut d = VoigtMatrix::zeros();
+                d[(0, 0)] = c;
+                d[(0, 1)] = c * nu;
+                d[(1, 0)] = c * nu;
+                d[(1, 1)] = c;
+                d[(2, 2)] = c * 0.5 * (1.0 - nu);
                 d
             }
         };
         Elasticity {
             youngs_modulus,
             nu,
-            plane,
+            plane: Some(plane),
             d,
         }
     }
 
-    pub fn stress(&self, strain: [f64; 3]) -> [f64; 3] {
-        (self.d * Vector3::from(strain)).into()
+    /// Plane strain or plane stress.
+    pub fn plane(&self) -> Plane {
+        self.plane.expect("a 2D material has its plane")
     }
 
     /// In-plane strain that produces the in-plane stress `s` (inverse of `D`).
@@ -108,8 +193,9 @@ impl Elasticity {
         ]
     }
 
+    /// The out-of-plane stress of the in-plane stress `s`.
     pub fn sigma_zz(&self, s: [f64; 3]) -> f64 {
-        match self.plane {
+        match self.plane() {
             Plane::Strain => self.nu * (s[0] + s[1]),
             Plane::Stress => 0.0,
         }
@@ -118,7 +204,7 @@ impl Elasticity {
     /// Young's modulus and Poisson ratio of the equivalent plane-stress problem (for formulas
     /// written in plane stress).
     pub fn plane_stress_equivalent(&self) -> (f64, f64) {
-        match self.plane {
+        match self.plane() {
             Plane::Stress => (self.youngs_modulus, self.nu),
             Plane::Strain => (
                 self.youngs_modulus / (1.0 - self.nu * self.nu),
@@ -128,319 +214,285 @@ impl Elasticity {
     }
 }
 
-/// How strains follow from displacements in this module's kernels: small strain. Finite
-/// strain (total Lagrangian: `F = I + H`, Green-Lagrange `E = (F^T F - I) / 2`,
-/// `f_int = int B(F)^T S t dA`, `K_T` = material + geometric part) takes a hyperelastic law
-/// instead of [`Elasticity`], so it has its own kernels, [`crate::solid_finite`], chosen by
-/// `physics.kinematics: "finite"`.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum Kinematics {
-    /// `eps = sym grad u`, `f_int = K_e u_e`, `K_T = K_e`.
-    SmallStrain,
+impl Elasticity<3> {
+    /// The 3D material of a solid body.
+    pub fn solid(youngs_modulus: f64, nu: f64) -> Self {
+        let (lambda, mu) = lame(youngs_modulus, nu);
+        Elasticity {
+            youngs_modulus,
+            nu,
+            plane: None,
+            d: Voigt::<3>::isotropic(lambda, mu),
+        }
+    }
 }
 
-/// An element vector: the leading `2 n` entries (dof order `[u_x0, u_y0, u_x1, ...]`) are the
-/// element's, the rest zero.
-pub type ElementVector = SVector<f64, MAX_DOFS>;
-/// An element matrix: the leading `2 n x 2 n` block is the element's, the rest zero.
-pub type ElementMatrix = SMatrix<f64, MAX_DOFS, MAX_DOFS>;
+impl<const D: usize> Elasticity<D> {
+    /// `sigma = D eps` (Voigt, `V` = [`Voigt::SIZE`]).
+    pub fn stress<const V: usize>(&self, strain: [f64; V]) -> [f64; V] {
+        const { assert!(V == D * (D + 1) / 2) };
+        std::array::from_fn(|p| {
+            (1..V).fold(self.d[(p, 0)] * strain[0], |s, q| {
+                s + self.d[(p, q)] * strain[q]
+            })
+        })
+    }
 
-/// One quadrature point of an element of `N` nodes: the gradients `dN_a/dx` (row `a`) and the
-/// weight `w = w_q det J t`.
-struct Point<const N: usize> {
-    dndx: SMatrix<f64, N, 2>,
+    /// Lamé's second parameter (the shear modulus).
+    pub fn mu(&self) -> f64 {
+        lame(self.youngs_modulus, self.nu).1
+    }
+
+    /// Lamé's first parameter (of the 3D law, also in plane stress).
+    pub fn lambda(&self) -> f64 {
+        lame(self.youngs_modulus, self.nu).0
+    }
+}
+
+/// Adds `w B^T D B` at one point with gradients `dndx` to the row-major `D n x D n` matrix
+/// `ke`, block by block: `K_ab += w B_a^T (D B_b)`, `B` applied through its structure.
+#[inline(always)]
+fn add_material_tangent<const D: usize>(
+    ke: &mut [f64],
+    dndx: &[[f64; D]],
+    d: &VoigtMatrix,
     w: f64,
-}
-
-impl<const N: usize> Point<N> {
-    /// `B_a = [[N_a,x, 0], [0, N_a,y], [N_a,y, N_a,x]]`.
-    #[inline(always)]
-    fn b(&self, a: usize) -> Matrix3x2<f64> {
-        let (x, y) = (self.dndx[(a, 0)], self.dndx[(a, 1)]);
-        Matrix3x2::new(x, 0.0, 0.0, y, y, x)
-    }
-}
-
-/// The element's nodes as the columns of a `2 x N` matrix.
-#[inline(always)]
-fn nodes<const N: usize>(coords: &[[f64; 2]]) -> SMatrix<f64, 2, N> {
-    debug_assert!(coords.len() >= N);
-    SMatrix::<f64, 2, N>::from_fn(|i, a| coords[a][i])
-}
-
-/// The quadrature point `q` on the element with nodes `x` (`N` of them, see [`nodes`]); `None`
-/// where `det J = 0`, a point that contributes nothing (the model refuses such elements).
-#[inline(always)]
-fn point<const N: usize>(
-    kind: ElementKind,
-    x: &SMatrix<f64, 2, N>,
-    q: &QuadPoint,
-    thickness: f64,
-) -> Option<Point<N>> {
-    debug_assert_eq!(kind.node_count(), N);
-    let mut n = [0.0; N];
-    let mut dn = [[0.0; 2]; N];
-    kind.shape(q.xi, &mut n, &mut dn);
-    let dn = SMatrix::<f64, N, 2>::from_fn(|a, k| dn[a][k]);
-    // J_ik = dx_i/dxi_k = sum_a x_ia dN_a/dxi_k
-    let j: Matrix2<f64> = x * dn;
-    let det_j = j[(0, 0)] * j[(1, 1)] - j[(0, 1)] * j[(1, 0)];
-    if det_j == 0.0 {
-        return None;
-    }
-    let inv = Matrix2::new(j[(1, 1)], -j[(0, 1)], -j[(1, 0)], j[(0, 0)]) / det_j;
-    Some(Point {
-        dndx: dn * inv,
-        w: q.weight * det_j * thickness,
-    })
-}
-
-/// An `ND x ND` matrix, owned or a view (into a slice, or into an [`ElementMatrix`]).
-type MatrixMut<const ND: usize, S> = Matrix<f64, Const<ND>, Const<ND>, S>;
-/// An `ND` vector, owned or a view.
-type VectorMut<const ND: usize, S> = Matrix<f64, Const<ND>, U1, S>;
-
-/// Adds `w B^T D B` at one point to `k`, block by block: `K_ab += w B_a^T (D B_b)`, with `B`
-/// applied through its structure (its zeros skipped).
-///
-/// Every block is computed, the lower ones too, with the operations of the array kernel this
-/// one replaced and in the same order, so that `K_e` is the same to the last bit: the assembly
-/// reads the upper triangle in global numbering, which takes local `(a, b)` or `(b, a)` blocks
-/// depending on the mesh, and mirroring the upper local blocks instead changes the iteration
-/// counts of round-off sensitive cells of the patch table.
-#[inline(always)]
-fn add_material_tangent<const N: usize, const ND: usize, S>(
-    k: &mut MatrixMut<ND, S>,
-    p: &Point<N>,
-    d: &Matrix3<f64>,
-) where
-    S: StorageMut<f64, Const<ND>, Const<ND>>,
-{
-    let (d0, d1, d2) = (d.column(0), d.column(1), d.column(2));
-    for b in 0..N {
-        let (bx, by) = (p.dndx[(b, 0)], p.dndx[(b, 1)]);
-        // D B_b
-        let db = Matrix3x2::from_columns(&[d0 * bx + d2 * by, d1 * by + d2 * bx]);
-        let (r0, r1, r2) = (db.row(0), db.row(1), db.row(2));
-        for a in 0..N {
-            let (ax, ay) = (p.dndx[(a, 0)], p.dndx[(a, 1)]);
+) {
+    let voigt = Voigt::<D>::SIZE;
+    let nd = D * dndx.len();
+    for (b, gb) in dndx.iter().enumerate() {
+        // D B_b, V x D
+        let mut db = [[0.0; D]; 6];
+        for c in 0..D {
+            let mut terms = Voigt::<D>::column_terms(c);
+            let (p0, k0) = terms.next().expect("every column of B has a term");
+            for (r, row) in db.iter_mut().enumerate().take(voigt) {
+                row[c] = terms
+                    .clone()
+                    .fold(d[(r, p0)] * gb[k0], |s, (p, k)| s + d[(r, p)] * gb[k]);
+            }
+        }
+        for (a, ga) in dndx.iter().enumerate() {
             // B_a^T (D B_b)
-            let kab = Matrix2::from_rows(&[r0 * ax + r2 * ay, r1 * ay + r2 * ax]);
-            let mut block = k.fixed_view_mut::<2, 2>(2 * a, 2 * b);
-            block += kab * p.w;
+            for i in 0..D {
+                let mut terms = Voigt::<D>::column_terms(i);
+                let (p0, k0) = terms.next().expect("every column of B has a term");
+                for j in 0..D {
+                    let kab = terms
+                        .clone()
+                        .fold(db[p0][j] * ga[k0], |s, (p, k)| s + db[p][j] * ga[k]);
+                    ke[(D * a + i) * nd + D * b + j] += kab * w;
+                }
+            }
         }
     }
 }
 
-/// `eps = [H_xx, H_yy, H_xy + H_yx]` from the displacement gradient `H = du/dx = sum_a u_a
-/// (dN_a/dx)^T` at one point (column `a` of `u` is node `a`).
+/// Adds `w B^T sigma` at one point to `f`, with `sigma = D eps(u)` and the strain from the
+/// displacement gradient `H = sum_a u_a (dN_a/dx)^T`.
 #[inline(always)]
-fn small_strain_at<const N: usize>(p: &Point<N>, u: &SMatrix<f64, 2, N>) -> Vector3<f64> {
-    let h: Matrix2<f64> = u * p.dndx;
-    Vector3::new(h[(0, 0)], h[(1, 1)], h[(0, 1)] + h[(1, 0)])
-}
-
-/// Adds `w B^T sigma` at one point to `f`, with `sigma = D eps(u)`.
-#[inline(always)]
-fn add_internal_force<const N: usize, const ND: usize, S>(
-    f: &mut VectorMut<ND, S>,
-    p: &Point<N>,
-    d: &Matrix3<f64>,
-    u: &SMatrix<f64, 2, N>,
-) where
-    S: StorageMut<f64, Const<ND>, U1>,
-{
-    let w_sigma = (d * small_strain_at(p, u)) * p.w;
-    for a in 0..N {
-        let mut fa = f.fixed_rows_mut::<2>(2 * a);
-        fa += p.b(a).tr_mul(&w_sigma);
-    }
-}
-
-/// Small strain, for an element of `N` nodes and `ND = 2 N` dofs: adds
-/// `f_int = int B^T D eps(u_e) t dA` (`= K_e u_e`) to `f` when given (`u_e` is read only then),
-/// and `K_T = K_e = int B^T D B t dA` to `k` when given.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn small_strain<const N: usize, const ND: usize, SF, SK>(
-    kind: ElementKind,
-    coords: &[[f64; 2]],
+fn add_internal_force<const D: usize>(
+    f: &mut [f64],
+    dndx: &[[f64; D]],
+    d: &VoigtMatrix,
     u_e: &[f64],
-    material: &Elasticity,
-    thickness: f64,
-    rule: &[QuadPoint],
-    mut f: Option<&mut VectorMut<ND, SF>>,
-    mut k: Option<&mut MatrixMut<ND, SK>>,
-) where
-    SF: StorageMut<f64, Const<ND>, U1>,
-    SK: StorageMut<f64, Const<ND>, Const<ND>>,
-{
-    const { assert!(ND == 2 * N) };
-    let u = match f {
-        Some(_) => SMatrix::<f64, 2, N>::from_column_slice(&u_e[..ND]),
-        None => SMatrix::<f64, 2, N>::zeros(),
-    };
-    let x = nodes::<N>(coords);
-    for q in rule {
-        let Some(p) = point(kind, &x, q, thickness) else {
-            continue;
+    w: f64,
+) {
+    let voigt = Voigt::<D>::SIZE;
+    let h = field_gradient(dndx, u_e);
+    let mut eps = [0.0; 6];
+    for (p, &(i, j)) in Voigt::<D>::PAIRS.iter().enumerate() {
+        eps[p] = if i == j {
+            h[(i, i)]
+        } else {
+            h[(i, j)] + h[(j, i)]
         };
-        if let Some(f) = f.as_deref_mut() {
-            add_internal_force(f, &p, &material.d, &u);
-        }
-        if let Some(k) = k.as_deref_mut() {
-            add_material_tangent(k, &p, &material.d);
+    }
+    let mut w_sigma = [0.0; 6];
+    for (p, ws) in w_sigma.iter_mut().enumerate().take(voigt) {
+        *ws = (1..voigt).fold(d[(p, 0)] * eps[0], |s, q| s + d[(p, q)] * eps[q]) * w;
+    }
+    for (a, g) in dndx.iter().enumerate() {
+        for i in 0..D {
+            let mut terms = Voigt::<D>::column_terms(i);
+            let (p0, k0) = terms.next().expect("every column of B has a term");
+            f[D * a + i] += terms.fold(g[k0] * w_sigma[p0], |s, (p, k)| s + g[k] * w_sigma[p]);
         }
     }
 }
 
-/// Calls `$body` with `N` (nodes) and `ND` (dofs) bound to the element kind's sizes.
-macro_rules! with_sizes {
-    ($kind:expr, |$n:ident, $nd:ident| $body:expr) => {
-        match $kind {
-            ElementKind::Q4 => {
-                const $n: usize = 4;
-                const $nd: usize = 8;
-                $body
-            }
-            ElementKind::Q9 => {
-                const $n: usize = 9;
-                const $nd: usize = 18;
-                $body
-            }
-            ElementKind::T3 => {
-                const $n: usize = 3;
-                const $nd: usize = 6;
-                $body
-            }
-            ElementKind::T6 => {
-                const $n: usize = 6;
-                const $nd: usize = 12;
-                $body
-            }
+/// Calls `visit(dndx, w)` at every point of `rule` with `det J != 0` (a point with `det J = 0`
+/// contributes nothing; the model refuses such elements): the gradients `dN_a/dx` of the
+/// cell's nodes and the weight `w = w_q det J t`.
+#[inline(always)]
+fn for_each_point<const D: usize, C: ReferenceCell<D>>(
+    kind: C,
+    coords: &[[f64; D]],
+    thickness: f64,
+    rule: &[QuadPoint<D>],
+    mut visit: impl FnMut(&[[f64; D]], f64),
+) {
+    let n = kind.node_count();
+    for q in rule {
+        let pv = kind.point_values(coords, q.xi);
+        let det_j = pv.jacobian_determinant();
+        if det_j == 0.0 {
+            continue;
         }
-    };
+        visit(&pv.gradients()[..n], q.weight * det_j * thickness);
+    }
 }
 
-/// Element stiffness `K_e` (row-major, `2 n x 2 n`, dof order `[u_x0, u_y0, u_x1, ...]`): the
-/// small-strain tangent of [`element_residual_and_tangent`], without the internal force.
-pub fn element_stiffness(
-    kind: ElementKind,
-    coords: &[[f64; 2]],
-    material: &Elasticity,
+/// Element stiffness `K_e = int B^T D B t dV` (row-major, `D n x D n`, dof order
+/// `[u_x0, u_y0, (u_z0,) u_x1, ...]`) with the rule `rule`; `thickness` is 1 in 3D.
+pub fn element_stiffness<const D: usize, C: ReferenceCell<D>>(
+    kind: C,
+    coords: &[[f64; D]],
+    material: &Elasticity<D>,
     thickness: f64,
-    rule: &[QuadPoint],
+    rule: &[QuadPoint<D>],
     ke: &mut [f64],
 ) {
-    with_sizes!(kind, |N, ND| {
-        let ke = &mut ke[..ND * ND];
-        ke.fill(0.0);
-        // accumulated in place, through a view whose rows are ND apart (row-major)
-        let mut k = MatrixViewMut::from_slice_with_strides_generic(
-            ke,
-            Const::<ND>,
-            Const::<ND>,
-            Const::<ND>,
-            U1,
-        );
-        small_strain::<N, ND, _, _>(
-            kind,
-            coords,
-            &[],
-            material,
-            thickness,
-            rule,
-            None::<&mut SVector<f64, ND>>,
-            Some(&mut k),
-        );
-    })
+    let nd = D * kind.node_count();
+    let ke = &mut ke[..nd * nd];
+    ke.fill(0.0);
+    for_each_point(kind, coords, thickness, rule, |dndx, w| {
+        add_material_tangent(ke, dndx, &material.d, w)
+    });
 }
 
-/// Internal force `f_int(u_e)` and tangent `K_T = d f_int / d u_e` of one element at the
-/// element displacements `u_e` (`2 n` values, dof order `[u_x0, u_y0, u_x1, ...]`), `coords`
-/// being the element's reference (undeformed) nodes.
-pub fn element_residual_and_tangent(
-    kinematics: Kinematics,
-    kind: ElementKind,
-    coords: &[[f64; 2]],
+/// Internal force `f_int(u_e) = int B^T D eps(u_e) t dV` (`= K_e u_e`) of one element at the
+/// element displacements `u_e` (`D n` values), written to `f[..D n]`.
+pub fn element_internal_force<const D: usize, C: ReferenceCell<D>>(
+    kind: C,
+    coords: &[[f64; D]],
     u_e: &[f64],
-    material: &Elasticity,
+    material: &Elasticity<D>,
     thickness: f64,
-    rule: &[QuadPoint],
-) -> (ElementVector, ElementMatrix) {
-    let mut f = ElementVector::zeros();
-    let mut k = ElementMatrix::zeros();
-    match kinematics {
-        Kinematics::SmallStrain => with_sizes!(kind, |N, ND| {
-            small_strain::<N, ND, _, _>(
-                kind,
-                coords,
-                u_e,
-                material,
-                thickness,
-                rule,
-                Some(&mut f.fixed_rows_mut::<ND>(0)),
-                Some(&mut k.fixed_view_mut::<ND, ND>(0, 0)),
-            );
-        }),
+    rule: &[QuadPoint<D>],
+    f: &mut [f64],
+) {
+    let f = &mut f[..D * kind.node_count()];
+    f.fill(0.0);
+    for_each_point(kind, coords, thickness, rule, |dndx, w| {
+        add_internal_force(f, dndx, &material.d, u_e, w)
+    });
+}
+
+/// Voigt strain `eps = sum_a B_a u_a` of the element displacements `u_e` at the natural point
+/// `xi`, with the point (`V` = [`Voigt::SIZE`]).
+pub fn strain_at<const D: usize, const V: usize, C: ReferenceCell<D>>(
+    kind: C,
+    coords: &[[f64; D]],
+    u_e: &[f64],
+    xi: [f64; D],
+) -> ([f64; V], [f64; D]) {
+    const { assert!(V == D * (D + 1) / 2) };
+    let pv = kind.point_values(coords, xi);
+    let mut eps = [0.0; V];
+    for (a, g) in pv.gradients()[..kind.node_count()].iter().enumerate() {
+        let u = &u_e[D * a..D * a + D];
+        for (e, &(i, j)) in eps.iter_mut().zip(Voigt::<D>::PAIRS) {
+            *e += if i == j {
+                g[i] * u[i]
+            } else {
+                g[j] * u[i] + g[i] * u[j]
+            };
+        }
     }
-    (f, k)
+    (eps, pv.point())
 }
 
-/// Internal force `f_int(u_e)` of one element alone (what [`element_residual_and_tangent`]
-/// returns first, without the cost of the tangent).
-pub fn element_internal_force(
-    kinematics: Kinematics,
-    kind: ElementKind,
-    coords: &[[f64; 2]],
-    u_e: &[f64],
-    material: &Elasticity,
-    thickness: f64,
-    rule: &[QuadPoint],
-) -> ElementVector {
-    let mut f = ElementVector::zeros();
-    match kinematics {
-        Kinematics::SmallStrain => with_sizes!(kind, |N, ND| {
-            small_strain::<N, ND, _, _>(
-                kind,
-                coords,
-                u_e,
-                material,
-                thickness,
-                rule,
-                Some(&mut f.fixed_rows_mut::<ND>(0)),
-                None::<&mut SMatrix<f64, ND, ND>>,
-            );
-        }),
+/// Consistent nodal forces `f_a = int N_a b(x) dV` of a body force on one cell, with the rule
+/// `rule` (a rich one: the cell's error rule).
+pub fn body_force_load<const D: usize, C: ReferenceCell<D>>(
+    kind: C,
+    coords: &[[f64; D]],
+    rule: &[QuadPoint<D>],
+    body_force: &dyn Fn([f64; D]) -> [f64; D],
+) -> Vec<f64> {
+    let nn = kind.node_count();
+    let mut f = vec![0.0; D * nn];
+    for q in rule {
+        let pv = kind.point_values(coords, q.xi);
+        let b = body_force(pv.point());
+        let w = q.weight * pv.jacobian_determinant();
+        for a in 0..nn {
+            for i in 0..D {
+                f[D * a + i] += w * pv.values()[a] * b[i];
+            }
+        }
     }
     f
 }
 
-/// Strain `[eps_xx, eps_yy, gamma_xy]` at natural point `xi` for element displacements `ue`.
-pub fn strain_at(
-    kind: ElementKind,
-    coords: &[[f64; 2]],
-    ue: &[f64],
-    xi: [f64; 2],
-) -> ([f64; 3], [f64; 2]) {
-    let pv = kind.point_values(coords, xi);
-    let mut e = [0.0; 3];
-    for a in 0..kind.node_count() {
-        let [dx, dy] = pv.dndx[a];
-        let (ux, uy) = (ue[2 * a], ue[2 * a + 1]);
-        e[0] += dx * ux;
-        e[1] += dy * uy;
-        e[2] += dy * ux + dx * uy;
+/// A rich rule on a facet's 2D reference element.
+fn facet_rule(facet: ElementKind) -> Vec<QuadPoint> {
+    match facet {
+        ElementKind::Q4 | ElementKind::Q9 => gauss_square(5),
+        ElementKind::T3 | ElementKind::T6 => triangle_rule(5),
     }
-    (e, pv.x)
 }
+
+/// Consistent nodal forces `f_a = int N_a t(x, n) dA` of a traction on one facet of a solid
+/// cell, whose nodes `coords` are in facet order ([`ReferenceCell::facets`]); `traction` gets
+/// the point and the outward unit normal (so a pressure `p` is `|_, n| -p n`).
+pub fn facet_traction_load(
+    facet: ElementKind,
+    coords: &[[f64; 3]],
+    traction: &dyn Fn([f64; 3], [f64; 3]) -> [f64; 3],
+) -> Vec<f64> {
+    let nn = facet.node_count();
+    let mut f = vec![0.0; 3 * nn];
+    let mut n = [0.0; 9];
+    let mut dn = [[0.0; 2]; 9];
+    for q in facet_rule(facet) {
+        facet.shape(q.xi, &mut n[..nn], &mut dn[..nn]);
+        let mut x = Vector3::zeros();
+        let (mut ts, mut tt) = (Vector3::zeros(), Vector3::zeros());
+        for a in 0..nn {
+            let p = Vector3::from(coords[a]);
+            x += p * n[a];
+            ts += p * dn[a][0];
+            tt += p * dn[a][1];
+        }
+        let normal_area = ts.cross(&tt);
+        let area = normal_area.dot(&normal_area).sqrt();
+        if area == 0.0 {
+            continue;
+        }
+        let unit = normal_area / area;
+        let t = traction([x[0], x[1], x[2]], [unit[0], unit[1], unit[2]]);
+        for a in 0..nn {
+            for i in 0..3 {
+                f[3 * a + i] += q.weight * area * n[a] * t[i];
+            }
+        }
+    }
+    f
+}
+
+/// An element vector in 2D: the leading `2 n` entries (dof order `[u_x0, u_y0, u_x1, ...]`)
+/// are the element's, the rest zero.
+pub type ElementVector = SVector<f64, MAX_DOFS>;
+/// An element matrix in 2D: the leading `2 n x 2 n` block is the element's, the rest zero.
+pub type ElementMatrix = SMatrix<f64, MAX_DOFS, MAX_DOFS>;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fe3d::SolidKind;
 
-    fn distorted(kind: ElementKind) -> Vec<[f64; 2]> {
-        // map the reference nodes through a smooth, orientation-preserving map
+    const PLANE_KINDS: [ElementKind; 4] = [
+        ElementKind::Q4,
+        ElementKind::Q9,
+        ElementKind::T3,
+        ElementKind::T6,
+    ];
+    const THICKNESS: f64 = 0.7;
+
+    /// The reference element's nodes through a smooth, orientation-preserving map.
+    fn distorted_plane(kind: ElementKind) -> Vec<[f64; 2]> {
         kind.node_coordinates()
             .iter()
             .map(|&[s, t]| {
@@ -452,175 +504,295 @@ mod tests {
             .collect()
     }
 
-    #[test]
-    fn stiffness_is_symmetric_with_three_rigid_modes() {
-        let mat = Elasticity::new(1000.0, 0.3, Plane::Strain);
-        for kind in [
-            ElementKind::Q4,
-            ElementKind::Q9,
-            ElementKind::T3,
-            ElementKind::T6,
-        ] {
-            let coords = distorted(kind);
-            let nd = 2 * kind.node_count();
-            let mut ke = vec![0.0; nd * nd];
-            element_stiffness(kind, &coords, &mat, 1.0, &kind.stiffness_rule(), &mut ke);
-            let scale = ke.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            for i in 0..nd {
-                for j in 0..nd {
-                    assert!((ke[i * nd + j] - ke[j * nd + i]).abs() < 1e-12 * scale);
-                }
-            }
-            // rigid modes give zero force
-            // translation x, translation y, rotation: u = a + w e_z x p
-            for (a, w) in [([1.0, 0.0], 0.0), ([0.0, 1.0], 0.0), ([0.0, 0.0], 1.0)] {
-                let u: Vec<f64> = coords
-                    .iter()
-                    .flat_map(|&p| [a[0] - w * p[1], a[1] + w * p[0]])
-                    .collect();
-                for i in 0..nd {
-                    let f: f64 = (0..nd).map(|j| ke[i * nd + j] * u[j]).sum();
-                    assert!(f.abs() < 1e-11 * scale, "{kind:?}: rigid mode force {f}");
-                }
-            }
-            // a uniform strain has positive energy
-            let u: Vec<f64> = coords
-                .iter()
-                .flat_map(|&p| [0.01 * p[0], -0.02 * p[1]])
-                .collect();
-            let energy: f64 = (0..nd)
-                .map(|i| u[i] * (0..nd).map(|j| ke[i * nd + j] * u[j]).sum::<f64>())
-                .sum();
-            assert!(energy > 0.0);
-        }
+    /// The reference cell's nodes under a fixed non-affine distortion (positive volume).
+    fn distorted_solid(kind: SolidKind) -> Vec<[f64; 3]> {
+        kind.node_coordinates()
+            .iter()
+            .map(|p| {
+                let [x, y, z] = *p;
+                [
+                    1.1 * x + 0.1 * y + 0.03 * y * z,
+                    0.9 * y - 0.05 * x + 0.04 * x * z,
+                    1.2 * z + 0.02 * x * y + 0.05 * x,
+                ]
+            })
+            .collect()
     }
 
-    const KINDS: [ElementKind; 4] = [
-        ElementKind::Q4,
-        ElementKind::Q9,
-        ElementKind::T3,
-        ElementKind::T6,
-    ];
-    const THICKNESS: f64 = 0.7;
-
-    fn materials() -> [Elasticity; 2] {
+    fn plane_materials() -> [Elasticity; 2] {
         [
             Elasticity::new(1000.0, 0.3, Plane::Strain),
             Elasticity::new(1000.0, 0.3, Plane::Stress),
         ]
     }
 
-    /// Element displacements of no particular form (`2 n` values of order 1e-2).
-    fn some_displacements(kind: ElementKind) -> Vec<f64> {
-        (0..2 * kind.node_count())
-            .map(|i| 0.01 * (1.7 * i as f64 + 0.3).sin())
-            .collect()
-    }
-
-    fn internal_force(kind: ElementKind, mat: &Elasticity, u: &[f64]) -> ElementVector {
-        let coords = distorted(kind);
-        let rule = kind.stiffness_rule();
-        element_internal_force(
-            Kinematics::SmallStrain,
-            kind,
-            &coords,
-            u,
-            mat,
-            THICKNESS,
-            &rule,
-        )
+    fn solid_material() -> Elasticity<3> {
+        Elasticity::solid(210.0, 0.3)
     }
 
     fn largest(v: impl IntoIterator<Item = f64>) -> f64 {
         v.into_iter().fold(0.0, |m, x| m.max(x.abs()))
     }
 
-    #[test]
-    fn tangent_is_the_central_difference_of_the_internal_force() {
-        for mat in materials() {
-            for kind in KINDS {
-                let coords = distorted(kind);
-                let rule = kind.stiffness_rule();
-                let nd = 2 * kind.node_count();
-                let u = some_displacements(kind);
-                let (f, k) = element_residual_and_tangent(
-                    Kinematics::SmallStrain,
-                    kind,
-                    &coords,
-                    &u,
-                    &mat,
-                    THICKNESS,
-                    &rule,
-                );
-                // the two entry points agree, and nothing is written beyond the element's dofs
-                assert_eq!(f, internal_force(kind, &mat, &u));
-                assert!(f.rows(nd, MAX_DOFS - nd).iter().all(|&v| v == 0.0));
-                assert!(k.columns(nd, MAX_DOFS - nd).iter().all(|&v| v == 0.0));
-                assert!(k.rows(nd, MAX_DOFS - nd).iter().all(|&v| v == 0.0));
-                // element_stiffness (row-major) is the same tangent
-                let mut ke = [0.0; MAX_DOFS * MAX_DOFS];
-                element_stiffness(kind, &coords, &mat, THICKNESS, &rule, &mut ke);
-                for i in 0..nd {
-                    for j in 0..nd {
-                        assert_eq!(ke[i * nd + j], k[(i, j)], "{kind:?} K[{i}][{j}]");
+    /// The cases of every test below: each element kind (2D with both materials and a
+    /// thickness, 3D with thickness 1) with its distorted nodes.
+    fn for_each_case(
+        mut plane: impl FnMut(ElementKind, &[[f64; 2]], &Elasticity, f64),
+        mut solid: impl FnMut(SolidKind, &[[f64; 3]], &Elasticity<3>, f64),
+    ) {
+        for mat in plane_materials() {
+            for kind in PLANE_KINDS {
+                plane(kind, &distorted_plane(kind), &mat, THICKNESS);
+            }
+        }
+        for kind in SolidKind::ALL {
+            solid(kind, &distorted_solid(kind), &solid_material(), 1.0);
+        }
+    }
+
+    fn stiffness<const D: usize, C: ReferenceCell<D>>(
+        kind: C,
+        coords: &[[f64; D]],
+        mat: &Elasticity<D>,
+        thickness: f64,
+        rule: &[QuadPoint<D>],
+    ) -> Vec<f64> {
+        let nd = D * kind.node_count();
+        let mut ke = vec![0.0; nd * nd];
+        element_stiffness(kind, coords, mat, thickness, rule, &mut ke);
+        ke
+    }
+
+    fn internal_force<const D: usize, C: ReferenceCell<D>>(
+        kind: C,
+        coords: &[[f64; D]],
+        u: &[f64],
+        mat: &Elasticity<D>,
+        thickness: f64,
+        rule: &[QuadPoint<D>],
+    ) -> Vec<f64> {
+        let mut f = vec![0.0; D * kind.node_count()];
+        element_internal_force(kind, coords, u, mat, thickness, rule, &mut f);
+        f
+    }
+
+    /// The rigid motions of the nodes `coords`: `D` translations and the `D (D - 1) / 2`
+    /// infinitesimal rotations `u_i = -x_j, u_j = x_i` in each plane `(i, j)`.
+    fn rigid_motions<const D: usize>(coords: &[[f64; D]]) -> Vec<Vec<f64>> {
+        let mut modes = Vec::new();
+        for axis in 0..D {
+            modes.push(
+                coords
+                    .iter()
+                    .flat_map(|_| (0..D).map(move |i| if i == axis { 1.0 } else { 0.0 }))
+                    .collect(),
+            );
+        }
+        for i in 0..D {
+            for j in i + 1..D {
+                let mut u = vec![0.0; D * coords.len()];
+                for (a, p) in coords.iter().enumerate() {
+                    u[D * a + i] = -p[j];
+                    u[D * a + j] = p[i];
+                }
+                modes.push(u);
+            }
+        }
+        modes
+    }
+
+    /// The rank of the row-major `nd x nd` matrix `a` by Gaussian elimination with full
+    /// pivoting, pivots below `1e-9` of the largest entry counting as zero.
+    fn rank(mut a: Vec<f64>, nd: usize) -> usize {
+        let largest = largest(a.iter().copied());
+        let mut rank = 0;
+        let (mut used_r, mut used_c) = (vec![false; nd], vec![false; nd]);
+        loop {
+            let mut best = (0.0, 0, 0);
+            for r in (0..nd).filter(|&r| !used_r[r]) {
+                for c in (0..nd).filter(|&c| !used_c[c]) {
+                    if a[r * nd + c].abs() > best.0 {
+                        best = (a[r * nd + c].abs(), r, c);
                     }
                 }
-                let h = 1e-6;
-                let mut fd = ElementMatrix::zeros();
-                for j in 0..nd {
-                    let (mut up, mut um) = (u.clone(), u.clone());
-                    up[j] += h;
-                    um[j] -= h;
-                    let column = (internal_force(kind, &mat, &up)
-                        - internal_force(kind, &mat, &um))
-                        / (2.0 * h);
-                    fd.set_column(j, &column);
-                    let scale = largest(k.column(j).iter().copied());
-                    let err = largest((0..nd).map(|i| column[i] - k[(i, j)]));
-                    assert!(
-                        err < 1e-7 * scale,
-                        "{kind:?} {:?}: column {j} of K_T differs from the central difference by {err:e} (scale {scale:e})",
-                        mat.plane
-                    );
-                }
-                // K_T is symmetric, and so is the difference quotient of f_int alone (f_int is
-                // the gradient of an energy)
-                let scale = largest(k.iter().copied());
-                for i in 0..nd {
-                    for j in 0..nd {
-                        assert!((k[(i, j)] - k[(j, i)]).abs() <= 1e-14 * scale);
-                        assert!((fd[(i, j)] - fd[(j, i)]).abs() < 1e-7 * scale);
-                    }
+            }
+            if best.0 <= 1e-9 * largest {
+                return rank;
+            }
+            let (_, pr, pc) = best;
+            used_r[pr] = true;
+            used_c[pc] = true;
+            rank += 1;
+            for r in (0..nd).filter(|&r| !used_r[r]) {
+                let factor = a[r * nd + pc] / a[pr * nd + pc];
+                for c in 0..nd {
+                    a[r * nd + c] -= factor * a[pr * nd + c];
                 }
             }
         }
     }
 
-    #[test]
-    fn rigid_motions_have_no_internal_force() {
-        for mat in materials() {
-            for kind in KINDS {
-                let coords = distorted(kind);
-                let scale = {
-                    let u = some_displacements(kind);
-                    largest(internal_force(kind, &mat, &u).iter().copied()) / 0.01
-                };
-                // translation x, translation y, infinitesimal rotation u = a + w e_z x p
-                for (a, w) in [([1.0, 0.0], 0.0), ([0.0, 1.0], 0.0), ([0.0, 0.0], 1.0)] {
-                    let u: Vec<f64> = coords
-                        .iter()
-                        .flat_map(|&p| [a[0] - w * p[1], a[1] + w * p[0]])
-                        .collect();
-                    let f = internal_force(kind, &mat, &u);
-                    let worst = largest(f.iter().copied());
-                    assert!(
-                        worst < 1e-12 * scale,
-                        "{kind:?} {:?}: rigid motion {a:?}, {w} has internal force {worst:e}",
-                        mat.plane
-                    );
-                }
+    /// `K_e` is symmetric, the rigid motions give no internal force, there are no others
+    /// (rank `D n - D (D + 1) / 2`), and a uniform strain has positive energy.
+    fn check_stiffness<const D: usize, C: ReferenceCell<D>>(
+        kind: C,
+        coords: &[[f64; D]],
+        mat: &Elasticity<D>,
+        thickness: f64,
+        rule: &[QuadPoint<D>],
+    ) {
+        let nd = D * kind.node_count();
+        let ke = stiffness(kind, coords, mat, thickness, rule);
+        let scale = largest(ke.iter().copied());
+        for i in 0..nd {
+            for j in 0..nd {
+                assert!((ke[i * nd + j] - ke[j * nd + i]).abs() <= 1e-13 * scale);
             }
         }
+        let modes = rigid_motions(coords);
+        for u in &modes {
+            let f = internal_force(kind, coords, u, mat, thickness, rule);
+            for i in 0..nd {
+                let ku: f64 = (0..nd).map(|j| ke[i * nd + j] * u[j]).sum();
+                assert!(ku.abs() < 1e-11 * scale, "{kind:?}: rigid mode K u = {ku}");
+                assert!(
+                    f[i].abs() < 1e-11 * scale,
+                    "{kind:?}: rigid mode f = {}",
+                    f[i]
+                );
+            }
+        }
+        assert_eq!(
+            rank(ke.clone(), nd),
+            nd - modes.len(),
+            "{kind:?}: rank of K_e"
+        );
+        let u: Vec<f64> = coords
+            .iter()
+            .flat_map(|p| (0..D).map(move |i| 0.01 * (i as f64 - 0.5) * p[i]))
+            .collect();
+        let energy: f64 = (0..nd)
+            .map(|i| u[i] * (0..nd).map(|j| ke[i * nd + j] * u[j]).sum::<f64>())
+            .sum();
+        assert!(energy > 0.0, "{kind:?}");
+    }
+
+    #[test]
+    fn stiffness_is_symmetric_with_only_the_rigid_modes_at_zero_energy() {
+        for_each_case(
+            |kind, coords, mat, t| check_stiffness(kind, coords, mat, t, &kind.stiffness_rule()),
+            |kind, coords, mat, t| check_stiffness(kind, coords, mat, t, &kind.stiffness_rule()),
+        );
+    }
+
+    /// `f_int = K_e u_e` and every column of `K_e` is the central difference of `f_int`
+    /// (1e-7 of the largest entry).
+    fn check_tangent<const D: usize, C: ReferenceCell<D>>(
+        kind: C,
+        coords: &[[f64; D]],
+        mat: &Elasticity<D>,
+        thickness: f64,
+        rule: &[QuadPoint<D>],
+    ) {
+        let nd = D * kind.node_count();
+        let ke = stiffness(kind, coords, mat, thickness, rule);
+        let scale = largest(ke.iter().copied());
+        let u: Vec<f64> = (0..nd)
+            .map(|i| 0.01 * (1.7 * i as f64 + 0.3).sin())
+            .collect();
+        let f = internal_force(kind, coords, &u, mat, thickness, rule);
+        for i in 0..nd {
+            let ku: f64 = (0..nd).map(|j| ke[i * nd + j] * u[j]).sum();
+            assert!((f[i] - ku).abs() <= 1e-12 * scale, "{kind:?}: f_int != K u");
+        }
+        let h = 1e-6;
+        for j in 0..nd {
+            let (mut up, mut um) = (u.clone(), u.clone());
+            up[j] += h;
+            um[j] -= h;
+            let fp = internal_force(kind, coords, &up, mat, thickness, rule);
+            let fm = internal_force(kind, coords, &um, mat, thickness, rule);
+            for i in 0..nd {
+                let fd = (fp[i] - fm[i]) / (2.0 * h);
+                assert!(
+                    (fd - ke[i * nd + j]).abs() < 1e-7 * scale,
+                    "{kind:?}: dF_{i}/du_{j}: {fd} vs {}",
+                    ke[i * nd + j]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn tangent_is_the_central_difference_of_the_internal_force() {
+        for_each_case(
+            |kind, coords, mat, t| check_tangent(kind, coords, mat, t, &kind.stiffness_rule()),
+            |kind, coords, mat, t| check_tangent(kind, coords, mat, t, &kind.stiffness_rule()),
+        );
+    }
+
+    /// `u(x) = c + A x` has the strain of `A` at every point (`strain_at` and the kernel's
+    /// `H`).
+    fn check_linear_field<const D: usize, const V: usize, C: ReferenceCell<D>>(
+        kind: C,
+        coords: &[[f64; D]],
+        a: &SMatrix<f64, D, D>,
+    ) {
+        let expected: [f64; V] = Voigt::<D>::strain(a);
+        let u: Vec<f64> = coords
+            .iter()
+            .flat_map(|p| {
+                let x = SVector::<f64, D>::from(*p);
+                let v = a * x;
+                (0..D).map(move |i| 0.3 - 0.1 * i as f64 + v[i])
+            })
+            .collect();
+        for &xi in kind.node_coordinates() {
+            let (eps, _) = strain_at::<D, V, C>(kind, coords, &u, xi);
+            let h = crate::fe::displacement_gradient_at(kind, coords, &u, xi).0;
+            let from_h: [f64; V] = Voigt::<D>::strain(&h);
+            for p in 0..V {
+                assert!((eps[p] - expected[p]).abs() < 1e-13, "{kind:?} eps_{p}");
+                assert!((from_h[p] - expected[p]).abs() < 1e-13, "{kind:?} eps_{p}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_linear_field_has_the_strain_of_its_gradient_and_the_stress_d_eps() {
+        // A neither symmetric nor small
+        let a2 = nalgebra::Matrix2::new(0.02, -0.05, 0.03, -0.01);
+        for kind in PLANE_KINDS {
+            check_linear_field::<2, 3, _>(kind, &distorted_plane(kind), &a2);
+        }
+        let a3 = nalgebra::Matrix3::new(1e-3, 2e-4, -3e-4, 5e-4, -2e-3, 1e-4, -4e-4, 3e-4, 1.5e-3);
+        for kind in SolidKind::ALL {
+            check_linear_field::<3, 6, _>(kind, &distorted_solid(kind), &a3);
+        }
+        // 2D: sigma = D eps written out
+        let eps: [f64; 3] = Voigt::<2>::strain(&a2);
+        for mat in plane_materials() {
+            let sigma = mat.stress(eps);
+            let (e, nu) = mat.plane_stress_equivalent();
+            let g = e / (2.0 * (1.0 + nu));
+            let expected = [
+                e / (1.0 - nu * nu) * (eps[0] + nu * eps[1]),
+                e / (1.0 - nu * nu) * (eps[1] + nu * eps[0]),
+                g * eps[2],
+            ];
+            for i in 0..3 {
+                assert!((sigma[i] - expected[i]).abs() < 1e-12 * largest(expected));
+            }
+        }
+        // 3D uniaxial stress: eps = s/E [1, -nu, -nu, 0, 0, 0] gives sigma = [s, 0, 0, 0, 0, 0]
+        let m = solid_material();
+        let (s, e) = (3.0, m.youngs_modulus);
+        let sigma = m.stress([s / e, -m.nu * s / e, -m.nu * s / e, 0.0, 0.0, 0.0]);
+        assert!((sigma[0] - s).abs() < 1e-13);
+        assert!(sigma[1..].iter().all(|v| v.abs() < 1e-13));
+        // pure shear: sigma_xy = mu gamma_xy
+        let sigma = m.stress([0.0, 0.0, 0.0, 0.0, 0.0, 2e-3]);
+        assert!((sigma[5] - m.mu() * 2e-3).abs() < 1e-15);
     }
 
     /// `int_{boundary} N_a sigma n t ds` for a constant stress, edge by edge (the element's own
@@ -653,50 +825,28 @@ mod tests {
         f
     }
 
+    /// In 2D the internal force of a linear field is the boundary integral of its constant
+    /// traction `sigma n` (in 3D the finite-strain kernels check the same with
+    /// [`facet_traction_load`]).
     #[test]
-    fn a_linear_field_has_the_constant_stress_d_eps() {
-        // u(x) = c + A x, A neither symmetric nor small: eps = [A_xx, A_yy, A_xy + A_yx]
-        let c = [0.3, -0.2];
+    fn a_linear_field_has_the_internal_force_of_its_boundary_traction() {
         let a = [[0.02, -0.05], [0.03, -0.01]];
         let eps = [a[0][0], a[1][1], a[0][1] + a[1][0]];
-        for mat in materials() {
+        for mat in plane_materials() {
             let sigma = mat.stress(eps);
-            // sigma = D eps written out, not through `stress`
-            let (e, nu) = mat.plane_stress_equivalent();
-            let g = e / (2.0 * (1.0 + nu));
-            let expected = [
-                e / (1.0 - nu * nu) * (eps[0] + nu * eps[1]),
-                e / (1.0 - nu * nu) * (eps[1] + nu * eps[0]),
-                g * eps[2],
-            ];
-            for i in 0..3 {
-                assert!((sigma[i] - expected[i]).abs() < 1e-12 * largest(expected));
-            }
-            for kind in KINDS {
-                let coords = distorted(kind);
+            for kind in PLANE_KINDS {
+                let coords = distorted_plane(kind);
                 let u: Vec<f64> = coords
                     .iter()
                     .flat_map(|p| {
                         [
-                            c[0] + a[0][0] * p[0] + a[0][1] * p[1],
-                            c[1] + a[1][0] * p[0] + a[1][1] * p[1],
+                            0.3 + a[0][0] * p[0] + a[0][1] * p[1],
+                            -0.2 + a[1][0] * p[0] + a[1][1] * p[1],
                         ]
                     })
                     .collect();
-                // the kernel's strain at every quadrature point is eps
                 let rule = kind.stiffness_rule();
-                with_sizes!(kind, |N, ND| {
-                    let um = SMatrix::<f64, 2, N>::from_column_slice(&u[..ND]);
-                    let x = nodes::<N>(&coords);
-                    for p in rule.iter().filter_map(|q| point(kind, &x, q, THICKNESS)) {
-                        let got = small_strain_at(&p, &um);
-                        for i in 0..3 {
-                            assert!((got[i] - eps[i]).abs() < 1e-13, "{kind:?}: {got:?}");
-                        }
-                    }
-                });
-                // and f_int is the boundary integral of the constant traction sigma n
-                let f = internal_force(kind, &mat, &u);
+                let f = internal_force(kind, &coords, &u, &mat, THICKNESS, &rule);
                 let expected = boundary_force(kind, &coords, sigma);
                 let scale = largest(expected.iter().copied());
                 assert!(scale > 0.0);
@@ -704,7 +854,7 @@ mod tests {
                     assert!(
                         (f[i] - want).abs() < 1e-12 * scale,
                         "{kind:?} {:?}: f_int[{i}] = {} but the traction gives {want}",
-                        mat.plane,
+                        mat.plane(),
                         f[i]
                     );
                 }
@@ -720,6 +870,55 @@ mod tests {
             let back = mat.stress(mat.strain_of_stress(s));
             for i in 0..3 {
                 assert!((back[i] - s[i]).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn consistent_loads_integrate_to_the_total_force() {
+        // a unit cube element: a traction t on a face sums to t (area 1); a body force b to b
+        for kind in SolidKind::ALL {
+            let coords: Vec<[f64; 3]> = kind
+                .node_coordinates()
+                .iter()
+                .map(|p| {
+                    if kind.is_hexahedron() {
+                        p.map(|x| 0.5 * (x + 1.0))
+                    } else {
+                        *p
+                    }
+                })
+                .collect();
+            let volume = if kind.is_hexahedron() { 1.0 } else { 1.0 / 6.0 };
+            let f = body_force_load(kind, &coords, &kind.error_rule(), &|_| [1.0, -2.0, 3.0]);
+            for (i, b) in [1.0, -2.0, 3.0].into_iter().enumerate() {
+                let sum: f64 = f.iter().skip(i).step_by(3).sum();
+                assert!((sum - b * volume).abs() < 1e-14, "{kind:?}");
+            }
+            for (k, local) in kind.facets().iter().enumerate() {
+                let fc: Vec<[f64; 3]> = local.iter().map(|&a| coords[a]).collect();
+                // a unit pressure: the force is minus the outward area vector
+                let f = facet_traction_load(kind.facet_kind(), &fc, &|_, n| n.map(|v| -v));
+                let total: Vec<f64> = (0..3)
+                    .map(|i| f.iter().skip(i).step_by(3).sum::<f64>())
+                    .collect();
+                // the area vector of the facet from its corners (flat facets)
+                let c: Vec<Vector3<f64>> = local
+                    .iter()
+                    .take(kind.facet_kind().corner_count())
+                    .map(|&a| Vector3::from(coords[a]))
+                    .collect();
+                let area_vector = if c.len() == 4 {
+                    (c[2] - c[0]).cross(&(c[3] - c[1])) * 0.5
+                } else {
+                    (c[1] - c[0]).cross(&(c[2] - c[0])) * 0.5
+                };
+                for i in 0..3 {
+                    assert!(
+                        (total[i] + area_vector[i]).abs() < 1e-14,
+                        "{kind:?} facet {k}: {total:?} vs {area_vector:?}"
+                    );
+                }
             }
         }
     }

@@ -17,11 +17,11 @@
 //!   `S = mu (I - C^-1) + lambda ln J C^-1` (evaluated as `C^-1 (2 mu E + lambda ln J I)`) and
 //!   `CC_IJKL = lambda C^-1_IJ C^-1_KL + (mu - lambda ln J)(C^-1_IK C^-1_JL + C^-1_IL C^-1_JK)`;
 //! * St. Venant-Kirchhoff, `W = lambda/2 (tr E)^2 + mu E:E`, `S = lambda tr E I + 2 mu E`,
-//!   `CC = lambda I (x) I + 2 mu II` (the small-strain `D` of [`crate::solid3d`]).
+//!   `CC = lambda I (x) I + 2 mu II` (the small-strain `D` of [`crate::solid`]).
 //!
 //! **Element** (Bonet & Wood chapter 9; Wriggers, *Nonlinear Finite Element Methods*,
 //! section 4.2). At a quadrature point of weight `w = w_q det J_0` (reference configuration),
-//! Voigt order `11, 22, 33, 23, 13, 12` with engineering shears (as [`crate::solid3d`]),
+//! Voigt order `11, 22, 33, 23, 13, 12` with engineering shears (as [`crate::solid`]),
 //!
 //! `f_a = sum_q w B_a^T S_v` (`= w F S grad_0 N_a`),
 //! `K_ab = sum_q w [B_a^T D B_b + (grad_0 N_a . S grad_0 N_b) I_3]`,
@@ -250,7 +250,7 @@ pub fn element_residual_and_tangent3(
 mod tests {
     use super::*;
     use crate::fe::displacement_gradient_at;
-    use crate::solid3d::{element_stiffness3, facet_traction_load, Elasticity3};
+    use crate::solid::{element_stiffness, facet_traction_load, Elasticity};
 
     const KINDS: [SolidKind; 4] = [
         SolidKind::Hex8,
@@ -505,12 +505,12 @@ mod tests {
     }
 
     /// The small-strain limit: the tangent at `u = 0` is the small-strain `K_e` of
-    /// [`crate::solid3d`] (1e-13), and at the displacement `eps u` the internal force differs
+    /// [`crate::solid`] (1e-13), and at the displacement `eps u` the internal force differs
     /// from `K_e eps u` by `O(eps^2)`: the ratio of the differences at `eps` and `eps / 2` is
     /// 4 (to 1 %).
     #[test]
     fn small_deformations_are_small_strain_elasticity() {
-        let linear = Elasticity3::new(E, NU);
+        let linear = Elasticity::solid(E, NU);
         for law in laws() {
             for kind in KINDS {
                 let coords = distorted(kind);
@@ -520,7 +520,7 @@ mod tests {
                 let (f0, k0) = force_and_tangent(kind, &coords, &zero, &law);
                 assert!(largest(f0) == 0.0);
                 let mut ke = vec![0.0; nd * nd];
-                element_stiffness3(kind, &coords, &linear, &rule, &mut ke);
+                element_stiffness(kind, &coords, &linear, 1.0, &rule, &mut ke);
                 let scale = largest(ke.iter().copied());
                 for (a, b) in k0.iter().zip(&ke) {
                     assert!((a - b).abs() < 1e-13 * scale, "{kind:?} {law:?}");

@@ -5,7 +5,7 @@
 
 use contact_patch::fe3d::SolidKind;
 use contact_patch::mesh::{block3, Mesh3};
-use contact_patch::solid3d::Elasticity3;
+use contact_patch::solid::Elasticity;
 use contact_patch::solver::elastic3d::Solid3;
 use contact_patch::solver::sparse::WorkLimit;
 use nalgebra::Matrix3;
@@ -44,7 +44,7 @@ fn gradient() -> Matrix3<f64> {
 }
 
 fn strain_of(h: &Matrix3<f64>) -> [f64; 6] {
-    contact_patch::solid3d::voigt_strain(h)
+    contact_patch::solid::Voigt::<3>::strain(h)
 }
 
 fn largest_stress_error(solid: &Solid3, u: &[f64], exact: [f64; 6]) -> f64 {
@@ -59,7 +59,7 @@ fn largest_stress_error(solid: &Solid3, u: &[f64], exact: [f64; 6]) -> f64 {
 
 #[test]
 fn displacement_patch_test_on_distorted_meshes_gives_the_exact_uniform_stress() {
-    let material = Elasticity3::new(200.0, 0.3);
+    let material = Elasticity::solid(200.0, 0.3);
     let h = gradient();
     let sigma = material.stress(strain_of(&h));
     for kind in SolidKind::ALL {
@@ -105,7 +105,7 @@ fn displacement_patch_test_on_distorted_meshes_gives_the_exact_uniform_stress() 
 fn traction_patch_test_with_minimal_supports_gives_the_exact_uniform_stress() {
     // t = sigma n on every face of the box; six dofs fixed at three corners at the values of
     // the exact field u = eps x (no rotation), which removes the six rigid motions only
-    let material = Elasticity3::new(200.0, 0.3);
+    let material = Elasticity::solid(200.0, 0.3);
     let eps_tensor = {
         let h = gradient();
         (h + h.transpose()) * 0.5
@@ -172,7 +172,7 @@ impl Manufactured {
     fn gradient(&self, x: [f64; 3]) -> Matrix3<f64> {
         Matrix3::from_fn(|i, j| self.a[i][j] * self.theta(i, x).cos())
     }
-    fn body_force(&self, m: &Elasticity3, x: [f64; 3]) -> [f64; 3] {
+    fn body_force(&self, m: &Elasticity<3>, x: [f64; 3]) -> [f64; 3] {
         let (lambda, mu) = (m.lambda(), m.mu());
         let s = [0, 1, 2].map(|i| self.theta(i, x).sin());
         [0, 1, 2].map(|k| {
@@ -205,7 +205,7 @@ fn smooth_cube(kind: SolidKind, n: usize) -> Mesh3 {
 
 #[test]
 fn every_element_converges_at_its_optimal_rates_on_a_smooth_solution() {
-    let material = Elasticity3::new(1.0, 0.3);
+    let material = Elasticity::solid(1.0, 0.3);
     let field = Manufactured::new();
     for (kind, levels, l2_rate, energy_rate) in [
         (SolidKind::Hex8, [2, 4, 8, 16], 2.0, 1.0),

@@ -111,7 +111,7 @@ impl CattaneoMindlin {
 
 /// Dundurs' second parameter `beta` of two materials (`None` for the second: rigid).
 pub fn dundurs_beta(one: &Elasticity, two: Option<&Elasticity>) -> f64 {
-    let kolosov = |m: &Elasticity| match m.plane {
+    let kolosov = |m: &Elasticity| match m.plane() {
         Plane::Strain => 3.0 - 4.0 * m.nu,
         Plane::Stress => (3.0 - m.nu) / (1.0 + m.nu),
     };

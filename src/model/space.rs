@@ -4,8 +4,8 @@
 //!
 //! Dofs are numbered `offset_b + D node + component` in both; a cell's element stiffness is
 //! `K_e = int_cell B^T C B dV` over its stiffness rule (times the thickness in 2D), with the
-//! plane-strain or plane-stress `C` of [`crate::solid::Elasticity`] in 2D and the isotropic
-//! 6x6 `C` of [`crate::solid3d::Elasticity3`] in 3D (Hughes, *The Finite Element Method*, 2000,
+//! plane-strain or plane-stress `C` of [`crate::solid::Elasticity`] in 2D and its isotropic
+//! 6x6 `C` in 3D (one kernel for both, [`crate::solid`]) (Hughes, *The Finite Element Method*, 2000,
 //! chapters 2-3). Everything that does not depend on the dimension (dof numbering, sparsity,
 //! Dirichlet elimination, the active-set loop and every enforcement method) is written once
 //! against this trait.
@@ -14,10 +14,7 @@ use crate::fe::{ElementKind, QuadPoint, ReferenceCell};
 use crate::fe3d::SolidKind;
 use crate::harness::exact::ExactField;
 use crate::model::{FacetLoad, Model};
-use crate::solid::{element_internal_force, element_stiffness, Elasticity, Kinematics};
-use crate::solid3d::{
-    element_internal_force3, element_stiffness3, facet_traction_load, Elasticity3,
-};
+use crate::solid::{element_internal_force, element_stiffness, facet_traction_load, Elasticity};
 use crate::solid_finite::{element_residual_and_tangent, Hyperelastic, Inverted};
 use crate::solid_finite3::element_residual_and_tangent3;
 
@@ -88,7 +85,7 @@ pub trait SolidCell<const D: usize>: ReferenceCell<D> + Send + Sync + 'static {
     /// facet of a cell of this kind whose nodes (the facet's own order) are at `coords`
     /// (times `thickness` in 2D): `add(a, i, value)` for each contribution to component `i`
     /// of the facet's node `a`. 2D: [`crate::model::add_edge_load`]; 3D:
-    /// [`crate::solid3d::facet_traction_load`] (an exact field is 2D only).
+    /// [`crate::solid::facet_traction_load`] (an exact field is 2D only).
     fn add_facet_load(
         self,
         coords: &[[f64; D]],
@@ -108,6 +105,23 @@ pub trait SolidCell<const D: usize>: ReferenceCell<D> + Send + Sync + 'static {
     /// The axis names of the components, `x, y(, z)`.
     fn axis_name(component: usize) -> &'static str {
         ["x", "y", "z"][component]
+    }
+}
+
+/// Adds the small-strain internal force of [`element_internal_force`] to `out` (`D n` entries).
+fn add_internal_force<const D: usize, C: ReferenceCell<D>>(
+    kind: C,
+    coords: &[[f64; D]],
+    u_e: &[f64],
+    material: &Elasticity<D>,
+    thickness: f64,
+    rule: &[QuadPoint<D>],
+    out: &mut [f64],
+) {
+    let mut fe = [0.0; 3 * crate::fe3d::MAX_SOLID_NODES];
+    element_internal_force(kind, coords, u_e, material, thickness, rule, &mut fe);
+    for (o, f) in out.iter_mut().zip(&fe[..D * kind.node_count()]) {
+        *o += f;
     }
 }
 
@@ -138,18 +152,7 @@ impl SolidCell<2> for ElementKind {
         rule: &[QuadPoint<2>],
         out: &mut [f64],
     ) {
-        let fe = element_internal_force(
-            Kinematics::SmallStrain,
-            self,
-            coords,
-            u_e,
-            material,
-            thickness,
-            rule,
-        );
-        for (o, f) in out.iter_mut().zip(fe.iter()) {
-            *o += f;
-        }
+        add_internal_force(self, coords, u_e, material, thickness, rule, out);
     }
 
     fn finite_residual_and_tangent(
@@ -209,17 +212,17 @@ impl SolidCell<2> for ElementKind {
 }
 
 impl SolidCell<3> for SolidKind {
-    type Material = Elasticity3;
+    type Material = Elasticity<3>;
 
     fn element_stiffness(
         self,
         coords: &[[f64; 3]],
-        material: &Elasticity3,
+        material: &Elasticity<3>,
         _thickness: f64,
         rule: &[QuadPoint<3>],
         ke: &mut [f64],
     ) {
-        element_stiffness3(self, coords, material, rule, ke);
+        element_stiffness(self, coords, material, 1.0, rule, ke);
     }
 
     fn stiffness_rule(self) -> Vec<QuadPoint<3>> {
@@ -230,15 +233,12 @@ impl SolidCell<3> for SolidKind {
         self,
         coords: &[[f64; 3]],
         u_e: &[f64],
-        material: &Elasticity3,
+        material: &Elasticity<3>,
         _thickness: f64,
         rule: &[QuadPoint<3>],
         out: &mut [f64],
     ) {
-        let fe = element_internal_force3(self, coords, u_e, material, rule);
-        for (o, f) in out.iter_mut().zip(&fe) {
-            *o += f;
-        }
+        add_internal_force(self, coords, u_e, material, 1.0, rule, out);
     }
 
     fn finite_residual_and_tangent(
@@ -259,11 +259,11 @@ impl SolidCell<3> for SolidKind {
         None
     }
 
-    fn youngs_modulus(material: &Elasticity3) -> f64 {
+    fn youngs_modulus(material: &Elasticity<3>) -> f64 {
         material.youngs_modulus
     }
 
-    fn exact_displacement(_: &ExactField, _: [f64; 3], _: &Elasticity3) -> Option<[f64; 3]> {
+    fn exact_displacement(_: &ExactField, _: [f64; 3], _: &Elasticity<3>) -> Option<[f64; 3]> {
         None
     }
 

@@ -14,7 +14,7 @@
 use crate::fe::ReferenceCell;
 use crate::mesh::{Facet, Mesh3};
 use crate::model::{Body3, Model3};
-use crate::solid3d::{body_force_load, facet_traction_load, voigt_strain, Elasticity3};
+use crate::solid::{body_force_load, facet_traction_load, strain_at, Elasticity, Voigt};
 use crate::solver::sparse::WorkLimit;
 use nalgebra::{Matrix3, SMatrix};
 
@@ -22,7 +22,7 @@ use nalgebra::{Matrix3, SMatrix};
 #[derive(Clone, Debug)]
 pub struct Solid3 {
     pub mesh: Mesh3,
-    pub material: Elasticity3,
+    pub material: Elasticity<3>,
     /// Prescribed value of each dof, if any.
     pub prescribed: Vec<Option<f64>>,
     /// Consistent external nodal forces.
@@ -30,7 +30,7 @@ pub struct Solid3 {
 }
 
 impl Solid3 {
-    pub fn new(mesh: Mesh3, material: Elasticity3) -> Self {
+    pub fn new(mesh: Mesh3, material: Elasticity<3>) -> Self {
         let n = 3 * mesh.nodes.len();
         Solid3 {
             mesh,
@@ -94,7 +94,12 @@ impl Solid3 {
     pub fn add_body_force(&mut self, body_force: &dyn Fn([f64; 3]) -> [f64; 3]) {
         let kind = self.mesh.kind;
         for c in 0..self.mesh.cell_count() {
-            let fe = body_force_load(kind, &self.mesh.cell_coords(c), body_force);
+            let fe = body_force_load(
+                kind,
+                &self.mesh.cell_coords(c),
+                &kind.error_rule(),
+                body_force,
+            );
             for (k, d) in self.cell_dofs(c).into_iter().enumerate() {
                 self.external_force[d] += fe[k];
             }
@@ -134,7 +139,7 @@ impl Solid3 {
             let coords = self.mesh.cell_coords(c);
             let u_e: Vec<f64> = self.cell_dofs(c).into_iter().map(|d| u[d]).collect();
             for q in &rule {
-                let (eps, x) = crate::solid3d::strain_at3(kind, &coords, &u_e, q.xi);
+                let (eps, x) = strain_at(kind, &coords, &u_e, q.xi);
                 out.push((x, self.material.stress(eps)));
             }
         }
@@ -171,7 +176,8 @@ impl Solid3 {
                 }
                 let ue = exact(pv.x);
                 l2 += w * (0..3).map(|i| (ue[i] - uh[i]).powi(2)).sum::<f64>();
-                let de = SMatrix::<f64, 6, 1>::from(voigt_strain(&(exact_gradient(pv.x) - hh)));
+                let de =
+                    SMatrix::<f64, 6, 1>::from(Voigt::<3>::strain(&(exact_gradient(pv.x) - hh)));
                 energy += w * (de.transpose() * self.material.d * de)[(0, 0)];
             }
         }
