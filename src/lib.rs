@@ -58,7 +58,6 @@ pub mod run;
 pub mod run3d;
 pub mod solid;
 pub mod solid_finite;
-pub mod solid_finite3;
 pub mod solver;
 
 pub use error::{Error, Result};

@@ -47,7 +47,8 @@ pub fn stress_at(body: &Body, u: &[f64], c: usize, xi: [f64; 2]) -> ([f64; 3], [
         if jacobian(&h) <= 0.0 {
             return ([f64::NAN; 3], x);
         }
-        return (law.cauchy(&h).0, x);
+        let sigma = law.cauchy(&h);
+        return ([sigma[(0, 0)], sigma[(1, 1)], sigma[(0, 1)]], x);
     }
     let (eps, x) = strain_at(body.mesh.kind, &coords, &ue, xi);
     (body.material.stress(eps), x)
@@ -94,7 +95,7 @@ pub fn out_of_plane_stress_at(body: &Body, u: &[f64], c: usize, xi: [f64; 2]) ->
         if jacobian(&h) <= 0.0 {
             return f64::NAN;
         }
-        return law.cauchy(&h).1;
+        return law.cauchy(&h)[(2, 2)];
     }
     body.material.sigma_zz(stress_at(body, u, c, xi).0)
 }

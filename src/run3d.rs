@@ -18,7 +18,7 @@
 //! they do not treat ([`crate::contact::discretization::Discretize`]).
 //!
 //! **Finite strain** (`physics.kinematics: "finite"`, hyperelastic materials
-//! [`crate::solid_finite3`]) runs the 2D driver [`crate::solver::finite`] (load steps of
+//! [`crate::solid_finite`]) runs the 2D driver [`crate::solver::finite`] (load steps of
 //! Newton's method with cuts, the same convergence rules and messages) on the 3D model,
 //! through the dimension-generic Newton contact system
 //! ([`crate::solver::contact_newton`]): frictionless contact against rigid planes and spheres
@@ -88,7 +88,7 @@ use crate::io::vtu::{write_grid, PointArray};
 use crate::mesh::block3;
 use crate::model::{Body3, MasterSide, Model3};
 use crate::post::pair_summaries;
-use crate::solid::{strain_at, Elasticity};
+use crate::solid::{strain_at, Elasticity, Voigt};
 use crate::solid_finite::Hyperelastic;
 use std::path::Path;
 
@@ -230,7 +230,7 @@ fn stress_at(body: &Body3, coords: &[[f64; 3]], u_e: &[f64], xi: [f64; 3]) -> ([
     match &body.hyperelastic {
         Some(law) => {
             let (h, x) = displacement_gradient_at(kind, coords, u_e, xi);
-            (x, law.cauchy3(&h))
+            (x, Voigt::<3>::symmetric_components(&law.cauchy(&h)))
         }
         None => {
             let (eps, x) = strain_at(kind, coords, u_e, xi);

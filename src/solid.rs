@@ -60,7 +60,7 @@ use crate::fe::{
     ReferenceCell, MAX_NODES,
 };
 use crate::io::scene::Plane;
-use nalgebra::{SMatrix, SVector, Vector3};
+use nalgebra::{SMatrix, Vector3};
 
 /// Largest number of element dofs in 2D.
 pub const MAX_DOFS: usize = 2 * MAX_NODES;
@@ -95,6 +95,16 @@ impl<const D: usize> Voigt<D> {
             } else {
                 h[(i, j)] + h[(j, i)]
             }
+        })
+    }
+
+    /// The components `(t_ij + t_ji) / 2` of the symmetric part of the tensor `t` (`V` =
+    /// [`Voigt::SIZE`]).
+    pub fn symmetric_components<const V: usize>(t: &SMatrix<f64, D, D>) -> [f64; V] {
+        const { assert!(V == D * (D + 1) / 2) };
+        std::array::from_fn(|p| {
+            let (i, j) = Self::PAIRS[p];
+            0.5 * (t[(i, j)] + t[(j, i)])
         })
     }
 
@@ -472,16 +482,11 @@ pub fn facet_traction_load(
     f
 }
 
-/// An element vector in 2D: the leading `2 n` entries (dof order `[u_x0, u_y0, u_x1, ...]`)
-/// are the element's, the rest zero.
-pub type ElementVector = SVector<f64, MAX_DOFS>;
-/// An element matrix in 2D: the leading `2 n x 2 n` block is the element's, the rest zero.
-pub type ElementMatrix = SMatrix<f64, MAX_DOFS, MAX_DOFS>;
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::fe3d::SolidKind;
+    use nalgebra::SVector;
 
     const PLANE_KINDS: [ElementKind; 4] = [
         ElementKind::Q4,

@@ -22,7 +22,8 @@
 use contact_patch::fe::displacement_gradient_at;
 use contact_patch::model::Model3;
 use contact_patch::run3d::{build3, run_case3, Outcome3};
-use contact_patch::solid_finite::{lame, Hyperelastic};
+use contact_patch::solid::{lame, Voigt};
+use contact_patch::solid_finite::Hyperelastic;
 use contact_patch::solver::linear::Solution;
 use nalgebra::{Matrix3, Vector3};
 use serde_json::{json, Value};
@@ -84,7 +85,10 @@ fn point_states(model: &Model3, u: &[f64]) -> Vec<(Matrix3<f64>, [f64; 6])> {
         let coords = body.mesh.cell_coords(c);
         for q in kind.stiffness_rule() {
             let (h, _) = displacement_gradient_at(kind, &coords, &ue, q.xi);
-            out.push((Matrix3::identity() + h, law.cauchy3(&h)));
+            out.push((
+                Matrix3::identity() + h,
+                Voigt::<3>::symmetric_components(&law.cauchy(&h)),
+            ));
         }
     }
     out
@@ -176,7 +180,7 @@ fn prescribed_everywhere(element: &str, material: &str, f: &Matrix3<f64>) -> Mod
 /// (1e-10 relative), every element and both materials; Newton converges quadratically.
 /// Objectivity on the same meshes: `x = R F X` (a rotation of 30 degrees about a skew axis)
 /// gives `R sigma(F) R^T` (1e-10), and a pure rotation of 60 degrees no stress (1e-10 of `E`).
-/// (The cells themselves are checked up to 90 degrees in `solid_finite3`; here the first
+/// (The cells themselves are checked up to 90 degrees in `solid_finite`; here the first
 /// iterate of a step leaves the interior behind the rotated boundary, and larger steps invert
 /// cells there and are cut.)
 #[test]
@@ -185,7 +189,9 @@ fn a_homogeneous_deformation_is_exact_and_objective_on_distorted_meshes() {
     let r = rotation([0.3, -0.4, 1.0], 30f64.to_radians());
     let turn = rotation([1.0, 1.0, 1.0], 60f64.to_radians());
     for material in MATERIALS {
-        let sigma = to_matrix(law(material).cauchy3(&(f - Matrix3::identity())));
+        let sigma = to_matrix(Voigt::<3>::symmetric_components(
+            &law(material).cauchy(&(f - Matrix3::identity())),
+        ));
         let scale = sigma.abs().max();
         for element in ELEMENTS {
             for (name, target, expected) in [

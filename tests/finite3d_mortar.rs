@@ -11,7 +11,7 @@
 
 use contact_patch::model::Model3;
 use contact_patch::run3d::{build3, run_case3, Outcome3};
-use contact_patch::solid_finite::lame;
+use contact_patch::solid::lame;
 use contact_patch::solver::linear::Solution;
 use nalgebra::{Matrix3, Vector3};
 use serde_json::{json, Value};

@@ -16,7 +16,6 @@ use crate::harness::exact::ExactField;
 use crate::model::{FacetLoad, Model};
 use crate::solid::{element_internal_force, element_stiffness, facet_traction_load, Elasticity};
 use crate::solid_finite::{element_residual_and_tangent, Hyperelastic, Inverted};
-use crate::solid_finite3::element_residual_and_tangent3;
 
 /// The cell kinds of a `D`-dimensional elastic body.
 pub trait SolidCell<const D: usize>: ReferenceCell<D> + Send + Sync + 'static {
@@ -53,8 +52,8 @@ pub trait SolidCell<const D: usize>: ReferenceCell<D> + Send + Sync + 'static {
     /// The total-Lagrangian internal force `f_e` (into `force[..D n]`) and, with
     /// `with_tangent`, the consistent tangent `K_e` (material + geometric, row-major, into
     /// `k[..(D n)^2]`) of the cell at `coords` under the element displacement `u_e`, for the
-    /// hyperelastic energy `law` ([`crate::solid_finite`] in 2D, plane strain, times the
-    /// thickness; [`crate::solid_finite3`] in 3D); `Err` at a quadrature point with
+    /// hyperelastic energy `law` ([`crate::solid_finite`]; in 2D plane strain, times the
+    /// thickness); `Err` at a quadrature point with
     /// `det F <= 0`.
     #[allow(clippy::too_many_arguments)]
     fn finite_residual_and_tangent(
@@ -166,18 +165,17 @@ impl SolidCell<2> for ElementKind {
         force: &mut [f64],
         k: &mut [f64],
     ) -> Result<(), Inverted<2>> {
-        let (f, ke) =
-            element_residual_and_tangent(self, coords, u_e, law, thickness, rule, with_tangent)?;
-        let nd = u_e.len();
-        force[..nd].copy_from_slice(&f.as_slice()[..nd]);
-        if with_tangent {
-            for i in 0..nd {
-                for j in 0..nd {
-                    k[i * nd + j] = ke[(i, j)];
-                }
-            }
-        }
-        Ok(())
+        element_residual_and_tangent(
+            self,
+            coords,
+            u_e,
+            law,
+            thickness,
+            rule,
+            with_tangent,
+            force,
+            k,
+        )
     }
 
     fn as_plane(model: &Model) -> Option<&Model> {
@@ -252,7 +250,7 @@ impl SolidCell<3> for SolidKind {
         force: &mut [f64],
         k: &mut [f64],
     ) -> Result<(), Inverted<3>> {
-        element_residual_and_tangent3(self, coords, u_e, law, rule, with_tangent, force, k)
+        element_residual_and_tangent(self, coords, u_e, law, 1.0, rule, with_tangent, force, k)
     }
 
     fn as_plane(_model: &Model<3, SolidKind>) -> Option<&Model> {

@@ -219,7 +219,7 @@ impl NewtonDimension<2> for crate::fe::ElementKind {
 }
 
 impl NewtonDimension<3> for crate::fe3d::SolidKind {
-    /// The hyperelastic kernels of [`crate::solid_finite3`] through the dimension-generic
+    /// The hyperelastic kernels of [`crate::solid_finite`] through the dimension-generic
     /// finite assembly.
     fn finite_tangent_and_residual(
         model: &crate::model::Model3,

@@ -10,8 +10,8 @@
 //! added by the contact system unchanged: in the current geometry their gap and normal are
 //! functions of `x = X + u`, searched again at every Newton iterate, and the circle's (2D) or
 //! sphere's (3D) second derivative of the gap enters the tangent. The driver is generic over
-//! the dimension: 3D cases ([`crate::run3d`]) run it with the kernels of
-//! [`crate::solid_finite3`].
+//! the dimension: 3D cases ([`crate::run3d`]) run it with the same kernels,
+//! generic over the dimension.
 //!
 //! **Load stepping with automatic cuts.** Step `k` of `n` drives the load factor to `k / n`
 //! (load paths at their own factors, [`crate::model::Model::at_load`]). When Newton fails on a

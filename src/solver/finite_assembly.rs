@@ -1,6 +1,6 @@
 //! Assembly of finite-kinematics solids: the internal force `f_int(u) = assemble_e f_e(u_e)`
 //! and the tangent `K_T(u) = assemble_e K_e(u_e)` from the total-Lagrangian hyperelastic
-//! kernels of [`crate::solid_finite`] (plane strain) and [`crate::solid_finite3`] (3D) behind
+//! kernels of [`crate::solid_finite`] (plane strain in 2D, and 3D) behind
 //! [`SolidCell::finite_residual_and_tangent`] (`f_a = sum_q w F S grad_0 N_a`, material +
 //! geometric tangent), in 2D and 3D alike, over the free equations of the Dirichlet constraints (prescribed dofs eliminated,
 //! [`crate::solver::constraints::AffineConstraints`]: the residual is `f_int(u) - f_ext`

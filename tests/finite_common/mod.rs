@@ -202,7 +202,7 @@ pub fn to_matrix(s: [f64; 6]) -> nalgebra::Matrix3<f64> {
 /// The lateral stretch `b` of a neo-Hookean bar (`E`, `NU`) stretched by `a` with free lateral
 /// faces: `sigma_xx = (mu (b^2 - 1) + lambda ln(a b^2)) / J = 0`, by bisection.
 pub fn lateral_stretch(a: f64) -> f64 {
-    let (lambda, mu) = contact_patch::solid_finite::lame(E, NU);
+    let (lambda, mu) = contact_patch::solid::lame(E, NU);
     let (mut lo, mut hi) = (0.1, 3.0);
     for _ in 0..200 {
         let m = 0.5 * (lo + hi);
