@@ -113,8 +113,8 @@ pub fn read_3d_case(path: &Path) -> Option<Case> {
     is_3d(&case, &source).then_some(case)
 }
 
-/// What a 3D run produced: the one [`crate::run::Outcome`] of both dimensions.
-pub type Outcome3 = crate::run::Outcome<3, SolidKind>;
+/// What a 3D run produced: the one [`crate::outcome::Outcome`] of both dimensions.
+pub type Outcome3 = crate::outcome::Outcome<3, SolidKind>;
 
 /// Run the 3D case `case` read from `source`.
 pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
@@ -654,7 +654,7 @@ fn contact_summary(outcome: &Outcome3, results: &[PairResults<3>]) -> Option<ser
         "max_penetration_share": most(|p| p.share_of_element),
         "pairs": pairs,
     });
-    if let Some(friction) = crate::contact::friction::step_summary(state) {
+    if let Some(friction) = state.friction_summary(None) {
         // Coulomb pairs: the tangential force, the open/stick/slip counts and the dissipation
         // of the last step, and the load steps' totals
         summary["friction"] = serde_json::to_value(friction).expect("the summary serializes");
