@@ -261,13 +261,12 @@ fn before_the_solve<const D: usize, K: crate::contact::discretization::Discretiz
     }
     let current = model.physics.contact_geometry == ContactGeometry::Current;
     let areas = if current {
-        crate::solver::active_set::reference_areas(model)?
+        crate::contact::rows::reference_areas(model)?
     } else {
-        crate::solver::active_set::ReferenceAreas::new()
+        crate::contact::rows::ReferenceAreas::new()
     };
     let start = vec![0.0; model.dof_count];
-    let rows =
-        crate::solver::active_set::rows_at(model, current.then_some((start.as_slice(), &areas)))?;
+    let rows = crate::contact::rows::rows_at(model, current.then_some((start.as_slice(), &areas)))?;
     crate::solver::refuse_obstacles(model, &rows)
 }
 

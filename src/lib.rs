@@ -53,6 +53,7 @@ pub mod harness;
 pub mod io;
 pub mod mesh;
 pub mod model;
+pub mod outcome;
 pub mod post;
 pub mod run;
 pub mod run3d;

@@ -474,7 +474,7 @@ pub fn pair_summaries<const D: usize, K: SolidCell<D>>(
                 node,
                 point,
             }),
-            friction: crate::contact::friction::pair_summary(state, f.pair),
+            friction: state.friction_summary(Some(f.pair)),
             normal_force: r.totals.normal_force,
             closed_area: r.totals.closed_area,
             point_status: PointStatusCounts {

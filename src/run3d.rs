@@ -77,7 +77,7 @@ use crate::error::{Error, Result};
 use crate::fe::displacement_gradient_at;
 use crate::fe::ReferenceCell;
 use crate::fe3d::SolidKind;
-use crate::harness::checks::{penetration_warnings, CheckResult};
+use crate::harness::checks::CheckResult;
 use crate::io::contact_output::{body_point_arrays, write_pair_files};
 use crate::io::paths::{file_name, name_problem, OutputFolder, NAME_RULE};
 use crate::io::scene::{
@@ -113,8 +113,8 @@ pub fn read_3d_case(path: &Path) -> Option<Case> {
     is_3d(&case, &source).then_some(case)
 }
 
-/// What a 3D run produced: the one [`crate::run::Outcome`] of both dimensions.
-pub type Outcome3 = crate::run::Outcome<3, SolidKind>;
+/// What a 3D run produced: the one [`crate::outcome::Outcome`] of both dimensions.
+pub type Outcome3 = crate::outcome::Outcome<3, SolidKind>;
 
 /// Run the 3D case `case` read from `source`.
 pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
@@ -128,66 +128,44 @@ pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
     crate::post::check_finite_nodal_stresses(&model, &solution.u, nodal_stress)?;
     solution.timings.mesh = meshed;
     solution.timings.total = start.elapsed().as_secs_f64();
-    let forces = solution
-        .contact
-        .as_ref()
-        .map(|state| pair_forces(&model, state));
-    let mut checks: Vec<CheckResult> = case
-        .checks
+    let checks = crate::harness::checks::evaluate(&model, &solution);
+    let warnings: Vec<String> = model
+        .warnings
         .iter()
-        .map(|check| match check {
-            Check::UniformStress3d { stress, tol } => {
-                uniform_stress_check3(&model, &solution.u, stress, *tol)
-            }
-            Check::ContactForce { .. }
-            | Check::MaxContactPressure { .. }
-            | Check::MaxPenetration { .. }
-            | Check::ForceBalance { .. } => {
-                let magnitudes = crate::harness::checks::Magnitudes::of(&model, &solution);
-                let (check, error, tol) = crate::harness::checks::contact_force_check(
-                    &model,
-                    &solution,
-                    forces.as_deref(),
-                    &magnitudes,
-                    check,
-                )
-                .expect("a contact force check");
-                CheckResult {
-                    check,
-                    error,
-                    tol,
-                    passed: error <= tol,
-                }
-            }
-            reaction @ Check::Reaction { .. } => {
-                crate::harness::checks::reaction_result(&model, &solution, reaction)
-                    .expect("a reaction check")
-            }
-            _ => unreachable!("Model::resolve_checks refuses in 3D every check matched above"),
-        })
+        .cloned()
+        .chain(crate::harness::checks::warnings(&model, &solution))
         .collect();
-    checks.extend(crate::harness::checks::unconverged(
-        &model.checks,
-        &solution,
-    ));
-    let mut warnings: Vec<String> = model.warnings.clone();
-    if let (Some(state), Some(f)) = (&solution.contact, &forces) {
-        warnings.extend(penetration_warnings(
-            &model,
-            state,
-            f.iter().map(|f| (f.pair, f.penetration.clone())),
-        ));
-    }
-    warnings.extend(crate::harness::stability::friction_cannot_hold(
-        &model, &solution,
-    ));
-    warnings.extend(crate::harness::stability::unstable_equilibrium(&solution));
     Ok(Outcome3 {
         model,
         solution,
         checks,
         warnings,
     })
+}
+
+/// The 3D checks of the stress; those against a 2D stress or exact field fail saying so (the
+/// model refuses them in a 3D case before a run).
+impl crate::harness::checks::DimensionChecks<3> for SolidKind {
+    fn judge_by_dimension(
+        model: &Model3,
+        solution: &crate::solver::linear::Solution<3>,
+        _contact_forces: Option<&[crate::contact::forces::PairForces<3>]>,
+        _magnitudes: &crate::harness::checks::Magnitudes,
+        check: &Check,
+    ) -> Option<(String, f64, f64)> {
+        match check {
+            Check::UniformStress3d { stress, tol } => {
+                let r = uniform_stress_check3(model, &solution.u, stress, *tol);
+                Some((r.check, r.error, r.tol))
+            }
+            Check::UniformStress { .. }
+            | Check::ExactDisplacement { .. }
+            | Check::ContactPressure { .. } => {
+                Some(crate::harness::checks::not_judged_in("3D", check))
+            }
+            _ => None,
+        }
+    }
 }
 
 /// The words of the `uniform_stress_3d` check with the expected `stress` (shared by the run and
@@ -654,7 +632,7 @@ fn contact_summary(outcome: &Outcome3, results: &[PairResults<3>]) -> Option<ser
         "max_penetration_share": most(|p| p.share_of_element),
         "pairs": pairs,
     });
-    if let Some(friction) = crate::contact::friction::step_summary(state) {
+    if let Some(friction) = state.friction_summary(None) {
         // Coulomb pairs: the tangential force, the open/stick/slip counts and the dissipation
         // of the last step, and the load steps' totals
         summary["friction"] = serde_json::to_value(friction).expect("the summary serializes");

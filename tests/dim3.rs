@@ -669,3 +669,103 @@ fn an_explicit_3d_mesh_runs_and_the_2d_model_refuses_3d_meshes() {
         "{err}"
     );
 }
+
+/// A 3D case is judged by the checks a 2D one is (issue 40: one set of checks): `equilibrium`,
+/// `displacement` at a point of three coordinates, `warns`, `terminates_with` and
+/// `status_changes` pass or fail as in 2D; only the checks against a 2D stress or exact field
+/// are refused, by name. (They were refused in 3D: "this check is not judged in 3D".)
+#[test]
+fn a_3d_case_is_judged_by_the_checks_of_a_2d_one() {
+    // patch-hex8: sigma_zz = -2 under E = 200 and the base held in z, so u_z = -0.01 z and the
+    // top corner (1, 0.8, 1.2) moves by -0.012
+    let checks = serde_json::json!([
+        {"check": "equilibrium", "tol": 1e-10},
+        {"check": "displacement", "body": "block", "point": [1.0, 0.8, 1.2], "component": "z",
+         "value": -0.012, "tol": 1e-9},
+        {"check": "displacement", "body": "block", "point": [1.0, 0.8, 1.2], "component": "z",
+         "value": -0.013, "tol": 1e-9},
+        {"check": "warns", "contains": "penetration"}
+    ]);
+    let (dir, path) = edited_case(|c| c["checks"] = checks.clone());
+    let (code, stdout, stderr) = run_binary(&path, &dir.path().join("out"));
+    assert_eq!(code, 1, "{stdout}\n{stderr}");
+    assert!(
+        line_of(&stdout, "relative equilibrium residual").contains("pass"),
+        "{stdout}"
+    );
+    assert!(
+        line_of(
+            &stdout,
+            "displacement Z of block at (1, 0.8, 1.2) = -1.200000e-2"
+        )
+        .contains("pass"),
+        "{stdout}"
+    );
+    assert!(
+        line_of(&stdout, "(expected -0.013)").contains("FAIL"),
+        "{stdout}"
+    );
+    assert!(
+        line_of(&stdout, "the run warns \"penetration\"").contains("FAIL"),
+        "{stdout}"
+    );
+
+    // a contact case: the solve's ending and its status changes
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let folder = root.join("cases/gmsh/3d");
+    let text = std::fs::read_to_string(folder.join("punch-on-foundation.json")).unwrap();
+    let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
+    case["checks"] = serde_json::json!([
+        {"check": "terminates_with", "reason": "converged"},
+        {"check": "status_changes", "per_iteration": 1000, "per_step": 1000},
+        {"check": "terminates_with", "reason": "iteration_limit"}
+    ]);
+    // the case names its mesh relative to its own folder: both go to a temporary one
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        folder.join("punch-on-foundation.msh"),
+        dir.path().join("punch-on-foundation.msh"),
+    )
+    .unwrap();
+    let path = dir.path().join("case.json");
+    std::fs::write(&path, case.to_string()).unwrap();
+    let (code, stdout, stderr) = run_binary(&path, &dir.path().join("out"));
+    assert_eq!(code, 1, "{stdout}\n{stderr}");
+    assert!(
+        line_of(&stdout, "the contact solve ends Converged").contains("pass"),
+        "{stdout}"
+    );
+    assert!(
+        line_of(&stdout, "(at most 1000)").contains("pass"),
+        "{stdout}"
+    );
+    assert!(
+        line_of(&stdout, "the contact solve ends IterationLimit").contains("FAIL"),
+        "{stdout}"
+    );
+
+    // refused by name: a 2D stress, and a point of two coordinates
+    for (check, expected) in [
+        (
+            serde_json::json!({"check": "uniform_stress", "stress": [0, 0, 0], "tol": 1e-10}),
+            "this check is not judged in 3D (uniform_stress, exact_displacement and contact_pressure",
+        ),
+        (
+            serde_json::json!({"check": "displacement", "body": "block", "point": [1.0, 0.8],
+                               "component": "z", "value": 0.0, "tol": 1e-9}),
+            "the point has 2 components, but body 'block' is 3D",
+        ),
+    ] {
+        let (dir, path) = edited_case(|c| c["checks"] = serde_json::json!([check]));
+        let (code, _, stderr) = run_binary(&path, &dir.path().join("out"));
+        assert_eq!(code, 2, "{stderr}");
+        assert!(stderr.contains(expected), "{expected}: {stderr}");
+    }
+}
+
+fn line_of(text: &str, words: &str) -> String {
+    text.lines()
+        .find(|l| l.contains(words))
+        .unwrap_or_else(|| panic!("no line with {words:?}: {text}"))
+        .to_string()
+}

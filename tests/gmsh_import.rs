@@ -604,14 +604,18 @@ fn the_contact_checks_judge_a_3d_pair() {
         failed,
         ["total contact force Z of 'interface' on its slave body = 1.000000e1 (expected 9)"]
     );
-    let refused =
-        edited(&|c| c["checks"] = serde_json::json!([{"check": "equilibrium", "tol": 1e-10}]));
+    // a check against the exact field (2D) is refused by name
+    let refused = edited(&|c| {
+        c["checks"] =
+            serde_json::json!([{"check": "contact_pressure", "pair": "interface", "tol": 1e-10}])
+    });
     let (code, stderr) = run(&refused, &dir.path().join("refused"));
     assert_eq!(code, 2, "{stderr}");
     assert!(
         stderr.contains("checks[0]")
             && stderr.contains("not judged in 3D")
-            && stderr.contains("force_balance"),
+            && stderr.contains("contact_pressure")
+            && stderr.contains("uniform_stress_3d"),
         "{stderr}"
     );
 }

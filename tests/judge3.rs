@@ -217,3 +217,44 @@ fn a_3d_reaction_check_is_judged_from_the_results_as_the_run_judges_it() {
         "{err}"
     );
 }
+
+/// The `displacement` check of a 3D case is judged from the results' displacements as the run
+/// judges it; the checks of how our own solve ran (`equilibrium`, `warns`, ...) are listed as
+/// not judged, with the reason, as in 2D.
+#[test]
+fn a_3d_displacement_check_is_judged_from_the_results_and_our_solves_checks_are_not() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = root().join("cases/3d/patch-hex8.json");
+    let mut case = read_3d_case(&path).unwrap();
+    let extra: Vec<contact_patch::io::scene::Check> = serde_json::from_value(serde_json::json!([
+        {"check": "displacement", "body": "block", "point": [1.0, 0.8, 1.2], "component": "z",
+         "value": -0.012, "tol": 1e-9},
+        {"check": "equilibrium", "tol": 1e-10}
+    ]))
+    .unwrap();
+    case.checks.extend(extra);
+    let direct = run_case3(&case, &path.display().to_string()).unwrap();
+    let displacement = direct
+        .checks
+        .iter()
+        .find(|c| c.check.starts_with("displacement Z of block at (1, 0.8, 1.2)"))
+        .unwrap_or_else(|| panic!("{:?}", direct.checks));
+    assert!(displacement.passed, "{displacement:?}");
+    let folder = OutputFolder::new(&tmp.path().join(&direct.model.name)).unwrap();
+    write_run3(&folder, &direct).unwrap();
+    let results = load_results3(&direct.model, folder.path()).unwrap();
+    let j = judge3(&direct.model, &results, 1e-8).unwrap();
+    let judged = j
+        .checks
+        .iter()
+        .find(|c| c.check == displacement.check)
+        .unwrap_or_else(|| panic!("{:?}", j.checks));
+    assert_eq!(judged.error, displacement.error, "u is read back bit for bit");
+    assert_eq!(j.not_judged.len(), 1, "{:?}", j.not_judged);
+    assert!(j.not_judged[0].check.contains("equilibrium"));
+    assert!(
+        j.not_judged[0].why.contains("how our own solve ran"),
+        "{}",
+        j.not_judged[0].why
+    );
+}

@@ -521,60 +521,6 @@ pub struct FrictionSummary {
     pub max_cone_ratio: f64,
 }
 
-/// The frictional totals of all pairs of `state` (`None`: no frictional row).
-pub fn step_summary<const D: usize>(
-    state: &super::state::ContactState<D>,
-) -> Option<FrictionSummary> {
-    summarize(state, None)
-}
-
-/// The frictional totals of pair `pair` of `state` (`None`: no frictional row).
-pub fn pair_summary<const D: usize>(
-    state: &super::state::ContactState<D>,
-    pair: usize,
-) -> Option<FrictionSummary> {
-    summarize(state, Some(pair))
-}
-
-fn summarize<const D: usize>(
-    state: &super::state::ContactState<D>,
-    pair: Option<usize>,
-) -> Option<FrictionSummary> {
-    let mut out = FrictionSummary {
-        tangential_force: vec![0.0; D],
-        open: 0,
-        stick: 0,
-        slip: 0,
-        dissipation: 0.0,
-        max_cone_ratio: 0.0,
-    };
-    let mut any = false;
-    for (r, f) in state.rows.iter().zip(&state.friction) {
-        let (Some(f), true) = (f, pair.is_none_or(|p| p == r.pair)) else {
-            continue;
-        };
-        any = true;
-        for (t, &component) in r.tangents.iter().zip(&f.force) {
-            for k in 0..D {
-                out.tangential_force[k] += component * t.direction[k];
-            }
-        }
-        match f.status {
-            Status::Open => out.open += 1,
-            Status::Stick => out.stick += 1,
-            Status::Slip => out.slip += 1,
-        }
-        out.dissipation += f.dissipation;
-        let magnitude = f.force_length();
-        if f.status != Status::Open && magnitude != 0.0 {
-            out.max_cone_ratio = out
-                .max_cone_ratio
-                .max(magnitude / (f.mu * f.normal_force.max(0.0)));
-        }
-    }
-    any.then_some(out)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -40,6 +40,7 @@ pub mod enforcement;
 pub mod forces;
 pub mod friction;
 pub mod results;
+pub mod rows;
 pub mod state;
 
 /// One linearized contact constraint (a row of `B`) in `D` dimensions (2 unless named: the

@@ -3,6 +3,7 @@
 //! iterations. Plain data, written by [`crate::solver::active_set`] and read by the checks, the harness and
 //! the output (`summary.json`).
 
+use super::friction::{FrictionSummary, Status};
 use super::Constraint;
 
 /// Why the active-set loop stopped.
@@ -67,6 +68,45 @@ impl<const D: usize> ContactState<D> {
     ) -> std::collections::HashMap<crate::contact::RowKey, crate::contact::friction::Committed>
     {
         committed_history(&self.rows, &self.friction)
+    }
+
+    /// The frictional totals (tangential force, stick/slip/open counts, dissipation, the
+    /// largest cone ratio) of pair `pair`, or of all pairs for `None`; `None` when no row of
+    /// them is frictional.
+    pub fn friction_summary(&self, pair: Option<usize>) -> Option<FrictionSummary> {
+        let mut out = FrictionSummary {
+            tangential_force: vec![0.0; D],
+            open: 0,
+            stick: 0,
+            slip: 0,
+            dissipation: 0.0,
+            max_cone_ratio: 0.0,
+        };
+        let mut any = false;
+        for (r, f) in self.rows.iter().zip(&self.friction) {
+            let (Some(f), true) = (f, pair.is_none_or(|p| p == r.pair)) else {
+                continue;
+            };
+            any = true;
+            for (t, &component) in r.tangents.iter().zip(&f.force) {
+                for k in 0..D {
+                    out.tangential_force[k] += component * t.direction[k];
+                }
+            }
+            match f.status {
+                Status::Open => out.open += 1,
+                Status::Stick => out.stick += 1,
+                Status::Slip => out.slip += 1,
+            }
+            out.dissipation += f.dissipation;
+            let magnitude = f.force_length();
+            if f.status != Status::Open && magnitude != 0.0 {
+                out.max_cone_ratio = out
+                    .max_cone_ratio
+                    .max(magnitude / (f.mu * f.normal_force.max(0.0)));
+            }
+        }
+        any.then_some(out)
     }
 }
 

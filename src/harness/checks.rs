@@ -18,6 +18,7 @@
 //! not change with the units (defect D19: a reaction expected to be 0 failed at 7.6e-6 once E
 //! and the loads were scaled by 1e9, while the stress was exact to 1.5e-15).
 
+use crate::contact::discretization::Discretize;
 use crate::contact::forces::{pair_forces, PairForces, Penetration};
 use crate::contact::state::{ContactState, Termination};
 use crate::io::scene::{Check, Interaction, TerminationReason};
@@ -312,26 +313,34 @@ pub fn force_balance_terms<const D: usize, K: SolidCell<D>>(
     (error, largest)
 }
 
+/// A point's coordinates as a message writes them: `(x, y)` or `(x, y, z)`, six decimals.
+pub(crate) fn point_text(x: &[f64]) -> String {
+    let x: Vec<String> = x.iter().map(|v| format!("{v:.6}")).collect();
+    format!("({})", x.join(", "))
+}
+
 /// Penetration above this share of the contact element size makes a run warn.
 pub const PENETRATION_WARNING_SHARE: f64 = 0.05;
 
 /// What a run should say even when every check passes: slave nodes that slid off the master
 /// surface (contact geometry in the current configuration), and penetration beyond
 /// [`PENETRATION_WARNING_SHARE`] of the contact element size.
-pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
+pub fn warnings<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+) -> Vec<String> {
     let Some(state) = &solution.contact else {
         return Vec::new();
     };
     let departures = state.departures.iter().map(|d| {
         format!(
-            "contact '{}': slave node {} of body '{}' left the master surface at ({:.6}, {:.6}) \
+            "contact '{}': slave node {} of body '{}' left the master surface at {} \
              (geometry update {}: no master facet under it, past the end of the master \
              surface); it carries no contact force from there on",
             model.contact[d.pair].name,
             d.node,
             model.bodies[d.body].name,
-            d.point[0],
-            d.point[1],
+            point_text(&d.point),
             d.update
         )
     });
@@ -363,11 +372,10 @@ pub fn penetration_warnings<const D: usize, K: SolidCell<D>>(
         .map(|(pair, p)| {
             let at =
                 p.at.map(|(b, n, x)| {
-                    let x: Vec<String> = x.iter().map(|v| format!("{v:.6}")).collect();
                     format!(
-                        " at node {n} of body '{}' ({})",
+                        " at node {n} of body '{}' {}",
                         model.bodies[b].name,
-                        x.join(", ")
+                        point_text(&x)
                     )
                 })
                 .unwrap_or_default();
@@ -393,7 +401,10 @@ pub fn penetration_warnings<const D: usize, K: SolidCell<D>>(
 /// One warning per tied pair whose slave surface has nodes with no tie row: no master facet
 /// under them (a slave surface longer than the master's), so they are not glued and carry no
 /// interface force. Named so that a tie that covers less than the user's set is never silent.
-fn untied_slave_nodes(model: &Model, state: &crate::contact::state::ContactState) -> Vec<String> {
+fn untied_slave_nodes<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    state: &ContactState<D>,
+) -> Vec<String> {
     let mut out = Vec::new();
     for (k, pair) in model.contact.iter().enumerate() {
         if pair.interaction != Interaction::Tied {
@@ -419,10 +430,7 @@ fn untied_slave_nodes(model: &Model, state: &crate::contact::state::ContactState
         }
         let named: Vec<String> = loose
             .iter()
-            .map(|&n| {
-                let x = mesh.nodes[n];
-                format!("{n} ({:.6}, {:.6})", x[0], x[1])
-            })
+            .map(|&n| format!("{n} {}", point_text(&mesh.nodes[n])))
             .collect();
         out.push(format!(
             "tied pair '{}': {} slave node(s) of body '{}' have no master facet under them and \
@@ -469,12 +477,145 @@ fn pair_of<'a, const D: usize, K: SolidCell<D>>(
 /// Judge every check of the model (names were resolved when the model was built). A contact
 /// solve that did not converge adds a failing check of its own, so that no declared check can
 /// pass on an unconverged solution.
-pub fn evaluate(model: &Model, solution: &Solution) -> Vec<CheckResult> {
-    let forces: Option<Vec<PairForces>> = solution
+pub fn evaluate<const D: usize, K: DimensionChecks<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+) -> Vec<CheckResult> {
+    let forces: Option<Vec<PairForces<D>>> = solution
         .contact
         .as_ref()
         .map(|state| pair_forces(model, state));
     evaluate_with(model, solution, forces.as_deref())
+}
+
+/// The checks whose judging depends on the dimension: the stress checks (`uniform_stress` over
+/// `[xx, yy, xy]` in 2D, `uniform_stress_3d` over six components in 3D) and those against the
+/// case's exact field (`exact_displacement`, `contact_pressure`; exact fields are 2D). Every
+/// other check is judged once for both dimensions by [`evaluate_with`].
+pub trait DimensionChecks<const D: usize>: Discretize<D> {
+    /// The words, error and tolerance of `check` when it is one of the checks above (a check
+    /// of the other dimension fails, saying so; the model refuses it before a run), `None`
+    /// for any other check.
+    fn judge_by_dimension(
+        model: &Model<D, Self>,
+        solution: &Solution<D>,
+        contact_forces: Option<&[PairForces<D>]>,
+        magnitudes: &Magnitudes,
+        check: &Check,
+    ) -> Option<(String, f64, f64)>;
+}
+
+/// The words, an infinite error and the tolerance of a check of the other dimension (or of a
+/// field this dimension has not built), for [`DimensionChecks::judge_by_dimension`].
+pub fn not_judged_in(dimension: &str, check: &Check) -> (String, f64, f64) {
+    let tol = match check {
+        Check::UniformStress { tol, .. }
+        | Check::UniformStress3d { tol, .. }
+        | Check::ExactDisplacement { tol }
+        | Check::ContactPressure { tol, .. } => *tol,
+        _ => 0.0,
+    };
+    // the check's name is its tag in the case file
+    let name = serde_json::to_value(check)
+        .ok()
+        .and_then(|v| v.get("check").and_then(|c| c.as_str()).map(String::from))
+        .unwrap_or_else(|| "this check".into());
+    (
+        format!("{name}: not judged in {dimension}"),
+        f64::INFINITY,
+        tol,
+    )
+}
+
+impl DimensionChecks<2> for crate::fe::ElementKind {
+    fn judge_by_dimension(
+        model: &Model,
+        solution: &Solution,
+        contact_forces: Option<&[PairForces]>,
+        magnitudes: &Magnitudes,
+        check: &Check,
+    ) -> Option<(String, f64, f64)> {
+        let u = &solution.u;
+        Some(match check {
+            Check::UniformStress {
+                body,
+                stress,
+                tol,
+                per_condition,
+            } => {
+                let (tol, stated) = conditioned_tolerance(model, solution, *tol, *per_condition);
+                let largest = stress.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let (scale, against) = if largest > 0.0 {
+                    (largest, String::new())
+                } else {
+                    (
+                        magnitudes.stress,
+                        format!(
+                            ", judged relative to the load's stress {:.3e}",
+                            magnitudes.stress
+                        ),
+                    )
+                };
+                let scale = scale.max(f64::MIN_POSITIVE);
+                let mut error = 0.0f64;
+                for b in model
+                    .bodies
+                    .iter()
+                    .filter(|b| body.as_ref().is_none_or(|n| *n == b.name))
+                {
+                    for_each_quadrature_stress(b, u, |_, _, s| {
+                        for i in 0..3 {
+                            error = worst(error, (s[i] - stress[i]).abs() / scale);
+                        }
+                    });
+                }
+                let on = body
+                    .as_deref()
+                    .map(|b| format!(" in body '{b}'"))
+                    .unwrap_or_default();
+                (
+                    format!("uniform stress {stress:?}{on}{against}{stated}"),
+                    error,
+                    tol,
+                )
+            }
+            Check::UniformStress3d { .. } => not_judged_in("2D", check),
+            Check::ExactDisplacement { tol } => {
+                let exact = model
+                    .exact
+                    .as_ref()
+                    .expect("resolved when the model was built");
+                (
+                    "relative L2 displacement error against the exact solution".to_string(),
+                    relative_l2_displacement_error(model, u, exact),
+                    *tol,
+                )
+            }
+            Check::ContactPressure { pair, tol } => {
+                let exact = model
+                    .exact
+                    .as_ref()
+                    .expect("resolved when the model was built");
+                let k = model
+                    .contact
+                    .iter()
+                    .position(|p| p.name == *pair)
+                    .expect("resolved when the model was built");
+                let error = match contact_forces {
+                    Some(forces) => {
+                        pressure_error_of(model, solution, forces, exact, Some(k), None)
+                    }
+                    None => f64::INFINITY,
+                };
+                (
+                    format!("contact pressure of '{pair}' against the exact stress"),
+                    error,
+                    *tol,
+                )
+            }
+            _ => return None,
+        })
+    }
 }
 
 /// The failing check a contact solve that did not converge adds to the declared `checks` (2D
@@ -584,132 +725,186 @@ pub fn contact_force_check<const D: usize, K: SolidCell<D>>(
 /// [`evaluate`] with the contact forces given: those of our solve (`solution.contact`), or,
 /// for another code's results, the ones [`crate::harness::outside_contact`] read (then
 /// `solution.contact` is `None`). `None`: no contact forces, every contact check fails.
-pub fn evaluate_with(
-    model: &Model,
-    solution: &Solution,
-    contact_forces: Option<&[PairForces]>,
+pub fn evaluate_with<const D: usize, K: DimensionChecks<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+    contact_forces: Option<&[PairForces<D>]>,
 ) -> Vec<CheckResult> {
-    let u = &solution.u;
     let magnitudes = Magnitudes::of(model, solution);
-    let has_forces = contact_forces.is_some();
-    let forces: &[PairForces] = contact_forces.unwrap_or(&[]);
     let convergence = unconverged(&model.checks, solution);
-    let declared: Vec<CheckResult> = model
+    let declared = model
         .checks
         .iter()
-        .map(|check| {
-            let (check_name, error, tol) = match check {
-                Check::UniformStress { body, stress, tol, per_condition } => {
-                    let (tol, stated) = conditioned_tolerance(model, solution, *tol, *per_condition);
-                    let largest = stress.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                    let (scale, against) = if largest > 0.0 {
-                        (largest, String::new())
-                    } else {
-                        (magnitudes.stress, format!(", judged relative to the load's stress {:.3e}", magnitudes.stress))
-                    };
-                    let scale = scale.max(f64::MIN_POSITIVE);
-                    let mut error = 0.0f64;
-                    for b in model.bodies.iter().filter(|b| body.as_ref().is_none_or(|n| *n == b.name)) {
-                        for_each_quadrature_stress(b, u, |_, _, s| {
-                            for i in 0..3 {
-                                error = worst(error, (s[i] - stress[i]).abs() / scale);
-                            }
-                        });
-                    }
-                    let on = body.as_deref().map(|b| format!(" in body '{b}'")).unwrap_or_default();
-                    (format!("uniform stress {stress:?}{on}{against}{stated}"), error, tol)
-                }
-                Check::UniformStress3d { tol, .. } => (
-                    "uniform_stress_3d: a 3D check, judged by the run of a 3D case only".to_string(),
-                    f64::INFINITY,
-                    *tol,
-                ),
-                Check::ExactDisplacement { tol } => {
-                    let exact = model.exact.as_ref().expect("resolved when the model was built");
-                    (
-                        "relative L2 displacement error against the exact solution".to_string(),
-                        relative_l2_displacement_error(model, u, exact),
-                        *tol,
-                    )
-                }
-                Check::Reaction { body, set, component, value, tol } => {
-                    reaction_check(model, solution, &magnitudes, (body, set), *component, *value, *tol)
-                }
-                Check::ContactPressure { pair, tol } => {
-                    let exact = model.exact.as_ref().expect("resolved when the model was built");
-                    let k = model.contact.iter().position(|p| p.name == *pair).expect("resolved when the model was built");
-                    let error = if has_forces { pressure_error_of(model, solution, forces, exact, Some(k), None) } else { f64::INFINITY };
-                    (format!("contact pressure of '{pair}' against the exact stress"), error, *tol)
-                }
-                Check::ContactForce { .. } | Check::MaxContactPressure { .. } | Check::MaxPenetration { .. } => {
-                    contact_force_check(model, solution, contact_forces, &magnitudes, check).expect("a contact force check")
-                }
-                Check::TerminatesWith { reason, contains } => {
-                    let (got, text) = match solution.contact.as_ref().map(|c| &c.termination) {
-                        Some(Termination::Converged) => (Some(TerminationReason::Converged), String::new()),
-                        Some(Termination::IterationLimit) => (Some(TerminationReason::IterationLimit), String::new()),
-                        Some(Termination::ActiveSetCycling(m)) => (Some(TerminationReason::ActiveSetCycling), m.clone()),
-                        Some(Termination::Singular(m)) => (Some(TerminationReason::Singular), m.clone()),
-                        Some(Termination::WorkLimit(m)) => (Some(TerminationReason::WorkLimit), m.clone()),
-                        None => (None, String::new()),
-                    };
-                    // the message of the stop and the run's warnings (diagnoses) are searched
-                    let said = format!("{text}\n{}", warnings(model, solution).join("\n"));
-                    let found = contains.as_ref().is_none_or(|c| said.contains(c.as_str()));
-                    let with = contains.as_ref().map(|c| format!(" with a message containing {c:?}")).unwrap_or_default();
-                    let how = if text.is_empty() { String::new() } else { format!(": {text}") };
-                    (
-                        format!("the contact solve ends {reason:?}{with} (it ended {got:?}{how})"),
-                        if got == Some(*reason) && found { 0.0 } else { f64::INFINITY },
-                        0.0,
-                    )
-                }
-                Check::Equilibrium { tol, per_condition } => {
-                    let (tol, stated) = conditioned_tolerance(model, solution, *tol, *per_condition);
-                    (format!("relative equilibrium residual{stated}"), solution.relative_residual, tol)
-                }
-                Check::StatusChanges { per_iteration, per_step } => {
-                    let (it, step) = solution.contact.as_ref().map(crate::harness::stability::status_changes).unwrap_or((usize::MAX, usize::MAX));
-                    let over = (it as f64 / (*per_iteration).max(1) as f64).max(step as f64 / (*per_step).max(1) as f64);
-                    let within = it <= *per_iteration && step <= *per_step;
-                    (
-                        format!("status changes {it} per iteration (at most {per_iteration}) and {step} per step (at most {per_step})"),
-                        if within { 0.0 } else { over },
-                        0.0,
-                    )
-                }
-                Check::Warns { contains } => {
-                    let found = warnings(model, solution).iter().any(|w| w.contains(contains.as_str()));
-                    (format!("the run warns {contains:?}"), if found { 0.0 } else { f64::INFINITY }, 0.0)
-                }
-                Check::ForceBalance { .. } => {
-                    contact_force_check(model, solution, contact_forces, &magnitudes, check).expect("a contact force check")
-                }
-                Check::Displacement { body, point, component, value, tol } => {
-                    let b = model.body(body).expect("resolved when the model was built");
-                    let (n, _) = b.mesh.nearest_node(*point).expect("a body has nodes");
-                    let got = u[b.dof(n, component.index())];
-                    let (error, expected) = judged(got, *value, magnitudes.displacement, "the largest displacement");
-                    (
-                        format!("displacement {component:?} of {body} at ({}, {}) = {got:.6e} ({expected})", point[0], point[1]),
-                        error,
-                        *tol,
-                    )
-                }
-            };
-            CheckResult { check: check_name, error, tol, passed: error <= tol }
-        })
-        .collect();
+        .map(|check| judge_check(model, solution, contact_forces, &magnitudes, check));
     convergence.into_iter().chain(declared).collect()
 }
 
+/// One declared check of `model` judged on `solution` (see [`evaluate_with`] for
+/// `contact_forces`), in either dimension.
+pub fn judge_check<const D: usize, K: DimensionChecks<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+    contact_forces: Option<&[PairForces<D>]>,
+    magnitudes: &Magnitudes,
+    check: &Check,
+) -> CheckResult {
+    let u = &solution.u;
+    let by_dimension = K::judge_by_dimension(model, solution, contact_forces, magnitudes, check);
+    let (check_name, error, tol) = if let Some(judged) = by_dimension {
+        judged
+    } else {
+        match check {
+            Check::Reaction {
+                body,
+                set,
+                component,
+                value,
+                tol,
+            } => reaction_check(
+                model,
+                solution,
+                magnitudes,
+                (body, set),
+                *component,
+                *value,
+                *tol,
+            ),
+            Check::ContactForce { .. }
+            | Check::MaxContactPressure { .. }
+            | Check::MaxPenetration { .. } => {
+                contact_force_check(model, solution, contact_forces, magnitudes, check)
+                    .expect("a contact force check")
+            }
+            Check::TerminatesWith { reason, contains } => {
+                let (got, text) = match solution.contact.as_ref().map(|c| &c.termination) {
+                    Some(Termination::Converged) => {
+                        (Some(TerminationReason::Converged), String::new())
+                    }
+                    Some(Termination::IterationLimit) => {
+                        (Some(TerminationReason::IterationLimit), String::new())
+                    }
+                    Some(Termination::ActiveSetCycling(m)) => {
+                        (Some(TerminationReason::ActiveSetCycling), m.clone())
+                    }
+                    Some(Termination::Singular(m)) => {
+                        (Some(TerminationReason::Singular), m.clone())
+                    }
+                    Some(Termination::WorkLimit(m)) => {
+                        (Some(TerminationReason::WorkLimit), m.clone())
+                    }
+                    None => (None, String::new()),
+                };
+                // the message of the stop and the run's warnings (diagnoses) are searched
+                let said = format!("{text}\n{}", warnings(model, solution).join("\n"));
+                let found = contains.as_ref().is_none_or(|c| said.contains(c.as_str()));
+                let with = contains
+                    .as_ref()
+                    .map(|c| format!(" with a message containing {c:?}"))
+                    .unwrap_or_default();
+                let how = if text.is_empty() {
+                    String::new()
+                } else {
+                    format!(": {text}")
+                };
+                (
+                    format!("the contact solve ends {reason:?}{with} (it ended {got:?}{how})"),
+                    if got == Some(*reason) && found {
+                        0.0
+                    } else {
+                        f64::INFINITY
+                    },
+                    0.0,
+                )
+            }
+            Check::Equilibrium { tol, per_condition } => {
+                let (tol, stated) = conditioned_tolerance(model, solution, *tol, *per_condition);
+                (
+                    format!("relative equilibrium residual{stated}"),
+                    solution.relative_residual,
+                    tol,
+                )
+            }
+            Check::StatusChanges {
+                per_iteration,
+                per_step,
+            } => {
+                let (it, step) = solution
+                    .contact
+                    .as_ref()
+                    .map(crate::harness::stability::status_changes)
+                    .unwrap_or((usize::MAX, usize::MAX));
+                let over = (it as f64 / (*per_iteration).max(1) as f64)
+                    .max(step as f64 / (*per_step).max(1) as f64);
+                let within = it <= *per_iteration && step <= *per_step;
+                (
+                format!("status changes {it} per iteration (at most {per_iteration}) and {step} per step (at most {per_step})"),
+                if within { 0.0 } else { over },
+                0.0,
+            )
+            }
+            Check::Warns { contains } => {
+                let found = warnings(model, solution)
+                    .iter()
+                    .any(|w| w.contains(contains.as_str()));
+                (
+                    format!("the run warns {contains:?}"),
+                    if found { 0.0 } else { f64::INFINITY },
+                    0.0,
+                )
+            }
+            Check::ForceBalance { .. } => {
+                contact_force_check(model, solution, contact_forces, magnitudes, check)
+                    .expect("a contact force check")
+            }
+            Check::Displacement {
+                body,
+                point,
+                component,
+                value,
+                tol,
+            } => {
+                let b = model.body(body).expect("resolved when the model was built");
+                let at: [f64; D] = std::array::from_fn(|i| point.0[i]);
+                let (n, _) = b.mesh.nearest_node(at).expect("a body has nodes");
+                let got = u[b.dof(n, component.index())];
+                let (error, expected) = judged(
+                    got,
+                    *value,
+                    magnitudes.displacement,
+                    "the largest displacement",
+                );
+                let at: Vec<String> = point.0.iter().map(|x| x.to_string()).collect();
+                (
+                    format!(
+                        "displacement {component:?} of {body} at ({}) = {got:.6e} ({expected})",
+                        at.join(", ")
+                    ),
+                    error,
+                    *tol,
+                )
+            }
+            Check::UniformStress { .. }
+            | Check::UniformStress3d { .. }
+            | Check::ExactDisplacement { .. }
+            | Check::ContactPressure { .. } => {
+                unreachable!("judged by the dimension (DimensionChecks)")
+            }
+        }
+    };
+    CheckResult {
+        check: check_name,
+        error,
+        tol,
+        passed: error <= tol,
+    }
+}
 /// A check's tolerance stated relative to the conditioning: with `per_condition = c`,
 /// `max(tol, c eps kappa)` with `kappa` the condition estimate of the last factored system
 /// ([`crate::harness::stability::conditioning`]): a backward-stable solve loses up to
 /// `eps kappa` relative accuracy (Higham 2002, ch. 7). Also the words that say so.
-fn conditioned_tolerance(
-    model: &Model,
-    solution: &Solution,
+fn conditioned_tolerance<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
     tol: f64,
     per_condition: Option<f64>,
 ) -> (f64, String) {

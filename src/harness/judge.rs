@@ -100,7 +100,7 @@ impl Judgement {
 }
 
 /// Why a check cannot be judged from point results, or `None` when it can.
-fn unjudgeable(check: &Check) -> Option<&'static str> {
+pub(crate) fn unjudgeable(check: &Check) -> Option<&'static str> {
     match check {
         Check::UniformStress { .. }
         | Check::ExactDisplacement { .. }

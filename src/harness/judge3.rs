@@ -253,7 +253,31 @@ pub fn judge3(model: &Model3, results: &Results, match_share: f64) -> Result<Jud
                       results, which a 3D judgement does not read"
                     .to_string(),
             }),
-            _ => unreachable!("Model::resolve_checks refuses in 3D every check matched above"),
+            Check::Displacement { .. } => {
+                let solution = crate::harness::judge::solution_of(model, u.clone(), None);
+                let magnitudes = crate::harness::checks::Magnitudes::of(model, &solution);
+                checks.push(crate::harness::checks::judge_check(
+                    model,
+                    &solution,
+                    None,
+                    &magnitudes,
+                    check,
+                ))
+            }
+            Check::TerminatesWith { .. }
+            | Check::Equilibrium { .. }
+            | Check::StatusChanges { .. }
+            | Check::Warns { .. } => not_judged.push(NotJudged {
+                check: serde_json::to_string(check).expect("checks serialize"),
+                why: crate::harness::judge::unjudgeable(check)
+                    .expect("a check of our own solve")
+                    .to_string(),
+            }),
+            Check::UniformStress { .. }
+            | Check::ExactDisplacement { .. }
+            | Check::ContactPressure { .. } => {
+                unreachable!("Model::resolve_checks refuses these checks in 3D")
+            }
         }
     }
     // the results' own stress field

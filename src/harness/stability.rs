@@ -36,6 +36,7 @@
 
 use crate::contact::enforcement::{method, Method};
 use crate::contact::state::{ContactState, Termination};
+use crate::model::space::SolidCell;
 use crate::model::Model;
 use crate::solver::conditioning::{lost_digits, EQUILIBRIUM_ROUND_OFF};
 use crate::solver::linear::Solution;
@@ -73,7 +74,7 @@ fn is_zero(n: &usize) -> bool {
 }
 
 /// The most status changes after one iteration, and summed over one load step.
-pub fn status_changes(state: &ContactState) -> (usize, usize) {
+pub fn status_changes<const D: usize>(state: &ContactState<D>) -> (usize, usize) {
     let per_iteration = state
         .history
         .iter()
@@ -89,7 +90,10 @@ pub fn status_changes(state: &ContactState) -> (usize, usize) {
 
 /// The penalty weight `kappa A` of a row of a penalty-type method (`None` for methods whose
 /// force is a multiplier).
-fn penalty_weight(model: &Model, row: &crate::contact::Constraint) -> Option<f64> {
+fn penalty_weight<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    row: &crate::contact::Constraint<D>,
+) -> Option<f64> {
     match method(&model.contact[row.pair].enforcement).kernel() {
         Method::Regularized { .. } | Method::PerturbedLagrange { .. } => {
             method(&model.contact[row.pair].enforcement)
@@ -102,7 +106,10 @@ fn penalty_weight(model: &Model, row: &crate::contact::Constraint) -> Option<f64
 
 /// The penalty floor of the relative equilibrium residual (see the module), `None` without
 /// penalty rows.
-pub fn penalty_floor(model: &Model, solution: &Solution) -> Option<f64> {
+pub fn penalty_floor<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+) -> Option<f64> {
     let state = solution.contact.as_ref()?;
     let u = crate::solver::linear::max_abs(&solution.u);
     // the force scale of the relative residual: the largest applied or contact force
@@ -127,7 +134,10 @@ pub fn penalty_floor(model: &Model, solution: &Solution) -> Option<f64> {
 }
 
 /// The conditioning and equilibrium of `solution`.
-pub fn conditioning(model: &Model, solution: &Solution) -> Conditioning {
+pub fn conditioning<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+) -> Conditioning {
     let condition_estimate = solution
         .contact
         .as_ref()
@@ -160,7 +170,10 @@ pub fn conditioning(model: &Model, solution: &Solution) -> Conditioning {
 
 /// The largest penalty of a pair that keeps its floor at round-off: `kappa` scaled by
 /// `EQUILIBRIUM_ROUND_OFF / floor`.
-fn largest_sound_penalty(model: &Model, floor: f64) -> Option<(String, f64)> {
+fn largest_sound_penalty<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    floor: f64,
+) -> Option<(String, f64)> {
     model.contact.iter().find_map(|p| {
         let m = method(&p.enforcement);
         match m.kernel() {
@@ -174,7 +187,10 @@ fn largest_sound_penalty(model: &Model, floor: f64) -> Option<(String, f64)> {
 
 /// The warning for a converged answer whose equilibrium is not at round-off, with the
 /// condition estimate and, when a penalty explains it, how far to lower the penalty.
-pub fn equilibrium_warning(model: &Model, solution: &Solution) -> Option<String> {
+pub fn equilibrium_warning<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+) -> Option<String> {
     let state = solution.contact.as_ref()?;
     if state.termination != Termination::Converged {
         return None;
@@ -212,7 +228,10 @@ pub fn equilibrium_warning(model: &Model, solution: &Solution) -> Option<String>
 /// Why a solve hit its iteration limit, and what would work: an augmented Lagrangian or
 /// perturbed-tangent iteration with too small a penalty, or a Newton
 /// residual that stagnates at the floor of too stiff a penalty; `None` for other stops.
-pub fn stall_diagnosis(model: &Model, solution: &Solution) -> Option<String> {
+pub fn stall_diagnosis<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+) -> Option<String> {
     let state = solution.contact.as_ref()?;
     if state.termination != Termination::IterationLimit {
         return None;
@@ -236,7 +255,10 @@ pub fn stall_diagnosis(model: &Model, solution: &Solution) -> Option<String> {
 
 /// The diagnosis of an augmented Lagrangian or perturbed-tangent iteration that reached its
 /// limit: the measured contraction of the penetration and a penalty that works.
-fn iterative_stall(model: &Model, state: &ContactState) -> Option<String> {
+fn iterative_stall<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    state: &ContactState<D>,
+) -> Option<String> {
     let (pair, kappa) = model.contact.iter().find_map(|p| {
         let m = method(&p.enforcement);
         match m.kernel() {
@@ -251,7 +273,7 @@ fn iterative_stall(model: &Model, state: &ContactState) -> Option<String> {
     let youngs = model
         .bodies
         .iter()
-        .map(|b| b.material.youngs_modulus)
+        .map(|b| K::youngs_modulus(&b.material))
         .fold(0.0f64, f64::max);
     let h = state
         .rows
@@ -296,7 +318,10 @@ fn iterative_stall(model: &Model, state: &ContactState) -> Option<String> {
 
 /// The stability warnings of a run: equilibrium not at round-off, a stalled iteration, an
 /// unstable equilibrium.
-pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
+pub fn warnings<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+) -> Vec<String> {
     // a step without equilibrium explains any stall: no penalty or iteration count helps
     let no_equilibrium = friction_cannot_hold(model, solution);
     let stall = if no_equilibrium.is_some() {
@@ -318,7 +343,7 @@ pub fn warnings(model: &Model, solution: &Solution) -> Vec<String> {
 /// masters of one normal, with Coulomb friction, loaded in that step beyond what the friction
 /// can hold (`|F_t| > mu F_n`, [`NO_HOLD_MARGIN`]) or pulled off the masters. `None` for a
 /// converged solve or any other cause.
-pub fn friction_cannot_hold<const D: usize, K: crate::model::space::SolidCell<D>>(
+pub fn friction_cannot_hold<const D: usize, K: SolidCell<D>>(
     model: &Model<D, K>,
     solution: &Solution<D>,
 ) -> Option<String> {
@@ -463,7 +488,10 @@ pub const STABILIZED_ENERGY_GROWTH_SHARE: f64 = 1e-8;
 /// Krause & Ertel's energy bound holds for constraints that hold exactly (Lagrange
 /// multipliers, elimination); a penalty's penetration stores and returns energy that the
 /// projection onto the admissible set does not see, and the run says so when it gains.
-pub fn energy_growth(model: &Model, solution: &Solution) -> Option<String> {
+pub fn energy_growth<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+) -> Option<String> {
     let h = solution.dynamics.as_ref()?;
     let first = h.steps.first()?;
     let scale = h

@@ -1413,10 +1413,11 @@ pub enum Check {
         pair: Option<String>,
         share: f64,
     },
-    /// Displacement component at the node nearest to `point`.
+    /// Displacement component at the node nearest to `point` (`[x, y]` in 2D, `[x, y, z]` in
+    /// 3D).
     Displacement {
         body: String,
-        point: [f64; 2],
+        point: Vector,
         component: Component,
         value: f64,
         tol: f64,

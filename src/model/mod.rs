@@ -325,8 +325,8 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
         Ok(())
     }
 
-    /// The `D` components of the load vector `v` (`what` names it in the message).
-    fn load_vector(&self, v: &[f64], what: &str, body: &str, at: &str) -> Result<[f64; D]> {
+    /// The `D` components of the vector or point `v` of a body (`what` names it in the message).
+    fn body_vector(&self, v: &[f64], what: &str, body: &str, at: &str) -> Result<[f64; D]> {
         if v.len() != D {
             let form = if D == 2 { "[x, y]" } else { "[x, y, z]" };
             return Err(Error::invalid(
@@ -362,7 +362,7 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
                     "add \"set\": the name of a node set of the body (e.g. a \"point\" set)",
                 ));
             };
-            let force = self.load_vector(&force.0, "force", body_name, at)?;
+            let force = self.body_vector(&force.0, "force", body_name, at)?;
             let body = &self.bodies[bi];
             for &n in self.find_node_set(body, set, at)? {
                 for (i, f) in force.iter().enumerate() {
@@ -380,7 +380,7 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
                     "remove \"set\"",
                 ));
             }
-            let b = self.load_vector(&b.0, "body force", body_name, at)?;
+            let b = self.body_vector(&b.0, "body force", body_name, at)?;
             add_body_force(
                 &self.bodies[bi],
                 b,
@@ -410,7 +410,7 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
                 FacetLoad::Pressure(p)
             }
             (_, Some(TractionSpec::Vector(t))) => {
-                FacetLoad::Vector(self.load_vector(&t.0, "traction", body_name, at)?)
+                FacetLoad::Vector(self.body_vector(&t.0, "traction", body_name, at)?)
             }
             (_, Some(TractionSpec::Exact(_))) if D == 3 => {
                 return Err(Error::invalid(
@@ -1147,27 +1147,25 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
     }
 
     /// The case's checks, validated against the model (names, tolerances, the dimension) into
-    /// [`Model::checks`]: one set of rules for 2D and 3D. A 3D case takes `uniform_stress_3d`,
-    /// `reaction`, `max_penetration`, `contact_force`, `max_contact_pressure` and
-    /// `force_balance`; the others are refused by name (not judged in 3D yet).
+    /// [`Model::checks`]: one set of rules for 2D and 3D. A 3D case takes every check but
+    /// those against a 2D stress or the exact field (`uniform_stress`, `exact_displacement`,
+    /// `contact_pressure`), which it refuses by name.
     pub(crate) fn resolve_checks(&mut self, case: &Case) -> Result<()> {
         for (k, check) in case.checks.iter().enumerate() {
             let at = format!("checks[{k}]");
-            let judged_in_3d = matches!(
+            // the checks against a 2D stress or the case's exact field (exact fields are 2D)
+            let planar = matches!(
                 check,
-                Check::UniformStress3d { .. }
-                    | Check::Reaction { .. }
-                    | Check::MaxPenetration { .. }
-                    | Check::ContactForce { .. }
-                    | Check::MaxContactPressure { .. }
-                    | Check::ForceBalance { .. }
+                Check::UniformStress { .. }
+                    | Check::ExactDisplacement { .. }
+                    | Check::ContactPressure { .. }
             );
-            if D == 3 && !judged_in_3d {
+            if D == 3 && planar {
                 return Err(Error::invalid(
                     &self.source,
                     &at,
-                    "this check is not judged in 3D (a 3D run judges uniform_stress_3d, reaction, max_penetration, contact_force, max_contact_pressure and force_balance)",
-                    "use one of those, or run the case in 2D",
+                    "this check is not judged in 3D (uniform_stress, exact_displacement and contact_pressure are checks against a 2D stress or exact field)",
+                    "use uniform_stress_3d with six components [xx, yy, zz, yz, xz, xy], or another check",
                 ));
             }
             let tol = match check {
@@ -1227,11 +1225,13 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
                 }
                 Check::Displacement {
                     body,
+                    point,
                     tol,
                     component,
                     ..
                 } => {
                     self.find_body(body, &at)?;
+                    self.body_vector(&point.0, "point", body, &at)?;
                     self.plane_component(*component, &at)?;
                     *tol
                 }

@@ -68,10 +68,11 @@
 
 use crate::contact::discretization::Discretize;
 use crate::contact::enforcement::{method, method as enforcement_method, Method};
+use crate::contact::rows::{reference_areas, rows_at, ReferenceAreas};
 pub use crate::contact::state::{
     ContactState, Departure, IterationRecord, StepRecord, Termination,
 };
-use crate::contact::Constraint;
+use crate::contact::{row_key, Constraint, RowKey};
 use crate::error::{Error, Result};
 use crate::io::scene::{ContactGeometry, CyclingRemedy, FactorUpdate, MultiplierUpdate};
 use crate::model::rigid::{FreeMode, RigidModes};
@@ -167,7 +168,7 @@ pub fn solve<const D: usize, K: ContactStep<D>>(
             iterations: state.iterations,
             geometry_updates: state.geometry_updates,
             geometry_changes: std::mem::take(&mut state.geometry_changes),
-            friction: crate::contact::friction::step_summary(state),
+            friction: state.friction_summary(None),
         });
         state.steps = records.clone();
         for r in &mut state.history {
@@ -355,8 +356,6 @@ fn solve_step(
     }
 }
 
-pub(crate) use crate::contact::{row_key, RowKey};
-
 /// The rows active in `previous` that have no row in `rows` (their slave nodes left the master
 /// surface), in order.
 fn slid_off<const D: usize>(previous: &HashSet<RowKey>, rows: &[Constraint<D>]) -> Vec<RowKey> {
@@ -368,83 +367,6 @@ fn slid_off<const D: usize>(previous: &HashSet<RowKey>, rows: &[Constraint<D>]) 
         .collect();
     lost.sort();
     lost
-}
-
-/// The tributary area of every row of the reference configuration, by point: computed once per
-/// solve and handed to [`rows_at`] for the current configuration.
-pub(crate) type ReferenceAreas = HashMap<RowKey, f64>;
-
-/// The rows' areas in the reference configuration.
-pub(crate) fn reference_areas<const D: usize, K: Discretize<D>>(
-    model: &Model<D, K>,
-) -> Result<ReferenceAreas> {
-    Ok(rows_at(model, None)?
-        .iter()
-        .map(|r| (row_key(r), r.area))
-        .collect())
-}
-
-/// The contact rows of every pair, evaluated at `X + u` for `current = Some((u, areas))`
-/// (the reference configuration if `None`) and linearized there. A row's `area`, the weight of
-/// a penalty (`kappa A`), stays its area in the reference configuration (`areas`, from
-/// [`reference_areas`]) when the point has a row there: the penalty acts per unit
-/// reference area (a nominal pressure), so the penalty force `kappa A_0 g(u)` has the exact
-/// derivative `kappa A_0 dg/du` (the current area would add the variation of the tributary
-/// lengths, which no tangent carries, and Newton would converge only linearly).
-pub(crate) fn rows_at<const D: usize, K: Discretize<D>>(
-    model: &Model<D, K>,
-    current: Option<(&[f64], &ReferenceAreas)>,
-) -> Result<Vec<Constraint<D>>> {
-    let u = current.map(|(u, _)| u);
-    let moved;
-    let geometry = match u {
-        None => model,
-        Some(u) => {
-            let mut m = model.clone();
-            for b in &mut m.bodies {
-                let offset = b.dof_offset;
-                for (n, p) in b.mesh.nodes.iter_mut().enumerate() {
-                    for (i, x) in p.iter_mut().enumerate() {
-                        *x += u[offset + D * n + i];
-                    }
-                }
-            }
-            moved = m;
-            &moved
-        }
-    };
-    let mut rows = Vec::new();
-    for (k, pair) in geometry.contact.iter().enumerate() {
-        let r = K::pair_rows(geometry, pair).map_err(|reason| {
-            Error::invalid(
-                &model.source,
-                format!("contact '{}'", pair.name),
-                format!("the discretization does not apply: {reason}"),
-                "choose another discretization for this pair",
-            )
-        })?;
-        rows.extend(r.into_iter().map(|mut c| {
-            c.pair = k;
-            if let Some(u) = u {
-                c.g0 -= c
-                    .dofs
-                    .iter()
-                    .zip(&c.coeffs)
-                    .map(|(&d, &w)| w * u[d])
-                    .sum::<f64>();
-                c.point = model.bodies[c.slave_body].mesh.nodes[c.slave_node];
-            }
-            c
-        }));
-    }
-    if let Some((_, reference)) = current {
-        for r in &mut rows {
-            if let Some(&area) = reference.get(&row_key(r)) {
-                r.area = area;
-            }
-        }
-    }
-    Ok(rows)
 }
 
 /// Newton's geometric term of the contact forces, for the rows whose gap has a second

@@ -148,7 +148,6 @@
 //! tensile, which pulls the body onto the surface, and the next evaluation decides their status
 //! from the gaps.
 
-use super::active_set::{reference_areas, row_key, rows_at, ContactStep, ReferenceAreas, RowKey};
 use super::finite_assembly::tangent_and_residual;
 use super::linear::{assemble, finish, max_abs, LinearSystem, Solution, Timings, NO_EQUATION};
 use super::newton::{self, Evaluation, System, Tangent};
@@ -161,8 +160,10 @@ use crate::contact::friction::{
     augmented_return_map, length, multiplier_status, return_map, Committed, FrictionPoint,
     MultiplierSet, ReturnMap, Status, Tangential, MAX_TANGENTS,
 };
+use crate::contact::rows::{reference_areas, rows_at, ReferenceAreas};
 use crate::contact::state::{ContactState, Departure, Termination};
 use crate::contact::Constraint;
+use crate::contact::{row_key, RowKey};
 use crate::error::Result;
 use crate::io::scene::{
     ContactGeometry, FrictionTangent, Interaction, Kinematics, MultiplierUpdate,
@@ -195,7 +196,7 @@ enum RowLaw {
 
 /// What the Newton contact scheme asks of the model's dimension beyond its discretization
 /// ([`Discretize`]): the solids' tangent and residual under finite kinematics.
-pub trait NewtonDimension<const D: usize>: Discretize<D> + ContactStep<D> {
+pub trait NewtonDimension<const D: usize>: Discretize<D> {
     /// The tangent `K_T(u)` on `pattern` and the residual `f_int(u) - f_ext` at the free
     /// equations of `constraints` (finite kinematics), or why not (an inverted element, or
     /// finite strain not built in this dimension).

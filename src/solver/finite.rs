@@ -30,12 +30,13 @@
 //! a flat rigid master only, whose tangents do not turn: see
 //! [`crate::model::coulomb_obstacle`].)
 
-use super::active_set::{active_keys, RowKey, StepRecord};
+use super::active_set::{active_keys, StepRecord};
 use super::contact_newton::solve_step;
 pub use super::history::{FiniteHistory, FiniteStep};
 use super::linear::Solution;
 use crate::contact::friction::Committed;
 use crate::contact::state::{IterationRecord, Termination};
+use crate::contact::RowKey;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::solver::contact_newton::NewtonDimension;
@@ -143,7 +144,7 @@ pub fn solve_observed<const D: usize, K: NewtonDimension<D>>(
             iterations: state.iterations,
             geometry_updates: state.geometry_updates,
             geometry_changes: std::mem::take(&mut state.geometry_changes),
-            friction: crate::contact::friction::step_summary(state),
+            friction: state.friction_summary(None),
         });
         contact_history.append(&mut state.history);
         done = target;

@@ -41,7 +41,10 @@ pub fn solve_static(model: &Model, progress: &mut dyn FnMut(&str)) -> Result<Sol
 /// final load only, so the load path's last factors apply), contact in load steps. Every branch
 /// applies the load path through [`Model::at_load`], so `path` is the load history in every
 /// run (one step or many, with or without contact).
-pub fn solve_quasi_static<const D: usize, K: crate::solver::contact_newton::NewtonDimension<D>>(
+pub fn solve_quasi_static<
+    const D: usize,
+    K: crate::solver::contact_newton::NewtonDimension<D> + crate::solver::active_set::ContactStep<D>,
+>(
     model: &crate::model::Model<D, K>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<crate::solver::linear::Solution<D>> {

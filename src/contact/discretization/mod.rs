@@ -50,6 +50,7 @@ pub(crate) mod mortar;
 pub mod mortar3;
 pub(crate) mod mortar3_linearization;
 pub(crate) mod mortar_linearization;
+pub(crate) mod mortar_segments;
 pub mod nodal_normal;
 pub mod nodal_normal3;
 pub mod node_based_rows;
@@ -781,7 +782,7 @@ fn node_to_surface(
 /// The cover ([`Constraint::cover`]) of the node-to-surface rows `rows.out[start..]` of `slave`
 /// against `master`: a slave facet that the master overlaps only in part (the master ends over
 /// it) covers each of its nodes by `t int N_a ds` over the overlapped pieces, found as mortar
-/// segments them ([`mortar::mortar_integrals`]); every other facet at a row's node covers the
+/// segments them ([`mortar_segments::mortar_integrals`]); every other facet at a row's node covers the
 /// node's whole share of it (to the bit, as before). The forces are unchanged: a node-based
 /// row acts at its node whatever the cover; the cover only tells the recovery of the nodal
 /// traction ([`crate::contact::forces`]) which part of the node's tributary transmits its
@@ -794,17 +795,17 @@ fn cover_where_the_master_ends(rows: &mut Rows, start: usize, slave: &Surface, m
     }
     let model = rows.model;
     let radius = rows.search_distance.unwrap_or_else(|| master.facet_size());
-    let (_, _, pieces) = mortar::mortar_integrals(
+    let (_, _, pieces) = mortar_segments::mortar_integrals(
         slave,
         master,
         MultiplierSpace::Standard,
         radius,
         model.thickness,
     );
-    let shares = mortar::covered_tributaries(
+    let shares = mortar_segments::covered_tributaries(
         slave,
         &pieces,
-        &mortar::gauss_rule(slave.kind, master.kind),
+        &mortar_segments::gauss_rule(slave.kind, master.kind),
         model.thickness,
     );
     // the facets the master overlaps in part (their covered area short of the whole)

@@ -50,7 +50,7 @@
 //! just crossed a master node.
 
 use super::geometry::{closest_point, Surface};
-use super::mortar::{gauss_rule, SubSegment};
+use super::mortar_segments::{gauss_rule, SubSegment};
 use crate::fe::EdgeKind;
 use crate::io::scene::MultiplierSpace;
 use num_dual::{Dual2DVec64, DualNum};
@@ -393,7 +393,7 @@ pub(crate) fn linearize_rigid_row(
 
 #[cfg(test)]
 mod tests {
-    use super::super::mortar::mortar_integrals;
+    use super::super::mortar_segments::mortar_integrals;
     use super::*;
 
     /// A slave surface (the bottom of an upper body: facets left to right, outward normal
@@ -656,7 +656,8 @@ mod tests {
         gauss: &[(f64, f64)],
     ) -> f64 {
         use super::super::geometry::facet_point as point_f64;
-        use super::super::mortar::{multiplier as phi_f64, rigid_gap};
+        use super::super::mortar::rigid_gap;
+        use super::super::mortar_segments::multiplier as phi_f64;
         let (mut weighted, mut area) = (0.0, 0.0);
         for (f, nodes) in slave.facets.iter().enumerate() {
             let Some(j) = nodes.iter().position(|&n| n == node) else {

@@ -72,7 +72,7 @@ pub fn pair_rows(model: &Model3, pair: &ContactPair) -> Result<Vec<Constraint<3>
         pair: 0,
         search_distance: pair.search_distance,
         // finite kinematics builds the rows in the current configuration (the model's nodes
-        // moved, `solver::active_set::rows_at`): their gaps' second derivatives for Newton
+        // moved, `contact::rows::rows_at`): their gaps' second derivatives for Newton
         current_finite: model.physics.kinematics == Kinematics::Finite
             && model.physics.contact_geometry == ContactGeometry::Current
             && !tied,
