@@ -1310,6 +1310,19 @@ fn an_outside_penalty_code_is_credited_with_its_kappa_series_and_a_cell_can_say_
         "a kappa series of one kappa",
     );
     std::fs::rename(&kept, &stiff).unwrap();
+    // results beside a series, or beside a reason: which is the code's answer is not clear
+    let beside = series_dir.join("punch.vtu");
+    refused(
+        &|| std::fs::write(&beside, "").unwrap(),
+        "holds results beside the kappa-<value> folders",
+    );
+    std::fs::remove_file(&beside).unwrap();
+    let beside = na.join("foundation.vtu");
+    refused(
+        &|| std::fs::write(&beside, "").unwrap(),
+        "says the code cannot solve the case, yet",
+    );
+    std::fs::remove_file(&beside).unwrap();
     refused(
         &|| std::fs::create_dir(series_dir.join("kappa-big")).unwrap(),
         "'big' is not a positive number",

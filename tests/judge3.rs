@@ -237,7 +237,10 @@ fn a_3d_displacement_check_is_judged_from_the_results_and_our_solves_checks_are_
     let displacement = direct
         .checks
         .iter()
-        .find(|c| c.check.starts_with("displacement Z of block at (1, 0.8, 1.2)"))
+        .find(|c| {
+            c.check
+                .starts_with("displacement Z of block at (1, 0.8, 1.2)")
+        })
         .unwrap_or_else(|| panic!("{:?}", direct.checks));
     assert!(displacement.passed, "{displacement:?}");
     let folder = OutputFolder::new(&tmp.path().join(&direct.model.name)).unwrap();
@@ -249,7 +252,10 @@ fn a_3d_displacement_check_is_judged_from_the_results_and_our_solves_checks_are_
         .iter()
         .find(|c| c.check == displacement.check)
         .unwrap_or_else(|| panic!("{:?}", j.checks));
-    assert_eq!(judged.error, displacement.error, "u is read back bit for bit");
+    assert_eq!(
+        judged.error, displacement.error,
+        "u is read back bit for bit"
+    );
     assert_eq!(j.not_judged.len(), 1, "{:?}", j.not_judged);
     assert!(j.not_judged[0].check.contains("equilibrium"));
     assert!(

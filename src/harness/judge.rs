@@ -750,6 +750,29 @@ fn measure_outside(
     Ok(measured)
 }
 
+/// Results of the case given outside a kappa series: `DIR/<case>.vtu` (`file`), or a `.vtu`
+/// file directly in `DIR/<case>/` (`folder`); `None` when there are none.
+fn direct_results(file: &Path, folder: &Path) -> Result<Option<std::path::PathBuf>> {
+    if file.is_file() {
+        return Ok(Some(file.to_path_buf()));
+    }
+    let shown = folder.display().to_string();
+    let entries = std::fs::read_dir(folder).map_err(|e| Error::io(&shown, "listing", e))?;
+    let mut found = Vec::new();
+    for entry in entries {
+        let path = entry.map_err(|e| Error::io(&shown, "listing", e))?.path();
+        if path.is_file()
+            && path
+                .extension()
+                .is_some_and(|x| x.eq_ignore_ascii_case("vtu"))
+        {
+            found.push(path);
+        }
+    }
+    found.sort();
+    Ok(found.into_iter().next())
+}
+
 /// The reason in `DIR/<case>/not-applicable.txt`, when the outside code gave one.
 fn not_applicable_reason(folder: &Path) -> Result<Option<String>> {
     let file = folder.join(NOT_APPLICABLE_FILE);
@@ -833,7 +856,7 @@ fn kappa_series(folder: &Path, case: &str) -> Result<Vec<(f64, std::path::PathBu
         ));
     }
     if let (Some(first), Some(last)) = (series.first(), series.last()) {
-        if series.len() > 1 && last.0 < SMALLEST_KAPPA_SPAN * first.0 {
+        if last.0 < SMALLEST_KAPPA_SPAN * first.0 {
             return Err(Error::invalid(
                 &shown,
                 "the kappa series",
@@ -892,14 +915,15 @@ pub fn outside_cells(
     let folder = dir.join(file_name("case name", &model.name, "")?);
     let file = dir.join(file_name("case name", &model.name, ".vtu")?);
     if folder.is_dir() {
+        let direct = direct_results(&file, &folder)?;
         if let Some(reason) = not_applicable_reason(&folder)? {
-            if file.is_file() {
+            if let Some(results) = direct {
                 return Err(Error::invalid(
                     folder.display(),
                     NOT_APPLICABLE_FILE,
                     format!(
                         "says the code cannot solve the case, yet {} holds its results",
-                        file.display()
+                        results.display()
                     ),
                     "remove one of the two",
                 ));
@@ -909,6 +933,19 @@ pub fn outside_cells(
         }
         let series = kappa_series(&folder, &model.name)?;
         if !series.is_empty() {
+            if let Some(results) = direct {
+                return Err(Error::invalid(
+                    folder.display(),
+                    "the kappa series",
+                    format!(
+                        "{} holds results beside the kappa-<value> folders, so which of them \
+                         is the code's answer is not clear",
+                        results.display()
+                    ),
+                    "move those results into a kappa-<value> folder of their kappa, or remove \
+                     the kappa folders",
+                ));
+            }
             return kappa_series_cell(cell, &model, &sweep, &series, options);
         }
     }
