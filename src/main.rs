@@ -534,7 +534,7 @@ fn run3(
     given: Option<OutputFolder>,
 ) -> ExitCode {
     let source = path.display().to_string();
-    let result = contact_patch::run3d::run_case3(case, &source).and_then(|outcome| {
+    let result = contact_patch::run::run_case3(case, &source).and_then(|outcome| {
         let folder = match given {
             Some(folder) => folder,
             None => OutputFolder::new(&Path::new("out").join(file_name(

@@ -116,33 +116,6 @@ pub fn read_3d_case(path: &Path) -> Option<Case> {
 /// What a 3D run produced: the one [`crate::outcome::Outcome`] of both dimensions.
 pub type Outcome3 = crate::outcome::Outcome<3, SolidKind>;
 
-/// Run the 3D case `case` read from `source`.
-pub fn run_case3(case: &Case, source: &str) -> Result<Outcome3> {
-    let start = std::time::Instant::now();
-    let model = build3(case, source)?;
-    let meshed = start.elapsed().as_secs_f64();
-    crate::model::admit::check_rigid_modes(&model)?;
-    let mut solution = crate::solver::solve_quasi_static(&model, &mut |_| {})?;
-    // what the output writes must be finite (the stresses of a displacement that is finite
-    // can overflow), as in 2D
-    crate::post::check_finite_nodal_stresses(&model, &solution.u, nodal_stress)?;
-    solution.timings.mesh = meshed;
-    solution.timings.total = start.elapsed().as_secs_f64();
-    let checks = crate::harness::checks::evaluate(&model, &solution);
-    let warnings: Vec<String> = model
-        .warnings
-        .iter()
-        .cloned()
-        .chain(crate::harness::checks::warnings(&model, &solution))
-        .collect();
-    Ok(Outcome3 {
-        model,
-        solution,
-        checks,
-        warnings,
-    })
-}
-
 /// The 3D checks of the stress; those against a 2D stress or exact field fail saying so (the
 /// model refuses them in a 3D case before a run).
 impl crate::harness::checks::DimensionChecks<3> for SolidKind {
@@ -582,7 +555,7 @@ fn material3(
 
 /// The nodal stress of `body`: the mean over the cells around each node of the stress at the
 /// cell's natural centre.
-fn nodal_stress(body: &Body3, u: &[f64]) -> Vec<[f64; 6]> {
+pub(crate) fn nodal_stress(body: &Body3, u: &[f64]) -> Vec<[f64; 6]> {
     let mesh = &body.mesh;
     let kind: SolidKind = mesh.kind;
     let mut sum = vec![[0.0; 6]; mesh.nodes.len()];

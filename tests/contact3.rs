@@ -4,7 +4,8 @@
 //! Mortar (segment-based, standard and dual) passes on non-matching grids, as the seed's
 //! 2D table says; node-to-surface one pass does not, two passes do.
 
-use contact_patch::run3d::{run_case3, Outcome3};
+use contact_patch::run::run_case3;
+use contact_patch::run3d::Outcome3;
 use serde_json::{json, Value};
 
 const PRESSURE: f64 = 10.0;

@@ -450,7 +450,7 @@ fn block_case(
         "checks": [{"check": "uniform_stress_3d", "stress": [0, 0, 0, 0, 0, 0], "tol": 1e-10}]
     });
     let parsed = contact_patch::model::parse(&case.to_string(), "loads-3d").unwrap();
-    contact_patch::run3d::run_case3(&parsed, "loads-3d").unwrap_or_else(|e| panic!("{e}"))
+    contact_patch::run::run_case3(&parsed, "loads-3d").unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Traction vectors on the six faces of a distorted block, `t = sigma n` of a uniform stress
@@ -570,7 +570,7 @@ fn user_node_and_facet_sets_of_a_3d_body_carry_supports_and_loads() {
     let parsed =
         contact_patch::model::parse(&case(serde_json::json!([0, 0, 0])).to_string(), "sets-3d")
             .unwrap();
-    let o = contact_patch::run3d::run_case3(&parsed, "sets-3d").unwrap_or_else(|e| panic!("{e}"));
+    let o = contact_patch::run::run_case3(&parsed, "sets-3d").unwrap_or_else(|e| panic!("{e}"));
     assert!(o.checks.iter().all(|c| c.passed), "{:?}", o.checks);
     let mesh = &o.model.bodies[0].mesh;
     assert_eq!(mesh.facet_sets["lid"], mesh.facet_sets["top"]);
@@ -584,7 +584,7 @@ fn user_node_and_facet_sets_of_a_3d_body_carry_supports_and_loads() {
     let parsed =
         contact_patch::model::parse(&case(serde_json::json!([0, 0])).to_string(), "sets-3d")
             .unwrap();
-    let err = contact_patch::run3d::run_case3(&parsed, "sets-3d")
+    let err = contact_patch::run::run_case3(&parsed, "sets-3d")
         .unwrap_err()
         .to_string();
     assert!(err.contains("bodies[0] 'block'.node_sets.origin"), "{err}");
@@ -632,8 +632,7 @@ fn an_explicit_3d_mesh_runs_and_the_2d_model_refuses_3d_meshes() {
     let good = case(serde_json::json!(nodes));
     let parsed = contact_patch::model::parse(&good.to_string(), "explicit-3d").unwrap();
     assert!(contact_patch::run3d::is_3d(&parsed, "explicit-3d"));
-    let o =
-        contact_patch::run3d::run_case3(&parsed, "explicit-3d").unwrap_or_else(|e| panic!("{e}"));
+    let o = contact_patch::run::run_case3(&parsed, "explicit-3d").unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(o.model.bodies[0].mesh.cell_count(), 2);
     assert!(o.checks.iter().all(|c| c.passed), "{:?}", o.checks);
     // the 2D model refuses it, naming the commands that run 3D cases
@@ -660,7 +659,7 @@ fn an_explicit_3d_mesh_runs_and_the_2d_model_refuses_3d_meshes() {
     let parsed =
         contact_patch::model::parse(&case(serde_json::json!(short)).to_string(), "explicit-3d")
             .unwrap();
-    let err = contact_patch::run3d::run_case3(&parsed, "explicit-3d")
+    let err = contact_patch::run::run_case3(&parsed, "explicit-3d")
         .unwrap_err()
         .to_string();
     assert!(err.contains("mesh.explicit.nodes[4]"), "{err}");

@@ -21,7 +21,8 @@
 
 use contact_patch::fe::displacement_gradient_at;
 use contact_patch::model::Model3;
-use contact_patch::run3d::{build3, run_case3, Outcome3};
+use contact_patch::run::run_case3;
+use contact_patch::run3d::{build3, Outcome3};
 use contact_patch::solid::{lame, Voigt};
 use contact_patch::solid_finite::Hyperelastic;
 use contact_patch::solver::linear::Solution;

@@ -10,7 +10,8 @@
 //! mortar rows of `mortar3` at the reference configuration.
 
 use contact_patch::model::Model3;
-use contact_patch::run3d::{build3, run_case3, Outcome3};
+use contact_patch::run::run_case3;
+use contact_patch::run3d::{build3, Outcome3};
 use contact_patch::solid::lame;
 use contact_patch::solver::linear::Solution;
 use nalgebra::{Matrix3, Vector3};

@@ -30,7 +30,8 @@
 
 use contact_patch::contact::friction::Status;
 use contact_patch::contact::state::{ContactState, Termination};
-use contact_patch::run3d::{build3, run_case3, Outcome3};
+use contact_patch::run::run_case3;
+use contact_patch::run3d::{build3, Outcome3};
 use contact_patch::solver::contact_newton::Probe;
 use serde_json::{json, Value};
 

@@ -290,7 +290,7 @@ fn run_3d(rel: &str) -> contact_patch::run3d::Outcome3 {
     let path = case(rel);
     let parsed = contact_patch::run3d::read_3d_case(&path)
         .unwrap_or_else(|| panic!("{rel} is read as a 3D case"));
-    contact_patch::run3d::run_case3(&parsed, &path.display().to_string())
+    contact_patch::run::run_case3(&parsed, &path.display().to_string())
         .unwrap_or_else(|e| panic!("{rel}: {e}"))
 }
 

@@ -6,7 +6,8 @@
 
 use contact_patch::harness::judge3::{judge3, load_results3};
 use contact_patch::io::paths::OutputFolder;
-use contact_patch::run3d::{read_3d_case, run_case3, write_run3};
+use contact_patch::run::run_case3;
+use contact_patch::run3d::{read_3d_case, write_run3};
 use std::path::Path;
 use std::process::{Command, Output};
 

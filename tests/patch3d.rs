@@ -5,7 +5,7 @@
 //! `patch3d_verdicts` (a contract: a changed verdict is reviewed, not accepted blindly).
 
 use contact_patch::harness::patch3d::{self, Patch3Cell};
-use contact_patch::run3d::run_case3;
+use contact_patch::run::run_case3;
 use serde_json::{json, Value};
 
 fn find<'a>(

@@ -90,7 +90,8 @@
 use crate::contact::friction::Status;
 use crate::error::{Error, Result};
 
-use crate::run3d::{run_case3, Outcome3};
+use crate::run::run_case3;
+use crate::run3d::Outcome3;
 use serde::Serialize;
 use serde_json::{json, Value};
 

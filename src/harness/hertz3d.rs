@@ -35,7 +35,8 @@
 
 use crate::error::Result;
 use crate::io::svg::{line_plot, Series};
-use crate::run3d::{run_case3, Outcome3};
+use crate::run::run_case3;
+use crate::run3d::Outcome3;
 use serde::Serialize;
 use serde_json::{json, Value};
 
