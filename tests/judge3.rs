@@ -40,6 +40,28 @@ fn say(o: &Output) -> String {
     )
 }
 
+/// The run `direct` written to `tmp` as `.vtu` results and judged as another code's.
+fn written_and_judged(
+    direct: &contact_patch::run3d::Outcome3,
+    tmp: &Path,
+) -> contact_patch::harness::judge3::Judgement3 {
+    let folder = OutputFolder::new(&tmp.join(&direct.model.name)).unwrap();
+    write_run3(&folder, direct).unwrap();
+    let results = load_results3(&direct.model, folder.path()).unwrap();
+    judge3(&direct.model, &results, 1e-8).unwrap()
+}
+
+/// The judged check with the words of the run's check `of`.
+fn same_check<'a>(
+    j: &'a contact_patch::harness::judge3::Judgement3,
+    of: &contact_patch::harness::checks::CheckResult,
+) -> &'a contact_patch::harness::checks::CheckResult {
+    j.checks
+        .iter()
+        .find(|c| c.check == of.check)
+        .unwrap_or_else(|| panic!("{:?}", j.checks))
+}
+
 #[test]
 fn our_3d_results_judged_as_outside_results_give_the_direct_verdicts() {
     let tmp = tempfile::tempdir().unwrap();
@@ -184,15 +206,8 @@ fn a_3d_reaction_check_is_judged_from_the_results_as_the_run_judges_it() {
         .find(|c| c.check.starts_with("reaction Z on block.base"))
         .unwrap_or_else(|| panic!("{:?}", direct.checks));
     assert!(reaction.passed, "{reaction:?}");
-    let folder = OutputFolder::new(&tmp.path().join(&direct.model.name)).unwrap();
-    write_run3(&folder, &direct).unwrap();
-    let results = load_results3(&direct.model, folder.path()).unwrap();
-    let j = judge3(&direct.model, &results, 1e-8).unwrap();
-    let judged = j
-        .checks
-        .iter()
-        .find(|c| c.check == reaction.check)
-        .unwrap_or_else(|| panic!("{:?}", j.checks));
+    let j = written_and_judged(&direct, tmp.path());
+    let judged = same_check(&j, reaction);
     assert!(judged.passed, "{judged:?}");
     assert!(
         (judged.error - reaction.error).abs() < 1e-12,
@@ -244,15 +259,8 @@ fn a_3d_displacement_check_is_judged_from_the_results_and_our_solves_checks_are_
         })
         .unwrap_or_else(|| panic!("{:?}", direct.checks));
     assert!(displacement.passed, "{displacement:?}");
-    let folder = OutputFolder::new(&tmp.path().join(&direct.model.name)).unwrap();
-    write_run3(&folder, &direct).unwrap();
-    let results = load_results3(&direct.model, folder.path()).unwrap();
-    let j = judge3(&direct.model, &results, 1e-8).unwrap();
-    let judged = j
-        .checks
-        .iter()
-        .find(|c| c.check == displacement.check)
-        .unwrap_or_else(|| panic!("{:?}", j.checks));
+    let j = written_and_judged(&direct, tmp.path());
+    let judged = same_check(&j, displacement);
     assert_eq!(
         judged.error, displacement.error,
         "u is read back bit for bit"
