@@ -1587,17 +1587,29 @@ fn friction_convergence(out: &Path, baseline: Option<&Path>) -> ExitCode {
             ".friction-convergence-baseline-{}",
             std::process::id()
         ));
-        // only a folder this run creates is removed: one that is there already is refused
-        if baseline.is_some() && work.exists() {
-            return Err(contact_patch::error::Error::invalid(
-                work.display(),
-                "--baseline",
-                "the scratch folder for the baseline's runs exists already",
-                "remove it, or choose another --out folder",
-            ));
+        // only a folder this run creates is removed: it is created here, at once, and one
+        // that is there already is refused
+        let created = baseline.is_some();
+        if created {
+            std::fs::create_dir(&work).map_err(|e| {
+                if e.kind() == std::io::ErrorKind::AlreadyExists {
+                    contact_patch::error::Error::invalid(
+                        work.display(),
+                        "--baseline",
+                        "the scratch folder for the baseline's runs exists already",
+                        "remove it, or choose another --out folder",
+                    )
+                } else {
+                    contact_patch::error::Error::io(
+                        work.display(),
+                        "creating the scratch folder",
+                        e,
+                    )
+                }
+            })?;
         }
         let steps = study::step_iterations(Path::new("."), baseline, &work);
-        if baseline.is_some() && work.exists() {
+        if created {
             let _ = std::fs::remove_dir_all(&work);
         }
         let steps = steps?;

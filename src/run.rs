@@ -6,10 +6,11 @@
 //! [`RunDimension`]. [`run_checked`] runs a case file of either dimension for the harness
 //! commands that only need its verdicts.
 
+use crate::contact::forces::pair_forces;
 use crate::error::Result;
 use crate::fe::ElementKind;
 use crate::fe3d::SolidKind;
-use crate::harness::checks::{evaluate, warnings, DimensionChecks};
+use crate::harness::checks::{evaluate_with, warnings_with, DimensionChecks};
 use crate::io::scene::Case;
 use crate::model::admit::load;
 use crate::model::Model;
@@ -95,12 +96,17 @@ pub fn run_model<const D: usize, K: RunDimension<D>>(
     let mut solution = K::solve(&model, progress)?;
     K::check_finite_stresses(&model, &solution.u)?;
     progress("checking");
-    let checks = evaluate(&model, &solution);
+    // the pairs' contact forces, once for the checks and the warnings
+    let forces = solution
+        .contact
+        .as_ref()
+        .map(|state| pair_forces(&model, state));
+    let checks = evaluate_with(&model, &solution, forces.as_deref());
     let warnings = model
         .warnings
         .iter()
         .cloned()
-        .chain(warnings(&model, &solution))
+        .chain(warnings_with(&model, &solution, forces.as_deref()))
         .collect();
     solution.timings.mesh = mesh_time;
     solution.timings.total = start.elapsed().as_secs_f64();

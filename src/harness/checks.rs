@@ -329,8 +329,27 @@ pub fn warnings<const D: usize, K: Discretize<D>>(
     model: &Model<D, K>,
     solution: &Solution<D>,
 ) -> Vec<String> {
+    warnings_with(model, solution, None)
+}
+
+/// [`warnings`] with the pairs' contact forces of the solve already at hand (`None`: computed
+/// here from `solution.contact`), so that a run computes them once for its checks and its
+/// warnings.
+pub fn warnings_with<const D: usize, K: Discretize<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+    contact_forces: Option<&[PairForces<D>]>,
+) -> Vec<String> {
     let Some(state) = &solution.contact else {
         return Vec::new();
+    };
+    let computed;
+    let forces = match contact_forces {
+        Some(forces) => forces,
+        None => {
+            computed = pair_forces(model, state);
+            &computed
+        }
     };
     let departures = state.departures.iter().map(|d| {
         format!(
@@ -347,9 +366,7 @@ pub fn warnings<const D: usize, K: Discretize<D>>(
     let penetrations = penetration_warnings(
         model,
         state,
-        pair_forces(model, state)
-            .into_iter()
-            .map(|f| (f.pair, f.penetration)),
+        forces.iter().map(|f| (f.pair, f.penetration.clone())),
     );
     departures
         .chain(untied_slave_nodes(model, state))
@@ -795,7 +812,10 @@ pub fn judge_check<const D: usize, K: DimensionChecks<D>>(
                     None => (None, String::new()),
                 };
                 // the message of the stop and the run's warnings (diagnoses) are searched
-                let said = format!("{text}\n{}", warnings(model, solution).join("\n"));
+                let said = format!(
+                    "{text}\n{}",
+                    warnings_with(model, solution, contact_forces).join("\n")
+                );
                 let found = contains.as_ref().is_none_or(|c| said.contains(c.as_str()));
                 let with = contains
                     .as_ref()
@@ -843,7 +863,7 @@ pub fn judge_check<const D: usize, K: DimensionChecks<D>>(
             )
             }
             Check::Warns { contains } => {
-                let found = warnings(model, solution)
+                let found = warnings_with(model, solution, contact_forces)
                     .iter()
                     .any(|w| w.contains(contains.as_str()));
                 (
