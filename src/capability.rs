@@ -10,7 +10,7 @@
 //! pressed onto a foundation of the same footprint on matching grids, or onto a rigid line or
 //! plane), so a refusal names a rule of the tool, not a property of a mesh. "yes" means such a
 //! case passes every check before the solve; whether the solve converges and passes the patch
-//! test is what the tables (`contact-patch table`, `patch-3d`, `finite-patch`) judge.
+//! test is what the tables (`contact-patch table`, 3D included, and `finite-patch`) judge.
 //!
 //! [`matrix_markdown`] writes the two tables of the README: discretizations x enforcement
 //! methods (frictionless, small strain, static; each dimension), and dimension x kinematics x

@@ -74,12 +74,13 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Run the patch-test catalogues (contact, tied, friction) and write reports/patch-table.md, tied-table.md, friction-table.md and their .json.
+    /// Run the patch-test catalogues (contact, tied, friction; 2D and 3D) and write reports/patch-table.md, tied-table.md, friction-table.md, patch-table-3d.md, tied-table-3d.md and their .json.
     #[command(
-        after_help = "Example:\n  contact-patch table\n  contact-patch table cases/patch/patch-C-nu0.3.json --out /tmp/reports\n  contact-patch table --out new --junit table.xml --baseline old/patch-table.json --baseline old/tied-table.json\n  contact-patch table cases/patch --results their-results --code mycode --out their-tables\n\nWith --baseline the exit code is 1 only on a regression against the baseline (a verdict lost,\na cell gone, an error grown by more than --baseline-factor above 1e-10), not on failing cells."
+        after_help = "Example:\n  contact-patch table\n  contact-patch table cases/patch/patch-C-nu0.3.json --out /tmp/reports\n  contact-patch table cases/3d --out /tmp/reports\n  contact-patch table --out new --junit table.xml --baseline old/patch-table.json --baseline old/tied-table.json\n  contact-patch table cases/patch --results their-results --code mycode --out their-tables\n\nWith --baseline the exit code is 1 only on a regression against the baseline (a verdict lost,\na cell gone, an error grown by more than --baseline-factor above 1e-10), not on failing cells."
     )]
     Table {
-        /// Case files or folders with a sweep (default: cases/patch, cases/tied and cases/friction).
+        /// Case files or folders with a sweep (default: cases/patch, cases/tied, cases/friction and
+        /// cases/3d).
         paths: Vec<PathBuf>,
         /// Folder for patch-table.md and patch-table.json.
         #[arg(long, default_value = "reports")]
@@ -198,19 +199,6 @@ enum Command {
         after_help = "Example:\n  contact-patch finite-patch\n  contact-patch finite-patch --out /tmp/reports"
     )]
     FinitePatch {
-        /// Output folder.
-        #[arg(long, default_value = "reports")]
-        out: PathBuf,
-    },
-    /// The 3D contact patch test (a punch on a foundation of the same footprint; matching,
-    /// nested, non-matching and skewed interfaces; Hex8, Tet4, Hex27, Tet10; every 3D
-    /// discretization and enforcement) and the 3D tied patch tests (normal, parallel, shear);
-    /// writes reports/patch-table-3d.md and .json.
-    #[command(
-        name = "patch-3d",
-        after_help = "Example:\n  contact-patch patch-3d\n  contact-patch patch-3d --out /tmp/reports"
-    )]
-    Patch3d {
         /// Output folder.
         #[arg(long, default_value = "reports")]
         out: PathBuf,
@@ -429,7 +417,6 @@ fn main() -> ExitCode {
             friction_convergence(&out, baseline.as_deref())
         }
         Command::FinitePatch { out } => finite_patch(&out),
-        Command::Patch3d { out } => patch_3d(&out),
         Command::HertzFinite { out } => hertz_finite(&out),
         Command::Hertz3d { out } => hertz_3d(&out),
         Command::FiniteSliding { out } => finite_sliding(&out),
@@ -1025,6 +1012,7 @@ fn table(
             PathBuf::from("cases/patch"),
             PathBuf::from("cases/tied"),
             PathBuf::from("cases/friction"),
+            PathBuf::from("cases/3d"),
         ]
     } else {
         paths.to_vec()
@@ -1161,11 +1149,14 @@ fn table(
     let mut suites = Vec::new();
     for w in &written {
         let part = &w.cells;
-        if w.catalogue == Catalogue::Patch && contact_patch::harness::report::has_seed_cells(part) {
+        if w.catalogue == Catalogue::Patch
+            && w.dimension == 2
+            && contact_patch::harness::report::has_seed_cells(part)
+        {
             println!("{}", contact_patch::harness::report::seed_summary(part));
         }
         suites.push(junit::TestSuite {
-            name: w.catalogue.name().to_string(),
+            name: w.title(),
             seconds: part.iter().filter_map(|c| c.time_ms).sum::<f64>() / 1e3,
             cases: part.iter().map(junit::cell_case).collect(),
         });
@@ -1560,16 +1551,6 @@ fn finite_patch(out: &Path) -> ExitCode {
     )
 }
 
-/// `contact-patch patch-3d`: the 3D contact and tied patch tables.
-fn patch_3d(out: &Path) -> ExitCode {
-    use contact_patch::harness::patch3d;
-    cell_report(out, patch3d::cell_count(), "patch-table-3d", |progress| {
-        let cells = patch3d::run(progress)?;
-        let json = serde_json::to_string_pretty(&cells).expect("cells serialize") + "\n";
-        Ok((patch3d::report(&cells), json))
-    })
-}
-
 /// `contact-patch friction-convergence`: the residual histories of the friction tangents.
 fn friction_convergence(out: &Path, baseline: Option<&Path>) -> ExitCode {
     let folder = match ReportFolder::new(out) {
@@ -1873,7 +1854,7 @@ fn print_catalogue(folder: &ReportFolder, w: &contact_patch::harness::shard::Wri
     let part = &w.cells;
     println!(
         "{}: {} cells ({} pass, {} fail, {} n/a); wrote {} and {}",
-        w.catalogue.name(),
+        w.title(),
         part.len(),
         part.iter().filter(|c| c.verdict == "pass").count(),
         part.iter().filter(|c| c.verdict == "fail").count(),

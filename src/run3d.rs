@@ -11,11 +11,11 @@
 //! and the active-set contact solve with every enforcement method
 //! ([`crate::solver::active_set`]) are the 2D code paths, generic over the dimension. What is
 //! not built in 3D yet is refused here with the reason (an invalid-case error, exit 2), never
-//! computed wrongly: dynamics, the current contact geometry under small strain, sweeps, exact
-//! solutions, checks other than `uniform_stress_3d`, `reaction` and `max_penetration`;
-//! the 3D
-//! discretizations refuse what
-//! they do not treat ([`crate::contact::discretization::Discretize`]).
+//! computed wrongly: dynamics, the current contact geometry under small strain, friction
+//! sweeps, exact solutions and the checks against them (`uniform_stress`, `exact_displacement`,
+//! `contact_pressure`); a sweep judges its cells against the stress of the case's
+//! `uniform_stress_3d` check ([`sweep_stress3`]). The 3D discretizations refuse what they do
+//! not treat ([`crate::contact::discretization::Discretize`]).
 //!
 //! **Finite strain** (`physics.kinematics: "finite"`, hyperelastic materials
 //! [`crate::solid_finite`]) runs the 2D driver [`crate::solver::finite`] (load steps of
@@ -141,6 +141,15 @@ impl crate::harness::checks::DimensionChecks<3> for SolidKind {
     }
 }
 
+/// The stress of a 3D case's `uniform_stress_3d` check: what its sweep judges the stress
+/// against.
+pub(crate) fn sweep_stress3(model: &Model3) -> Option<[f64; 6]> {
+    model.checks.iter().find_map(|c| match c {
+        Check::UniformStress3d { stress, .. } => Some(*stress),
+        _ => None,
+    })
+}
+
 /// The words of the `uniform_stress_3d` check with the expected `stress` (shared by the run and
 /// `contact-patch judge`, whose report matches checks by their words).
 pub fn uniform_stress_words3(stress: &[f64; 6]) -> String {
@@ -235,8 +244,13 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
             "remove physics.contact_geometry (contact in the reference geometry), or use \"kinematics\": \"finite\"",
         ));
     }
-    if case.sweep.is_some() {
-        return Err(not_built(source, "sweep", "a sweep", "remove the sweep"));
+    if case.sweep.as_ref().is_some_and(|s| s.expect.is_some()) {
+        return Err(not_built(
+            source,
+            "sweep.expect",
+            "a friction sweep",
+            "remove \"expect\" and the Coulomb interaction, or sweep the case in 2D",
+        ));
     }
     if case.exact.is_some() {
         return Err(not_built(
@@ -312,6 +326,7 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
     }
     let mut model = Model3::with_bodies(&case.name, source, bodies);
     model.warnings = set_warnings;
+    model.sweep = case.sweep.clone();
     model.description = case.description.clone();
     model.plane = case.analysis.plane;
     model.physics = case.physics.clone();
@@ -328,6 +343,14 @@ pub fn build3(case: &Case, source: &str) -> Result<Model3> {
         check_finite3(&model, case)?;
     }
     model.resolve_checks(case)?;
+    if model.sweep.is_some() && sweep_stress3(&model).is_none() {
+        return Err(Error::invalid(
+            source,
+            "sweep",
+            "a 3D sweep judges every cell's stress against the stress of the case's uniform_stress_3d check, and the case has none",
+            "add {\"check\": \"uniform_stress_3d\", \"stress\": [xx, yy, zz, yz, xz, xy], \"tol\": 1e-10} with the exact stress of the case",
+        ));
+    }
     Ok(model)
 }
 

@@ -41,6 +41,8 @@ fn a_table_whose_reader_has_gone_is_still_written_with_its_exit_code() {
         "patch-table.json",
         "tied-table.md",
         "friction-table.json",
+        "patch-table-3d.md",
+        "tied-table-3d.json",
     ] {
         let written = std::fs::read_to_string(out.join(name)).unwrap();
         assert!(!written.is_empty(), "{name} is written");

@@ -419,7 +419,9 @@ fn check_runs_3d_cases_and_reports_their_verdicts() {
             "{element}: {stdout}"
         );
     }
-    assert!(stdout.contains("all 4 cases pass"), "{stdout}");
+    // the four single-body cases and the 40 of the 3D patch tables (16 contact, 24 tied), each
+    // with its own pair (standard mortar, Lagrange multipliers)
+    assert!(stdout.contains("all 44 cases pass"), "{stdout}");
     // the exact stress is sigma_zz = -2: expecting -3 fails the check, not the run
     let (_dir, wrong) = edited_case(|c| c["checks"][0]["stress"][2] = serde_json::json!(-3.0));
     let (code, stdout, stderr) = check(&wrong);
@@ -767,4 +769,56 @@ fn line_of(text: &str, words: &str) -> String {
         .find(|l| l.contains(words))
         .unwrap_or_else(|| panic!("no line with {words:?}: {text}"))
         .to_string()
+}
+
+/// A 3D sweep is judged against the stress of the case's `uniform_stress_3d` check: a sweep
+/// without one, or a friction sweep (not built in 3D), is bad input naming the field (exit 2),
+/// and `table` writes nothing for it.
+#[test]
+fn a_3d_sweep_without_its_stress_check_or_with_friction_is_refused() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base = root.join("cases/3d/patch/patch-3d-linear-hex8-matching.json");
+    let case: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&base).unwrap()).unwrap();
+    let refused = |edit: &dyn Fn(&mut serde_json::Value), wanted: &str| {
+        let mut c = case.clone();
+        edit(&mut c);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("case.json");
+        std::fs::write(&path, c.to_string()).unwrap();
+        let out = dir.path().join("tables");
+        let (code, stdout, stderr) = contact_patch(&[
+            "table".as_ref(),
+            path.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ]);
+        assert_eq!(code, 2, "{stdout}\n{stderr}");
+        assert!(stderr.contains(wanted), "{stderr}");
+        assert!(!out.join("patch-table-3d.md").exists());
+    };
+    refused(
+        &|c| c["checks"] = serde_json::json!([]),
+        "a 3D sweep judges every cell's stress against the stress of the case's uniform_stress_3d check",
+    );
+    refused(
+        &|c| {
+            c["contact"][0]["interaction"] = serde_json::json!({"coulomb": {"mu": 0.3}});
+            c["sweep"]["catalogue"] = serde_json::json!("friction");
+            c["sweep"]["expect"] = serde_json::json!("stick");
+        },
+        "a friction sweep in 3D is not built yet",
+    );
+    // the case as shipped runs: one mesh, 42 cells
+    let dir = tempfile::tempdir().unwrap();
+    let (code, stdout, stderr) = contact_patch(&[
+        "table".as_ref(),
+        base.as_os_str(),
+        "--out".as_ref(),
+        dir.path().as_os_str(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    assert!(stdout.contains("patch-3d: 42 cells"), "{stdout}");
+    let md = std::fs::read_to_string(dir.path().join("patch-table-3d.md")).unwrap();
+    assert!(md.contains("| mortar dual | lagrange | p |"), "{md}");
 }

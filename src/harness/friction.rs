@@ -31,12 +31,13 @@
 use crate::contact::forces::PairForces;
 use crate::contact::friction::Status;
 use crate::io::scene::{ExpectedFriction, Interaction};
+use crate::model::space::SolidCell;
 use crate::model::{coulomb_obstacle, newton_mortar_obstacle, ContactPair, Model};
 use crate::solver::linear::Solution;
 
 /// What the friction judge measured in one solve.
 #[derive(Clone, Debug)]
-pub(crate) struct FrictionMeasured {
+pub struct FrictionMeasured {
     pub tangential_error: f64,
     /// Points in the expected status at the end of the last step, and all frictional points.
     pub expected: usize,
@@ -100,7 +101,10 @@ pub fn name(expect: ExpectedFriction) -> &'static str {
 }
 
 /// Why the friction of `pair` cannot be solved in `model` (an `n/a` cell), if it cannot.
-pub(crate) fn obstacle(model: &Model, pair: &ContactPair) -> Option<String> {
+pub(crate) fn obstacle<const D: usize, K: SolidCell<D>>(
+    model: &Model<D, K>,
+    pair: &ContactPair,
+) -> Option<String> {
     if !matches!(pair.interaction, Interaction::Coulomb { .. }) {
         return None;
     }

@@ -59,8 +59,13 @@ pub const KNOWN_REPORTS: &[KnownReport] = &[
     },
     KnownReport {
         stem: "patch-table-3d",
-        title: "Contact and tied patch tests in 3D",
-        command: "contact-patch patch-3d",
+        title: "Contact patch test in 3D (Hex8, Tet4, Hex27, Tet10)",
+        command: "contact-patch table cases/3d",
+    },
+    KnownReport {
+        stem: "tied-table-3d",
+        title: "Tied patch tests in 3D",
+        command: "contact-patch table cases/3d",
     },
     KnownReport {
         stem: "hard-cases",

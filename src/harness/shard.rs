@@ -356,42 +356,53 @@ pub fn merge(parts: Vec<(String, Part)>) -> Result<Merged> {
 /// One catalogue's files as written.
 pub struct Written {
     pub catalogue: Catalogue,
+    /// The cases' dimension: 2, or 3 for `<catalogue>-table-3d.*`.
+    pub dimension: u8,
     pub md: String,
     pub json: String,
     pub cells: Vec<Cell>,
 }
 
+impl Written {
+    /// The table's name as printed: `patch`, `tied-3d`, ...
+    pub fn title(&self) -> String {
+        crate::harness::report::table_stem(self.catalogue, self.dimension).replace("-table", "")
+    }
+}
+
 /// Write `<catalogue>-table.md`, `.json` and `.times.csv` for every catalogue among `cells`
-/// (what `table` writes; `seconds` is the run's time, written with the cells' times).
+/// (`<catalogue>-table-3d.*` for the cells of 3D cases; what `table` writes; `seconds` is the
+/// run's time, written with the cells' times).
 pub fn write_tables(folder: &ReportFolder, cells: &[Cell], seconds: f64) -> Result<Vec<Written>> {
-    let mut catalogues: Vec<Catalogue> = cells.iter().map(|c| c.catalogue).collect();
-    catalogues.sort();
-    catalogues.dedup();
+    let mut tables: Vec<(Catalogue, u8)> =
+        cells.iter().map(|c| (c.catalogue, c.dimension)).collect();
+    tables.sort();
+    tables.dedup();
     let mut out = Vec::new();
-    for catalogue in catalogues {
+    for (catalogue, dimension) in tables {
         let part: Vec<Cell> = cells
             .iter()
-            .filter(|c| c.catalogue == catalogue)
+            .filter(|c| c.catalogue == catalogue && c.dimension == dimension)
             .cloned()
             .collect();
-        let report = match catalogue {
-            Catalogue::Tied => crate::harness::report::tied_report(&part),
-            Catalogue::Patch => crate::harness::report::patch_report(&part),
-            Catalogue::Friction => crate::harness::report::friction_report(&part),
+        let stem = crate::harness::report::table_stem(catalogue, dimension);
+        let report = match (catalogue, dimension) {
+            (_, 3) => crate::harness::report::report_3d(catalogue, &part),
+            (Catalogue::Tied, _) => crate::harness::report::tied_report(&part),
+            (Catalogue::Patch, _) => crate::harness::report::patch_report(&part),
+            (Catalogue::Friction, _) => crate::harness::report::friction_report(&part),
         };
         folder.write_file(
-            &format!("{}-table.times.csv", catalogue.name()),
+            &format!("{stem}.times.csv"),
             &crate::harness::report::times_csv(&part, seconds),
         )?;
         let json = serde_json::to_string_pretty(&part).expect("cells serialize") + "\n";
-        let (md, js) = (
-            format!("{}-table.md", catalogue.name()),
-            format!("{}-table.json", catalogue.name()),
-        );
+        let (md, js) = (format!("{stem}.md"), format!("{stem}.json"));
         folder.write_file(&js, &json)?;
         folder.write_file(&md, &report)?;
         out.push(Written {
             catalogue,
+            dimension,
             md,
             json: js,
             cells: part,
