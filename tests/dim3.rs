@@ -371,7 +371,9 @@ fn what_3d_does_not_have_yet_is_refused_and_2d_cases_refuse_3d_fields() {
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains("3D cases run with `contact-patch run`, `check` and `judge`"),
+        err.contains(
+            "3D cases run with `contact-patch run`, `check`, `judge`, `table` and `study`"
+        ),
         "{err}"
     );
     let text = std::fs::read_to_string(root.join("cases/patch-single/q4-distorted.json")).unwrap();

@@ -14,6 +14,11 @@
 //! axis values, the last axis fastest: a cell's index depends only on the study file, which
 //! shards rely on ([`crate::harness::shard`]).
 //!
+//! A 3D base case (a body with a 3D mesh, [`crate::run3d::is_3d`]) runs in 3D: each cell is
+//! built by [`crate::run3d::build3`] and solved by the same [`run_model`]; `refine` splits the
+//! x, y and z breaks of `block3d` meshes. The Hertz metrics read a 2D contact line and are
+//! refused for a 3D base ([`StudyDimension`]).
+//!
 //! Metrics, each against a reference that is not our own output:
 //! * `checks`: the case's declared checks (closed forms, loads); the worst `error / tol`.
 //! * `check`: one declared check's error (as the check measures it).
@@ -437,6 +442,30 @@ impl Study {
         let src = self.source.clone();
         self.check_spec(&src)?;
         let s = &self.spec;
+        // the Hertz metrics read a pressure profile along a 2D contact line
+        let base_source = self.base_path.display().to_string();
+        if let Ok(base) = parse(&self.base.to_string(), &base_source) {
+            if crate::run3d::is_3d(&base, &base_source) {
+                if let Some(k) = s.metrics.iter().position(|m| {
+                    matches!(
+                        m,
+                        Metric::HertzPeak { .. }
+                            | Metric::HertzHalfWidth { .. }
+                            | Metric::HertzProfile { .. }
+                    )
+                }) {
+                    return Err(refused(
+                        &src,
+                        format!("metrics[{k}]"),
+                        format!(
+                            "'{}' reads a pressure profile along a 2D contact line, and the base case is 3D",
+                            s.metrics[k].name()
+                        ),
+                        "measure a 3D study by its checks: \"checks\" or {\"check\": N}",
+                    ));
+                }
+            }
+        }
         // every value of every axis, applied to the base after the first value of each
         // earlier axis (a later axis may set a field of an earlier one's value), must give a
         // case
@@ -511,8 +540,8 @@ impl Study {
         out
     }
 
-    /// The case of cell `index`, as a model (the meshes built).
-    fn cell_model(&self, index: usize) -> Result<Model> {
+    /// The case of cell `index` and the source its messages name.
+    fn cell_case(&self, index: usize) -> Result<(Case, String)> {
         let coords = self.coordinates(index);
         let mut value = self.base.clone();
         let mut refine = 1usize;
@@ -534,7 +563,24 @@ impl Study {
         if refine > 1 {
             refine_case(&mut case, refine);
         }
-        admit(Model::build(&case, &source)?)
+        Ok((case, source))
+    }
+
+    /// Build, solve and judge cell `index` in its case's dimension (3D when a body is 3D,
+    /// [`crate::run3d::is_3d`]), measured into `cell`.
+    fn solve_cell(&self, index: usize, start: Instant, cell: &mut StudyCell) -> Result<()> {
+        let (case, source) = self.cell_case(index)?;
+        if crate::run3d::is_3d(&case, &source) {
+            let model = crate::run3d::build3(&case, &source)?;
+            crate::model::admit::check_rigid_modes(&model)?;
+            let mesh = start.elapsed().as_secs_f64();
+            self.measure(&run_model(model, mesh, start, &mut |_| {})?, cell);
+        } else {
+            let model = admit(Model::build(&case, &source)?)?;
+            let mesh = start.elapsed().as_secs_f64();
+            self.measure(&run_model(model, mesh, start, &mut |_| {})?, cell);
+        }
+        Ok(())
     }
 
     /// The labels of cell `index`, in axis order.
@@ -565,10 +611,7 @@ impl Study {
         let memory = reset_peak_memory();
         let start = Instant::now();
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            self.cell_model(index).and_then(|model| {
-                let mesh = start.elapsed().as_secs_f64();
-                run_model(model, mesh, start, &mut |_| {})
-            })
+            self.solve_cell(index, start, &mut cell)
         }));
         match outcome {
             Err(_) => {
@@ -580,7 +623,7 @@ impl Study {
             Ok(Err(e)) => {
                 cell.error = Some(e.to_string().lines().next().unwrap_or_default().to_string())
             }
-            Ok(Ok(o)) => self.measure(&o, &mut cell),
+            Ok(Ok(())) => {}
         }
         if memory {
             cell.peak_memory_mb = peak_memory_mb();
@@ -588,7 +631,11 @@ impl Study {
         cell
     }
 
-    fn measure(&self, o: &Outcome, cell: &mut StudyCell) {
+    fn measure<const D: usize, K: StudyDimension<D>>(
+        &self,
+        o: &Outcome<D, K>,
+        cell: &mut StudyCell,
+    ) {
         let t = &o.solution.timings;
         cell.times = PhaseTimes {
             mesh: t.mesh,
@@ -631,30 +678,9 @@ impl Study {
                     })
                     .reduce(f64::max),
                 Metric::Check { index } => o.checks.get(*index).map(|c| c.error),
-                Metric::HertzPeak { pair }
-                | Metric::HertzHalfWidth { pair }
-                | Metric::HertzProfile { pair } => {
-                    crate::harness::profile::pressure_profile(o, pair)
-                        .ok()
-                        .and_then(|p| {
-                            let h = p.hertz?;
-                            let (a, p0) = (h.half_width(), h.peak());
-                            match m {
-                                Metric::HertzPeak { .. } => {
-                                    let peak = p
-                                        .points
-                                        .iter()
-                                        .map(|x| x.1)
-                                        .fold(f64::NEG_INFINITY, f64::max);
-                                    Some((peak - p0).abs() / p0)
-                                }
-                                Metric::HertzHalfWidth { .. } => {
-                                    Some((p.contact_extent() - a).abs() / a)
-                                }
-                                _ => p.deviation(crate::harness::profile::INTERIOR_SHARE),
-                            }
-                        })
-                }
+                Metric::HertzPeak { .. }
+                | Metric::HertzHalfWidth { .. }
+                | Metric::HertzProfile { .. } => K::hertz_metric(o, m),
             };
             if let Some(v) = value {
                 cell.metrics.insert(m.name(), v);
@@ -804,26 +830,73 @@ fn get_path<'a>(root: &'a Value, path: &str) -> Option<&'a Value> {
     })
 }
 
-/// Split every interval of every block mesh axis into `k` equal intervals.
+/// Split every interval of every block mesh axis (`block`, `block3d`) into `k` equal intervals
+/// (the breaks stay grid vertices, so a block's moves still apply).
 pub fn refine_case(case: &mut Case, k: usize) {
     for b in &mut case.bodies {
-        if let MeshSpec::Block(block) = &mut b.mesh {
-            for breaks in [&mut block.x, &mut block.y] {
-                match breaks {
-                    Breaks::Uniform(u) => u.divisions = u.divisions.saturating_mul(k),
-                    Breaks::List(list) => {
-                        let mut out = Vec::with_capacity(list.len() * k);
-                        for w in list.windows(2) {
-                            for i in 0..k {
-                                out.push(w[0] + (w[1] - w[0]) * i as f64 / k as f64);
-                            }
+        let axes = match &mut b.mesh {
+            MeshSpec::Block(block) => vec![&mut block.x, &mut block.y],
+            MeshSpec::Block3d(block) => vec![&mut block.x, &mut block.y, &mut block.z],
+            _ => Vec::new(),
+        };
+        for breaks in axes {
+            match breaks {
+                Breaks::Uniform(u) => u.divisions = u.divisions.saturating_mul(k),
+                Breaks::List(list) => {
+                    let mut out = Vec::with_capacity(list.len() * k);
+                    for w in list.windows(2) {
+                        for i in 0..k {
+                            out.push(w[0] + (w[1] - w[0]) * i as f64 / k as f64);
                         }
-                        out.extend(list.last().copied());
-                        *list = out;
                     }
+                    out.extend(list.last().copied());
+                    *list = out;
                 }
             }
         }
+    }
+}
+
+/// What a study measures differently by dimension: the Hertz metrics read a pressure profile
+/// along a 2D contact line ([`crate::harness::profile`]); a 3D study is refused them when it is
+/// loaded.
+pub trait StudyDimension<const D: usize>: crate::run::RunDimension<D> {
+    /// The value of a Hertz metric of `o` (`None` where it cannot be measured).
+    fn hertz_metric(o: &Outcome<D, Self>, m: &Metric) -> Option<f64>;
+}
+
+impl StudyDimension<2> for crate::fe::ElementKind {
+    fn hertz_metric(o: &Outcome, m: &Metric) -> Option<f64> {
+        let (Metric::HertzPeak { pair }
+        | Metric::HertzHalfWidth { pair }
+        | Metric::HertzProfile { pair }) = m
+        else {
+            return None;
+        };
+        crate::harness::profile::pressure_profile(o, pair)
+            .ok()
+            .and_then(|p| {
+                let h = p.hertz?;
+                let (a, p0) = (h.half_width(), h.peak());
+                match m {
+                    Metric::HertzPeak { .. } => {
+                        let peak = p
+                            .points
+                            .iter()
+                            .map(|x| x.1)
+                            .fold(f64::NEG_INFINITY, f64::max);
+                        Some((peak - p0).abs() / p0)
+                    }
+                    Metric::HertzHalfWidth { .. } => Some((p.contact_extent() - a).abs() / a),
+                    _ => p.deviation(crate::harness::profile::INTERIOR_SHARE),
+                }
+            })
+    }
+}
+
+impl StudyDimension<3> for crate::fe3d::SolidKind {
+    fn hertz_metric(_o: &Outcome<3, Self>, _m: &Metric) -> Option<f64> {
+        None
     }
 }
 

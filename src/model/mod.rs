@@ -1882,14 +1882,14 @@ fn build_mesh(spec: &MeshSpec, source: &str, at: &str, notes: &mut Vec<String>) 
     }
 }
 
-/// The refusal of a 3D body in a case that goes through the 2D model (tables, sweeps,
-/// studies, exports).
+/// The refusal of a 3D body in a case that goes through the 2D model (a case with 2D and 3D
+/// bodies, or `export`).
 fn three_d_through_the_plane_model(source: &str, at: String) -> Error {
     Error::invalid(
         source,
         at,
-        "a 3D body in a case that goes through the 2D model: 3D cases run with `contact-patch run`, `check` and `judge`, with 3D bodies only (no 2D bodies beside them); tables, sweeps, studies and exports are 2D for now",
-        "run the case with `contact-patch run CASE` or `contact-patch check CASE`, or give the body a 2D mesh",
+        "a 3D body in a case that goes through the 2D model: 3D cases run with `contact-patch run`, `check`, `judge`, `table` and `study`, with 3D bodies only (no 2D bodies beside them); `export` is 2D for now",
+        "run the case with `contact-patch run CASE`, `check CASE` or `table CASE`, or give the body a 2D mesh",
     )
 }
 
