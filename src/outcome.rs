@@ -22,8 +22,10 @@ pub struct Outcome<const D: usize = 2, K: SolidCell<D> = ElementKind> {
 }
 
 impl<const D: usize, K: SolidCell<D>> Outcome<D, K> {
+    /// Whether the case passes: no check fails it ([`CheckResult::fails_the_case`]: a check
+    /// the case expects to fail may fail, and must).
     pub fn passed(&self) -> bool {
-        self.checks.iter().all(|c| c.passed)
+        self.checks.iter().all(|c| !c.fails_the_case())
     }
 
     /// Whether the contact solve converged (`true` without contact).

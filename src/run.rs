@@ -10,7 +10,7 @@ use crate::contact::forces::pair_forces;
 use crate::error::Result;
 use crate::fe::ElementKind;
 use crate::fe3d::SolidKind;
-use crate::harness::checks::{evaluate_with, warnings_with, DimensionChecks};
+use crate::harness::checks::{evaluate_run, warnings_with, DimensionChecks};
 use crate::io::scene::Case;
 use crate::model::admit::load;
 use crate::model::Model;
@@ -101,7 +101,7 @@ pub fn run_model<const D: usize, K: RunDimension<D>>(
         .contact
         .as_ref()
         .map(|state| pair_forces(&model, state));
-    let checks = evaluate_with(&model, &solution, forces.as_deref());
+    let checks = evaluate_run(&model, &solution, forces.as_deref());
     let warnings = model
         .warnings
         .iter()

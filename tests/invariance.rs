@@ -22,6 +22,8 @@ fn patch_c() -> Value {
     let mut v: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
     v.as_object_mut().unwrap().remove("sweep");
     v["checks"] = json!([]);
+    // the case's expected failures name the checks removed here
+    v.as_object_mut().unwrap().remove("expected_failures");
     v
 }
 

@@ -23,6 +23,8 @@ fn patch(mesh: &str, discretization: Value, enforcement: Value, uneven: bool) ->
         Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("cases/patch/patch-{mesh}-nu0.3.json"));
     let mut v: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
     v.as_object_mut().unwrap().remove("sweep");
+    // the case's expected failures are statements about its own pair, replaced here
+    v.as_object_mut().unwrap().remove("expected_failures");
     v["contact"][0]["discretization"] = discretization;
     v["contact"][0]["enforcement"] = enforcement;
     if uneven {

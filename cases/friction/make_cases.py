@@ -67,7 +67,7 @@ def case(mesh, status):
     # the augmented Lagrangian again with Laursen & Simo's symmetric form (a column of its own)
     sweep["friction_tangents"] = ["laursen_simo"]
     name = f"friction-{mesh}-{status}"
-    return {
+    c = {
         "name": name,
         "description": f"Frictional contact patch test, mesh {mesh}, nu = {nu}, Coulomb mu = {MU}: step 1 presses the "
         f"punch with p = {P}, step 2 adds {what}. The shear part of the uniform field's traction on every other free "
@@ -96,6 +96,13 @@ def case(mesh, status):
             {"check": "force_balance", "tol": 1e-12},
         ],
     }
+    # the same pair as the patch case (node-to-surface one-pass, punch slave): the checks it is
+    # known to fail there, with the patch case's reason, where this case declares them
+    declared = {check["check"] for check in c["checks"]}
+    failures = [e for e in base.get("expected_failures", []) if e["check"] in declared]
+    if failures:
+        c["expected_failures"] = failures
+    return c
 
 
 for mesh in "ABCDE":

@@ -19,6 +19,11 @@ MESHES = {
     "E": ("Q9", [0, 2, 4, 5, 6, 7, 8], [4, 4 + 2 / 3, 4 + 4 / 3, 6], [5, 7], "non-matching Q9"),
 }
 KAPPA = 1e4  # pressure per unit gap: 10 E / (1 length unit)
+# The meshes on which the pair as written (node-to-surface one-pass, punch slave) is known not to
+# pass the patch test (the verdict row of Taylor & Papadopoulos 1991: C-1p and E fail): their
+# cases state it in "expected_failures", so that `contact-patch check` reports an expected
+# failure with the reason, not a failed run (a listed check that passes fails the case).
+NOT_PASSING = {"C", "E"}
 
 ENFORCEMENTS = [
     {"kind": "lagrange"},
@@ -39,10 +44,22 @@ DISCRETIZATIONS = [
 ]
 
 
+def expected_failures(mesh):
+    """The checks the pair as written fails on `mesh`, with the reason (none on A, B, D)."""
+    if mesh not in NOT_PASSING:
+        return []
+    reason = (
+        f"node-to-surface one-pass with the punch as slave on the non-matching mesh {mesh} "
+        f"({MESHES[mesh][4]}) does not pass the contact patch test (Taylor & Papadopoulos 1991); "
+        "`contact-patch table` runs the methods that do"
+    )
+    return [{"check": check, "reason": reason} for check in ("uniform_stress", "contact_pressure")]
+
+
 def case(mesh, nu):
     element, fx, px, py, character = MESHES[mesh]
     name = f"patch-{mesh}-nu{nu}"
-    return {
+    c = {
         "name": name,
         "description": f"Contact patch test, mesh {mesh} ({character}), nu = {nu}: punch on foundation under "
         f"uniform pressure {P}; exact solution sigma_yy = -{P} everywhere. The pair as written is node-to-surface "
@@ -98,6 +115,10 @@ def case(mesh, nu):
             {"check": "force_balance", "tol": 1e-12},
         ],
     }
+    failures = expected_failures(mesh)
+    if failures:
+        c["expected_failures"] = failures
+    return c
 
 
 for mesh in MESHES:

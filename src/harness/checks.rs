@@ -29,14 +29,160 @@ use crate::solver::linear::Solution;
 use serde::Serialize;
 
 /// The verdict of one check.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
 pub struct CheckResult {
     /// What was checked, in words.
     pub check: String,
     /// The measured error.
     pub error: f64,
     pub tol: f64,
+    /// The error is within the tolerance. Whether the case passes also depends on
+    /// `expected_failure`: see [`CheckResult::verdict`].
     pub passed: bool,
+    /// The reason the case gives for expecting this check to fail (its `expected_failures`);
+    /// `None` for a check it does not list.
+    pub expected_failure: Option<String>,
+}
+
+/// How one check ended, the case's expected failures taken into account (like pytest's strict
+/// `xfail`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CheckVerdict {
+    /// Within the tolerance, and not listed as expected to fail.
+    Passed,
+    /// Beyond the tolerance (or not measured: NaN), and not listed; or listed, but its error
+    /// is not a measurement (NaN or infinite: the check could not be judged).
+    Failed,
+    /// Listed as expected to fail, and failed by a measured error: the case passes.
+    ExpectedFailure,
+    /// Listed as expected to fail, but within the tolerance: the case fails, so that the
+    /// statement cannot go stale.
+    UnexpectedPass,
+}
+
+impl CheckResult {
+    /// A check judged `error` against `tol` (passed when `error <= tol`; a NaN error fails),
+    /// not listed as expected to fail.
+    pub fn judged(check: String, error: f64, tol: f64) -> CheckResult {
+        CheckResult {
+            check,
+            error,
+            tol,
+            passed: error <= tol,
+            expected_failure: None,
+        }
+    }
+
+    /// The check as the case expects it: `reason` is the case's reason for expecting it to
+    /// fail, `None` when the case does not list it.
+    pub fn expected_to_fail(self, reason: Option<&str>) -> CheckResult {
+        CheckResult {
+            expected_failure: reason.map(str::to_string),
+            ..self
+        }
+    }
+
+    pub fn verdict(&self) -> CheckVerdict {
+        match (&self.expected_failure, self.passed) {
+            (None, true) => CheckVerdict::Passed,
+            (None, false) => CheckVerdict::Failed,
+            (Some(_), true) => CheckVerdict::UnexpectedPass,
+            (Some(_), false) if self.error.is_finite() => CheckVerdict::ExpectedFailure,
+            (Some(_), false) => CheckVerdict::Failed,
+        }
+    }
+
+    /// Whether the check fails its case: it failed and was not expected to, or it was
+    /// expected to fail and passed.
+    pub fn fails_the_case(&self) -> bool {
+        matches!(
+            self.verdict(),
+            CheckVerdict::Failed | CheckVerdict::UnexpectedPass
+        )
+    }
+
+    /// The measured error against the tolerance, e.g. `error 4.016e-2 > tol 1.0e-10`.
+    pub fn measured(&self) -> String {
+        let sign = if self.passed { "<=" } else { ">" };
+        format!("error {:.3e} {sign} tol {:.1e}", self.error, self.tol)
+    }
+
+    /// What the verdict says beyond the measurement: the case's reason for an expected
+    /// failure, or why a listed check fails its case; empty for a check the case does not list.
+    pub fn expectation(&self) -> String {
+        let Some(reason) = &self.expected_failure else {
+            return String::new();
+        };
+        match self.verdict() {
+            CheckVerdict::ExpectedFailure => reason.clone(),
+            CheckVerdict::UnexpectedPass => {
+                format!("expected to fail ({reason}) but passed: remove it from expected_failures")
+            }
+            _ => format!(
+                "expected to fail ({reason}), but its error was not measured ({}): a check \
+                 that cannot be judged fails the case",
+                self.error
+            ),
+        }
+    }
+
+    /// One line of a report: the verdict (`pass`, `FAIL`, `expected failure`), the check, the
+    /// measurement and, for a listed check, [`CheckResult::expectation`].
+    pub fn report_line(&self) -> String {
+        let verdict = match self.verdict() {
+            CheckVerdict::Passed => "pass",
+            CheckVerdict::Failed | CheckVerdict::UnexpectedPass => "FAIL",
+            CheckVerdict::ExpectedFailure => "expected failure",
+        };
+        let expectation = self.expectation();
+        let expectation = if expectation.is_empty() {
+            String::new()
+        } else {
+            format!(": {expectation}")
+        };
+        format!(
+            "{verdict} {} (error {:.3e}, tol {:.1e}){expectation}",
+            self.check, self.error, self.tol
+        )
+    }
+}
+
+/// A check's entry in `summary.json`: `check`, `error`, `tol` and `passed` (the error is within
+/// the tolerance), and for a check the case lists as expected to fail, `expected_failure`:
+/// `{"reason", "verdict"}` with the verdict `"failed as expected"`, `"passed, but expected to
+/// fail"` (the case fails) or `"not measured"` (the case fails).
+impl Serialize for CheckResult {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        #[derive(Serialize)]
+        struct Expected<'a> {
+            reason: &'a str,
+            verdict: &'static str,
+        }
+        #[derive(Serialize)]
+        struct Entry<'a> {
+            check: &'a str,
+            error: f64,
+            tol: f64,
+            passed: bool,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            expected_failure: Option<Expected<'a>>,
+        }
+        Entry {
+            check: &self.check,
+            error: self.error,
+            tol: self.tol,
+            passed: self.passed,
+            expected_failure: self.expected_failure.as_deref().map(|reason| Expected {
+                reason,
+                verdict: match self.verdict() {
+                    CheckVerdict::ExpectedFailure => "failed as expected",
+                    CheckVerdict::UnexpectedPass => "passed, but expected to fail",
+                    _ => "not measured",
+                },
+            }),
+        }
+        .serialize(serializer)
+    }
 }
 
 /// The magnitudes a value of 0 is judged against.
@@ -141,12 +287,7 @@ pub fn reaction_result<const D: usize, K: SolidCell<D>>(
         *value,
         *tol,
     );
-    Some(CheckResult {
-        check,
-        error,
-        tol,
-        passed: error <= tol,
-    })
+    Some(CheckResult::judged(check, error, tol))
 }
 
 /// NaN-keeping maximum: a NaN error must fail, so it is kept rather than dropped by `max`.
@@ -651,12 +792,11 @@ pub fn unconverged<const D: usize>(
         .filter(|_| !expects_termination)
         .and_then(|c| match &c.termination {
             crate::solver::active_set::Termination::Converged => None,
-            t => Some(CheckResult {
-                check: format!("the contact solve converged (it ended: {t:?})"),
-                error: f64::INFINITY,
-                tol: 0.0,
-                passed: false,
-            }),
+            t => Some(CheckResult::judged(
+                format!("the contact solve converged (it ended: {t:?})"),
+                f64::INFINITY,
+                0.0,
+            )),
         })
 }
 
@@ -741,18 +881,44 @@ pub fn contact_force_check<const D: usize, K: SolidCell<D>>(
 
 /// [`evaluate`] with the contact forces given: those of our solve (`solution.contact`), or,
 /// for another code's results, the ones [`crate::harness::outside_contact`] read (then
-/// `solution.contact` is `None`). `None`: no contact forces, every contact check fails.
+/// `solution.contact` is `None`). `None`: no contact forces, every contact check fails. The
+/// checks are plain ones: the case's `expected_failures` are the run's ([`evaluate_run`]).
 pub fn evaluate_with<const D: usize, K: DimensionChecks<D>>(
     model: &Model<D, K>,
     solution: &Solution<D>,
     contact_forces: Option<&[PairForces<D>]>,
 ) -> Vec<CheckResult> {
+    judge_declared(model, solution, contact_forces, |_| None)
+}
+
+/// The verdicts of a run of `model` ([`crate::run::run_model`], both dimensions): the checks
+/// of [`evaluate_with`], each one the case lists in `expected_failures` carrying the case's
+/// reason ([`CheckResult::verdict`]). `judge` does not state them: the results it judges come
+/// from another code, whose method the case does not state.
+pub fn evaluate_run<const D: usize, K: DimensionChecks<D>>(
+    model: &Model<D, K>,
+    solution: &Solution<D>,
+    contact_forces: Option<&[PairForces<D>]>,
+) -> Vec<CheckResult> {
+    judge_declared(model, solution, contact_forces, |check| {
+        model.expected_failure(check)
+    })
+}
+
+/// The failing check of an unconverged solve ([`unconverged`]), then each declared check
+/// judged, carrying the reason `expected` gives for expecting it to fail.
+fn judge_declared<'m, const D: usize, K: DimensionChecks<D>>(
+    model: &'m Model<D, K>,
+    solution: &Solution<D>,
+    contact_forces: Option<&[PairForces<D>]>,
+    expected: impl Fn(&Check) -> Option<&'m str>,
+) -> Vec<CheckResult> {
     let magnitudes = Magnitudes::of(model, solution);
     let convergence = unconverged(&model.checks, solution);
-    let declared = model
-        .checks
-        .iter()
-        .map(|check| judge_check(model, solution, contact_forces, &magnitudes, check));
+    let declared = model.checks.iter().map(|check| {
+        judge_check(model, solution, contact_forces, &magnitudes, check)
+            .expected_to_fail(expected(check))
+    });
     convergence.into_iter().chain(declared).collect()
 }
 
@@ -911,12 +1077,7 @@ pub fn judge_check<const D: usize, K: DimensionChecks<D>>(
             }
         }
     };
-    CheckResult {
-        check: check_name,
-        error,
-        tol,
-        passed: error <= tol,
-    }
+    CheckResult::judged(check_name, error, tol)
 }
 /// A check's tolerance stated relative to the conditioning: with `per_condition = c`,
 /// `max(tol, c eps kappa)` with `kappa` the condition estimate of the last factored system
@@ -939,5 +1100,61 @@ fn conditioned_tolerance<const D: usize, K: SolidCell<D>>(
         }
         (Some(_), None) => (tol, ", no condition estimate".to_string()),
         _ => (tol, String::new()),
+    }
+}
+
+#[cfg(test)]
+mod verdict_tests {
+    use super::*;
+
+    fn listed(error: f64) -> CheckResult {
+        CheckResult::judged("c".into(), error, 1e-10).expected_to_fail(Some("known"))
+    }
+
+    /// Like pytest's strict xfail: a listed check fails as expected only by a measured error;
+    /// passing, or not measured (NaN, infinite), it fails the case.
+    #[test]
+    fn a_listed_check_passes_its_case_only_by_failing_with_a_measured_error() {
+        let plain = |error| CheckResult::judged("c".into(), error, 1e-10);
+        assert_eq!(plain(1e-12).verdict(), CheckVerdict::Passed);
+        assert_eq!(plain(1e-3).verdict(), CheckVerdict::Failed);
+        assert_eq!(plain(f64::NAN).verdict(), CheckVerdict::Failed);
+        assert_eq!(listed(1e-3).verdict(), CheckVerdict::ExpectedFailure);
+        assert!(!listed(1e-3).fails_the_case());
+        assert_eq!(listed(1e-12).verdict(), CheckVerdict::UnexpectedPass);
+        assert!(listed(1e-12).fails_the_case());
+        for error in [f64::NAN, f64::INFINITY] {
+            assert_eq!(listed(error).verdict(), CheckVerdict::Failed, "{error}");
+            assert!(listed(error).expectation().contains("not measured"));
+        }
+        assert_eq!(
+            listed(1e-3).report_line(),
+            "expected failure c (error 1.000e-3, tol 1.0e-10): known"
+        );
+        assert_eq!(
+            listed(1e-12).report_line(),
+            "FAIL c (error 1.000e-12, tol 1.0e-10): expected to fail (known) but passed: \
+             remove it from expected_failures"
+        );
+        assert_eq!(
+            plain(1e-12).report_line(),
+            "pass c (error 1.000e-12, tol 1.0e-10)"
+        );
+    }
+
+    /// `summary.json`: the four fields as before, and for a listed check its reason and verdict.
+    #[test]
+    fn a_summary_entry_records_the_expected_failure() {
+        let plain = serde_json::to_value(CheckResult::judged("c".into(), 0.5, 1.0)).unwrap();
+        assert_eq!(
+            plain,
+            serde_json::json!({"check": "c", "error": 0.5, "tol": 1.0, "passed": true})
+        );
+        let entry = serde_json::to_value(listed(1e-3)).unwrap();
+        assert_eq!(
+            entry["expected_failure"],
+            serde_json::json!({"reason": "known", "verdict": "failed as expected"})
+        );
+        assert_eq!(entry["passed"], false);
     }
 }

@@ -95,7 +95,7 @@ pub struct Judgement {
 
 impl Judgement {
     pub fn passed(&self) -> bool {
-        self.checks.iter().all(|c| c.passed)
+        self.checks.iter().all(|c| !c.fails_the_case())
     }
 }
 
@@ -462,14 +462,11 @@ pub fn judge_with(model: &Model, results: &Results, options: ReadOptions) -> Res
                 .as_deref()
                 .map(|b| format!(" in body '{b}'"))
                 .unwrap_or_default();
-            checks.push(CheckResult {
-                check: format!(
-                    "uniform stress {stress:?}{on} in the results' own nodal 'stress' field"
-                ),
+            checks.push(CheckResult::judged(
+                format!("uniform stress {stress:?}{on} in the results' own nodal 'stress' field"),
                 error,
-                tol: *tol,
-                passed: error <= *tol,
-            });
+                *tol,
+            ));
         }
     }
     let contact_use = |found: bool, what: &str| {

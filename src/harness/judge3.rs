@@ -48,7 +48,7 @@ pub struct Judgement3 {
 
 impl Judgement3 {
     pub fn passed(&self) -> bool {
-        self.checks.iter().all(|c| c.passed)
+        self.checks.iter().all(|c| !c.fails_the_case())
     }
 }
 
@@ -315,15 +315,14 @@ pub fn judge3(model: &Model3, results: &Results, match_share: f64) -> Result<Jud
                     }
                 }
             }
-            checks.push(CheckResult {
-                check: format!(
+            checks.push(CheckResult::judged(
+                format!(
                     "{} in the results' own nodal 'stress' field",
                     uniform_stress_words3(stress)
                 ),
                 error,
-                tol: *tol,
-                passed: error <= *tol,
-            });
+                *tol,
+            ));
         }
     }
     Ok(Judgement3 {

@@ -5,11 +5,12 @@
 //! errors skipped time>` per group, each holding `<testcase classname name time>`; a test case
 //! is passed (empty), `<failure message="...">` (a check or cell that ran and failed, the
 //! message carrying the measured errors and tolerances), `<error message="...">` (it could not
-//! run) or `<skipped message="..."/>` (a table cell that does not apply). Times are seconds.
+//! run) or `<skipped message="..."/>` (a table cell that does not apply, or a check that failed
+//! as its case expects, with the case's reason). Times are seconds.
 //! Text is escaped with `quick_xml::escape`; characters XML 1.0 cannot carry at all (control
 //! characters other than tab, newline and carriage return) become U+FFFD.
 
-use crate::harness::checks::CheckResult;
+use crate::harness::checks::{CheckResult, CheckVerdict};
 use crate::harness::Cell;
 
 /// How one test case ended.
@@ -145,25 +146,39 @@ pub fn render(name: &str, suites: &[TestSuite]) -> String {
     x
 }
 
-/// `check`: one test case per declared check of a case that ran.
+/// `check`: one test case per declared check of a case that ran. A check the case expects to
+/// fail (`expected_failures`) that failed is `<skipped>` with the reason, as pytest reports an
+/// expected failure; one that passed is a `<failure>` saying so.
 pub fn check_cases(case: &str, checks: &[CheckResult]) -> Vec<TestCase> {
     checks
         .iter()
-        .map(|c| TestCase {
-            classname: case.to_string(),
-            name: c.check.clone(),
-            seconds: 0.0,
-            verdict: if c.passed {
-                Verdict::Passed
-            } else {
-                Verdict::Failure {
-                    message: format!("error {:.3e} > tol {:.1e}", c.error, c.tol),
-                    text: format!(
-                        "{}\nmeasured error: {:e}\ntolerance: {:e}",
-                        c.check, c.error, c.tol
-                    ),
-                }
-            },
+        .map(|c| {
+            let text = |also: String| {
+                format!(
+                    "{}\nmeasured error: {:e}\ntolerance: {:e}{also}",
+                    c.check, c.error, c.tol
+                )
+            };
+            let verdict = match c.verdict() {
+                CheckVerdict::Passed => Verdict::Passed,
+                CheckVerdict::ExpectedFailure => Verdict::Skipped {
+                    message: format!("expected failure ({}): {}", c.measured(), c.expectation()),
+                },
+                CheckVerdict::Failed if c.expected_failure.is_none() => Verdict::Failure {
+                    message: c.measured(),
+                    text: text(String::new()),
+                },
+                CheckVerdict::Failed | CheckVerdict::UnexpectedPass => Verdict::Failure {
+                    message: format!("{}: {}", c.measured(), c.expectation()),
+                    text: text(format!("\n{}", c.expectation())),
+                },
+            };
+            TestCase {
+                classname: case.to_string(),
+                name: c.check.clone(),
+                seconds: 0.0,
+                verdict,
+            }
         })
         .collect()
 }

@@ -46,6 +46,7 @@
 //!   breaks down, with the reason.
 
 use crate::error::{Error, Result};
+use crate::harness::checks::CheckVerdict;
 use crate::io::scene::{Breaks, Case, MeshSpec};
 use crate::io::svg::{line_plot, Series};
 use crate::model::admit::admit;
@@ -650,8 +651,13 @@ impl Study {
         cell.failed_checks = o
             .checks
             .iter()
-            .filter(|c| !c.passed)
-            .map(|c| format!("{} {:.1e} x tol", check_kind(&c.check), c.error / c.tol))
+            .filter(|c| c.fails_the_case())
+            .map(|c| match c.verdict() {
+                CheckVerdict::UnexpectedPass => {
+                    format!("{} passed, but expected to fail", check_kind(&c.check))
+                }
+                _ => format!("{} {:.1e} x tol", check_kind(&c.check), c.error / c.tol),
+            })
             .collect();
         if let Some(state) = &o.solution.contact {
             cell.iterations = Some(state.iterations);

@@ -47,6 +47,15 @@ pub struct Case {
     pub sweep: Option<SweepSpec>,
     #[serde(default)]
     pub checks: Vec<Check>,
+    /// Checks of `checks` the case expects to fail, each with the reason (a known result of the
+    /// method as written, not a defect of the run). A listed check that fails is an expected
+    /// failure and the case passes; a listed check that passes fails the case, so that the
+    /// statement cannot go stale; a check that cannot be measured (error NaN or infinite) fails
+    /// the case as always. `contact-patch judge` judges another code's results, whose method
+    /// the case does not state, as plain checks.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    #[schemars(extend("default" = []))]
+    pub expected_failures: Vec<ExpectedFailure>,
     /// Bounds on the work a case may ask for, checked before anything is allocated.
     #[serde(default)]
     pub limits: Limits,
@@ -1448,6 +1457,34 @@ pub enum Check {
     /// The run warns, with a warning that contains `contains` (e.g. a diagnosis expected of a
     /// hard case).
     Warns { contains: String },
+}
+
+impl Check {
+    /// The check's kind as the case file names it in its `check` field (`"uniform_stress"`,
+    /// `"contact_pressure"`, ...), which [`ExpectedFailure::check`] names.
+    pub fn kind(&self) -> String {
+        match serde_json::to_value(self) {
+            Ok(serde_json::Value::Object(fields)) => match fields.get("check") {
+                Some(serde_json::Value::String(kind)) => kind.clone(),
+                _ => unreachable!("a check serializes with its kind in \"check\""),
+            },
+            _ => unreachable!("a check serializes as an object"),
+        }
+    }
+}
+
+/// A declared check the case expects to fail (`expected_failures`), named by its kind; the case
+/// must declare exactly one check of that kind.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ExpectedFailure {
+    /// The kind of the check, as its `check` field names it (e.g. `"uniform_stress"`).
+    pub check: String,
+    /// Why it fails: the method and the known result, with a source (required, not empty), e.g.
+    /// "node-to-surface one-pass with the punch as slave on a non-matching mesh does not pass
+    /// the contact patch test (Taylor & Papadopoulos 1991)".
+    #[schemars(length(min = 1))]
+    pub reason: String,
 }
 
 /// How a contact solve ended, as a case names it (see [`Check::TerminatesWith`]).

@@ -32,9 +32,9 @@ use crate::fe3d::SolidKind;
 use crate::harness::exact::ExactField;
 use crate::io::paths::{name_problem, NAME_RULE};
 use crate::io::scene::{
-    Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, FacetSetSpec, GmshMeshSpec,
-    Interaction, Kinematics, MaterialModel, MeshSpec, MultiplierSpace, NodeSetSpec, NormalChoice,
-    Physics, Plane, Prescribed, RigidSurface, SolverSpec, SweepSpec, TractionSpec,
+    Case, Check, DiscretizationSpec, EnforcementSpec, ExactSpec, ExpectedFailure, FacetSetSpec,
+    GmshMeshSpec, Interaction, Kinematics, MaterialModel, MeshSpec, MultiplierSpace, NodeSetSpec,
+    NormalChoice, Physics, Plane, Prescribed, RigidSurface, SolverSpec, SweepSpec, TractionSpec,
     MAX_SOLVER_COUNT,
 };
 use crate::mesh::{block, Facet, Mesh};
@@ -183,6 +183,10 @@ pub struct Model<const D: usize = 2, K: SolidCell<D> = ElementKind> {
     pub physics: Physics,
     /// Checks with every name already resolved.
     pub checks: Vec<Check>,
+    /// The checks the case expects to fail, each naming the kind of exactly one of `checks`
+    /// (validated by [`Model::resolve_checks`]); a run's verdicts carry the reason
+    /// ([`Model::expected_failure`]).
+    pub expected_failures: Vec<ExpectedFailure>,
     /// `(body index, node set)` of every support, for reaction summaries.
     pub support_sets: Vec<(usize, String)>,
     /// `(index into support_sets, component, dof)` for every dof a support prescribes, in the
@@ -585,6 +589,7 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
             exact: None,
             physics: Physics::default(),
             checks: Vec::new(),
+            expected_failures: Vec::new(),
             support_sets: Vec::new(),
             support_dofs: Vec::new(),
             contact: Vec::new(),
@@ -728,6 +733,16 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
 
     pub fn body(&self, name: &str) -> Option<&Body<D, K>> {
         self.bodies.iter().find(|b| b.name == name)
+    }
+
+    /// The reason the case gives for expecting `check`, one of [`Model::checks`], to fail, or
+    /// `None` when the case does not list its kind in `expected_failures`.
+    pub fn expected_failure(&self, check: &Check) -> Option<&str> {
+        let kind = check.kind();
+        self.expected_failures
+            .iter()
+            .find(|e| e.check == kind)
+            .map(|e| e.reason.as_str())
     }
 
     pub(crate) fn find_body(&self, name: &str, location: &str) -> Result<&Body<D, K>> {
@@ -1303,6 +1318,86 @@ impl<const D: usize, K: SolidCell<D>> Model<D, K> {
             }
             self.checks.push(check.clone());
         }
+        self.resolve_expected_failures(case)
+    }
+
+    /// The case's `expected_failures`, validated against its checks into
+    /// [`Model::expected_failures`]: each entry names, with a reason that is not empty, the kind
+    /// of exactly one declared check, once, and a check that has a measured error (`warns` and
+    /// `terminates_with` pass or fail without one, so they cannot fail by a measured error).
+    fn resolve_expected_failures(&mut self, case: &Case) -> Result<()> {
+        let kinds: Vec<String> = case.checks.iter().map(Check::kind).collect();
+        for (k, entry) in case.expected_failures.iter().enumerate() {
+            let at = format!("expected_failures[{k}]");
+            let invalid = |problem: String, hint: String| {
+                Err(Error::invalid(&self.source, &at, problem, hint))
+            };
+            if entry.reason.trim().is_empty() {
+                return invalid(
+                    "the reason is empty".into(),
+                    "say why the check fails: the method, the known result and its source, e.g. \"node-to-surface one-pass with the punch as slave on a non-matching mesh does not pass the contact patch test (Taylor & Papadopoulos 1991)\"".into(),
+                );
+            }
+            let declared: Vec<usize> = (0..kinds.len())
+                .filter(|&i| kinds[i] == entry.check)
+                .collect();
+            match declared.as_slice() {
+                [] => {
+                    let listed = if kinds.is_empty() {
+                        "the case declares no checks".to_string()
+                    } else {
+                        format!("its checks are: {}", kinds.join(", "))
+                    };
+                    return invalid(
+                        format!(
+                            "the case declares no check of kind '{}' ({listed})",
+                            entry.check
+                        ),
+                        "name the kind of one of the case's checks (its \"check\" field), or remove the entry".into(),
+                    );
+                }
+                [_] => {}
+                several => {
+                    let at: Vec<String> = several.iter().map(|i| format!("checks[{i}]")).collect();
+                    return invalid(
+                        format!(
+                            "the case declares {} checks of kind '{}' ({}), and an entry names one check by its kind",
+                            several.len(),
+                            entry.check,
+                            at.join(", ")
+                        ),
+                        format!("keep one check of kind '{}' in this case (move the others to a case of their own), or remove the entry", entry.check),
+                    );
+                }
+            }
+            if matches!(entry.check.as_str(), "warns" | "terminates_with") {
+                return invalid(
+                    format!(
+                        "a '{}' check passes or fails without a measured error, so it cannot fail as expected",
+                        entry.check
+                    ),
+                    if entry.check == "warns" {
+                        "remove the entry; if the run is not expected to warn so, remove the check"
+                    } else {
+                        "remove the entry and state the ending the solve is expected to have in the check's \"reason\""
+                    }
+                    .into(),
+                );
+            }
+            if let Some(j) = case.expected_failures[..k]
+                .iter()
+                .position(|e| e.check == entry.check)
+            {
+                return invalid(
+                    format!(
+                        "the kind '{}' is listed twice (also at expected_failures[{j}])",
+                        entry.check
+                    ),
+                    "keep one entry for it".into(),
+                );
+            }
+            self.expected_failures.push(entry.clone());
+        }
         Ok(())
     }
 }
@@ -1450,6 +1545,7 @@ impl Model {
             exact,
             physics: case.physics.clone(),
             checks: Vec::new(),
+            expected_failures: Vec::new(),
             support_sets: Vec::new(),
             support_dofs: Vec::new(),
             contact: Vec::new(),
@@ -2862,6 +2958,85 @@ mod solve_work_tests {
                 estimate.factor_operations <= found.factor_operations,
                 "{mesh}"
             );
+        }
+    }
+}
+
+#[cfg(test)]
+mod expected_failure_tests {
+    use super::*;
+
+    /// The message of building a one-block case with `checks` and `expected_failures` (JSON),
+    /// or `None` when it builds.
+    fn refusal(checks: &str, expected_failures: &str) -> Option<String> {
+        let text = format!(
+            r#"{{"name": "x", "materials": {{"m": {{"E": 1.0, "nu": 0.3}}}},
+                "bodies": [{{"name": "b", "material": "m", "mesh": {{"block": {{"element": "Q4",
+                    "x": [0, 1], "y": [0, 1]}}}}}}],
+                "checks": {checks}, "expected_failures": {expected_failures}}}"#
+        );
+        let case = parse(&text, "x").unwrap();
+        Model::build(&case, "x").err().map(|e| e.to_string())
+    }
+
+    const STRESS: &str = r#"{"check": "uniform_stress", "stress": [0, 0, 0], "tol": 1e-10}"#;
+    const DISPLACEMENT: &str = r#"{"check": "displacement", "body": "b", "point": [1, 1],
+        "component": "x", "value": 0, "tol": 1e-10}"#;
+
+    #[test]
+    fn an_entry_names_one_declared_check_with_a_reason() {
+        let why = r#""a known result""#;
+        // one check of the kind, with a reason: built, and the model knows the reason by check
+        let text = format!(
+            r#"{{"name": "x", "materials": {{"m": {{"E": 1.0, "nu": 0.3}}}},
+                "bodies": [{{"name": "b", "material": "m", "mesh": {{"block": {{"element": "Q4",
+                    "x": [0, 1], "y": [0, 1]}}}}}}],
+                "checks": [{STRESS}, {DISPLACEMENT}],
+                "expected_failures": [{{"check": "displacement", "reason": {why}}}]}}"#
+        );
+        let model = Model::build(&parse(&text, "x").unwrap(), "x").unwrap();
+        assert_eq!(model.expected_failure(&model.checks[0]), None);
+        assert_eq!(
+            model.expected_failure(&model.checks[1]),
+            Some("a known result")
+        );
+        let entry = |kind: &str| format!(r#"{{"check": "{kind}", "reason": {why}}}"#);
+        let cases = [
+            (
+                format!("[{STRESS}]"),
+                format!("[{}]", entry("reaction")),
+                "expected_failures[0]: the case declares no check of kind 'reaction' (its checks are: uniform_stress)",
+            ),
+            (
+                "[]".to_string(),
+                format!("[{}]", entry("uniform_stress")),
+                "(the case declares no checks)",
+            ),
+            (
+                format!("[{STRESS}, {STRESS}]"),
+                format!("[{}]", entry("uniform_stress")),
+                "the case declares 2 checks of kind 'uniform_stress' (checks[0], checks[1])",
+            ),
+            (
+                format!("[{STRESS}]"),
+                format!("[{}, {}]", entry("uniform_stress"), entry("uniform_stress")),
+                "expected_failures[1]: the kind 'uniform_stress' is listed twice (also at expected_failures[0])",
+            ),
+            (
+                format!(r#"[{STRESS}, {{"check": "warns", "contains": "w"}}]"#),
+                format!("[{}]", entry("warns")),
+                "a 'warns' check passes or fails without a measured error",
+            ),
+            (
+                format!("[{STRESS}]"),
+                r#"[{"check": "uniform_stress", "reason": ""}]"#.to_string(),
+                "expected_failures[0]: the reason is empty",
+            ),
+        ];
+        for (checks, listed, said) in cases {
+            let message = refusal(&checks, &listed).expect("refused");
+            assert!(message.contains(said), "{message}");
+            assert!(message.contains("hint: "), "{message}");
         }
     }
 }
